@@ -1,0 +1,678 @@
+/*
+ * beam.c — planar flexible beam in a floating frame: the complete geometric nonlinear model of
+ * Liu, Hong & Liu (2009), with the FOAC and ZOAC approximations beside it.
+ *
+ * Coordinates q = [x, y, theta, p], p = [u_i, v_i, v'_i] for nodes i = 1..ne (node 0, the root,
+ * is clamped to the frame). Axial w1 linear, transverse w2 cubic Hermite per element. The
+ * coupling deformation w_c(x) = -1/2 int_0^x (w2')^2 enters the axial displacement.
+ *
+ * The residual R = M(q) a - Q(q, v) is evaluated as virtual work per quadrature point without
+ * forming M (docs/beam.md, formulation note §4-5). Per point, in the body frame, the velocity is
+ * J q' with J = J_R + J_D + J_C (rigid, linear deformation, coupling); the three models differ
+ * only in which products of the parts they keep, so each point contributes
+ *     J_R^T F_R + J_D^T F_D + J_C^T F_C
+ * with three force vectors (per model, see point_forces). J_C's p-columns are -e1 h^T with the
+ * dense h(x) = H(x) p; its products are accumulated with prefix sums (scalars h^T(.)) and tail
+ * sums (the vector sum over points of c h), so a residual costs O(ne * points).
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "flexmbd.h"
+
+enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
+enum { INNER = 3 }; /* Gauss points of the nested rule for slope products (degree 4: exact) */
+enum { MAX_ELEMENTS = 4096 };
+
+typedef struct Beam {
+  /* parameters */
+  double L, rho, A, I, E, beta;
+  int ne, ng, model;
+  double pos0[2], angle0, vel0[2], omega0;
+  /* derived */
+  double le, r;   /* element length, cross-section point offset sqrt(I/A) */
+  int n;          /* 3 * ne deformation coordinates */
+  /* quadrature: outer points along an element, and the nested rule on [0, xi_g] */
+  double xg[FMB_GAUSS_MAX], wg[FMB_GAUSS_MAX];
+  double xi3[INNER], wi3[INNER];
+  /* Hermite slope shape functions (d/dx of [H1, le H2, H3, le H4]) at the inner points of the
+     nested rule of each outer point [g][k][j] and of the full element [k][j] */
+  double nd_in[FMB_GAUSS_MAX][INNER][4];
+  double nd_full[INNER][4];
+  double kb[4][4], ka; /* element bending stiffness, axial stiffness EA/le */
+} Beam;
+
+/* ---------------------------------------------------------------------------------------------
+ * Shape functions on one element, xi in [0, 1], element length le.
+ * ------------------------------------------------------------------------------------------- */
+static void hermite(double xi, double le, double ns[4], double nd[4]) {
+  double x2 = xi * xi, x3 = x2 * xi;
+  if (ns) {
+    ns[0] = 1.0 - 3.0 * x2 + 2.0 * x3;
+    ns[1] = le * (xi - 2.0 * x2 + x3);
+    ns[2] = 3.0 * x2 - 2.0 * x3;
+    ns[3] = le * (-x2 + x3);
+  }
+  if (nd) {
+    nd[0] = (-6.0 * xi + 6.0 * x2) / le;
+    nd[1] = 1.0 - 4.0 * xi + 3.0 * x2;
+    nd[2] = (6.0 * xi - 6.0 * x2) / le;
+    nd[3] = -2.0 * xi + 3.0 * x2;
+  }
+}
+
+/* element dofs of a deformation vector p: axial ends a[2], transverse d[4] (root node = 0) */
+static void gather(const double* p, int e, double a[2], double d[4]) {
+  if (e == 0) {
+    a[0] = d[0] = d[1] = 0.0;
+  } else {
+    const double* nl = p + 3 * (e - 1);
+    a[0] = nl[0];
+    d[0] = nl[1];
+    d[1] = nl[2];
+  }
+  const double* nr = p + 3 * e;
+  a[1] = nr[0];
+  d[2] = nr[1];
+  d[3] = nr[2];
+}
+
+/* index in p of the transverse element dof j (0..3) of element e, or -1 at the clamped root */
+static int tdof(int e, int j) {
+  int node = e + (j >= 2);
+  if (node == 0) return -1;
+  return 3 * (node - 1) + 1 + (j & 1);
+}
+
+static int adof(int e, int j) {
+  int node = e + j;
+  return node == 0 ? -1 : 3 * (node - 1);
+}
+
+static double dot4(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+
+/* ---------------------------------------------------------------------------------------------
+ * Parse.
+ * ------------------------------------------------------------------------------------------- */
+static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
+
+static void beam_setup(Beam* b) {
+  b->le = b->L / b->ne;
+  b->r = sqrt(b->I / b->A);
+  b->n = 3 * b->ne;
+  fmb_gauss_legendre01(b->ng, b->xg, b->wg);
+  fmb_gauss_legendre01(INNER, b->xi3, b->wi3);
+  for (int g = 0; g < b->ng; ++g)
+    for (int k = 0; k < INNER; ++k) hermite(b->xg[g] * b->xi3[k], b->le, NULL, b->nd_in[g][k]);
+  for (int k = 0; k < INNER; ++k) hermite(b->xi3[k], b->le, NULL, b->nd_full[k]);
+  double le = b->le, ei = b->E * b->I / (le * le * le);
+  double kb[4][4] = {{12.0, 6.0 * le, -12.0, 6.0 * le},
+                     {6.0 * le, 4.0 * le * le, -6.0 * le, 2.0 * le * le},
+                     {-12.0, -6.0 * le, 12.0, -6.0 * le},
+                     {6.0 * le, 2.0 * le * le, -6.0 * le, 4.0 * le * le}};
+  for (int i = 0; i < 4; ++i)
+    for (int j = 0; j < 4; ++j) b->kb[i][j] = ei * kb[i][j];
+  b->ka = b->E * b->A / le;
+}
+
+/* default Gauss points per element: the highest polynomial degree in xi of the model's
+   integrands is 10 for complete (h h^T, h of degree 5), 6 for FOAC and ZOAC */
+static int default_points(int model) { return model == BEAM_COMPLETE ? 6 : 4; }
+
+static int beam_parse(fmbParser* p, fmbNode item, void** self) {
+  Beam* b = calloc(1, sizeof *b);
+  if (!b) return fmb_parse_error(p, item, "out of memory");
+  int err = 0;
+  err |= fmb_get_double(p, item, "length", FMB_REQUIRED | FMB_POSITIVE, &b->L);
+  err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, MAX_ELEMENTS, &b->ne);
+  err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, &b->rho);
+  err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
+  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->I);
+  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->E);
+  b->model = BEAM_COMPLETE;
+  err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, model_names, &b->model);
+  err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
+  err |= fmb_get_double(p, item, "angle", FMB_OPTIONAL, &b->angle0);
+  err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
+  err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
+  err |= fmb_get_double(p, item, "damping", FMB_OPTIONAL | FMB_NONNEGATIVE, &b->beta);
+  if (!err) {
+    b->ng = default_points(b->model);
+    err |= fmb_get_int(p, item, "quadrature_points", FMB_OPTIONAL, 1, FMB_GAUSS_MAX, &b->ng);
+  }
+  if (err) {
+    free(b);
+    return err;
+  }
+  beam_setup(b);
+  *self = b;
+  return 0;
+}
+
+static void beam_destroy(void* self) { free(self); }
+
+static int beam_ncoord(const void* self) { return 3 + ((const Beam*)self)->n; }
+
+static size_t beam_nwork(const void* self) { return (size_t)9 * (size_t)((const Beam*)self)->ne; }
+
+static void beam_initial(const void* self, double* q0, double* v0) {
+  const Beam* b = self;
+  int nc = 3 + b->n;
+  memset(q0, 0, sizeof(double) * (size_t)nc);
+  memset(v0, 0, sizeof(double) * (size_t)nc);
+  q0[0] = b->pos0[0];
+  q0[1] = b->pos0[1];
+  q0[2] = b->angle0;
+  v0[0] = b->vel0[0];
+  v0[1] = b->vel0[1];
+  v0[2] = b->omega0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Residual.
+ * ------------------------------------------------------------------------------------------- */
+
+/* Force vectors per point (body frame, mass-weighted) that multiply J_R, J_D and J_C.
+     a_RD: acceleration of the rigid + linear-deformation part, a_R: rigid part, a_C: coupling
+     part, f: body force per unit mass (gravity in the body frame).
+   ZOAC      J_RD^T (a_RD - f)
+   FOAC      J_RD^T (a_RD - f) + J_R^T a_C + J_C^T (a_R - f)
+   complete  J^T (a_RD + a_C - f)                                                            */
+static void point_forces(int model, double m, const double aRD[2], const double aR[2], const double aC[2],
+                         const double f[2], double FR[2], double FD[2], double FC[2]) {
+  for (int i = 0; i < 2; ++i) {
+    switch (model) {
+      case BEAM_ZOAC:
+        FR[i] = FD[i] = m * (aRD[i] - f[i]);
+        FC[i] = 0.0;
+        break;
+      case BEAM_FOAC:
+        FD[i] = m * (aRD[i] - f[i]);
+        FR[i] = FD[i] + m * aC[i];
+        FC[i] = m * (aR[i] - f[i]);
+        break;
+      default:
+        FR[i] = FD[i] = FC[i] = m * (aRD[i] + aC[i] - f[i]);
+        break;
+    }
+  }
+}
+
+static int beam_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                         double* R, double* work) {
+  const Beam* b = self;
+  const int ne = b->ne, ng = b->ng, model = b->model;
+  const int coupled = model != BEAM_ZOAC;
+  const double le = b->le;
+  const double* p = q + 3;
+  const double* pd = v + 3;
+  const double* pdd = a + 3;
+  double* Rp = R + 3;
+  double c = cos(q[2]), s = sin(q[2]);
+  double om = v[2], om2 = v[2] * v[2], al = a[2];
+  /* frame acceleration and gravity in the body frame */
+  double a0[2] = {c * a[0] + s * a[1], -s * a[0] + c * a[1]};
+  double f[2] = {0.0, 0.0};
+  if (env && env->has_gravity) {
+    f[0] = c * env->gravity[0] + s * env->gravity[1];
+    f[1] = -s * env->gravity[0] + c * env->gravity[1];
+  }
+  /* work: per element full integrals F[4] of N2j' w2', partial sums pv[4], point sum csum */
+  double* Fe = work;
+  double* pv = work + 4 * ne;
+  double* csum = work + 8 * ne;
+
+  memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
+  double Fr[2] = {0.0, 0.0}, Rth = 0.0;
+  /* prefix integrals over inboard elements: int w2'^2, w2' w2d', w2' w2dd', w2d'^2 */
+  double Ipp = 0.0, Ipv = 0.0, Ipa = 0.0, Ivv = 0.0;
+  const double mhalf = 0.5 * b->rho * b->A * le;
+  const double ys[2] = {-b->r, b->r};
+
+  for (int e = 0; e < ne; ++e) {
+    double ua[2], d[4], uda[2], dd[4], udda[2], ddd[4];
+    gather(p, e, ua, d);
+    gather(pd, e, uda, dd);
+    gather(pdd, e, udda, ddd);
+    double xe = e * le;
+    double rp_a[2] = {0.0, 0.0}, rp_t[4] = {0.0, 0.0, 0.0, 0.0};
+    if (coupled) {
+      for (int j = 0; j < 4; ++j) pv[4 * e + j] = 0.0;
+      csum[e] = 0.0;
+    }
+    for (int g = 0; g < ng; ++g) {
+      double xi = b->xg[g], x = xe + xi * le;
+      double ns[4], nd[4];
+      hermite(xi, le, ns, nd);
+      double n1[2] = {1.0 - xi, xi};
+      double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
+      double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
+      double w1dd = n1[0] * udda[0] + n1[1] * udda[1], w2dd = dot4(ns, ddd), w2sdd = dot4(nd, ddd);
+      double wc = 0.0, wcd = 0.0, hacc = 0.0, Pv[4] = {0.0, 0.0, 0.0, 0.0};
+      if (coupled) {
+        /* partial integrals over [0, xi] of this element (nested rule, exact for degree 4) */
+        double Ppp = 0.0, Ppv = 0.0, Ppa = 0.0, Pvv = 0.0;
+        for (int k = 0; k < INNER; ++k) {
+          const double* ndk = b->nd_in[g][k];
+          double wk = b->wi3[k] * xi * le;
+          double sp = dot4(ndk, d), sv = dot4(ndk, dd), sa = dot4(ndk, ddd);
+          Ppp += wk * sp * sp;
+          Ppv += wk * sp * sv;
+          Ppa += wk * sp * sa;
+          Pvv += wk * sv * sv;
+          for (int j = 0; j < 4; ++j) Pv[j] += wk * ndk[j] * sp;
+        }
+        wc = -0.5 * (Ipp + Ppp);  /* w_c = -1/2 p^T H p */
+        wcd = -(Ipv + Ppv);       /* dw_c/dt = -p^T H pd */
+        hacc = Ipa + Ppa + Ivv + Pvv; /* h^T pdd + pd^T H pd */
+      }
+      for (int iy = 0; iy < 2; ++iy) {
+        double y = ys[iy], m = mhalf * b->wg[g];
+        double uD[2] = {w1 - y * w2s, w2};
+        double uDd[2] = {w1d - y * w2sd, w2d};
+        double uDdd[2] = {w1dd - y * w2sdd, w2dd};
+        double rx = x + uD[0], ry = y + uD[1];
+        double aR[2] = {a0[0] - y * al - x * om2, a0[1] + x * al - y * om2};
+        double aRD[2] = {a0[0] - ry * al - rx * om2 - 2.0 * uDd[1] * om + uDdd[0],
+                         a0[1] + rx * al - ry * om2 + 2.0 * uDd[0] * om + uDdd[1]};
+        double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
+        double FR[2], FD[2], FC[2];
+        point_forces(model, m, aRD, aR, aC, f, FR, FD, FC);
+        Fr[0] += FR[0];
+        Fr[1] += FR[1];
+        /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C */
+        Rth += x * FR[1] - y * FR[0] + uD[0] * FD[1] - uD[1] * FD[0] + wc * FC[1];
+        /* p rows: S_D^T F_D (local) */
+        rp_a[0] += n1[0] * FD[0];
+        rp_a[1] += n1[1] * FD[0];
+        for (int j = 0; j < 4; ++j) rp_t[j] += ns[j] * FD[1] - y * nd[j] * FD[0];
+        if (coupled) {
+          /* p rows: -h F_C[0]; h's own element part now, the inboard part by tail sums */
+          csum[e] += FC[0];
+          for (int j = 0; j < 4; ++j) pv[4 * e + j] += FC[0] * Pv[j];
+        }
+      }
+    }
+    for (int j = 0; j < 2; ++j) {
+      int i = adof(e, j);
+      if (i >= 0) Rp[i] += rp_a[j];
+    }
+    for (int j = 0; j < 4; ++j) {
+      int i = tdof(e, j);
+      if (i >= 0) Rp[i] += rp_t[j];
+    }
+    if (coupled) {
+      /* full-element integrals: prefix scalars and F_e = int N2' w2' */
+      double* F = Fe + 4 * e;
+      F[0] = F[1] = F[2] = F[3] = 0.0;
+      for (int k = 0; k < INNER; ++k) {
+        const double* ndk = b->nd_full[k];
+        double wk = b->wi3[k] * le;
+        double sp = dot4(ndk, d), sv = dot4(ndk, dd), sa = dot4(ndk, ddd);
+        Ipp += wk * sp * sp;
+        Ipv += wk * sp * sv;
+        Ipa += wk * sp * sa;
+        Ivv += wk * sv * sv;
+        for (int j = 0; j < 4; ++j) F[j] += wk * ndk[j] * sp;
+      }
+    }
+  }
+  if (coupled) {
+    /* tail sums: sum over points of c h = for each element e, F_e (sum of c outboard of e)
+       + the partial parts of e's own points */
+    double tail = 0.0;
+    for (int e = ne - 1; e >= 0; --e) {
+      for (int j = 0; j < 4; ++j) {
+        int i = tdof(e, j);
+        if (i >= 0) Rp[i] -= Fe[4 * e + j] * tail + pv[4 * e + j];
+      }
+      tail += csum[e];
+    }
+  }
+  R[0] = c * Fr[0] - s * Fr[1];
+  R[1] = s * Fr[0] + c * Fr[1];
+  R[2] = Rth;
+  /* elastic and damping forces: K (p + beta pd), element by element */
+  for (int e = 0; e < ne; ++e) {
+    double ua[2], d[4], uda[2], dd[4];
+    gather(p, e, ua, d);
+    gather(pd, e, uda, dd);
+    if (b->beta > 0.0) {
+      for (int j = 0; j < 2; ++j) ua[j] += b->beta * uda[j];
+      for (int j = 0; j < 4; ++j) d[j] += b->beta * dd[j];
+    }
+    double fa = b->ka * (ua[1] - ua[0]);
+    int i0 = adof(e, 0), i1 = adof(e, 1);
+    if (i0 >= 0) Rp[i0] -= fa;
+    Rp[i1] += fa;
+    for (int j = 0; j < 4; ++j) {
+      int i = tdof(e, j);
+      if (i >= 0) Rp[i] += dot4(b->kb[j], d);
+    }
+  }
+  for (int i = 0; i < 3 + b->n; ++i)
+    if (!isfinite(R[i])) return 1;
+  return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Kinematics of one material point: element, shape and coupling at reference x.
+ * ------------------------------------------------------------------------------------------- */
+
+/* w_c(x), and optionally dw_c/dt, by the same prefix + nested rule as the residual (element e
+   at xi); model must be coupled */
+static void coupling_at(const Beam* b, const double* p, const double* pd, int e, double xi, double* wc, double* wcd) {
+  double Ipp = 0.0, Ipv = 0.0;
+  double ua[2], d[4], dd[4] = {0.0, 0.0, 0.0, 0.0};
+  for (int k = 0; k <= e; ++k) {
+    gather(p, k, ua, d);
+    if (pd) gather(pd, k, ua, dd);
+    double span = (k == e) ? xi : 1.0;
+    for (int i = 0; i < INNER; ++i) {
+      double nd[4];
+      hermite(span * b->xi3[i], b->le, NULL, nd);
+      double wk = b->wi3[i] * span * b->le, sp = dot4(nd, d), sv = dot4(nd, dd);
+      Ipp += wk * sp * sp;
+      Ipv += wk * sp * sv;
+    }
+  }
+  *wc = -0.5 * Ipp;
+  if (wcd) *wcd = -Ipv;
+}
+
+static void locate(const Beam* b, double x, int* e, double* xi) {
+  int k = (int)floor(x / b->le);
+  if (k < 0) k = 0;
+  if (k > b->ne - 1) k = b->ne - 1;
+  *e = k;
+  *xi = x / b->le - k;
+}
+
+static int beam_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
+                       double* dpos_dq, double* dangle_dq, double* work) {
+  (void)work;
+  const Beam* b = self;
+  const int nc = 3 + b->n;
+  const double* p = q + 3;
+  double x = local[0], y = local[1];
+  double c = cos(q[2]), s = sin(q[2]);
+  if (x > b->L * (1.0 + 1e-12)) return -1;
+  if (dpos_dq) memset(dpos_dq, 0, sizeof(double) * 2 * (size_t)nc);
+  if (dangle_dq) memset(dangle_dq, 0, sizeof(double) * (size_t)nc);
+  double u[2] = {0.0, 0.0}, slope = 0.0;
+  int e = 0;
+  double xi = 0.0, n1[2] = {0.0, 0.0}, ns[4] = {0.0, 0.0, 0.0, 0.0}, nd[4] = {0.0, 0.0, 0.0, 0.0};
+  int onbeam = x > 0.0; /* points at x <= 0 move rigidly with the frame (the root is clamped) */
+  if (onbeam) {
+    double ua[2], d[4];
+    locate(b, x, &e, &xi);
+    gather(p, e, ua, d);
+    hermite(xi, b->le, ns, nd);
+    n1[0] = 1.0 - xi;
+    n1[1] = xi;
+    slope = dot4(nd, d);
+    u[0] = n1[0] * ua[0] + n1[1] * ua[1] - y * slope;
+    u[1] = dot4(ns, d);
+    if (b->model != BEAM_ZOAC) {
+      double wc;
+      coupling_at(b, p, NULL, e, xi, &wc, NULL);
+      u[0] += wc;
+    }
+  }
+  double rb[2] = {x + u[0], y + u[1]};
+  pos[0] = q[0] + c * rb[0] - s * rb[1];
+  pos[1] = q[1] + s * rb[0] + c * rb[1];
+  if (angle) *angle = q[2] + slope;
+  if (dangle_dq) {
+    dangle_dq[2] = 1.0;
+    if (onbeam)
+      for (int j = 0; j < 4; ++j) {
+        int i = tdof(e, j);
+        if (i >= 0) dangle_dq[3 + i] = nd[j];
+      }
+  }
+  if (dpos_dq) {
+    double* r0 = dpos_dq;
+    double* r1 = dpos_dq + nc;
+    r0[0] = 1.0;
+    r1[1] = 1.0;
+    r0[2] = -s * rb[0] - c * rb[1];
+    r1[2] = c * rb[0] - s * rb[1];
+    if (onbeam) {
+      /* body-frame d u / d p = S_D - e1 h^T, then rotate by A */
+      for (int j = 0; j < 2; ++j) {
+        int i = adof(e, j);
+        if (i >= 0) {
+          r0[3 + i] += c * n1[j];
+          r1[3 + i] += s * n1[j];
+        }
+      }
+      for (int j = 0; j < 4; ++j) {
+        int i = tdof(e, j);
+        if (i < 0) continue;
+        double du0 = -y * nd[j], du1 = ns[j];
+        r0[3 + i] += c * du0 - s * du1;
+        r1[3 + i] += s * du0 + c * du1;
+      }
+      if (b->model != BEAM_ZOAC) {
+        /* -h(x): h_j = int_0^x N2j' w2' over the inboard elements and [0, xi] of e */
+        for (int k = 0; k <= e; ++k) {
+          double ua[2], d[4];
+          gather(p, k, ua, d);
+          double span = (k == e) ? xi : 1.0, h[4] = {0.0, 0.0, 0.0, 0.0};
+          for (int i = 0; i < INNER; ++i) {
+            double ndi[4];
+            hermite(span * b->xi3[i], b->le, NULL, ndi);
+            double wk = b->wi3[i] * span * b->le, sp = dot4(ndi, d);
+            for (int j = 0; j < 4; ++j) h[j] += wk * ndi[j] * sp;
+          }
+          for (int j = 0; j < 4; ++j) {
+            int i = tdof(k, j);
+            if (i < 0) continue;
+            r0[3 + i] -= c * h[j];
+            r1[3 + i] -= s * h[j];
+          }
+        }
+      }
+    }
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Energy: each model's own kinetic energy, strain energy 1/2 p^T K p, gravity -int rho g.r.
+ * ------------------------------------------------------------------------------------------- */
+static void beam_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                        double* work) {
+  (void)work;
+  const Beam* b = self;
+  const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
+  const double le = b->le;
+  const double* p = q + 3;
+  const double* pd = v + 3;
+  double c = cos(q[2]), s = sin(q[2]), om = v[2];
+  double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
+  int grav = env && env->has_gravity;
+  double f[2] = {0.0, 0.0};
+  if (grav) {
+    f[0] = c * env->gravity[0] + s * env->gravity[1];
+    f[1] = -s * env->gravity[0] + c * env->gravity[1];
+  }
+  double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0;
+  double Ipp = 0.0, Ipv = 0.0;
+  const double mhalf = 0.5 * b->rho * b->A * le;
+  for (int e = 0; e < ne; ++e) {
+    double ua[2], d[4], uda[2], dd[4];
+    gather(p, e, ua, d);
+    gather(pd, e, uda, dd);
+    for (int g = 0; g < ng; ++g) {
+      double xi = b->xg[g], x = e * le + xi * le;
+      double ns[4], nd[4];
+      hermite(xi, le, ns, nd);
+      double n1[2] = {1.0 - xi, xi};
+      double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
+      double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
+      double wc = 0.0, wcd = 0.0;
+      if (coupled) {
+        double Ppp = 0.0, Ppv = 0.0;
+        for (int k = 0; k < INNER; ++k) {
+          const double* ndk = b->nd_in[g][k];
+          double wk = b->wi3[k] * xi * le, sp = dot4(ndk, d), sv = dot4(ndk, dd);
+          Ppp += wk * sp * sp;
+          Ppv += wk * sp * sv;
+        }
+        wc = -0.5 * (Ipp + Ppp);
+        wcd = -(Ipv + Ppv);
+      }
+      for (int iy = 0; iy < 2; ++iy) {
+        double y = iy ? b->r : -b->r, m = mhalf * b->wg[g];
+        double uD[2] = {w1 - y * w2s, w2}, uDd[2] = {w1d - y * w2sd, w2d};
+        double vR[2] = {v0[0] - y * om, v0[1] + x * om};
+        double vD[2] = {-uD[1] * om + uDd[0], uD[0] * om + uDd[1]};
+        double vC[2] = {wcd, wc * om};
+        double vRD[2] = {vR[0] + vD[0], vR[1] + vD[1]};
+        switch (model) {
+          case BEAM_ZOAC:
+            T += 0.5 * m * (vRD[0] * vRD[0] + vRD[1] * vRD[1]);
+            break;
+          case BEAM_FOAC:
+            T += m * (0.5 * (vRD[0] * vRD[0] + vRD[1] * vRD[1]) + vR[0] * vC[0] + vR[1] * vC[1]);
+            break;
+          default:
+            T += 0.5 * m * ((vRD[0] + vC[0]) * (vRD[0] + vC[0]) + (vRD[1] + vC[1]) * (vRD[1] + vC[1]));
+            break;
+        }
+        /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
+        if (grav) Ug -= m * (f[0] * (x + uD[0] + wc) + f[1] * (y + uD[1]));
+        mtot += m;
+      }
+    }
+    if (coupled) {
+      for (int k = 0; k < INNER; ++k) {
+        const double* ndk = b->nd_full[k];
+        double wk = b->wi3[k] * le, sp = dot4(ndk, d), sv = dot4(ndk, dd);
+        Ipp += wk * sp * sp;
+        Ipv += wk * sp * sv;
+      }
+    }
+    /* strain energy of the element */
+    Ue += 0.5 * b->ka * (ua[1] - ua[0]) * (ua[1] - ua[0]);
+    for (int j = 0; j < 4; ++j) Ue += 0.5 * d[j] * dot4(b->kb[j], d);
+  }
+  if (grav) Ug -= mtot * (env->gravity[0] * q[0] + env->gravity[1] * q[1]);
+  en->kinetic = T;
+  en->strain = Ue;
+  en->gravity = Ug;
+  en->spring = 0.0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Outputs.
+ * ------------------------------------------------------------------------------------------- */
+enum { OUT_TIP_U, OUT_TIP_V, OUT_TIP_U_RATE, OUT_TIP_V_RATE, OUT_TIP_X, OUT_TIP_Y, OUT_NTIP };
+enum { OUT_NODE_BASE = 1000, OUT_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
+
+static const char* const beam_output_names[] = {"tip_u",  "tip_v",  "tip_u_rate", "tip_v_rate",
+                                                "tip_x",  "tip_y",  "nodeK_u",    "nodeK_v",
+                                                "nodeK_x", "nodeK_y", NULL};
+
+static int beam_output_lookup(const void* self, const char* quantity) {
+  const Beam* b = self;
+  for (int i = 0; i < OUT_NTIP; ++i)
+    if (strcmp(quantity, beam_output_names[i]) == 0) return i;
+  if (strncmp(quantity, "node", 4) == 0) {
+    const char* s = quantity + 4;
+    char* end;
+    if (*s < '0' || *s > '9') return -1;
+    long k = strtol(s, &end, 10);
+    if (k < 0 || k > b->ne || end[0] != '_' || end[1] == '\0' || end[2] != '\0') return -1;
+    static const char comp[] = "uvxy";
+    const char* at = strchr(comp, end[1]);
+    if (!at) return -1;
+    return OUT_NODE_BASE + OUT_NODE_STRIDE * (int)k + (int)(at - comp);
+  }
+  return -1;
+}
+
+/* axial (with w_c in coupled models) and transverse deformation at reference (x, 0), rates */
+static void deformation_at(const Beam* b, const double* p, const double* pd, double x, double u[2], double ud[2]) {
+  int e;
+  double xi, ua[2], d[4], uda[2], dd[4], ns[4];
+  locate(b, x, &e, &xi);
+  gather(p, e, ua, d);
+  gather(pd, e, uda, dd);
+  hermite(xi, b->le, ns, NULL);
+  u[0] = (1.0 - xi) * ua[0] + xi * ua[1];
+  u[1] = dot4(ns, d);
+  ud[0] = (1.0 - xi) * uda[0] + xi * uda[1];
+  ud[1] = dot4(ns, dd);
+  if (b->model != BEAM_ZOAC && x > 0.0) {
+    double wc, wcd;
+    coupling_at(b, p, pd, e, xi, &wc, &wcd);
+    u[0] += wc;
+    ud[0] += wcd;
+  }
+}
+
+static int beam_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
+  (void)work;
+  const Beam* b = self;
+  double x = b->L;
+  int comp = id;
+  if (id >= OUT_NODE_BASE) {
+    int k = (id - OUT_NODE_BASE) / OUT_NODE_STRIDE;
+    x = k * b->le;
+    comp = (id - OUT_NODE_BASE) % OUT_NODE_STRIDE; /* u, v, x, y */
+    comp = comp == 0 ? OUT_TIP_U : comp == 1 ? OUT_TIP_V : comp == 2 ? OUT_TIP_X : OUT_TIP_Y;
+  } else if (id < 0 || id >= OUT_NTIP) {
+    return -1;
+  }
+  double u[2], ud[2];
+  deformation_at(b, q + 3, v + 3, x, u, ud);
+  double c = cos(q[2]), s = sin(q[2]);
+  switch (comp) {
+    case OUT_TIP_U: *value = u[0]; break;
+    case OUT_TIP_V: *value = u[1]; break;
+    case OUT_TIP_U_RATE: *value = ud[0]; break;
+    case OUT_TIP_V_RATE: *value = ud[1]; break;
+    case OUT_TIP_X: *value = q[0] + c * (x + u[0]) - s * u[1]; break;
+    default: *value = q[1] + s * (x + u[0]) + c * u[1]; break;
+  }
+  return 0;
+}
+
+static void beam_describe(const void* self, FILE* f) {
+  const Beam* b = self;
+  static const char* const terms[] = {"w_c dropped (no coupling deformation)",
+                                      "w_c to first order (rigid x coupling products only)",
+                                      "w_c and all its high-order terms kept"};
+  fprintf(f, "%s model, %d elements, %d Gauss points/element, %s%s", model_names[b->model], b->ne, b->ng,
+          terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "");
+}
+
+static const char* beam_indefinite_mass(const void* self) {
+  const Beam* b = self;
+  if (b->model != BEAM_FOAC) return NULL;
+  return "the FOAC beam's kinetic energy is not positive definite at large deformation (its mass matrix keeps "
+         "-p^T D p in M22 without the high-order terms that balance it); use `model: complete`";
+}
+
+const fmbBodyType fmb_body_beam = {
+    .name = "beam",
+    .abi = FMB_ABI_VERSION,
+    .parse = beam_parse,
+    .destroy = beam_destroy,
+    .ncoord = beam_ncoord,
+    .initial = beam_initial,
+    .residual = beam_residual,
+    .marker = beam_marker,
+    .nwork = beam_nwork,
+    .jacobian = NULL,
+    .energy = beam_energy,
+    .output_names = beam_output_names,
+    .output_lookup = beam_output_lookup,
+    .output = beam_output,
+    .describe = beam_describe,
+    .indefinite_mass = beam_indefinite_mass,
+};
