@@ -27,7 +27,7 @@ enum { MAX_ELEMENTS = 4096 };
 
 typedef struct Beam {
   /* parameters */
-  double L, rho, A, I, E, beta;
+  double L, rho, A, Izz, Emod, beta;
   int ne, ng, model;
   double pos0[2], angle0, vel0[2], omega0;
   /* derived */
@@ -99,21 +99,21 @@ static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
 
 static void beam_setup(Beam* b) {
   b->le = b->L / b->ne;
-  b->r = sqrt(b->I / b->A);
+  b->r = sqrt(b->Izz / b->A);
   b->n = 3 * b->ne;
   fmb_gauss_legendre01(b->ng, b->xg, b->wg);
   fmb_gauss_legendre01(INNER, b->xi3, b->wi3);
   for (int g = 0; g < b->ng; ++g)
     for (int k = 0; k < INNER; ++k) hermite(b->xg[g] * b->xi3[k], b->le, NULL, b->nd_in[g][k]);
   for (int k = 0; k < INNER; ++k) hermite(b->xi3[k], b->le, NULL, b->nd_full[k]);
-  double le = b->le, ei = b->E * b->I / (le * le * le);
+  double le = b->le, ei = b->Emod * b->Izz / (le * le * le);
   double kb[4][4] = {{12.0, 6.0 * le, -12.0, 6.0 * le},
                      {6.0 * le, 4.0 * le * le, -6.0 * le, 2.0 * le * le},
                      {-12.0, -6.0 * le, 12.0, -6.0 * le},
                      {6.0 * le, 2.0 * le * le, -6.0 * le, 4.0 * le * le}};
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) b->kb[i][j] = ei * kb[i][j];
-  b->ka = b->E * b->A / le;
+  b->ka = b->Emod * b->A / le;
 }
 
 /* default Gauss points per element: the highest polynomial degree in xi of the model's
@@ -128,8 +128,8 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, MAX_ELEMENTS, &b->ne);
   err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, &b->rho);
   err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
-  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->I);
-  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->E);
+  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->Izz);
+  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
   b->model = BEAM_COMPLETE;
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, model_names, &b->model);
   err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
@@ -649,6 +649,7 @@ static void beam_describe(const void* self, FILE* f) {
                                       "w_c and all its high-order terms kept"};
   fprintf(f, "%s model, %d elements, %d Gauss points/element, %s%s", model_names[b->model], b->ne, b->ng,
           terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "");
+  fputc('\n', f);
 }
 
 static const char* beam_indefinite_mass(const void* self) {

@@ -52,7 +52,7 @@ static inline int bt_finish(const char* name) {
 #define SEED_E 68.95e9
 
 /* a beam built from numbers, with the plugin's own defaults; ng <= 0 = the model's default */
-static inline Beam* bt_beam(int model, int ne, int ng, double L, double rho, double A, double I, double E) {
+static inline Beam* bt_beam(int model, int ne, int ng, double L, double rho, double A, double Izz, double Emod) {
   Beam* b = calloc(1, sizeof *b);
   b->model = model;
   b->ne = ne;
@@ -60,8 +60,8 @@ static inline Beam* bt_beam(int model, int ne, int ng, double L, double rho, dou
   b->L = L;
   b->rho = rho;
   b->A = A;
-  b->I = I;
-  b->E = E;
+  b->Izz = Izz;
+  b->Emod = Emod;
   beam_setup(b);
   return b;
 }

@@ -100,7 +100,7 @@ static void slow_build(const Beam* b, const fmbEnv* env, const double* q, const 
   memset(S->K, 0, sizeof(double) * (size_t)nc * (size_t)nc);
   memset(S->C, 0, sizeof(double) * (size_t)n * (size_t)n);
   memset(S->D, 0, sizeof(double) * (size_t)n * (size_t)n);
-  double r = sqrt(b->I / b->A);
+  double r = sqrt(b->Izz / b->A);
   for (int e = 0; e < b->ne; ++e)
     for (int g = 0; g < ngs; ++g) {
       double x = (e + gx[g]) * le;
@@ -121,7 +121,7 @@ static void slow_build(const Beam* b, const fmbEnv* env, const double* q, const 
         }
       /* stiffness */
       for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) S->K[(3 + i) + (size_t)(3 + j) * nc] += wx * b->E * b->I * n2dd[i] * n2dd[j];
+        for (int j = 0; j < n; ++j) S->K[(3 + i) + (size_t)(3 + j) * nc] += wx * b->Emod * b->Izz * n2dd[i] * n2dd[j];
       for (int iy = 0; iy < 2; ++iy) {
         double y = iy ? r : -r, m = wx * b->rho * b->A * 0.5;
         double uD[2] = {w1 - y * w2s, w2}, uDd[2] = {w1d - y * w2sd, w2d};
@@ -177,7 +177,7 @@ static void slow_build(const Beam* b, const fmbEnv* env, const double* q, const 
   /* axial stiffness: EA int N1'^T N1' (piecewise constant derivative, one point per element) */
   for (int e = 0; e < b->ne; ++e) {
     int ia = e == 0 ? -1 : 3 + 3 * (e - 1), ib = 3 + 3 * e;
-    double k = b->E * b->A / le;
+    double k = b->Emod * b->A / le;
     S->K[ib + (size_t)ib * nc] += k;
     if (ia >= 0) {
       S->K[ia + (size_t)ia * nc] += k;
@@ -248,7 +248,7 @@ static void seed_form(const Beam* b, const fmbEnv* env, const Slow* S, const dou
   double le = b->L / b->ne, gx[8], gw[8];
   fmb_gauss_legendre01(ngs, gx, gw);
   const double *p = q + 3, *pd = v + 3, *pdd = a + 3;
-  double rho = b->rho, Ar = b->A, I = b->I, L = b->L;
+  double rho = b->rho, Ar = b->A, I = b->Izz, L = b->L;
   double m = rho * Ar * L, E1 = rho * Ar * L * L / 2.0, J11 = rho * Ar * L * L * L / 3.0, J22 = rho * L * I;
   /* vectors Y1, Y2, Ybar2, Z11, Z12 and matrices W11, W12, W21, W22, Wbar22 */
   double* buf = calloc((size_t)(5 * n + 5 * n * n + 4 * n), sizeof(double));
