@@ -1,0 +1,55 @@
+/* ground.c — a fixed frame with a pose of its own (a base plate, a second anchor). No
+ * coordinates; joints attach to it through its marker. The world frame "ground" is always
+ * defined by the engine; declare a `type: ground` body only to name another fixed frame. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "flexmbd.h"
+
+typedef struct {
+  double pos[2], angle;
+} Ground;
+
+static int ground_parse(fmbParser* p, fmbNode item, void** self) {
+  Ground* g = calloc(1, sizeof *g);
+  if (!g) return fmb_parse_error(p, item, "out of memory");
+  *self = g;
+  return fmb_get_vec2(p, item, "position", 0, g->pos) || fmb_get_double(p, item, "angle", 0, &g->angle) ? -1 : 0;
+}
+
+static void ground_destroy(void* self) { free(self); }
+static int ground_ncoord(const void* self) {
+  (void)self;
+  return 0;
+}
+static void ground_initial(const void* self, double* q, double* v) {
+  (void)self;
+  (void)q;
+  (void)v;
+}
+static int ground_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                           double* R, double* work) {
+  (void)self, (void)env, (void)q, (void)v, (void)a, (void)R, (void)work;
+  return 0;
+}
+static int ground_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
+                         double* dpos_dq, double* dangle_dq, double* work) {
+  (void)q, (void)dpos_dq, (void)dangle_dq, (void)work;
+  const Ground* g = self;
+  const double c = cos(g->angle), s = sin(g->angle);
+  pos[0] = g->pos[0] + c * local[0] - s * local[1];
+  pos[1] = g->pos[1] + s * local[0] + c * local[1];
+  if (angle) *angle = g->angle;
+  return 0;
+}
+
+const fmbBodyType fmb_body_ground = {
+    .name = "ground",
+    .abi = FMB_ABI_VERSION,
+    .parse = ground_parse,
+    .destroy = ground_destroy,
+    .ncoord = ground_ncoord,
+    .initial = ground_initial,
+    .residual = ground_residual,
+    .marker = ground_marker,
+};

@@ -1,0 +1,121 @@
+/* rigid.c — a planar rigid body. Coordinates q = [x, y, theta] of the centre of mass and the
+ * body's orientation; the body frame sits at the centre of mass, so the equations are
+ *   m (a_x, a_y) = m g,   J alpha = 0          (Newton–Euler, no velocity terms)
+ * and everything else (joints, springs, applied loads) comes in through markers. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "flexmbd.h"
+
+typedef struct {
+  double mass, inertia;
+  double pos[2], angle, vel[2], omega;
+} Rigid;
+
+static int rigid_parse(fmbParser* p, fmbNode item, void** self) {
+  Rigid* r = calloc(1, sizeof *r);
+  if (!r) return fmb_parse_error(p, item, "out of memory");
+  *self = r;
+  if (fmb_get_double(p, item, "mass", FMB_REQUIRED | FMB_POSITIVE, &r->mass) ||
+      fmb_get_double(p, item, "inertia", FMB_REQUIRED | FMB_POSITIVE, &r->inertia) ||
+      fmb_get_vec2(p, item, "position", 0, r->pos) || fmb_get_double(p, item, "angle", 0, &r->angle) ||
+      fmb_get_vec2(p, item, "velocity", 0, r->vel) || fmb_get_double(p, item, "angular_velocity", 0, &r->omega))
+    return -1;
+  return 0;
+}
+
+static void rigid_destroy(void* self) { free(self); }
+static int rigid_ncoord(const void* self) {
+  (void)self;
+  return 3;
+}
+
+static void rigid_initial(const void* self, double* q, double* v) {
+  const Rigid* r = self;
+  q[0] = r->pos[0];
+  q[1] = r->pos[1];
+  q[2] = r->angle;
+  v[0] = r->vel[0];
+  v[1] = r->vel[1];
+  v[2] = r->omega;
+}
+
+static int rigid_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                          double* R, double* work) {
+  (void)q;
+  (void)v;
+  (void)work;
+  const Rigid* r = self;
+  R[0] = r->mass * a[0];
+  R[1] = r->mass * a[1];
+  R[2] = r->inertia * a[2];
+  if (env->has_gravity) {
+    R[0] -= r->mass * env->gravity[0];
+    R[1] -= r->mass * env->gravity[1];
+  }
+  return 0;
+}
+
+static int rigid_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                          double* K, double* C, double* M, double* work) {
+  (void)env;
+  (void)q;
+  (void)v;
+  (void)a;
+  (void)work;
+  const Rigid* r = self;
+  for (int i = 0; i < 9; ++i) K[i] = C[i] = M[i] = 0.0;
+  M[0] = M[4] = r->mass;
+  M[8] = r->inertia;
+  return 0;
+}
+
+static int rigid_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
+                        double* dpos_dq, double* dangle_dq, double* work) {
+  (void)self;
+  (void)work;
+  const double c = cos(q[2]), s = sin(q[2]);
+  pos[0] = q[0] + c * local[0] - s * local[1];
+  pos[1] = q[1] + s * local[0] + c * local[1];
+  if (angle) *angle = q[2];
+  if (dpos_dq) {
+    dpos_dq[0] = 1.0;
+    dpos_dq[1] = 0.0;
+    dpos_dq[2] = -s * local[0] - c * local[1];
+    dpos_dq[3] = 0.0;
+    dpos_dq[4] = 1.0;
+    dpos_dq[5] = c * local[0] - s * local[1];
+  }
+  if (dangle_dq) {
+    dangle_dq[0] = dangle_dq[1] = 0.0;
+    dangle_dq[2] = 1.0;
+  }
+  return 0;
+}
+
+static void rigid_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
+                         double* work) {
+  (void)work;
+  const Rigid* r = self;
+  e->kinetic = 0.5 * r->mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * r->inertia * v[2] * v[2];
+  e->gravity = env->has_gravity ? -r->mass * (env->gravity[0] * q[0] + env->gravity[1] * q[1]) : 0.0;
+}
+
+static void rigid_describe(const void* self, FILE* f) {
+  const Rigid* r = self;
+  fprintf(f, "mass %g kg, inertia %g kg m^2 about the centre of mass\n", r->mass, r->inertia);
+}
+
+const fmbBodyType fmb_body_rigid = {
+    .name = "rigid",
+    .abi = FMB_ABI_VERSION,
+    .parse = rigid_parse,
+    .destroy = rigid_destroy,
+    .ncoord = rigid_ncoord,
+    .initial = rigid_initial,
+    .residual = rigid_residual,
+    .marker = rigid_marker,
+    .jacobian = rigid_jacobian,
+    .energy = rigid_energy,
+    .describe = rigid_describe,
+};

@@ -1,0 +1,60 @@
+/* fd.c — forward-difference derivatives of a body's residual over its own coordinates.
+ * Used when a plugin provides no analytic `jacobian`. Because R = M a - Q is linear in a, the
+ * M columns are exact differences with a unit step; K and C use IDA's own increment rule
+ * inc = max(sqrt(eps) |y|, 1/ewt) so the step is never below the error tolerance. One residual
+ * per column: a plugin whose residual is O(n) gets an O(n^2) Jacobian. */
+#include <math.h>
+#include <string.h>
+
+#include "internal.h"
+
+static double increment(double y, double ewt) {
+  const double srur = 1.4901161193847656e-08; /* sqrt(DBL_EPSILON) */
+  double inc = srur * fabs(y);
+  double floor_ = ewt > 0 ? 1.0 / ewt : srur;
+  return inc > floor_ ? inc : floor_;
+}
+
+int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                         const double* ewt_q, const double* ewt_v, double* K, double* C, double* M, double* work,
+                         double* scratch) {
+  const int n = b->nq;
+  double* qq = scratch;
+  double* vv = scratch + n;
+  double* aa = scratch + 2 * n;
+  double* R0 = scratch + 3 * n;
+  double* R1 = scratch + 4 * n;
+  memcpy(qq, q, (size_t)n * sizeof(double));
+  memcpy(vv, v, (size_t)n * sizeof(double));
+  memcpy(aa, a, (size_t)n * sizeof(double));
+  int rc = b->type->residual(b->self, env, q, v, a, R0, work);
+  if (rc) return rc;
+  for (int j = 0; j < n; ++j) {
+    if (K) {
+      double h = increment(q[j], ewt_q[j]);
+      qq[j] = q[j] + h;
+      h = qq[j] - q[j]; /* the step actually taken */
+      rc = b->type->residual(b->self, env, qq, v, a, R1, work);
+      qq[j] = q[j];
+      if (rc) return rc;
+      for (int i = 0; i < n; ++i) K[(size_t)j * n + i] = (R1[i] - R0[i]) / h;
+    }
+    if (C) {
+      double h = increment(v[j], ewt_v[j]);
+      vv[j] = v[j] + h;
+      h = vv[j] - v[j];
+      rc = b->type->residual(b->self, env, q, vv, a, R1, work);
+      vv[j] = v[j];
+      if (rc) return rc;
+      for (int i = 0; i < n; ++i) C[(size_t)j * n + i] = (R1[i] - R0[i]) / h;
+    }
+    if (M) {
+      aa[j] = a[j] + 1.0;
+      rc = b->type->residual(b->self, env, q, v, aa, R1, work);
+      aa[j] = a[j];
+      if (rc) return rc;
+      for (int i = 0; i < n; ++i) M[(size_t)j * n + i] = R1[i] - R0[i];
+    }
+  }
+  return 0;
+}

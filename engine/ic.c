@@ -1,0 +1,196 @@
+/* ic.c — consistent initial conditions for the GGL system.
+ *
+ * 1. positions: Gauss–Newton projection onto Phi(q, t0) = 0, the minimum-norm correction
+ *    dq = -Phi_q^T (Phi_q Phi_q^T)^-1 Phi;
+ * 2. velocities: the minimum-norm correction onto Phi_q v + Phi_t = 0;
+ * 3. accelerations and multipliers from the augmented system
+ *        [M  Phi_q^T] [a     ]   [Q    ]
+ *        [Phi_q   0 ] [lambda] = [gamma],   gamma = -(Phi_q v)_q v - Phi_tt,
+ *    so IDA starts from F(t0, y0, y0') = 0. mu = 0. The sizes of the corrections are reported.
+ * Setup-time code: it may allocate. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+static double norm2(const double* x, int n) {
+  double s = 0.0;
+  for (int i = 0; i < n; ++i) s += x[i] * x[i];
+  return sqrt(s);
+}
+
+/* G = Phi_q Phi_q^T (column-major nc x nc) from the row-major nc x nq Phi_q; LU in place */
+static int gram_factor(int nc, int nq, const double* PhiQ, double* G, int* piv) {
+  for (int i = 0; i < nc; ++i)
+    for (int k = 0; k < nc; ++k) {
+      double s = 0.0;
+      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)i * nq + c] * PhiQ[(size_t)k * nq + c];
+      G[(size_t)k * nc + i] = s;
+    }
+  return fmb_lu_factor(nc, G, piv);
+}
+
+int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  const double t0 = m->solver.t0;
+  double* q = y;
+  double* v = y + nq;
+  memset(y, 0, (size_t)m->ny * sizeof(double));
+  memset(yp, 0, (size_t)m->ny * sizeof(double));
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
+  }
+  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+  double* PhiQ2 = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* phit = calloc((size_t)nc + 1, sizeof(double));
+  double* phitt = calloc((size_t)nc + 1, sizeof(double));
+  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
+  int* piv = calloc((size_t)n + 1, sizeof(int));
+  double* A = calloc((size_t)n * n, sizeof(double));
+  double* rhs = calloc((size_t)n + 1, sizeof(double));
+  double* q0 = calloc((size_t)nq, sizeof(double));
+  double* v0 = calloc((size_t)nq, sizeof(double));
+  double* qs = calloc((size_t)nq, sizeof(double));
+  int rc = 0;
+  if (!PhiQ || !PhiQ2 || !phi || !phit || !phitt || !G || !piv || !A || !rhs || !q0 || !v0 || !qs) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  memcpy(q0, q, (size_t)nq * sizeof(double));
+  memcpy(v0, v, (size_t)nq * sizeof(double));
+
+  if (nc > 0) {
+    double scale = 1.0 + norm2(q, nq), res = 0.0;
+    int it, converged = 0;
+    for (it = 0; it < 50; ++it) {
+      if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt)) break;
+      res = norm2(phi, nc);
+      if (res <= 1e-13 * scale) {
+        converged = 1;
+        break;
+      }
+      if (gram_factor(nc, nq, PhiQ, G, piv)) break;
+      memcpy(rhs, phi, (size_t)nc * sizeof(double));
+      fmb_lu_solve(nc, G, piv, rhs);
+      for (int c = 0; c < nq; ++c) {
+        double s = 0.0;
+        for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+        q[c] -= s;
+      }
+    }
+    if (!converged) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps, "
+                   "or redundant constraints): check the joints' points, the bodies' initial poses, and that no joint repeats another",
+                   t0, res, it);
+      rc = FMB_EXIT_BAD_INPUT;
+      goto done;
+    }
+    /* velocities */
+    if (gram_factor(nc, nq, PhiQ, G, piv)) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "redundant constraints: the joints' equations are not independent");
+      rc = FMB_EXIT_BAD_INPUT;
+      goto done;
+    }
+    for (int r = 0; r < nc; ++r) {
+      double s = phit[r];
+      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
+      rhs[r] = s;
+    }
+    fmb_lu_solve(nc, G, piv, rhs);
+    for (int c = 0; c < nq; ++c) {
+      double s = 0.0;
+      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+      v[c] -= s;
+    }
+  }
+  for (int i = 0; i < nq; ++i) {
+    q0[i] = q[i] - q0[i];
+    v0[i] = v[i] - v0[i];
+  }
+  st->ic_position_correction = norm2(q0, nq);
+  st->ic_velocity_correction = norm2(v0, nq);
+
+  /* augmented system for accelerations and multipliers */
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    double* Mb = calloc((size_t)bi->nq * bi->nq, sizeof(double));
+    if (!Mb || fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, Mb)) {
+      free(Mb);
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g", bi->name, t0);
+      rc = FMB_EXIT_SOLVER;
+      goto done;
+    }
+    for (int c = 0; c < bi->nq; ++c)
+      for (int r = 0; r < bi->nq; ++r) A[(size_t)(bi->qadr + c) * n + bi->qadr + r] = Mb[(size_t)c * bi->nq + r];
+    free(Mb);
+  }
+  if (fmb_generalized_forces(m, w, t0, q, v, rhs)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  if (nc > 0) {
+    fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt);
+    /* (Phi_q v)_q v by a central difference along v */
+    double vn = norm2(v, nq);
+    double h = vn > 0 ? 1e-5 * (1.0 + norm2(q, nq)) / vn : 0.0;
+    double* dpv = phit; /* reuse: holds (Phi_q v)_q v below */
+    memset(dpv, 0, (size_t)nc * sizeof(double));
+    if (h > 0) {
+      for (int i = 0; i < nq; ++i) qs[i] = q[i] + h * v[i];
+      fmb_constraints_all(m, w, t0, qs, v, NULL, PhiQ2, NULL, NULL);
+      for (int r = 0; r < nc; ++r)
+        for (int c = 0; c < nq; ++c) dpv[r] += PhiQ2[(size_t)r * nq + c] * v[c];
+      for (int i = 0; i < nq; ++i) qs[i] = q[i] - h * v[i];
+      fmb_constraints_all(m, w, t0, qs, v, NULL, PhiQ2, NULL, NULL);
+      for (int r = 0; r < nc; ++r) {
+        double s = 0.0;
+        for (int c = 0; c < nq; ++c) s += PhiQ2[(size_t)r * nq + c] * v[c];
+        dpv[r] = (dpv[r] - s) / (2.0 * h);
+      }
+    }
+    for (int r = 0; r < nc; ++r) {
+      rhs[nq + r] = -dpv[r] - phitt[r];
+      for (int c = 0; c < nq; ++c) {
+        A[(size_t)c * n + nq + r] = PhiQ[(size_t)r * nq + c];
+        A[(size_t)(nq + r) * n + c] = PhiQ[(size_t)r * nq + c];
+      }
+    }
+  }
+  if (fmb_lu_factor(n, A, piv)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
+                 "with redundant joints): cannot compute initial accelerations");
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  fmb_lu_solve(n, A, piv, rhs);
+  memcpy(yp, v, (size_t)nq * sizeof(double));
+  memcpy(yp + nq, rhs, (size_t)nq * sizeof(double));
+  memcpy(y + 2 * nq, rhs + nq, (size_t)nc * sizeof(double));
+  for (int i = 0; i < n; ++i)
+    if (!isfinite(rhs[i])) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
+      rc = FMB_EXIT_SOLVER;
+      break;
+    }
+done:
+  free(PhiQ);
+  free(PhiQ2);
+  free(phi);
+  free(phit);
+  free(phitt);
+  free(G);
+  free(piv);
+  free(A);
+  free(rhs);
+  free(q0);
+  free(v0);
+  free(qs);
+  return rc;
+}

@@ -1,0 +1,264 @@
+/* integrate.c — run a model with SUNDIALS IDA (BDF, variable order and step) on the GGL system
+ * of system.c, with KLU (default) or SUNDIALS' dense solver for the Newton systems.
+ * lambda and mu are algebraic and excluded from the error test (IDASetId + IDASetSuppressAlg), so
+ * the error control acts on positions and velocities only. Output rows are written at the scene's
+ * output step; on any failure every row so far is already on disk and the message says when,
+ * why, and what to try. */
+#include <ida/ida.h>
+#include <math.h>
+#include <nvector/nvector_serial.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sundials/sundials_context.h>
+#include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_klu.h>
+#include <sunmatrix/sunmatrix_dense.h>
+#include <sunmatrix/sunmatrix_sparse.h>
+#include <time.h>
+
+#include "internal.h"
+
+typedef struct {
+  const fmbModel* m;
+  fmbWorkspace* w;
+  void* ida;
+  N_Vector ewt;
+  char ida_msg[512];
+} RunCtx;
+
+static int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void* ud) {
+  RunCtx* c = ud;
+  return fmb_system_residual(c->m, c->w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(F));
+}
+
+static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* ud,
+                       N_Vector t1, N_Vector t2, N_Vector t3) {
+  (void)r;
+  (void)t1;
+  (void)t2;
+  (void)t3;
+  RunCtx* c = ud;
+  const fmbModel* m = c->m;
+  IDAGetErrWeights(c->ida, c->ewt);
+  if (m->solver.dense)
+    return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
+                               N_VGetArrayPointer(c->ewt), NULL, SUNDenseMatrix_Data(J));
+  /* the pattern is fixed; rewrite it in case the solver touched the index arrays */
+  sunindextype* colptr = SUNSparseMatrix_IndexPointers(J);
+  sunindextype* rowind = SUNSparseMatrix_IndexValues(J);
+  for (int i = 0; i <= m->ny; ++i) colptr[i] = (sunindextype)m->colptr[i];
+  for (long k = 0; k < m->nnz; ++k) rowind[k] = (sunindextype)m->rowind[k];
+  return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(c->ewt),
+                             SUNSparseMatrix_Data(J), NULL);
+}
+
+static void ida_error_handler(int code, const char* module, const char* function, char* msg, void* ud) {
+  (void)code;
+  (void)module;
+  RunCtx* c = ud;
+  snprintf(c->ida_msg, sizeof c->ida_msg, "%s: %s", function, msg);
+}
+
+static const char* failure_advice(int flag) {
+  switch (flag) {
+    case IDA_TOO_MUCH_WORK:
+      return "too many steps between two outputs: the problem is very stiff or changing very fast here. "
+             "Try a larger solver.max_steps, a looser rtol, or check for unphysical parameters";
+    case IDA_TOO_MUCH_ACC: return "the tolerances are tighter than machine precision allows: loosen rtol/atol";
+    case IDA_ERR_FAIL:
+      return "the error test failed repeatedly down to the minimum step: the solution is blowing up or jumps "
+             "(an unstable model, e.g. a ZOAC beam spun above its first bending frequency, or a discontinuous input)";
+    case IDA_CONV_FAIL:
+      return "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
+             "has become unstable. Try a smaller solver.max_step or a tighter rtol";
+    case IDA_LSETUP_FAIL:
+      return "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
+             "(a dead point) or a mass matrix that lost definiteness";
+    case IDA_LSOLVE_FAIL: return "the linear solver failed: the Newton matrix is singular or ill-conditioned";
+    case IDA_REP_RES_ERR:
+      return "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
+    case IDA_RES_FAIL: return "a plugin could not evaluate its equations";
+    default: return "the integrator stopped";
+  }
+}
+
+void fmb_print_stats(const fmbStats* s, FILE* f) {
+  fprintf(f, "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld cpu_s=%.4f\n",
+          s->status_ok ? "ok" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
+          s->error_test_fails, s->cpu_s);
+}
+
+static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
+  const fmbBodyInst* b = &m->body[bad - 1];
+  const char* hint = (b->type && b->type->indefinite_mass) ? b->type->indefinite_mass(b->self) : NULL;
+  fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+               "stopped at t = %.6g: the mass matrix is no longer positive definite on the constraint manifold "
+               "(body '%s')%s%s",
+               t, b->name, hint ? ": " : "", hint ? hint : "");
+}
+
+int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* diag) {
+  clock_t c0 = clock();
+  memset(st, 0, sizeof *st);
+  memset(diag, 0, sizeof *diag);
+  st->t_reached = m->solver.t0;
+  const int ny = m->ny;
+  fmbCsv* csv = fmb_csv_open(opt ? opt->csv_path : NULL, diag);
+  if (!csv) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
+
+  RunCtx ctx;
+  memset(&ctx, 0, sizeof ctx);
+  ctx.m = m;
+  SUNContext sun = NULL;
+  N_Vector y = NULL, yp = NULL, id = NULL, atol = NULL;
+  SUNMatrix A = NULL;
+  SUNLinearSolver LS = NULL;
+  void* ida = NULL;
+  int rc = 0;
+  double t = m->solver.t0;
+
+  ctx.w = fmb_workspace_new(m);
+  if (!ctx.w || SUNContext_Create(NULL, &sun) != 0) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  y = N_VNew_Serial(ny, sun);
+  yp = N_VNew_Serial(ny, sun);
+  id = N_VNew_Serial(ny, sun);
+  ctx.ewt = N_VNew_Serial(ny, sun);
+  if (!y || !yp || !id || !ctx.ewt) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  rc = fmb_initial_conditions(m, ctx.w, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), st, diag);
+  if (rc) goto done;
+  if (!opt || !opt->quiet)
+    fprintf(stderr, "initial conditions: position correction %.3g, velocity correction %.3g\n",
+            st->ic_position_correction, st->ic_velocity_correction);
+
+  int bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq);
+  if (bad) {
+    mass_failure(m, bad, t, diag);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  fmb_csv_header(csv, m);
+  int wr = fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp));
+  if (wr) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                 wr < 0 ? "writing the output failed at t = %g (disk full?)" : "an output is not finite at t = %g", t);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  st->rows_written = 1;
+
+  /* q and v are differential; lambda and mu algebraic. The multipliers of an index-2 system
+     carry roundoff of order eps/h^2 (Hairer & Wanner VII.3), so weighing them like positions in
+     IDA's Newton test makes small steps fail: they get an absolute tolerance so large that only
+     q and v decide convergence. They are already out of the error test (suppressalg). */
+  double* idv = N_VGetArrayPointer(id);
+  atol = N_VNew_Serial(ny, sun);
+  if (!atol) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  double* atv = N_VGetArrayPointer(atol);
+  for (int i = 0; i < ny; ++i) {
+    idv[i] = i < 2 * m->nq ? 1.0 : 0.0;
+    atv[i] = i < 2 * m->nq ? m->solver.atol : 1e30;
+  }
+  ida = IDACreate(sun);
+  ctx.ida = ida;
+  if (!ida || IDAInit(ida, residual_fn, t, y, yp) != IDA_SUCCESS ||
+      IDASVtolerances(ida, m->solver.rtol, atol) != IDA_SUCCESS || IDASetUserData(ida, &ctx) != IDA_SUCCESS ||
+      IDASetErrHandlerFn(ida, ida_error_handler, &ctx) != IDA_SUCCESS || IDASetId(ida, id) != IDA_SUCCESS ||
+      IDASetSuppressAlg(ida, SUNTRUE) != IDA_SUCCESS ||
+      IDASetMaxNumSteps(ida, m->solver.max_steps_per_output) != IDA_SUCCESS ||
+      (m->solver.max_step > 0 && IDASetMaxStep(ida, m->solver.max_step) != IDA_SUCCESS)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up IDA: %s", ctx.ida_msg);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  if (m->solver.dense) {
+    A = SUNDenseMatrix(ny, ny, sun);
+    LS = A ? SUNLinSol_Dense(y, A, sun) : NULL;
+  } else {
+    A = SUNSparseMatrix(ny, ny, m->nnz, CSC_MAT, sun);
+    LS = A ? SUNLinSol_KLU(y, A, sun) : NULL;
+  }
+  if (!A || !LS || IDASetLinearSolver(ida, LS, A) != IDA_SUCCESS || IDASetJacFn(ida, jacobian_fn) != IDA_SUCCESS) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up the linear solver");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+
+  const double dt = m->solver.output_step, t_end = m->solver.t_end, t0 = m->solver.t0;
+  const long nout = (long)ceil((t_end - t0) / dt - 1e-9);
+  for (long k = 1; k <= nout; ++k) {
+    double tout = k == nout ? t_end : t0 + (double)k * dt;
+    double tret = t;
+    int flag = IDASolve(ida, tout, &tret, y, yp, IDA_NORMAL);
+    if (flag < 0) {
+      t = tret;
+      bad = fmb_check_mass(m, ctx.w, tret, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq);
+      if (bad) {
+        mass_failure(m, bad, tret, diag);
+      } else {
+        double hcur = 0.0;
+        IDAGetCurrentStep(ida, &hcur);
+        char* flag_name = IDAGetReturnFlagName(flag); /* allocated by SUNDIALS */
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s [IDA %s: %s]",
+                     tret, hcur, failure_advice(flag), flag_name ? flag_name : "?", ctx.ida_msg);
+        free(flag_name);
+      }
+      rc = FMB_EXIT_SOLVER;
+      break;
+    }
+    t = tret;
+    bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq);
+    if (bad) {
+      mass_failure(m, bad, t, diag);
+      rc = FMB_EXIT_SOLVER;
+      break;
+    }
+    wr = fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp));
+    if (wr) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   wr < 0 ? "writing the output failed at t = %.6g (disk full?)"
+                          : "stopped at t = %.6g: an output is not finite (the solution blew up)",
+                   t);
+      rc = FMB_EXIT_SOLVER;
+      break;
+    }
+    st->rows_written++;
+  }
+
+done:
+  st->t_reached = t;
+  st->status_ok = rc == 0;
+  if (ida) {
+    long v;
+    if (IDAGetNumSteps(ida, &v) == IDA_SUCCESS) st->steps = v;
+    if (IDAGetNumResEvals(ida, &v) == IDA_SUCCESS) st->residuals = v;
+    if (IDAGetNumJacEvals(ida, &v) == IDA_SUCCESS) st->jacobians = v;
+    if (IDAGetNumNonlinSolvIters(ida, &v) == IDA_SUCCESS) st->newton_iters = v;
+    if (IDAGetNumErrTestFails(ida, &v) == IDA_SUCCESS) st->error_test_fails = v;
+    IDAFree(&ida);
+  }
+  if (LS) SUNLinSolFree(LS);
+  if (A) SUNMatDestroy(A);
+  if (y) N_VDestroy(y);
+  if (yp) N_VDestroy(yp);
+  if (id) N_VDestroy(id);
+  if (atol) N_VDestroy(atol);
+  if (ctx.ewt) N_VDestroy(ctx.ewt);
+  if (sun) SUNContext_Free(&sun);
+  fmb_workspace_free(ctx.w);
+  fmb_csv_close(csv);
+  st->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
+  return rc;
+}

@@ -1,0 +1,197 @@
+/* internal.h — engine-private structures. Model = what the scene fixed (read-only while
+ * integrating); state/workspace = what integration changes, allocated once at setup. */
+#ifndef FLEXMBD_INTERNAL_H
+#define FLEXMBD_INTERNAL_H
+
+#include <yaml.h>
+
+#include "flexmbd.h"
+
+#define FMB_NAME_MAX 64
+#define FMB_WORLD 0 /* body index of the fixed world frame, named "ground" */
+
+typedef struct fmbBodyInst {
+  char name[FMB_NAME_MAX];
+  const fmbBodyType* type; /* NULL for the world frame */
+  void* self;
+  int qadr, nq; /* slice of the coordinate vector */
+  size_t workadr, nwork;
+} fmbBodyInst;
+
+typedef struct fmbJointInst {
+  char name[FMB_NAME_MAX];
+  const fmbJointType* type;
+  void* self;
+  int body[2];   /* body indices, -1 = none */
+  int ncol;      /* nq(body0) + nq(body1) */
+  int rowadr, nrows;
+} fmbJointInst;
+
+typedef enum {
+  FMB_OUT_TIME,
+  FMB_OUT_FRAME,       /* body frame quantity: index into frame_names */
+  FMB_OUT_BODY,        /* body plugin output */
+  FMB_OUT_JOINT,       /* joint plugin output */
+  FMB_OUT_JOINT_POWER, /* power of a joint's constraint forces, lambda^T Phi_t */
+  FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total */
+  FMB_OUT_CONSTRAINT   /* 0 position 1 velocity */
+} fmbOutKind;
+
+typedef struct fmbOutput {
+  char name[2 * FMB_NAME_MAX + 32];
+  fmbOutKind kind;
+  int owner; /* body or joint index */
+  int id;
+} fmbOutput;
+
+typedef struct fmbSolverSettings {
+  double t0, t_end, rtol, atol, output_step, max_step;
+  int dense; /* linear solver: 0 KLU (sparse), 1 SUNDIALS dense */
+  long max_steps_per_output;
+} fmbSolverSettings;
+
+/* one rectangle (or diagonal run) of the iteration matrix's fixed sparsity pattern */
+typedef struct fmbBlock {
+  int r0, nr, c0, nc, diag;
+} fmbBlock;
+
+struct fmbModel {
+  char path[512];
+  int nbody, njoint;
+  fmbBodyInst* body;
+  fmbJointInst* joint;
+  int nq;   /* coordinates */
+  int nc;   /* constraint rows */
+  int ny;   /* unknowns of the DAE: 2 nq + 2 nc */
+  size_t nwork; /* total plugin scratch doubles */
+  int max_joint_cols;
+  fmbEnv env;
+  fmbSolverSettings solver;
+  int noutput;
+  fmbOutput* output;
+  int need_energy, need_constraint, check_definiteness;
+  /* sparsity pattern of the iteration matrix, CSC, fixed at load */
+  int nblock;
+  fmbBlock* block;
+  long nnz;
+  long* colptr; /* ny + 1 */
+  long* rowind; /* nnz */
+};
+
+/* evaluation context a joint sees */
+struct fmbJointEval {
+  const fmbModel* m;
+  const fmbJointInst* j;
+  double t;
+  const double* q; /* whole coordinate vector */
+  const double* v;
+  double* work;    /* plugin scratch (body markers) */
+  double* mk;      /* 3 x max body ncoord: marker derivatives before scattering */
+  double* js;      /* 2 x max joint columns: the joint's own scratch */
+};
+
+/* ---- yaml_get.c: document, overrides, accessors ---- */
+struct fmbParser {
+  yaml_document_t doc;
+  int have_doc;
+  const char* path;
+  fmbDiag* diag;
+  unsigned char* known;     /* per node id: key node looked up */
+  int* override_of;         /* per node id: index of the --set that made it, or -1 */
+  int nnodes_cap;
+  const char* const* overrides;
+  const char* looked[64];   /* keys looked up in the current item, for "expected one of" */
+  int nlooked;
+  fmbModel* model;          /* under construction */
+  const fmbRegistry* reg;
+};
+
+int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag);
+void fmbp_close(fmbParser* p);
+fmbNode fmbp_root(fmbParser* p);
+yaml_node_t* fmbp_node(fmbParser* p, fmbNode n);
+int fmbp_error_at(fmbParser* p, fmbNode node, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+/* start a new item (resets the looked-up key list); check that every key of `map` was looked up */
+void fmbp_begin_item(fmbParser* p);
+int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what);
+int fmbp_is_map(fmbParser* p, fmbNode n);
+int fmbp_is_seq(fmbParser* p, fmbNode n);
+int fmbp_seq_len(fmbParser* p, fmbNode seq);
+fmbNode fmbp_seq_item(fmbParser* p, fmbNode seq, int i);
+const char* fmbp_scalar(fmbParser* p, fmbNode n); /* NULL if not a scalar */
+int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]);
+
+/* ---- diag ---- */
+void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+
+/* ---- system.c: DAE residual and iteration matrix ---- */
+typedef struct fmbWorkspace fmbWorkspace;
+fmbWorkspace* fmb_workspace_new(const fmbModel* m);
+void fmb_workspace_free(fmbWorkspace* w);
+double* fmb_workspace_plugin(fmbWorkspace* w);
+/* F(t, y, yp) of the stabilized index-2 (GGL) system; returns 0, >0 recoverable, <0 fatal */
+int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
+                        double* F);
+/* J = dF/dy + cj dF/dyp into a CSC matrix with the model's pattern (data only), or a dense
+   column-major ny x ny matrix when dense != NULL. ewt: IDA's error weights (for FD steps). */
+int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj, const double* y,
+                        const double* yp, const double* ewt, double* csc_data, double* dense);
+/* building blocks shared by the residual, Jacobian and initial conditions */
+int fmb_joint_constraint(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                         double* phi, double* phi_q, double* phi_t, double* phi_tt);
+int fmb_body_blocks(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, const double* a,
+                    const double* ewt, double* K, double* C, double* M);
+int fmb_body_mass(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, double* M);
+int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                           double* Qtot);
+int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                        double* phi, double* phi_q_dense, double* phi_t, double* phi_tt);
+void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, fmbEnergy* e);
+int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols);
+void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* pos,
+                          double* vel);
+double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y);
+int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
+                     double* value);
+/* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1 */
+int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v);
+
+/* ---- pattern.c ---- */
+int fmb_pattern_build(fmbModel* m);
+void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals,
+                       int ld, double scale);
+void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v);
+
+/* ---- dense.c: small dense linear algebra (initial conditions, checks) ---- */
+int fmb_lu_factor(int n, double* A, int* piv);             /* column-major, in place; 0 ok */
+void fmb_lu_solve(int n, const double* LU, const int* piv, double* b);
+int fmb_cholesky(int n, double* A);                        /* lower, in place; 0 ok, else k+1 */
+
+/* ---- ic.c ---- */
+int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
+                           fmbDiag* diag);
+
+/* ---- output.c ---- */
+int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
+void fmb_outputs_default(fmbModel* m);
+typedef struct fmbCsv fmbCsv;
+fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
+void fmb_csv_header(fmbCsv* c, const fmbModel* m);
+int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
+void fmb_csv_close(fmbCsv* c);
+
+/* ---- fd.c ---- */
+/* dense column-major derivative of a body's residual: K = dR/dq, C = dR/dv, M = dR/da */
+int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
+                         const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
+                         double* M, double* work, double* scratch);
+
+#endif

@@ -1,0 +1,215 @@
+/* output.c — named outputs and the one CSV writer.
+ * Columns are resolved once at load ("BODY.quantity", "JOINT.quantity", "energy.*",
+ * "constraint.*"); a row computes only what its columns need (no energy pass unless an energy
+ * column is asked for). Rows are flushed as they are written, so a run that stops keeps them. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+static const char* const frame_names[] = {"x", "y", "theta", "omega", "vx", "vy", NULL};
+static const char* const energy_names[] = {"kinetic", "strain", "gravity", "spring", "total", NULL};
+static const char* const constraint_names[] = {"position", "velocity", NULL};
+
+static int lookup(const char* const* names, const char* s) {
+  for (int i = 0; names[i]; ++i)
+    if (strcmp(names[i], s) == 0) return i;
+  return -1;
+}
+
+static void list_names(char* buf, size_t len, const char* const* names) {
+  size_t used = strlen(buf);
+  for (int i = 0; names && names[i] && used + 30 < len; ++i)
+    used += (size_t)snprintf(buf + used, len - used, "%s%s", used ? ", " : "", names[i]);
+}
+
+static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text, fmbOutput* o) {
+  snprintf(o->name, sizeof o->name, "%s", text);
+  const char* dot = strchr(text, '.');
+  if (!dot || dot == text || !dot[1])
+    return fmbp_error_at(p, node, "expected an output name NAME.quantity (e.g. beam.tip_v, energy.total), got '%s'", text);
+  char owner[FMB_NAME_MAX];
+  size_t len = (size_t)(dot - text);
+  if (len >= sizeof owner) return fmbp_error_at(p, node, "no body or joint named '%.*s...'", 20, text);
+  memcpy(owner, text, len);
+  owner[len] = '\0';
+  const char* qty = dot + 1;
+  char avail[700] = "";
+  if (strcmp(owner, "energy") == 0) {
+    o->kind = FMB_OUT_ENERGY;
+    o->id = lookup(energy_names, qty);
+    m->need_energy = 1;
+    list_names(avail, sizeof avail, energy_names);
+  } else if (strcmp(owner, "constraint") == 0) {
+    o->kind = FMB_OUT_CONSTRAINT;
+    o->id = lookup(constraint_names, qty);
+    m->need_constraint = 1;
+    list_names(avail, sizeof avail, constraint_names);
+  } else {
+    int b = -1, j = -1;
+    for (int i = 1; i < m->nbody; ++i)
+      if (strcmp(m->body[i].name, owner) == 0) b = i;
+    for (int i = 0; i < m->njoint; ++i)
+      if (strcmp(m->joint[i].name, owner) == 0) j = i;
+    if (b < 0 && j < 0)
+      return fmbp_error_at(p, node, "output '%s': no body or joint named '%s' (outputs are NAME.quantity, energy.*, constraint.*)",
+                           text, owner);
+    o->id = -1;
+    if (b >= 0) {
+      const fmbBodyInst* bi = &m->body[b];
+      o->owner = b;
+      if (bi->nq >= 3 && (o->id = lookup(frame_names, qty)) >= 0) {
+        o->kind = FMB_OUT_FRAME;
+      } else if (bi->type->output_lookup && (o->id = bi->type->output_lookup(bi->self, qty)) >= 0) {
+        o->kind = FMB_OUT_BODY;
+      }
+      if (bi->nq >= 3) list_names(avail, sizeof avail, frame_names);
+      list_names(avail, sizeof avail, bi->type->output_names);
+    } else {
+      const fmbJointInst* ji = &m->joint[j];
+      o->owner = j;
+      if (ji->nrows > 0 && strcmp(qty, "power") == 0) {
+        o->kind = FMB_OUT_JOINT_POWER;
+        o->id = 0;
+      } else if (ji->type->output_lookup && (o->id = ji->type->output_lookup(ji->self, qty)) >= 0) {
+        o->kind = FMB_OUT_JOINT;
+      }
+      if (ji->nrows > 0) list_names(avail, sizeof avail, (const char* const[]){"power", NULL});
+      list_names(avail, sizeof avail, ji->type->output_names);
+    }
+  }
+  if (o->id < 0) return fmbp_error_at(p, node, "output '%s': unknown quantity '%s' (available: %s)", text, qty, avail);
+  return 0;
+}
+
+int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
+  if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list of output names for 'outputs', e.g. [beam.tip_v, energy.total]");
+  int n = fmbp_seq_len(p, list);
+  m->output = calloc((size_t)n + 1, sizeof *m->output);
+  if (!m->output) return fmbp_error_at(p, list, "out of memory");
+  m->output[0].kind = FMB_OUT_TIME;
+  snprintf(m->output[0].name, sizeof m->output[0].name, "t");
+  m->noutput = 1;
+  for (int i = 0; i < n; ++i) {
+    fmbNode item = fmbp_seq_item(p, list, i);
+    const char* s = fmbp_scalar(p, item);
+    if (!s) return fmbp_error_at(p, item, "expected an output name NAME.quantity in 'outputs'");
+    for (int k = 1; k < m->noutput; ++k)
+      if (strcmp(m->output[k].name, s) == 0) return fmbp_error_at(p, item, "output '%s' is listed twice", s);
+    if (resolve_one(p, m, item, s, &m->output[m->noutput])) return -1;
+    m->noutput++;
+  }
+  return 0;
+}
+
+void fmb_outputs_default(fmbModel* m) {
+  int n = 1;
+  for (int b = 1; b < m->nbody; ++b)
+    if (m->body[b].nq >= 3) n += 4;
+  m->output = calloc((size_t)n, sizeof *m->output);
+  if (!m->output) return;
+  m->output[0].kind = FMB_OUT_TIME;
+  snprintf(m->output[0].name, sizeof m->output[0].name, "t");
+  m->noutput = 1;
+  for (int b = 1; b < m->nbody; ++b) {
+    if (m->body[b].nq < 3) continue;
+    for (int k = 0; k < 4; ++k) {
+      fmbOutput* o = &m->output[m->noutput++];
+      o->kind = FMB_OUT_FRAME;
+      o->owner = b;
+      o->id = k;
+      snprintf(o->name, sizeof o->name, "%s.%s", m->body[b].name, frame_names[k]);
+    }
+  }
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+struct fmbCsv {
+  FILE* f;
+  int owns;
+  double* row;
+  int nrow;
+};
+
+fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
+  fmbCsv* c = calloc(1, sizeof *c);
+  if (!c) return NULL;
+  if (!path || strcmp(path, "-") == 0) {
+    c->f = stdout;
+  } else {
+    c->f = fopen(path, "w");
+    c->owns = 1;
+    if (!c->f) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", strerror(errno));
+      free(c);
+      return NULL;
+    }
+  }
+  return c;
+}
+
+void fmb_csv_header(fmbCsv* c, const fmbModel* m) {
+  for (int i = 0; i < m->noutput; ++i) fprintf(c->f, "%s%s", i ? "," : "", m->output[i].name);
+  fprintf(c->f, "\n");
+  fflush(c->f);
+  free(c->row);
+  c->row = calloc((size_t)m->noutput, sizeof(double));
+  c->nrow = m->noutput;
+}
+
+/* 0 ok; 1 a value is not finite (nothing written); -1 a write failed */
+int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp) {
+  const double *q = y, *v = y + m->nq;
+  (void)yp;
+  fmbEnergy e = {0, 0, 0, 0};
+  double cpos = 0.0, cvel = 0.0;
+  if (m->need_energy) fmb_energy(m, w, t, q, v, &e);
+  if (m->need_constraint) fmb_constraint_norms(m, w, t, q, v, &cpos, &cvel);
+  double* work = fmb_workspace_plugin(w);
+  for (int i = 0; i < m->noutput; ++i) {
+    const fmbOutput* o = &m->output[i];
+    double val = 0.0;
+    switch (o->kind) {
+      case FMB_OUT_TIME: val = t; break;
+      case FMB_OUT_FRAME: {
+        const fmbBodyInst* b = &m->body[o->owner];
+        static const int src[] = {0, 1, 2, 2, 0, 1}; /* x y theta | omega vx vy from v */
+        val = (o->id < 3 ? q : v)[b->qadr + src[o->id]];
+        break;
+      }
+      case FMB_OUT_BODY: {
+        const fmbBodyInst* b = &m->body[o->owner];
+        if (b->type->output(b->self, o->id, q + b->qadr, v + b->qadr, &val, work + b->workadr)) val = NAN;
+        break;
+      }
+      case FMB_OUT_JOINT:
+        if (fmb_joint_output(m, w, o->owner, o->id, t, q, v, &val)) val = NAN;
+        break;
+      case FMB_OUT_JOINT_POWER: val = fmb_joint_power(m, w, o->owner, t, y); break;
+      case FMB_OUT_ENERGY: {
+        const double parts[5] = {e.kinetic, e.strain, e.gravity, e.spring,
+                                 e.kinetic + e.strain + e.gravity + e.spring};
+        val = parts[o->id];
+        break;
+      }
+      case FMB_OUT_CONSTRAINT: val = o->id == 0 ? cpos : cvel; break;
+    }
+    if (!isfinite(val)) return 1;
+    c->row[i] = val;
+  }
+  for (int i = 0; i < m->noutput; ++i) fprintf(c->f, "%s%.12g", i ? "," : "", c->row[i]);
+  fprintf(c->f, "\n");
+  if (fflush(c->f) != 0 || ferror(c->f)) return -1;
+  return 0;
+}
+
+void fmb_csv_close(fmbCsv* c) {
+  if (!c) return;
+  if (c->owns && c->f) fclose(c->f);
+  free(c->row);
+  free(c);
+}

@@ -1,0 +1,56 @@
+/* quad.c — Gauss–Legendre rules: the one quadrature of the project.
+ * Nodes are the roots of P_n, found by Newton's method from Tricomi's initial guess; weights
+ * w_i = 2 / ((1 - x_i^2) P_n'(x_i)^2). Mapped to [0, 1]. Computed once per n and cached. */
+#include <math.h>
+
+#include "flexmbd.h"
+
+static double rule_x[FMB_GAUSS_MAX + 1][FMB_GAUSS_MAX];
+static double rule_w[FMB_GAUSS_MAX + 1][FMB_GAUSS_MAX];
+static int rule_ready[FMB_GAUSS_MAX + 1];
+
+static void legendre(int n, double x, double* p, double* dp) {
+  double p0 = 1.0, p1 = x;
+  for (int k = 2; k <= n; ++k) {
+    double pk = ((2.0 * k - 1.0) * x * p1 - (k - 1.0) * p0) / k;
+    p0 = p1;
+    p1 = pk;
+  }
+  *p = (n == 0) ? 1.0 : p1;
+  *dp = n * (x * p1 - p0) / (x * x - 1.0);
+}
+
+static void build_rule(int n) {
+  for (int i = 0; i < n; ++i) {
+    double x = cos(M_PI * (i + 0.75) / (n + 0.5));
+    for (int it = 0; it < 100; ++it) {
+      double p, dp;
+      legendre(n, x, &p, &dp);
+      double dx = p / dp;
+      x -= dx;
+      if (fabs(dx) < 1e-16) break;
+    }
+    double p, dp;
+    legendre(n, x, &p, &dp);
+    double w = 2.0 / ((1.0 - x * x) * dp * dp);
+    /* map [-1, 1] -> [0, 1], ascending */
+    rule_x[n][n - 1 - i] = 0.5 * (x + 1.0);
+    rule_w[n][n - 1 - i] = 0.5 * w;
+  }
+  rule_ready[n] = 1;
+}
+
+int fmb_gauss_legendre01(int n, double* x, double* w) {
+  if (n < 1 || n > FMB_GAUSS_MAX) return -1;
+  if (n == 1) {
+    x[0] = 0.5;
+    w[0] = 1.0;
+    return 0;
+  }
+  if (!rule_ready[n]) build_rule(n);
+  for (int i = 0; i < n; ++i) {
+    x[i] = rule_x[n][i];
+    w[i] = rule_w[n][i];
+  }
+  return 0;
+}

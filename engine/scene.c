@@ -1,0 +1,250 @@
+/* scene.c — build an fmbModel from a YAML scene: solver settings, gravity, bodies and joints
+ * (through the registry the program hands in), outputs, and the fixed sparsity pattern.
+ * The keys are documented in docs/scenes.md. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+#define FMB_MAX_TYPES 64
+#define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
+
+static const char* const reserved_names[] = {"ground", "energy", "constraint", "t", NULL};
+
+static int name_taken(const fmbModel* m, const char* name) {
+  for (int b = 0; b < m->nbody; ++b)
+    if (strcmp(m->body[b].name, name) == 0) return 1;
+  for (int j = 0; j < m->njoint; ++j)
+    if (strcmp(m->joint[j].name, name) == 0) return 1;
+  for (int i = 0; reserved_names[i]; ++i)
+    if (strcmp(reserved_names[i], name) == 0) return 1;
+  return 0;
+}
+
+static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
+  fmbSolverSettings* s = &m->solver;
+  s->t0 = 0.0;
+  s->t_end = 0.0;
+  s->rtol = 1e-6;
+  s->atol = 1e-8;
+  s->output_step = 0.0;
+  s->max_step = 0.0;
+  s->dense = 0;
+  s->max_steps_per_output = 100000;
+  if (node < 0) return fmbp_error_at(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
+  if (!fmbp_is_map(p, node)) return fmbp_error_at(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, linear_solver, max_steps)");
+  fmbp_begin_item(p);
+  static const char* const solvers[] = {"klu", "dense", NULL};
+  int max_steps = 100000;
+  if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
+      fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) ||
+      fmb_get_double(p, node, "atol", FMB_POSITIVE, &s->atol) ||
+      fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
+      fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
+      fmb_get_choice(p, node, "linear_solver", 0, solvers, &s->dense) ||
+      fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps))
+    return -1;
+  if (fmbp_check_unknown(p, node, "solver")) return -1;
+  s->max_steps_per_output = max_steps;
+  if (s->rtol >= 0.1)
+    return fmbp_error_at(p, fmb_find_key(p, node, "rtol"), "expected rtol below 0.1 (a relative tolerance), got %g", s->rtol);
+  if (s->output_step == 0.0) s->output_step = s->t_end / 1000.0;
+  if (s->output_step > s->t_end)
+    return fmbp_error_at(p, fmb_find_key(p, node, "output_step"), "output_step (%g) is longer than t_end (%g)",
+                         s->output_step, s->t_end);
+  if (s->t_end / s->output_step > (double)FMB_MAX_ROWS)
+    return fmbp_error_at(p, fmb_find_key(p, node, "output_step"),
+                         "output_step %g with t_end %g asks for more than %ld rows", s->output_step, s->t_end, FMB_MAX_ROWS);
+  return 0;
+}
+
+static int type_names(const fmbRegistry* reg, int bodies, const char** names) {
+  int n = bodies ? reg->nbodies : reg->njoints;
+  if (n > FMB_MAX_TYPES - 1) n = FMB_MAX_TYPES - 1;
+  for (int i = 0; i < n; ++i) names[i] = bodies ? reg->bodies[i]->name : reg->joints[i]->name;
+  names[n] = NULL;
+  return n;
+}
+
+static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
+  if (list < 0) return fmbp_error_at(p, fmbp_root(p), "missing required key 'bodies' (a list of bodies, each with name and type)");
+  if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list for 'bodies' (each item a mapping with name and type)");
+  int n = fmbp_seq_len(p, list);
+  if (n == 0) return fmbp_error_at(p, list, "'bodies' is empty: a scene needs at least one body");
+  m->body = calloc((size_t)n + 1, sizeof *m->body);
+  if (!m->body) return fmbp_error_at(p, list, "out of memory");
+  /* body 0: the fixed world frame */
+  snprintf(m->body[0].name, FMB_NAME_MAX, "ground");
+  m->nbody = 1;
+  const char* names[FMB_MAX_TYPES];
+  type_names(p->reg, 1, names);
+  for (int i = 0; i < n; ++i) {
+    fmbNode item = fmbp_seq_item(p, list, i);
+    if (!fmbp_is_map(p, item)) return fmbp_error_at(p, item, "expected a mapping for a body (with name and type)");
+    fmbp_begin_item(p);
+    fmbBodyInst* b = &m->body[m->nbody];
+    int t = 0;
+    if (fmbp_get_name(p, item, "name", b->name)) return -1;
+    if (name_taken(m, b->name))
+      return fmbp_error_at(p, fmb_find_key(p, item, "name"), "duplicate or reserved name '%s': every body and joint needs its own name", b->name);
+    if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, &t)) return -1;
+    b->type = p->reg->bodies[t];
+    if (b->type->abi != FMB_ABI_VERSION)
+      return fmbp_error_at(p, item, "body type '%s' was built for plugin ABI %d, the engine has %d", b->type->name,
+                           b->type->abi, FMB_ABI_VERSION);
+    if (b->type->parse(p, item, &b->self)) {
+      if (!p->diag->code) fmbp_error_at(p, item, "body '%s' (type %s) could not be set up", b->name, b->type->name);
+      return -1;
+    }
+    m->nbody++; /* owns self from here on, freed by fmb_free */
+    char what[FMB_NAME_MAX + 40];
+    snprintf(what, sizeof what, "body '%s' (type %s)", b->name, b->type->name);
+    if (fmbp_check_unknown(p, item, what)) return -1;
+    b->qadr = m->nq;
+    b->nq = b->type->ncoord(b->self);
+    m->nq += b->nq;
+    b->workadr = m->nwork;
+    b->nwork = b->type->nwork ? b->type->nwork(b->self) : 0;
+    m->nwork += b->nwork;
+    if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
+  }
+  return 0;
+}
+
+static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
+  if (list < 0) return 0;
+  if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list for 'joints' (each item a mapping with name and type)");
+  int n = fmbp_seq_len(p, list);
+  m->joint = calloc((size_t)n + 1, sizeof *m->joint);
+  if (!m->joint) return fmbp_error_at(p, list, "out of memory");
+  const char* names[FMB_MAX_TYPES];
+  type_names(p->reg, 0, names);
+  for (int i = 0; i < n; ++i) {
+    fmbNode item = fmbp_seq_item(p, list, i);
+    if (!fmbp_is_map(p, item)) return fmbp_error_at(p, item, "expected a mapping for a joint (with name and type)");
+    fmbp_begin_item(p);
+    fmbJointInst* j = &m->joint[m->njoint];
+    int t = 0;
+    if (fmbp_get_name(p, item, "name", j->name)) return -1;
+    if (name_taken(m, j->name))
+      return fmbp_error_at(p, fmb_find_key(p, item, "name"), "duplicate or reserved name '%s': every body and joint needs its own name", j->name);
+    if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, &t)) return -1;
+    j->type = p->reg->joints[t];
+    if (j->type->abi != FMB_ABI_VERSION)
+      return fmbp_error_at(p, item, "joint type '%s' was built for plugin ABI %d, the engine has %d", j->type->name,
+                           j->type->abi, FMB_ABI_VERSION);
+    if (j->type->parse(p, item, &j->self)) {
+      if (!p->diag->code) fmbp_error_at(p, item, "joint '%s' (type %s) could not be set up", j->name, j->type->name);
+      return -1;
+    }
+    m->njoint++;
+    char what[FMB_NAME_MAX + 40];
+    snprintf(what, sizeof what, "joint '%s' (type %s)", j->name, j->type->name);
+    if (fmbp_check_unknown(p, item, what)) return -1;
+    j->type->bodies(j->self, j->body);
+    if (j->body[0] == j->body[1])
+      return fmbp_error_at(p, item, "joint '%s' connects body '%s' to itself", j->name, m->body[j->body[0]].name);
+    j->ncol = 0;
+    for (int k = 0; k < 2; ++k)
+      if (j->body[k] >= 0) j->ncol += m->body[j->body[k]].nq;
+    j->rowadr = m->nc;
+    j->nrows = j->type->nrows ? j->type->nrows(j->self) : 0;
+    m->nc += j->nrows;
+    if (j->ncol > m->max_joint_cols) m->max_joint_cols = j->ncol;
+  }
+  return 0;
+}
+
+static int parse_scene(fmbParser* p, fmbModel* m) {
+  fmbNode root = fmbp_root(p);
+  fmbp_begin_item(p);
+  fmbNode solver = fmb_find_key(p, root, "solver");
+  fmbNode bodies = fmb_find_key(p, root, "bodies");
+  fmbNode joints = fmb_find_key(p, root, "joints");
+  fmbNode outputs = fmb_find_key(p, root, "outputs");
+  double g[2] = {0.0, 0.0};
+  if (fmb_get_vec2(p, root, "gravity", 0, g)) return -1;
+  if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
+  m->env.gravity[0] = g[0];
+  m->env.gravity[1] = g[1];
+  m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);
+  if (parse_solver(p, m, solver) || parse_bodies(p, m, bodies) || parse_joints(p, m, joints)) return -1;
+  if (m->nq == 0) return fmbp_error_at(p, bodies, "the scene has no moving body (no generalized coordinates)");
+  if (m->nc > m->nq)
+    return fmbp_error_at(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
+                         m->nc, m->nq);
+  m->ny = 2 * m->nq + 2 * m->nc;
+  if (outputs >= 0) {
+    if (fmb_outputs_resolve(p, m, outputs)) return -1;
+  } else {
+    fmb_outputs_default(m);
+  }
+  if (fmb_pattern_build(m)) return fmbp_error_at(p, root, "out of memory building the sparsity pattern");
+  return 0;
+}
+
+fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
+                   fmbDiag* diag) {
+  memset(diag, 0, sizeof *diag);
+  fmbModel* m = calloc(1, sizeof *m);
+  if (!m) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "out of memory");
+    return NULL;
+  }
+  snprintf(m->path, sizeof m->path, "%s", path);
+  fmbParser p;
+  memset(&p, 0, sizeof p);
+  p.model = m;
+  p.reg = reg;
+  int rc = fmbp_open(&p, path, overrides, noverrides, diag);
+  if (rc == 0) rc = parse_scene(&p, m);
+  fmbp_close(&p);
+  if (rc) {
+    if (!diag->code) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "invalid scene");
+    fmb_free(m);
+    return NULL;
+  }
+  return m;
+}
+
+void fmb_free(fmbModel* m) {
+  if (!m) return;
+  for (int b = 0; b < m->nbody; ++b)
+    if (m->body[b].type && m->body[b].self) m->body[b].type->destroy(m->body[b].self);
+  for (int j = 0; j < m->njoint; ++j)
+    if (m->joint[j].self) m->joint[j].type->destroy(m->joint[j].self);
+  free(m->body);
+  free(m->joint);
+  free(m->output);
+  free(m->block);
+  free(m->colptr);
+  free(m->rowind);
+  free(m);
+}
+
+void fmb_describe(const fmbModel* m, FILE* f) {
+  fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
+          m->path, m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);
+  fprintf(f, "gravity: %s\n", m->env.has_gravity ? "on" : "off (no gravity terms evaluated)");
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    fprintf(f, "body '%s' (%s, %d coordinates): ", bi->name, bi->type->name, bi->nq);
+    if (bi->type->describe)
+      bi->type->describe(bi->self, f);
+    else
+      fprintf(f, "\n");
+  }
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    fprintf(f, "joint '%s' (%s, %d constraint rows): ", ji->name, ji->type->name, ji->nrows);
+    if (ji->type->describe)
+      ji->type->describe(ji->self, f);
+    else
+      fprintf(f, "\n");
+  }
+  fprintf(f, "outputs:");
+  for (int i = 0; i < m->noutput; ++i) fprintf(f, " %s", m->output[i].name);
+  fprintf(f, "\n");
+}

@@ -1,0 +1,510 @@
+/* system.c — the DAE of a planar multibody system in the stabilized index-2 form of
+ * Gear, Gupta & Leimkuhler (GGL), with unknowns y = [q, v, lambda, mu]:
+ *
+ *   F_q      = q' - v - Phi_q^T mu                 = 0   (mu -> 0: velocity-level stabilization)
+ *   F_v      = M(q) v' - Q(q, v, t) + Phi_q^T lambda = 0
+ *   F_lambda = Phi(q, t)                            = 0   (position constraints)
+ *   F_mu     = Phi_q v + Phi_t                      = 0   (velocity constraints)
+ *
+ * lambda and mu are algebraic (excluded from IDA's error test). Bodies supply M v' - Q through
+ * their `residual`, joints supply Phi, Phi_q, Phi_t, force elements supply Q. The iteration
+ * matrix dF/dy + cj dF/dy' is assembled into the fixed CSC pattern of pattern.c; blocks a plugin
+ * does not provide analytically are differentiated numerically over that plugin's own
+ * coordinates. Nothing here allocates: all scratch lives in the workspace made at setup. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+struct fmbWorkspace {
+  double* plugin;  /* m->nwork: plugin scratch */
+  /* joint scratch */
+  double *phi, *phi_q, *phi_q2, *phi_t, *phi_tt, *jq, *jv, *jQ, *jQ2;
+  int* cols;
+  /* body scratch: dense blocks and FD */
+  double *K, *C, *M, *fd, *mk, *js;
+  double *qpert, *vpert;
+  double* ewt_default;
+  /* global scratch */
+  double *Mg, *PhiQ, *Qg;
+  int max_rows, max_nq;
+};
+
+static size_t max_body_nq(const fmbModel* m) {
+  int mx = 1;
+  for (int b = 1; b < m->nbody; ++b)
+    if (m->body[b].nq > mx) mx = m->body[b].nq;
+  return (size_t)mx;
+}
+
+fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
+  fmbWorkspace* w = calloc(1, sizeof *w);
+  if (!w) return NULL;
+  int mr = 1;
+  for (int j = 0; j < m->njoint; ++j)
+    if (m->joint[j].nrows > mr) mr = m->joint[j].nrows;
+  size_t mc = (size_t)(m->max_joint_cols > 0 ? m->max_joint_cols : 1);
+  size_t nb = max_body_nq(m);
+  size_t nq = (size_t)m->nq;
+  w->max_rows = mr;
+  w->max_nq = (int)nb;
+  w->plugin = calloc(m->nwork + 1, sizeof(double));
+  w->phi = calloc((size_t)mr, sizeof(double));
+  w->phi_t = calloc((size_t)mr, sizeof(double));
+  w->phi_tt = calloc((size_t)mr, sizeof(double));
+  w->phi_q = calloc((size_t)mr * mc, sizeof(double));
+  w->phi_q2 = calloc((size_t)mr * mc, sizeof(double));
+  w->jq = calloc(mc, sizeof(double));
+  w->jv = calloc(mc, sizeof(double));
+  w->jQ = calloc(mc, sizeof(double));
+  w->jQ2 = calloc(mc * (mc + 1), sizeof(double));
+  w->cols = calloc(mc, sizeof(int));
+  w->K = calloc(nb * nb, sizeof(double));
+  w->C = calloc(nb * nb, sizeof(double));
+  w->M = calloc(nb * nb, sizeof(double));
+  w->fd = calloc(6 * nb, sizeof(double));
+  w->mk = calloc(3 * nb, sizeof(double));
+  w->js = calloc(2 * mc, sizeof(double));
+  w->qpert = calloc(nq, sizeof(double));
+  w->vpert = calloc(nq, sizeof(double));
+  w->ewt_default = calloc(2 * nq, sizeof(double));
+  w->Qg = calloc(nq, sizeof(double));
+  if (!w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
+      !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
+    fmb_workspace_free(w);
+    return NULL;
+  }
+  if (m->check_definiteness) {
+    w->Mg = calloc(nq * nq, sizeof(double));
+    w->PhiQ = calloc((size_t)(m->nc > 0 ? m->nc : 1) * nq, sizeof(double));
+    if (!w->Mg || !w->PhiQ) {
+      fmb_workspace_free(w);
+      return NULL;
+    }
+  }
+  return w;
+}
+
+void fmb_workspace_free(fmbWorkspace* w) {
+  if (!w) return;
+  double* bufs[] = {w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
+                    w->K, w->C, w->M, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(w->cols);
+  free(w);
+}
+
+double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
+
+/* ---------------------------------------------------------------------------------------------
+ * joints' view of the bodies */
+
+double fmb_eval_time(const fmbJointEval* ev) { return ev->t; }
+
+int fmb_eval_ncoord(const fmbJointEval* ev, int k) {
+  int b = ev->j->body[k];
+  return b >= 0 ? ev->m->body[b].nq : 0;
+}
+
+const double* fmb_eval_q(const fmbJointEval* ev, int k) {
+  int b = ev->j->body[k];
+  return b >= 0 ? ev->q + ev->m->body[b].qadr : NULL;
+}
+
+const double* fmb_eval_v(const fmbJointEval* ev, int k) {
+  int b = ev->j->body[k];
+  return b >= 0 ? ev->v + ev->m->body[b].qadr : NULL;
+}
+
+double* fmb_eval_scratch(const fmbJointEval* ev) { return ev->js; }
+
+int fmb_eval_col0(const fmbJointEval* ev, int k) { return k == 0 ? 0 : fmb_eval_ncoord(ev, 0); }
+
+int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle, double* dpos_dq,
+               int ld, double* dangle_dq) {
+  int b = ev->j->body[k];
+  const fmbBodyInst* bi = b >= 0 ? &ev->m->body[b] : NULL;
+  if (!bi || !bi->type) { /* the world frame */
+    pos[0] = local[0];
+    pos[1] = local[1];
+    if (angle) *angle = 0.0;
+    return 0;
+  }
+  const int n = bi->nq;
+  double* dp = dpos_dq ? ev->mk : NULL;
+  int rc = bi->type->marker(bi->self, ev->q + bi->qadr, local, pos, angle, dp, dangle_dq, ev->work + bi->workadr);
+  if (rc || !dpos_dq) return rc;
+  for (int i = 0; i < n; ++i) {
+    dpos_dq[i] = dp[i];
+    dpos_dq[ld + i] = dp[n + i];
+  }
+  return 0;
+}
+
+int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols) {
+  int n = 0;
+  for (int k = 0; k < 2; ++k) {
+    if (j->body[k] < 0) continue;
+    const fmbBodyInst* b = &m->body[j->body[k]];
+    for (int i = 0; i < b->nq; ++i) cols[n++] = b->qadr + i;
+  }
+  return n;
+}
+
+static int joint_eval(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                      double* phi, double* phi_q, double* phi_t, double* phi_tt) {
+  const fmbJointInst* ji = &m->joint[j];
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  memset(phi_q, 0, (size_t)ji->nrows * (size_t)ji->ncol * sizeof(double));
+  for (int r = 0; r < ji->nrows; ++r) phi_t[r] = phi_tt[r] = 0.0;
+  return ji->type->constraint(ji->self, &ev, phi, phi_q, phi_t, phi_tt);
+}
+
+int fmb_joint_constraint(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                         double* phi, double* phi_q, double* phi_t, double* phi_tt) {
+  return joint_eval(m, w, j, t, q, v, phi, phi_q, phi_t, phi_tt);
+}
+
+static int joint_force(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       double* Q) {
+  const fmbJointInst* ji = &m->joint[j];
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  memset(Q, 0, (size_t)ji->ncol * sizeof(double));
+  return ji->type->force(ji->self, &ev, Q);
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * residual */
+
+static int all_finite(const double* x, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!isfinite(x[i])) return 0;
+  return 1;
+}
+
+int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F) {
+  const int nq = m->nq, nc = m->nc;
+  const double *q = y, *v = y + nq, *lam = y + 2 * nq, *mu = y + 2 * nq + nc;
+  const double *qp = yp, *vp = yp + nq;
+  double *Fq = F, *Fv = F + nq, *Fl = F + 2 * nq, *Fm = F + 2 * nq + nc;
+  if (!all_finite(y, m->ny) || !all_finite(yp, m->ny)) return 1; /* IDA retries with a smaller step */
+  for (int i = 0; i < nq; ++i) Fq[i] = qp[i] - v[i];
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    int rc = bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr, Fv + bi->qadr,
+                                w->plugin + bi->workadr);
+    if (rc) return rc;
+  }
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (!ji->type->force && ji->nrows == 0) continue;
+    int ncol = fmb_joint_cols(m, ji, w->cols);
+    if (ji->type->force) {
+      int rc = joint_force(m, w, j, t, q, v, w->jQ);
+      if (rc) return rc;
+      for (int c = 0; c < ncol; ++c) Fv[w->cols[c]] -= w->jQ[c];
+    }
+    if (ji->nrows == 0) continue;
+    int rc = joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt);
+    if (rc) return rc;
+    for (int r = 0; r < ji->nrows; ++r) {
+      const double* row = w->phi_q + (size_t)r * (size_t)ncol;
+      double pv = 0.0;
+      const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
+      for (int c = 0; c < ncol; ++c) {
+        pv += row[c] * v[w->cols[c]];
+        Fv[w->cols[c]] += row[c] * l;
+        Fq[w->cols[c]] -= row[c] * u;
+      }
+      Fl[ji->rowadr + r] = w->phi[r];
+      Fm[ji->rowadr + r] = pv + w->phi_t[r];
+    }
+  }
+  return all_finite(F, m->ny) ? 0 : 1;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * iteration matrix */
+
+typedef struct {
+  const fmbModel* m;
+  double* csc;
+  double* dense;
+} Sink;
+
+static void sink_add(const Sink* s, int r, int c, double v) {
+  if (s->dense)
+    s->dense[(size_t)c * (size_t)s->m->ny + (size_t)r] += v;
+  else
+    fmb_csc_add(s->m, s->csc, r, c, v);
+}
+
+static void sink_block(const Sink* s, int r0, int nr, int c0, int nc, const double* vals, int ld, double scale) {
+  if (!s->dense) {
+    fmb_csc_add_block(s->m, s->csc, r0, nr, c0, nc, vals, ld, scale);
+    return;
+  }
+  for (int j = 0; j < nc; ++j)
+    for (int i = 0; i < nr; ++i) s->dense[(size_t)(c0 + j) * (size_t)s->m->ny + (size_t)(r0 + i)] += scale * vals[(size_t)j * ld + i];
+}
+
+static double fd_increment(double y, double ewt) {
+  const double srur = 1.4901161193847656e-08;
+  double inc = srur * fabs(y), fl = 1.0 / ewt;
+  return inc > fl ? inc : fl;
+}
+
+int fmb_body_blocks(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, const double* a,
+                    const double* ewt, double* K, double* C, double* M) {
+  const fmbBodyInst* bi = &m->body[b];
+  double* work = w->plugin + bi->workadr;
+  if (bi->type->jacobian) return bi->type->jacobian(bi->self, &m->env, q, v, a, K, C, M, work);
+  return fmb_fd_body_jacobian(bi, &m->env, q, v, a, ewt, ewt + m->nq, K, C, M, work, w->fd);
+}
+
+int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj, const double* y, const double* yp,
+                        const double* ewt, double* csc_data, double* dense) {
+  const int nq = m->nq, nc = m->nc;
+  const int Fq = 0, Fv = nq, Fl = 2 * nq, Fm = 2 * nq + nc;
+  const int Yq = 0, Yv = nq, Yl = 2 * nq, Ym = 2 * nq + nc;
+  const double *q = y, *v = y + nq, *lam = y + 2 * nq, *mu = y + 2 * nq + nc, *vp = yp + nq;
+  Sink s = {m, csc_data, dense};
+  if (dense)
+    memset(dense, 0, (size_t)m->ny * (size_t)m->ny * sizeof(double));
+  else
+    memset(csc_data, 0, (size_t)m->nnz * sizeof(double));
+
+  for (int i = 0; i < nq; ++i) {
+    sink_add(&s, Fq + i, Yq + i, cj);
+    sink_add(&s, Fq + i, Yv + i, -1.0);
+  }
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    const int n = bi->nq, a0 = bi->qadr;
+    int rc = fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, w->K, w->C, w->M);
+    if (rc) return rc;
+    /* dR/dq under q, dR/dv + cj dR/da under v */
+    for (size_t k = 0; k < (size_t)n * (size_t)n; ++k) w->C[k] += cj * w->M[k];
+    sink_block(&s, Fv + a0, n, Yq + a0, n, w->K, n, 1.0);
+    sink_block(&s, Fv + a0, n, Yv + a0, n, w->C, n, 1.0);
+  }
+
+  memcpy(w->qpert, q, (size_t)nq * sizeof(double));
+  memcpy(w->vpert, v, (size_t)nq * sizeof(double));
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (!ji->type->force && ji->nrows == 0) continue;
+    const int ncol = fmb_joint_cols(m, ji, w->cols), nr = ji->nrows;
+    const int* cols = w->cols;
+    if (ji->type->force) {
+      /* -dQ/dq and -dQ/dv by forward differences over the two bodies' coordinates */
+      int rc = joint_force(m, w, j, t, q, v, w->jQ);
+      if (rc) return rc;
+      for (int pass = 0; pass < 2; ++pass) {
+        double* x = pass == 0 ? w->qpert : w->vpert;
+        const double* ew = ewt + (pass == 0 ? 0 : nq);
+        for (int c = 0; c < ncol; ++c) {
+          const int gc = cols[c];
+          const double x0 = x[gc];
+          double h = fd_increment(x0, ew[gc]);
+          x[gc] = x0 + h;
+          h = x[gc] - x0;
+          rc = joint_force(m, w, j, t, w->qpert, w->vpert, w->jQ2);
+          x[gc] = x0;
+          if (rc) return rc;
+          for (int r = 0; r < ncol; ++r) sink_add(&s, Fv + cols[r], (pass == 0 ? Yq : Yv) + gc, -(w->jQ2[r] - w->jQ[r]) / h);
+        }
+      }
+    }
+    if (nr == 0) continue;
+    int rc = joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt);
+    if (rc) return rc;
+    for (int r = 0; r < nr; ++r)
+      for (int c = 0; c < ncol; ++c) {
+        const double d = w->phi_q[(size_t)r * ncol + c];
+        if (d == 0.0) continue;
+        sink_add(&s, Fl + ji->rowadr + r, Yq + cols[c], d);
+        sink_add(&s, Fm + ji->rowadr + r, Yv + cols[c], d);
+        sink_add(&s, Fv + cols[c], Yl + ji->rowadr + r, d);
+        sink_add(&s, Fq + cols[c], Ym + ji->rowadr + r, -d);
+      }
+    /* d(Phi_q v)/dq, d(Phi_q^T lambda)/dq and d(Phi_q^T mu)/dq by forward differences of Phi_q */
+    for (int c = 0; c < ncol; ++c) {
+      const int gc = cols[c];
+      const double x0 = w->qpert[gc];
+      double h = fd_increment(x0, ewt[gc]);
+      w->qpert[gc] = x0 + h;
+      h = w->qpert[gc] - x0;
+      rc = joint_eval(m, w, j, t, w->qpert, v, w->jq, w->phi_q2, w->jv, w->jQ2);
+      w->qpert[gc] = x0;
+      if (rc) return rc;
+      for (int r = 0; r < nr; ++r) {
+        double dpv = 0.0;
+        const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
+        for (int k = 0; k < ncol; ++k) {
+          const double dphiq = (w->phi_q2[(size_t)r * ncol + k] - w->phi_q[(size_t)r * ncol + k]) / h;
+          if (dphiq == 0.0) continue;
+          dpv += dphiq * v[cols[k]];
+          sink_add(&s, Fv + cols[k], Yq + gc, dphiq * l);
+          sink_add(&s, Fq + cols[k], Yq + gc, -dphiq * u);
+        }
+        if (dpv != 0.0) sink_add(&s, Fm + ji->rowadr + r, Yq + gc, dpv);
+      }
+    }
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * pieces for initial conditions, outputs and checks (not on the integration path) */
+
+int fmb_body_mass(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, double* M) {
+  const fmbBodyInst* bi = &m->body[b];
+  double* a = w->fd + 5 * (size_t)w->max_nq; /* zero acceleration */
+  memset(a, 0, (size_t)bi->nq * sizeof(double));
+  double* ew = w->ewt_default;
+  for (int i = 0; i < bi->nq; ++i) ew[i] = ew[m->nq + i] = 1.0 / (m->solver.atol + m->solver.rtol * fabs(q[i]));
+  if (bi->type->jacobian) return bi->type->jacobian(bi->self, &m->env, q, v, a, w->K, w->C, M, w->plugin + bi->workadr);
+  return fmb_fd_body_jacobian(bi, &m->env, q, v, a, ew, ew + m->nq, NULL, NULL, M, w->plugin + bi->workadr, w->fd);
+}
+
+int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* Qtot) {
+  memset(Qtot, 0, (size_t)m->nq * sizeof(double));
+  double* zero = w->fd + 5 * (size_t)w->max_nq;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    memset(zero, 0, (size_t)bi->nq * sizeof(double));
+    int rc = bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, zero, Qtot + bi->qadr,
+                                w->plugin + bi->workadr);
+    if (rc) return rc;
+    for (int i = 0; i < bi->nq; ++i) Qtot[bi->qadr + i] = -Qtot[bi->qadr + i];
+  }
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (!ji->type->force) continue;
+    int ncol = fmb_joint_cols(m, ji, w->cols);
+    int rc = joint_force(m, w, j, t, q, v, w->jQ);
+    if (rc) return rc;
+    for (int c = 0; c < ncol; ++c) Qtot[w->cols[c]] += w->jQ[c];
+  }
+  return 0;
+}
+
+int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* phi,
+                        double* phi_q_dense, double* phi_t, double* phi_tt) {
+  if (phi_q_dense) memset(phi_q_dense, 0, (size_t)m->nc * (size_t)m->nq * sizeof(double));
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (ji->nrows == 0) continue;
+    int ncol = fmb_joint_cols(m, ji, w->cols);
+    int rc = joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt);
+    if (rc) return rc;
+    for (int r = 0; r < ji->nrows; ++r) {
+      const int row = ji->rowadr + r;
+      if (phi) phi[row] = w->phi[r];
+      if (phi_t) phi_t[row] = w->phi_t[r];
+      if (phi_tt) phi_tt[row] = w->phi_tt[r];
+      if (phi_q_dense)
+        for (int c = 0; c < ncol; ++c) phi_q_dense[(size_t)row * m->nq + w->cols[c]] += w->phi_q[(size_t)r * ncol + c];
+    }
+  }
+  return 0;
+}
+
+void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, fmbEnergy* e) {
+  memset(e, 0, sizeof *e);
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->type->energy) continue;
+    fmbEnergy eb = {0, 0, 0, 0};
+    bi->type->energy(bi->self, &m->env, q + bi->qadr, v + bi->qadr, &eb, w->plugin + bi->workadr);
+    e->kinetic += eb.kinetic;
+    e->strain += eb.strain;
+    e->gravity += eb.gravity;
+    e->spring += eb.spring;
+  }
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (!ji->type->energy) continue;
+    fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+    e->spring += ji->type->energy(ji->self, &ev);
+  }
+}
+
+/* Mass matrix positive definite on the constraint manifold? By Finsler's lemma M is positive
+ * definite on null(Phi_q) iff M + r Phi_q^T Phi_q is positive definite for r large enough; a
+ * Cholesky factorization with r = 1e8 (relative to M's diagonal) tells. Runs only when a body
+ * declares its model can lose definiteness (FOAC). */
+int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v) {
+  if (!m->check_definiteness) return 0;
+  const int nq = m->nq;
+  memset(w->Mg, 0, (size_t)nq * nq * sizeof(double));
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, w->M)) return b + 1;
+    for (int c = 0; c < bi->nq; ++c)
+      for (int r = 0; r < bi->nq; ++r) w->Mg[(size_t)(bi->qadr + c) * nq + bi->qadr + r] = w->M[(size_t)c * bi->nq + r];
+  }
+  double dmax = 0.0;
+  for (int i = 0; i < nq; ++i) dmax = fmax(dmax, fabs(w->Mg[(size_t)i * nq + i]));
+  if (m->nc > 0) {
+    fmb_constraints_all(m, w, t, q, v, NULL, w->PhiQ, NULL, NULL);
+    double pmax = 0.0;
+    for (size_t k = 0; k < (size_t)m->nc * nq; ++k) pmax = fmax(pmax, fabs(w->PhiQ[k]));
+    const double r = 1e8 * dmax / fmax(pmax * pmax, 1e-300);
+    for (int i = 0; i < nq; ++i)
+      for (int k = 0; k < nq; ++k) {
+        double s = 0.0;
+        for (int c = 0; c < m->nc; ++c) s += w->PhiQ[(size_t)c * nq + i] * w->PhiQ[(size_t)c * nq + k];
+        w->Mg[(size_t)k * nq + i] += r * s;
+      }
+  }
+  int bad = fmb_cholesky(nq, w->Mg);
+  if (!bad) return 0;
+  /* name the body whose model can lose definiteness and whose coordinates hold the failing pivot */
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bad - 1 >= bi->qadr && bad - 1 < bi->qadr + bi->nq) return b + 1;
+  }
+  for (int b = 1; b < m->nbody; ++b)
+    if (m->body[b].type->indefinite_mass && m->body[b].type->indefinite_mass(m->body[b].self)) return b + 1;
+  return 1;
+}
+
+/* norms of the position and velocity constraint residuals */
+void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* pos,
+                          double* vel) {
+  double sp = 0.0, sv = 0.0;
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (ji->nrows == 0) continue;
+    int ncol = fmb_joint_cols(m, ji, w->cols);
+    if (joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) continue;
+    for (int r = 0; r < ji->nrows; ++r) {
+      double pv = w->phi_t[r];
+      for (int c = 0; c < ncol; ++c) pv += w->phi_q[(size_t)r * ncol + c] * v[w->cols[c]];
+      sp += w->phi[r] * w->phi[r];
+      sv += pv * pv;
+    }
+  }
+  *pos = sqrt(sp);
+  *vel = sqrt(sv);
+}
+
+/* power of joint j's constraint forces on the system: -lambda^T Phi_q v = lambda^T Phi_t */
+double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y) {
+  const fmbJointInst* ji = &m->joint[j];
+  const double *q = y, *v = y + m->nq, *lam = y + 2 * m->nq;
+  if (ji->nrows == 0 || joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) return 0.0;
+  double p = 0.0;
+  for (int r = 0; r < ji->nrows; ++r) p += lam[ji->rowadr + r] * w->phi_t[r];
+  return p;
+}
+
+int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
+                     double* value) {
+  const fmbJointInst* ji = &m->joint[j];
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  return ji->type->output(ji->self, id, &ev, value);
+}

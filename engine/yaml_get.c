@@ -1,0 +1,570 @@
+/* yaml_get.c — the one YAML accessor layer.
+ *
+ * The scene is loaded into a libyaml document; `--set PATH=VALUE` overrides edit that tree before
+ * anything is parsed, so an override is validated exactly like the file. Every accessor marks the
+ * keys it looks up, so that after an item is parsed any key nobody asked for is reported as
+ * unknown, together with the keys that were expected. Errors carry the node's file:line:column
+ * (libyaml marks are 0-based; we print 1-based) or, for nodes made by an override, its text. */
+#include <ctype.h>
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "internal.h"
+
+void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...) {
+  if (!d || d->code) return; /* the first error wins */
+  d->code = code;
+  snprintf(d->file, sizeof d->file, "%s", file ? file : "");
+  d->line = line;
+  d->col = col;
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(d->msg, sizeof d->msg, fmt, ap);
+  va_end(ap);
+}
+
+yaml_node_t* fmbp_node(fmbParser* p, fmbNode n) {
+  if (n <= 0) return NULL;
+  return yaml_document_get_node(&p->doc, n);
+}
+
+fmbNode fmbp_root(fmbParser* p) {
+  yaml_node_t* r = yaml_document_get_root_node(&p->doc);
+  return r ? (int)(r - p->doc.nodes.start) + 1 : -1;
+}
+
+static int node_count(fmbParser* p) { return (int)(p->doc.nodes.top - p->doc.nodes.start); }
+
+static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
+  char msg[900];
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  yaml_node_t* nd = fmbp_node(p, node);
+  int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
+  if (ov >= 0)
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", p->overrides[ov], msg);
+  else if (nd)
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1,
+                 (int)nd->start_mark.column + 1, "%s", msg);
+  else
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "%s", msg);
+  return -1;
+}
+
+int fmbp_error_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  verror_at(p, node, fmt, ap);
+  va_end(ap);
+  return -1;
+}
+
+int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
+  va_list ap;
+  va_start(ap, fmt);
+  verror_at(p, node, fmt, ap);
+  va_end(ap);
+  return -1;
+}
+
+int fmbp_is_map(fmbParser* p, fmbNode n) {
+  yaml_node_t* nd = fmbp_node(p, n);
+  return nd && nd->type == YAML_MAPPING_NODE;
+}
+int fmbp_is_seq(fmbParser* p, fmbNode n) {
+  yaml_node_t* nd = fmbp_node(p, n);
+  return nd && nd->type == YAML_SEQUENCE_NODE;
+}
+int fmbp_seq_len(fmbParser* p, fmbNode seq) {
+  yaml_node_t* nd = fmbp_node(p, seq);
+  return (nd && nd->type == YAML_SEQUENCE_NODE) ? (int)(nd->data.sequence.items.top - nd->data.sequence.items.start)
+                                                 : 0;
+}
+fmbNode fmbp_seq_item(fmbParser* p, fmbNode seq, int i) {
+  yaml_node_t* nd = fmbp_node(p, seq);
+  return nd->data.sequence.items.start[i];
+}
+const char* fmbp_scalar(fmbParser* p, fmbNode n) {
+  yaml_node_t* nd = fmbp_node(p, n);
+  return (nd && nd->type == YAML_SCALAR_NODE) ? (const char*)nd->data.scalar.value : NULL;
+}
+
+static const char* node_kind(yaml_node_t* nd) {
+  if (!nd) return "nothing";
+  switch (nd->type) {
+    case YAML_MAPPING_NODE: return "a mapping";
+    case YAML_SEQUENCE_NODE: return "a list";
+    case YAML_SCALAR_NODE:
+      if (nd->data.scalar.length == 0) return "an empty value";
+      return (nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+              nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
+                 ? "a quoted string"
+                 : "a scalar";
+    default: return "nothing";
+  }
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* keys */
+
+void fmbp_begin_item(fmbParser* p) { p->nlooked = 0; }
+
+static void remember_key(fmbParser* p, const char* key) {
+  for (int i = 0; i < p->nlooked; ++i)
+    if (strcmp(p->looked[i], key) == 0) return;
+  if (p->nlooked < (int)(sizeof p->looked / sizeof p->looked[0])) p->looked[p->nlooked++] = key;
+}
+
+fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
+  remember_key(p, key);
+  yaml_node_t* nd = fmbp_node(p, map);
+  if (!nd || nd->type != YAML_MAPPING_NODE) return -1;
+  for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr) {
+    yaml_node_t* k = fmbp_node(p, pr->key);
+    if (k && k->type == YAML_SCALAR_NODE && strcmp((const char*)k->data.scalar.value, key) == 0) {
+      if (pr->key <= p->nnodes_cap) p->known[pr->key] = 1;
+      return pr->value;
+    }
+  }
+  return -1;
+}
+
+int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
+  yaml_node_t* nd = fmbp_node(p, map);
+  if (!nd || nd->type != YAML_MAPPING_NODE) return 0;
+  for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr) {
+    if (pr->key <= p->nnodes_cap && p->known[pr->key]) continue;
+    const char* k = fmbp_scalar(p, pr->key);
+    char expected[600] = "";
+    size_t used = 0;
+    for (int i = 0; i < p->nlooked && used + 40 < sizeof expected; ++i)
+      used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s", i ? ", " : "", p->looked[i]);
+    if (!k) return fmbp_error_at(p, pr->key, "keys must be plain words in %s", what);
+    return fmbp_error_at(p, pr->key, "unknown key '%s' in %s (expected one of: %s)", k, what, expected);
+  }
+  return 0;
+}
+
+/* every mapping in the document: no duplicate keys, keys are scalars */
+static int check_duplicates(fmbParser* p) {
+  int n = node_count(p);
+  for (int id = 1; id <= n; ++id) {
+    yaml_node_t* nd = fmbp_node(p, id);
+    if (nd->type != YAML_MAPPING_NODE) continue;
+    for (yaml_node_pair_t* a = nd->data.mapping.pairs.start; a < nd->data.mapping.pairs.top; ++a) {
+      const char* ka = fmbp_scalar(p, a->key);
+      if (!ka) return fmbp_error_at(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
+      for (yaml_node_pair_t* b = nd->data.mapping.pairs.start; b < a; ++b) {
+        const char* kb = fmbp_scalar(p, b->key);
+        if (kb && strcmp(ka, kb) == 0) {
+          yaml_node_t* first = fmbp_node(p, b->key);
+          return fmbp_error_at(p, a->key, "duplicate key '%s' (first given at line %d)", ka,
+                               (int)first->start_mark.line + 1);
+        }
+      }
+    }
+  }
+  return 0;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* typed values */
+
+static int parse_number(const char* s, double* out) {
+  if (!s || !*s) return -1;
+  for (const char* c = s; *c; ++c)
+    if (!(isdigit((unsigned char)*c) || *c == '.' || *c == '-' || *c == '+' || *c == 'e' || *c == 'E')) return -1;
+  errno = 0;
+  char* end = NULL;
+  double v = strtod(s, &end);
+  if (end == s || *end != '\0') return -1;
+  if (!isfinite(v)) return -2;
+  *out = v;
+  return 0;
+}
+
+static int number_at(fmbParser* p, fmbNode n, const char* key, unsigned flags, double* out) {
+  yaml_node_t* nd = fmbp_node(p, n);
+  if (!nd || nd->type != YAML_SCALAR_NODE || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+      nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
+    return fmbp_error_at(p, n, "expected a number for '%s', found %s", key, node_kind(nd));
+  const char* s = (const char*)nd->data.scalar.value;
+  double v = 0;
+  int rc = parse_number(s, &v);
+  if (rc == -2) return fmbp_error_at(p, n, "expected a finite number for '%s', got '%s'", key, s);
+  if (rc) return fmbp_error_at(p, n, "expected a number for '%s', got '%s'", key, s);
+  if ((flags & FMB_POSITIVE) && !(v > 0))
+    return fmbp_error_at(p, n, "expected a positive number for '%s', got %s", key, s);
+  if ((flags & FMB_NONNEGATIVE) && !(v >= 0))
+    return fmbp_error_at(p, n, "expected a non-negative number for '%s', got %s", key, s);
+  *out = v;
+  return 0;
+}
+
+static int absent(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* what) {
+  if (flags & FMB_REQUIRED) return fmbp_error_at(p, map, "missing required key '%s' (%s)", key, what);
+  return 0;
+}
+
+int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "a number");
+  return number_at(p, n, key, flags, out);
+}
+
+int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out) {
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "a whole number");
+  const char* s = fmbp_scalar(p, n);
+  yaml_node_t* nd = fmbp_node(p, n);
+  char* end = NULL;
+  errno = 0;
+  long v = s ? strtol(s, &end, 10) : 0;
+  if (!s || !*s || *end != '\0' || errno == ERANGE || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+      nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
+    return fmbp_error_at(p, n, "expected a whole number for '%s', found %s%s%s%s", key, s ? "'" : "",
+                         s ? s : node_kind(nd), s ? "'" : "", "");
+  if (v < lo || v > hi)
+    return fmbp_error_at(p, n, "expected a whole number from %ld to %ld for '%s', got %ld", lo, hi, key, v);
+  *out = (int)v;
+  return 0;
+}
+
+int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]) {
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "a list of two numbers [x, y]");
+  if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != 2)
+    return fmbp_error_at(p, n, "expected a list of two numbers [x, y] for '%s', found %s", key,
+                         fmbp_is_seq(p, n) ? "a list of another length" : node_kind(fmbp_node(p, n)));
+  double v[2];
+  for (int i = 0; i < 2; ++i)
+    if (number_at(p, fmbp_seq_item(p, n, i), key, flags & ~(unsigned)FMB_REQUIRED, &v[i])) return -1;
+  out[0] = v[0];
+  out[1] = v[1];
+  return 0;
+}
+
+int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
+                   int* out) {
+  fmbNode n = fmb_find_key(p, map, key);
+  char list[400] = "";
+  size_t used = 0;
+  for (int i = 0; choices[i] && used + 40 < sizeof list; ++i)
+    used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", choices[i]);
+  if (n < 0) {
+    if (flags & FMB_REQUIRED) return fmbp_error_at(p, map, "missing required key '%s' (one of: %s)", key, list);
+    return 0;
+  }
+  const char* s = fmbp_scalar(p, n);
+  if (s)
+    for (int i = 0; choices[i]; ++i)
+      if (strcmp(s, choices[i]) == 0) {
+        *out = i;
+        return 0;
+      }
+  return fmbp_error_at(p, n, "expected one of %s for '%s', got %s%s%s", list, key, s ? "'" : "",
+                       s ? s : node_kind(fmbp_node(p, n)), s ? "'" : "");
+}
+
+int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]) {
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return fmbp_error_at(p, map, "missing required key '%s' (a name)", key);
+  const char* s = fmbp_scalar(p, n);
+  if (!s || !*s) return fmbp_error_at(p, n, "expected a name for '%s', found %s", key, node_kind(fmbp_node(p, n)));
+  size_t len = strlen(s);
+  if (len >= FMB_NAME_MAX) return fmbp_error_at(p, n, "name '%.20s...' is too long (at most %d characters)", s, FMB_NAME_MAX - 1);
+  for (const char* c = s; *c; ++c)
+    if (!(isalnum((unsigned char)*c) || *c == '_' || *c == '-'))
+      return fmbp_error_at(p, n, "name '%s' may contain only letters, digits, '_' and '-'", s);
+  memcpy(out, s, len + 1);
+  return 0;
+}
+
+int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "a body name");
+  const char* s = fmbp_scalar(p, n);
+  fmbModel* m = p->model;
+  if (s)
+    for (int b = 0; b < m->nbody; ++b)
+      if (strcmp(m->body[b].name, s) == 0) {
+        *out = b;
+        return 0;
+      }
+  char list[400] = "";
+  size_t used = 0;
+  for (int b = 0; b < m->nbody && used + 70 < sizeof list; ++b)
+    used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", b ? ", " : "", m->body[b].name);
+  return fmbp_error_at(p, n, "no body named %s%s%s for '%s' (bodies: %s)", s ? "'" : "", s ? s : "(not a name)",
+                       s ? "'" : "", key, list);
+}
+
+int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "a joint name");
+  const char* s = fmbp_scalar(p, n);
+  fmbModel* m = p->model;
+  if (s)
+    for (int j = 0; j < m->njoint; ++j)
+      if (strcmp(m->joint[j].name, s) == 0) {
+        *out = j;
+        return 0;
+      }
+  return fmbp_error_at(p, n, "no joint named %s%s%s for '%s' (a joint must be defined above the one that uses it)",
+                       s ? "'" : "", s ? s : "(not a name)", s ? "'" : "", key);
+}
+
+int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]) {
+  fmbModel* m = p->model;
+  if (joint < 0 || joint >= m->njoint) return -1;
+  const fmbJointInst* j = &m->joint[joint];
+  if (!j->type->attachment) return -1;
+  return j->type->attachment(j->self, k, body, local);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* overrides: PATH=VALUE edits the tree; VALUE is YAML (a scalar or a flow list) */
+
+static int copy_node(fmbParser* p, yaml_document_t* src, int id, int ov) {
+  yaml_node_t* s = yaml_document_get_node(src, id);
+  int nid = 0;
+  if (s->type == YAML_SCALAR_NODE) {
+    nid = yaml_document_add_scalar(&p->doc, NULL, s->data.scalar.value, (int)s->data.scalar.length,
+                                   s->data.scalar.style);
+  } else if (s->type == YAML_SEQUENCE_NODE) {
+    nid = yaml_document_add_sequence(&p->doc, NULL, YAML_FLOW_SEQUENCE_STYLE);
+    int n = (int)(s->data.sequence.items.top - s->data.sequence.items.start);
+    for (int i = 0; i < n && nid; ++i) {
+      s = yaml_document_get_node(src, id);
+      int c = copy_node(p, src, s->data.sequence.items.start[i], ov);
+      if (!c || !yaml_document_append_sequence_item(&p->doc, nid, c)) return 0;
+    }
+  } else {
+    nid = yaml_document_add_mapping(&p->doc, NULL, YAML_FLOW_MAPPING_STYLE);
+    int n = (int)(s->data.mapping.pairs.top - s->data.mapping.pairs.start);
+    for (int i = 0; i < n && nid; ++i) {
+      s = yaml_document_get_node(src, id);
+      yaml_node_pair_t pr = s->data.mapping.pairs.start[i];
+      int k = copy_node(p, src, pr.key, ov);
+      int v = copy_node(p, src, pr.value, ov);
+      if (!k || !v || !yaml_document_append_mapping_pair(&p->doc, nid, k, v)) return 0;
+    }
+  }
+  return nid;
+}
+
+static void grow_override_marks(fmbParser* p) {
+  int n = node_count(p);
+  if (n <= p->nnodes_cap) return;
+  p->override_of = realloc(p->override_of, (size_t)(n + 1) * sizeof(int));
+  for (int i = p->nnodes_cap + 1; i <= n; ++i) p->override_of[i] = -1;
+  p->nnodes_cap = n;
+}
+
+static void mark_override(fmbParser* p, int first_new, int ov) {
+  grow_override_marks(p);
+  for (int i = first_new; i <= p->nnodes_cap; ++i) p->override_of[i] = ov;
+}
+
+static int apply_override(fmbParser* p, int ov) {
+  const char* text = p->overrides[ov];
+  const char* eq = strchr(text, '=');
+  if (!eq || eq == text) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected PATH=VALUE, e.g. solver.rtol=1e-8", text);
+    return -1;
+  }
+  char path[512];
+  size_t plen = (size_t)(eq - text);
+  if (plen >= sizeof path) plen = sizeof path - 1;
+  memcpy(path, text, plen);
+  path[plen] = '\0';
+  const char* value = eq + 1;
+
+  /* parse VALUE as a YAML document of its own */
+  yaml_parser_t parser;
+  yaml_document_t vdoc;
+  yaml_parser_initialize(&parser);
+  yaml_parser_set_input_string(&parser, (const unsigned char*)value, strlen(value));
+  int ok = yaml_parser_load(&parser, &vdoc);
+  if (!ok || !yaml_document_get_root_node(&vdoc)) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: the value is not valid YAML%s%s", text,
+                 parser.problem ? ": " : (ok ? " (it is empty)" : ""), parser.problem ? parser.problem : "");
+    if (ok) yaml_document_delete(&vdoc);
+    yaml_parser_delete(&parser);
+    return -1;
+  }
+  yaml_parser_delete(&parser);
+
+  int node = fmbp_root(p);
+  char* save = NULL;
+  char* seg = strtok_r(path, ".", &save);
+  int rc = 0;
+  while (seg) {
+    char* next = strtok_r(NULL, ".", &save);
+    yaml_node_t* nd = fmbp_node(p, node);
+    if (nd && nd->type == YAML_SEQUENCE_NODE) {
+      /* a list of named items: bodies.NAME, joints.NAME */
+      int found = -1, n = fmbp_seq_len(p, node);
+      for (int i = 0; i < n && found < 0; ++i) {
+        int item = fmbp_seq_item(p, node, i);
+        yaml_node_t* it = fmbp_node(p, item);
+        if (!it || it->type != YAML_MAPPING_NODE) continue;
+        for (yaml_node_pair_t* pr = it->data.mapping.pairs.start; pr < it->data.mapping.pairs.top; ++pr) {
+          const char* k = fmbp_scalar(p, pr->key);
+          const char* v = fmbp_scalar(p, pr->value);
+          if (k && v && strcmp(k, "name") == 0 && strcmp(v, seg) == 0) found = item;
+        }
+      }
+      if (found < 0 || !next) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s '%s' in the scene", text,
+                     found < 0 ? "no item named" : "cannot replace a whole item; name a key of", seg);
+        rc = -1;
+        break;
+      }
+      node = found;
+      seg = next;
+      continue;
+    }
+    if (!nd || nd->type != YAML_MAPPING_NODE) {
+      fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: '%s' is not inside a mapping", text, seg);
+      rc = -1;
+      break;
+    }
+    yaml_node_pair_t* hit = NULL;
+    for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr) {
+      const char* k = fmbp_scalar(p, pr->key);
+      if (k && strcmp(k, seg) == 0) hit = pr;
+    }
+    if (!next) {
+      int first_new = node_count(p) + 1;
+      int vid = copy_node(p, &vdoc, 1, ov);
+      if (!vid) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: out of memory", text);
+        rc = -1;
+        break;
+      }
+      if (hit) {
+        /* the pair pointer may have moved when nodes were added: look it up again */
+        nd = fmbp_node(p, node);
+        for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr) {
+          const char* k = fmbp_scalar(p, pr->key);
+          if (k && strcmp(k, seg) == 0) pr->value = vid;
+        }
+      } else {
+        int kid = yaml_document_add_scalar(&p->doc, NULL, (yaml_char_t*)seg, (int)strlen(seg), YAML_PLAIN_SCALAR_STYLE);
+        if (!kid || !yaml_document_append_mapping_pair(&p->doc, node, kid, vid)) rc = -1;
+      }
+      mark_override(p, first_new, ov);
+      break;
+    }
+    if (!hit) {
+      fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: unknown path: no key '%s' in the scene", text, seg);
+      rc = -1;
+      break;
+    }
+    node = hit->value;
+    seg = next;
+  }
+  if (!seg && rc == 0) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: empty path", text);
+    rc = -1;
+  }
+  yaml_document_delete(&vdoc);
+  return rc;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag) {
+  memset(&p->doc, 0, sizeof p->doc);
+  p->path = path;
+  p->diag = diag;
+  p->overrides = overrides;
+  p->have_doc = 0;
+  p->known = NULL;
+  p->override_of = NULL;
+  p->nnodes_cap = 0;
+  p->nlooked = 0;
+  struct stat st;
+  if (stat(path, &st) != 0) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));
+    return -1;
+  }
+  if (S_ISDIR(st.st_mode)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "is a directory, expected a YAML scene file");
+    return -1;
+  }
+  FILE* f = fopen(path, "rb");
+  if (!f) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));
+    return -1;
+  }
+  yaml_parser_t parser;
+  yaml_parser_initialize(&parser);
+  yaml_parser_set_input_file(&parser, f);
+  int ok = yaml_parser_load(&parser, &p->doc);
+  if (!ok) {
+    yaml_mark_t mk = parser.problem_mark;
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1, "YAML syntax error: %s%s%s",
+                 parser.problem ? parser.problem : "unknown problem", parser.context ? " " : "",
+                 parser.context ? parser.context : "");
+    yaml_parser_delete(&parser);
+    fclose(f);
+    return -1;
+  }
+  p->have_doc = 1;
+  /* a second document in the same file is a mistake worth reporting */
+  yaml_document_t extra;
+  if (yaml_parser_load(&parser, &extra)) {
+    int more = yaml_document_get_root_node(&extra) != NULL;
+    yaml_mark_t mk = extra.start_mark;
+    yaml_document_delete(&extra);
+    if (more) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1,
+                   "a scene file holds one YAML document; found a second one");
+      yaml_parser_delete(&parser);
+      fclose(f);
+      return -1;
+    }
+  } else {
+    yaml_mark_t mk = parser.problem_mark;
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1, "YAML syntax error: %s",
+                 parser.problem ? parser.problem : "unknown problem");
+    yaml_parser_delete(&parser);
+    fclose(f);
+    return -1;
+  }
+  yaml_parser_delete(&parser);
+  fclose(f);
+
+  if (!yaml_document_get_root_node(&p->doc)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1,
+                 "the scene file is empty: expected a mapping with keys solver, bodies (and optionally gravity, joints, outputs)");
+    return -1;
+  }
+  if (!fmbp_is_map(p, fmbp_root(p)))
+    return fmbp_error_at(p, fmbp_root(p),
+                         "expected a mapping with keys solver, bodies, gravity, joints, outputs at the top, found %s",
+                         node_kind(fmbp_node(p, fmbp_root(p))));
+  grow_override_marks(p);
+  if (check_duplicates(p)) return -1;
+  for (int i = 0; i < noverrides; ++i)
+    if (apply_override(p, i)) return -1;
+  if (check_duplicates(p)) return -1;
+  grow_override_marks(p);
+  p->known = calloc((size_t)p->nnodes_cap + 1, 1);
+  return p->known ? 0 : -1;
+}
+
+void fmbp_close(fmbParser* p) {
+  if (p->have_doc) yaml_document_delete(&p->doc);
+  free(p->known);
+  free(p->override_of);
+  p->known = NULL;
+  p->override_of = NULL;
+  p->have_doc = 0;
+}

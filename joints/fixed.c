@@ -1,0 +1,58 @@
+/* fixed.c — a weld: point1 and point2 coincide and the relative angle stays `angle` (default 0):
+ * Phi = [p1 - p2; (angle2 - angle1) - angle] (3 rows). A beam on a hub is a fixed joint between
+ * the hub and the beam's root. */
+#include <stdlib.h>
+
+#include "two_point.h"
+
+typedef struct {
+  fmbTwoPoint tp;
+  double angle;
+} Fixed;
+
+static int fixed_parse(fmbParser* p, fmbNode item, void** self) {
+  Fixed* f = calloc(1, sizeof *f);
+  if (!f) return fmb_parse_error(p, item, "out of memory");
+  *self = f;
+  return fmbj_parse_two_points(p, item, &f->tp) || fmb_get_double(p, item, "angle", 0, &f->angle) ? -1 : 0;
+}
+
+static void fixed_destroy(void* self) { free(self); }
+static int fixed_nrows(const void* self) {
+  (void)self;
+  return 3;
+}
+static void fixed_bodies(const void* self, int body[2]) {
+  const Fixed* f = self;
+  body[0] = f->tp.body[0];
+  body[1] = f->tp.body[1];
+}
+static int fixed_attachment(const void* self, int k, int* body, double local[2]) {
+  const Fixed* f = self;
+  *body = f->tp.body[k];
+  local[0] = f->tp.point[k][0];
+  local[1] = f->tp.point[k][1];
+  return 0;
+}
+
+static int fixed_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
+                            double* phi_tt) {
+  (void)phi_t, (void)phi_tt;
+  const Fixed* f = self;
+  const int ld = fmb_eval_ncoord(ev, 0) + fmb_eval_ncoord(ev, 1);
+  double ang[2];
+  int rc = fmbj_point_gap(ev, &f->tp, phi, phi_q, ld, ang, phi_q + 2 * ld);
+  phi[2] = (ang[1] - ang[0]) - f->angle;
+  return rc;
+}
+
+const fmbJointType fmb_joint_fixed = {
+    .name = "fixed",
+    .abi = FMB_ABI_VERSION,
+    .parse = fixed_parse,
+    .destroy = fixed_destroy,
+    .bodies = fixed_bodies,
+    .nrows = fixed_nrows,
+    .attachment = fixed_attachment,
+    .constraint = fixed_constraint,
+};

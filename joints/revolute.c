@@ -1,0 +1,66 @@
+/* revolute.c — a pin: point1 on body1 and point2 on body2 coincide, Phi = p1 - p2 (2 rows). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "two_point.h"
+
+static int revolute_parse(fmbParser* p, fmbNode item, void** self) {
+  fmbTwoPoint* tp = calloc(1, sizeof *tp);
+  if (!tp) return fmb_parse_error(p, item, "out of memory");
+  *self = tp;
+  return fmbj_parse_two_points(p, item, tp);
+}
+
+static void revolute_destroy(void* self) { free(self); }
+static int revolute_nrows(const void* self) {
+  (void)self;
+  return 2;
+}
+static void revolute_bodies(const void* self, int body[2]) {
+  const fmbTwoPoint* tp = self;
+  body[0] = tp->body[0];
+  body[1] = tp->body[1];
+}
+static int revolute_attachment(const void* self, int k, int* body, double local[2]) {
+  const fmbTwoPoint* tp = self;
+  *body = tp->body[k];
+  local[0] = tp->point[k][0];
+  local[1] = tp->point[k][1];
+  return 0;
+}
+
+static int revolute_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
+                               double* phi_tt) {
+  (void)phi_t, (void)phi_tt; /* scleronomic */
+  const int ld = fmb_eval_ncoord(ev, 0) + fmb_eval_ncoord(ev, 1);
+  double ang[2];
+  return fmbj_point_gap(ev, self, phi, phi_q, ld, ang, NULL);
+}
+
+static const char* const revolute_outputs[] = {"angle", NULL};
+static int revolute_lookup(const void* self, const char* q) {
+  (void)self;
+  return strcmp(q, "angle") == 0 ? 0 : -1;
+}
+/* relative angle body2 - body1 at the pin */
+static int revolute_output(const void* self, int id, const fmbJointEval* ev, double* value) {
+  (void)id;
+  double gap[2], ang[2];
+  int rc = fmbj_point_gap(ev, self, gap, NULL, 0, ang, NULL);
+  *value = ang[1] - ang[0];
+  return rc;
+}
+
+const fmbJointType fmb_joint_revolute = {
+    .name = "revolute",
+    .abi = FMB_ABI_VERSION,
+    .parse = revolute_parse,
+    .destroy = revolute_destroy,
+    .bodies = revolute_bodies,
+    .nrows = revolute_nrows,
+    .attachment = revolute_attachment,
+    .constraint = revolute_constraint,
+    .output_names = revolute_outputs,
+    .output_lookup = revolute_lookup,
+    .output = revolute_output,
+};

@@ -1,0 +1,106 @@
+/* spring.c — a linear spring–damper between point1 on body1 and point2 on body2:
+ * tension f = k (l - l0) + c dl/dt along the line of the points, Q = (dp/dq)^T (force on each
+ * point); potential energy k (l - l0)^2 / 2. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "two_point.h"
+
+typedef struct {
+  fmbTwoPoint tp;
+  double stiffness, damping, rest_length;
+} Spring;
+
+static int spring_parse(fmbParser* p, fmbNode item, void** self) {
+  Spring* s = calloc(1, sizeof *s);
+  if (!s) return fmb_parse_error(p, item, "out of memory");
+  *self = s;
+  return fmbj_parse_two_points(p, item, &s->tp) ||
+                 fmb_get_double(p, item, "stiffness", FMB_REQUIRED | FMB_NONNEGATIVE, &s->stiffness) ||
+                 fmb_get_double(p, item, "damping", FMB_NONNEGATIVE, &s->damping) ||
+                 fmb_get_double(p, item, "rest_length", FMB_REQUIRED | FMB_NONNEGATIVE, &s->rest_length)
+             ? -1
+             : 0;
+}
+
+static void spring_destroy(void* self) { free(self); }
+static void spring_bodies(const void* self, int body[2]) {
+  const Spring* s = self;
+  body[0] = s->tp.body[0];
+  body[1] = s->tp.body[1];
+}
+
+/* length, its rate, unit vector from point1 to point2; D (2 x ld) = d(p1 - p2)/dq */
+static int spring_geometry(const Spring* s, const fmbJointEval* ev, double* D, int ld, double* len, double* rate,
+                           double e[2]) {
+  double gap[2], ang[2];
+  memset(D, 0, 2 * (size_t)ld * sizeof(double));
+  int rc = fmbj_point_gap(ev, &s->tp, gap, D, ld, ang, NULL);
+  if (rc) return rc;
+  const double l = hypot(gap[0], gap[1]);
+  *len = l;
+  e[0] = l > 0 ? -gap[0] / l : 0.0; /* p2 - p1 direction */
+  e[1] = l > 0 ? -gap[1] / l : 0.0;
+  double gdot[2] = {0.0, 0.0};
+  for (int k = 0; k < 2; ++k) {
+    const double* v = fmb_eval_v(ev, k);
+    const int c0 = fmb_eval_col0(ev, k), n = fmb_eval_ncoord(ev, k);
+    for (int i = 0; i < n; ++i) {
+      gdot[0] += D[c0 + i] * v[i];
+      gdot[1] += D[ld + c0 + i] * v[i];
+    }
+  }
+  *rate = -(e[0] * gdot[0] + e[1] * gdot[1]);
+  return 0;
+}
+
+static int spring_force(const void* self, const fmbJointEval* ev, double* Q) {
+  const Spring* s = self;
+  const int ld = fmb_eval_ncoord(ev, 0) + fmb_eval_ncoord(ev, 1);
+  double* D = fmb_eval_scratch(ev);
+  double l, ldot, e[2];
+  int rc = spring_geometry(s, ev, D, ld, &l, &ldot, e);
+  if (rc) return rc;
+  const double f = s->stiffness * (l - s->rest_length) + s->damping * ldot;
+  /* force on point1 = +f e, on point2 = -f e: Q = D^T (f e), D = d(p1 - p2)/dq */
+  for (int i = 0; i < ld; ++i) Q[i] += f * (D[i] * e[0] + D[ld + i] * e[1]);
+  return 0;
+}
+
+static double spring_energy(const void* self, const fmbJointEval* ev) {
+  const Spring* s = self;
+  double gap[2], ang[2];
+  if (fmbj_point_gap(ev, &s->tp, gap, NULL, 0, ang, NULL)) return NAN;
+  const double x = hypot(gap[0], gap[1]) - s->rest_length;
+  return 0.5 * s->stiffness * x * x;
+}
+
+static const char* const spring_outputs[] = {"length", "tension", NULL};
+static int spring_lookup(const void* self, const char* q) {
+  (void)self;
+  for (int i = 0; spring_outputs[i]; ++i)
+    if (strcmp(q, spring_outputs[i]) == 0) return i;
+  return -1;
+}
+static int spring_output(const void* self, int id, const fmbJointEval* ev, double* value) {
+  const Spring* s = self;
+  const int ld = fmb_eval_ncoord(ev, 0) + fmb_eval_ncoord(ev, 1);
+  double *D = fmb_eval_scratch(ev), l, ldot, e[2];
+  int rc = spring_geometry(s, ev, D, ld, &l, &ldot, e);
+  *value = id == 0 ? l : s->stiffness * (l - s->rest_length) + s->damping * ldot;
+  return rc;
+}
+
+const fmbJointType fmb_joint_spring = {
+    .name = "spring",
+    .abi = FMB_ABI_VERSION,
+    .parse = spring_parse,
+    .destroy = spring_destroy,
+    .bodies = spring_bodies,
+    .force = spring_force,
+    .energy = spring_energy,
+    .output_names = spring_outputs,
+    .output_lookup = spring_lookup,
+    .output = spring_output,
+};

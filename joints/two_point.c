@@ -1,0 +1,36 @@
+/* two_point.c — shared pieces of joints that connect a point on one body to a point on another. */
+#include <string.h>
+
+#include "two_point.h"
+
+int fmbj_parse_two_points(fmbParser* p, fmbNode item, fmbTwoPoint* tp) {
+  memset(tp, 0, sizeof *tp);
+  return (fmb_get_body(p, item, "body1", FMB_REQUIRED, &tp->body[0]) ||
+          fmb_get_body(p, item, "body2", FMB_REQUIRED, &tp->body[1]) ||
+          fmb_get_vec2(p, item, "point1", 0, tp->point[0]) || fmb_get_vec2(p, item, "point2", 0, tp->point[1]))
+             ? -1
+             : 0;
+}
+
+/* gap = p1 - p2; phi_q rows 0..1 = [dp1/dq1, -dp2/dq2]; ang = marker angles, dang (ld entries)
+   = [-dang1/dq1, dang2/dq2] so that d(ang2 - ang1)/dq = dang */
+int fmbj_point_gap(const fmbJointEval* ev, const fmbTwoPoint* tp, double gap[2], double* phi_q, int ld, double ang[2],
+                   double* dang) {
+  double p[2][2];
+  for (int k = 0; k < 2; ++k) {
+    const int c0 = fmb_eval_col0(ev, k);
+    int rc = fmb_marker(ev, k, tp->point[k], p[k], &ang[k], phi_q ? phi_q + c0 : NULL, ld, dang ? dang + c0 : NULL);
+    if (rc) return rc;
+    const int n = fmb_eval_ncoord(ev, k);
+    if (k == 1 && phi_q)
+      for (int i = 0; i < n; ++i) {
+        phi_q[c0 + i] = -phi_q[c0 + i];
+        phi_q[ld + c0 + i] = -phi_q[ld + c0 + i];
+      }
+    if (k == 0 && dang)
+      for (int i = 0; i < n; ++i) dang[c0 + i] = -dang[c0 + i];
+  }
+  gap[0] = p[0][0] - p[1][0];
+  gap[1] = p[0][1] - p[1][1];
+  return 0;
+}

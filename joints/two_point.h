@@ -1,0 +1,16 @@
+/* two_point.h — what revolute, fixed and spring joints share: two bodies, a point on each. */
+#ifndef FLEXMBD_TWO_POINT_H
+#define FLEXMBD_TWO_POINT_H
+#include "flexmbd.h"
+
+typedef struct {
+  int body[2];
+  double point[2][2]; /* in each body's reference frame */
+} fmbTwoPoint;
+
+/* keys body1, body2 (required), point1, point2 (default [0, 0]) */
+int fmbj_parse_two_points(fmbParser* p, fmbNode item, fmbTwoPoint* tp);
+/* positions of both points; with ld > 0, rows r0 and r0+1 of phi_q receive d(p1 - p2)/dq */
+int fmbj_point_gap(const fmbJointEval* ev, const fmbTwoPoint* tp, double gap[2], double* phi_q, int ld, double ang[2],
+                   double* dang);
+#endif

@@ -1,0 +1,59 @@
+/* testlib.h — the tests' small toolkit: checks that report file:line and the values, running a
+ * scene in-process, and reading the CSV it wrote back into named columns. */
+#ifndef FLEXMBD_TESTLIB_H
+#define FLEXMBD_TESTLIB_H
+#include <math.h>
+#include <stdio.h>
+
+#include "builtin.h"
+#include "flexmbd.h"
+
+extern int fmbt_failures;
+
+#define ENSURE(cond)                                                        \
+  do {                                                                      \
+    if (!(cond)) {                                                          \
+      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
+      ++fmbt_failures;                                                      \
+    }                                                                       \
+  } while (0)
+
+/* |a - b| <= tol, reporting both values */
+#define ENSURE_NEAR(a, b, tol)                                                                        \
+  do {                                                                                                \
+    double fmbt_a = (a), fmbt_b = (b), fmbt_t = (tol);                                                \
+    if (!(fabs(fmbt_a - fmbt_b) <= fmbt_t)) {                                                         \
+      fprintf(stderr, "%s:%d: %s = %.12g, %s = %.12g, differ by %.3g > %.3g\n", __FILE__, __LINE__, #a, \
+              fmbt_a, #b, fmbt_b, fabs(fmbt_a - fmbt_b), fmbt_t);                                     \
+      ++fmbt_failures;                                                                                \
+    }                                                                                                 \
+  } while (0)
+
+/* |a - b| <= rel |b| */
+#define ENSURE_REL(a, b, rel) ENSURE_NEAR(a, b, (rel) * fabs((double)(b)))
+
+/* "N passed, N failed" summary and exit code */
+int fmbt_finish(const char* name, int checks_run);
+
+typedef struct {
+  int ncol, nrow;
+  char** names;
+  double* data; /* column-major: column c at data + c * nrow */
+} fmbtCsv;
+
+/* scene path relative to the source tree */
+const char* fmbt_path(const char* rel, char* buf, size_t len);
+/* run SCENE (path relative to the source tree) with overrides, writing OUT (in the build's test
+   output folder); returns fmb_run's code (or the load error's), stats and diag filled */
+int fmbt_run(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name,
+             fmbStats* st, fmbDiag* diag);
+/* run and read the CSV back; returns the run code, c filled (empty on load failure) */
+int fmbt_run_read(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name,
+                  fmbtCsv* c, fmbStats* st);
+int fmbt_csv_read(const char* path, fmbtCsv* c);
+/* the column called name, or NULL (and a failure recorded) */
+const double* fmbt_col(const fmbtCsv* c, const char* name);
+void fmbt_csv_free(fmbtCsv* c);
+const char* fmbt_out_path(const char* name, char* buf, size_t len);
+
+#endif
