@@ -95,6 +95,8 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
       return fmbp_error_at(p, item, "body type '%s' was built for plugin ABI %d, the engine has %d", b->type->name,
                            b->type->abi, FMB_ABI_VERSION);
     if (b->type->parse(p, item, &b->self)) {
+      if (b->self) b->type->destroy(b->self); /* a parse that failed after setting *self */
+      b->self = NULL;
       if (!p->diag->code) fmbp_error_at(p, item, "body '%s' (type %s) could not be set up", b->name, b->type->name);
       return -1;
     }
@@ -136,6 +138,8 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
       return fmbp_error_at(p, item, "joint type '%s' was built for plugin ABI %d, the engine has %d", j->type->name,
                            j->type->abi, FMB_ABI_VERSION);
     if (j->type->parse(p, item, &j->self)) {
+      if (j->self) j->type->destroy(j->self); /* a parse that failed after setting *self */
+      j->self = NULL;
       if (!p->diag->code) fmbp_error_at(p, item, "joint '%s' (type %s) could not be set up", j->name, j->type->name);
       return -1;
     }
