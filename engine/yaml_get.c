@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 
 #include "internal.h"
@@ -176,6 +177,10 @@ static int check_duplicates(fmbParser* p) {
 
 static int parse_number(const char* s, double* out) {
   if (!s || !*s) return -1;
+  /* YAML's .nan/.inf spellings (and C's nan/inf) are numbers, just not usable ones */
+  const char* u = (*s == '+' || *s == '-') ? s + 1 : s;
+  if (*u == '.') ++u;
+  if (strcasecmp(u, "nan") == 0 || strcasecmp(u, "inf") == 0 || strcasecmp(u, "infinity") == 0) return -2;
   for (const char* c = s; *c; ++c)
     if (!(isdigit((unsigned char)*c) || *c == '.' || *c == '-' || *c == '+' || *c == 'e' || *c == 'E')) return -1;
   errno = 0;
