@@ -334,7 +334,11 @@ int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local
 /* ------------------------------------------------------------------------------------------ */
 /* overrides: PATH=VALUE edits the tree; VALUE is YAML (a scalar or a flow list) */
 
-static int copy_node(fmbParser* p, yaml_document_t* src, int id, int ov) {
+/* an alias may point at its own enclosing node (&a [*a]) or fan out exponentially: the copy
+   is a tree, so it is bounded by a node budget; 0 = failure (budget < 0 when exhausted) */
+#define FMB_OVERRIDE_NODES_MAX 10000
+static int copy_node(fmbParser* p, yaml_document_t* src, int id, int* budget) {
+  if (--*budget < 0) return 0;
   yaml_node_t* s = yaml_document_get_node(src, id);
   int nid = 0;
   if (s->type == YAML_SCALAR_NODE) {
@@ -345,7 +349,7 @@ static int copy_node(fmbParser* p, yaml_document_t* src, int id, int ov) {
     int n = (int)(s->data.sequence.items.top - s->data.sequence.items.start);
     for (int i = 0; i < n && nid; ++i) {
       s = yaml_document_get_node(src, id);
-      int c = copy_node(p, src, s->data.sequence.items.start[i], ov);
+      int c = copy_node(p, src, s->data.sequence.items.start[i], budget);
       if (!c || !yaml_document_append_sequence_item(&p->doc, nid, c)) return 0;
     }
   } else {
@@ -354,8 +358,8 @@ static int copy_node(fmbParser* p, yaml_document_t* src, int id, int ov) {
     for (int i = 0; i < n && nid; ++i) {
       s = yaml_document_get_node(src, id);
       yaml_node_pair_t pr = s->data.mapping.pairs.start[i];
-      int k = copy_node(p, src, pr.key, ov);
-      int v = copy_node(p, src, pr.value, ov);
+      int k = copy_node(p, src, pr.key, budget);
+      int v = copy_node(p, src, pr.value, budget);
       if (!k || !v || !yaml_document_append_mapping_pair(&p->doc, nid, k, v)) return 0;
     }
   }
@@ -446,9 +450,11 @@ static int apply_override(fmbParser* p, int ov) {
     }
     if (!next) {
       int first_new = node_count(p) + 1;
-      int vid = copy_node(p, &vdoc, 1, ov);
+      int budget = FMB_OVERRIDE_NODES_MAX;
+      int vid = copy_node(p, &vdoc, 1, &budget);
       if (!vid) {
-        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: out of memory", text);
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", text,
+                     budget < 0 ? "the value is too large or refers to itself (through a YAML alias)" : "out of memory");
         rc = -1;
         break;
       }
