@@ -1,8 +1,8 @@
-/* fd.c — forward-difference derivatives of a body's residual over its own coordinates.
- * Used when a plugin provides no analytic `jacobian`. Because R = M a - Q is linear in a, the
- * M columns are exact differences with a unit step; K and C use IDA's own increment rule
- * inc = max(sqrt(eps) |y|, 1/ewt) so the step is never below the error tolerance. One residual
- * per column: a plugin whose residual is O(n) gets an O(n^2) Jacobian. */
+/* fd.c — difference derivatives of a body's residual over its own coordinates, used when a
+ * plugin provides no analytic `jacobian`. R = M a - Q is linear in a, so the M columns are exact
+ * differences with a unit step; K uses forward differences with IDA's own increment rule
+ * inc = max(sqrt(eps) |q|, 1/ewt); C uses central differences (exact for R quadratic in v).
+ * Four residuals per column: a plugin whose residual is O(n) gets an O(n^2) Jacobian. */
 #include <math.h>
 #include <string.h>
 
@@ -24,6 +24,9 @@ int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* 
   double* aa = scratch + 2 * n;
   double* R0 = scratch + 3 * n;
   double* R1 = scratch + 4 * n;
+  double* Rm = scratch + 5 * n;
+  double vmax = 1e-3;
+  for (int j = 0; j < n; ++j) vmax = fmax(vmax, fabs(v[j]));
   memcpy(qq, q, (size_t)n * sizeof(double));
   memcpy(vv, v, (size_t)n * sizeof(double));
   memcpy(aa, a, (size_t)n * sizeof(double));
@@ -40,13 +43,19 @@ int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* 
       for (int i = 0; i < n; ++i) K[(size_t)j * n + i] = (R1[i] - R0[i]) / h;
     }
     if (C) {
-      double h = increment(v[j], ewt_v[j]);
+      /* central: R is quadratic in v for mechanical systems (Coriolis, centrifugal, damping),
+         so the difference has no truncation error and the step can be large enough that
+         roundoff from big elastic forces in R does not swamp the small velocity terms */
+      double h = 6.0e-6 * fmax(fmax(fabs(v[j]), vmax), 1.0 / ewt_v[j]);
       vv[j] = v[j] + h;
-      h = vv[j] - v[j];
       rc = b->type->residual(b->self, env, q, vv, a, R1, work);
+      if (!rc) {
+        vv[j] = v[j] - h;
+        rc = b->type->residual(b->self, env, q, vv, a, Rm, work);
+      }
       vv[j] = v[j];
       if (rc) return rc;
-      for (int i = 0; i < n; ++i) C[(size_t)j * n + i] = (R1[i] - R0[i]) / h;
+      for (int i = 0; i < n; ++i) C[(size_t)j * n + i] = (R1[i] - Rm[i]) / (2.0 * h);
     }
     if (M) {
       aa[j] = a[j] + 1.0;

@@ -63,7 +63,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->K = calloc(nb * nb, sizeof(double));
   w->C = calloc(nb * nb, sizeof(double));
   w->M = calloc(nb * nb, sizeof(double));
-  w->fd = calloc(6 * nb, sizeof(double));
+  w->fd = calloc(7 * nb, sizeof(double));
   w->mk = calloc(3 * nb, sizeof(double));
   w->js = calloc(2 * mc, sizeof(double));
   w->qpert = calloc(nq, sizeof(double));
@@ -361,7 +361,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
 
 int fmb_body_mass(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, double* M) {
   const fmbBodyInst* bi = &m->body[b];
-  double* a = w->fd + 5 * (size_t)w->max_nq; /* zero acceleration */
+  double* a = w->fd + 6 * (size_t)w->max_nq; /* zero acceleration */
   memset(a, 0, (size_t)bi->nq * sizeof(double));
   double* ew = w->ewt_default;
   for (int i = 0; i < bi->nq; ++i) ew[i] = ew[m->nq + i] = 1.0 / (m->solver.atol + m->solver.rtol * fabs(q[i]));
@@ -371,7 +371,7 @@ int fmb_body_mass(const fmbModel* m, fmbWorkspace* w, int b, const double* q, co
 
 int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* Qtot) {
   memset(Qtot, 0, (size_t)m->nq * sizeof(double));
-  double* zero = w->fd + 5 * (size_t)w->max_nq;
+  double* zero = w->fd + 6 * (size_t)w->max_nq;
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     memset(zero, 0, (size_t)bi->nq * sizeof(double));

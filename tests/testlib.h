@@ -8,10 +8,11 @@
 #include "builtin.h"
 #include "flexmbd.h"
 
-extern int fmbt_failures;
+extern int fmbt_failures, fmbt_checks;
 
 #define ENSURE(cond)                                                        \
   do {                                                                      \
+    ++fmbt_checks;                                                          \
     if (!(cond)) {                                                          \
       fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
       ++fmbt_failures;                                                      \
@@ -22,6 +23,7 @@ extern int fmbt_failures;
 #define ENSURE_NEAR(a, b, tol)                                                                        \
   do {                                                                                                \
     double fmbt_a = (a), fmbt_b = (b), fmbt_t = (tol);                                                \
+    ++fmbt_checks;                                                                                    \
     if (!(fabs(fmbt_a - fmbt_b) <= fmbt_t)) {                                                         \
       fprintf(stderr, "%s:%d: %s = %.12g, %s = %.12g, differ by %.3g > %.3g\n", __FILE__, __LINE__, #a, \
               fmbt_a, #b, fmbt_b, fabs(fmbt_a - fmbt_b), fmbt_t);                                     \
@@ -32,8 +34,8 @@ extern int fmbt_failures;
 /* |a - b| <= rel |b| */
 #define ENSURE_REL(a, b, rel) ENSURE_NEAR(a, b, (rel) * fabs((double)(b)))
 
-/* "N passed, N failed" summary and exit code */
-int fmbt_finish(const char* name, int checks_run);
+/* "N passed, N failed" summary (counting every ENSURE*) and the exit code */
+int fmbt_finish(const char* name);
 
 typedef struct {
   int ncol, nrow;
