@@ -490,6 +490,36 @@ static int apply_override(fmbParser* p, int ov) {
 
 /* ------------------------------------------------------------------------------------------ */
 
+/* libyaml's failure as file:line:column. A reader error (bad UTF-8, a NUL byte) has only a byte
+   offset, so the position is counted from the file; a parser error may name where the construct
+   it was reading began. */
+static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* parser, FILE* f) {
+  const char* problem = parser->problem ? parser->problem : "unknown problem";
+  if (parser->error == YAML_READER_ERROR) {
+    int line = 1, col = 1, c;
+    rewind(f);
+    for (size_t i = 0; i < parser->problem_offset && (c = getc(f)) != EOF; ++i) {
+      if (c == '\n') {
+        ++line;
+        col = 1;
+      } else if ((c & 0xC0) != 0x80) {
+        ++col;
+      }
+    }
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, line, col, "YAML syntax error: %s: a scene file must be UTF-8 text",
+                 problem);
+    return;
+  }
+  yaml_mark_t mk = parser->problem_mark, cm = parser->context_mark;
+  if (parser->context && (cm.line != mk.line || cm.column != mk.column))
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1,
+                 "YAML syntax error: %s %s (which began at line %d, column %d)", problem, parser->context,
+                 (int)cm.line + 1, (int)cm.column + 1);
+  else
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1, "YAML syntax error: %s%s%s",
+                 problem, parser->context ? " " : "", parser->context ? parser->context : "");
+}
+
 int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag) {
   memset(&p->doc, 0, sizeof p->doc);
   p->path = path;
@@ -519,10 +549,7 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   yaml_parser_set_input_file(&parser, f);
   int ok = yaml_parser_load(&parser, &p->doc);
   if (!ok) {
-    yaml_mark_t mk = parser.problem_mark;
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1, "YAML syntax error: %s%s%s",
-                 parser.problem ? parser.problem : "unknown problem", parser.context ? " " : "",
-                 parser.context ? parser.context : "");
+    syntax_error(diag, path, &parser, f);
     yaml_parser_delete(&parser);
     fclose(f);
     return -1;
@@ -542,9 +569,7 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
       return -1;
     }
   } else {
-    yaml_mark_t mk = parser.problem_mark;
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1, "YAML syntax error: %s",
-                 parser.problem ? parser.problem : "unknown problem");
+    syntax_error(diag, path, &parser, f);
     yaml_parser_delete(&parser);
     fclose(f);
     return -1;
