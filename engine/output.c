@@ -132,7 +132,8 @@ struct fmbCsv {
   FILE* f;
   int owns;
   double* row;
-  int nrow;
+  int nrow;      /* 0 until the header is written */
+  char* path;    /* owned file: removed on close if no header was ever written */
 };
 
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
@@ -143,8 +144,10 @@ fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
   } else {
     c->f = fopen(path, "w");
     c->owns = 1;
-    if (!c->f) {
+    c->path = c->f ? strdup(path) : NULL;
+    if (!c->f || !c->path) {
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", strerror(errno));
+      if (c->f) fclose(c->f);
       free(c);
       return NULL;
     }
@@ -210,6 +213,9 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
 void fmb_csv_close(fmbCsv* c) {
   if (!c) return;
   if (c->owns && c->f) fclose(c->f);
+  /* a run that stopped before its first row (bad initial conditions) leaves no empty file */
+  if (c->owns && c->path && c->nrow == 0) remove(c->path);
+  free(c->path);
   free(c->row);
   free(c);
 }
