@@ -659,6 +659,13 @@ static const char* beam_indefinite_mass(const void* self) {
          "-p^T D p in M22 without the high-order terms that balance it); use `model: complete`";
 }
 
+/* Undamped axial and bending modes up to ~1e5 rad/s: only A-stable BDF (order <= 2) steps over
+   them without the error test chasing modes that orders 3-5 amplify. */
+static int beam_max_bdf_order(const void* self) {
+  (void)self;
+  return 2;
+}
+
 const fmbBodyType fmb_body_beam = {
     .name = "beam",
     .abi = FMB_ABI_VERSION,
@@ -676,4 +683,5 @@ const fmbBodyType fmb_body_beam = {
     .output = beam_output,
     .describe = beam_describe,
     .indefinite_mass = beam_indefinite_mass,
+    .max_bdf_order = beam_max_bdf_order,
 };

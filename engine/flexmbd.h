@@ -125,6 +125,11 @@ typedef struct fmbBodyType {
      output time and stops the run with that hint when it is no longer positive definite.
      NULL op or NULL return = always definite, no check. */
   const char* (*indefinite_mass)(const void* self);
+  /* the highest BDF order this body's dynamics tolerate. A body with many undamped stiff
+     oscillatory modes (a finite-element beam) returns 2: BDF2 is A-stable, orders 3-5 amplify
+     modes inside their instability wedge and the error test then forces tiny steps. NULL = 5.
+     The engine uses the minimum over bodies unless the scene sets solver.max_order. */
+  int (*max_bdf_order)(const void* self);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

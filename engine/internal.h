@@ -47,6 +47,8 @@ typedef struct fmbOutput {
 typedef struct fmbSolverSettings {
   double t0, t_end, rtol, atol, output_step, max_step;
   int dense; /* linear solver: 0 KLU (sparse), 1 SUNDIALS dense */
+  int max_order; /* BDF order cap */
+  int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
 } fmbSolverSettings;
 
@@ -70,6 +72,7 @@ struct fmbModel {
   int noutput;
   fmbOutput* output;
   int need_energy, need_constraint, check_definiteness;
+  int bdf_order_cap; /* min over bodies' max_bdf_order */
   /* sparsity pattern of the iteration matrix, CSC, fixed at load */
   int nblock;
   fmbBlock* block;

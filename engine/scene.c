@@ -34,17 +34,21 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->dense = 0;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmbp_error_at(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmbp_error_at(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, linear_solver, max_steps)");
+  if (!fmbp_is_map(p, node)) return fmbp_error_at(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, max_order, error_control, linear_solver, max_steps)");
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", NULL};
+  static const char* const controls[] = {"full", "positions", NULL};
   int max_steps = 100000;
+  s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
   if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
       fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) ||
       fmb_get_double(p, node, "atol", FMB_POSITIVE, &s->atol) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
       fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
       fmb_get_choice(p, node, "linear_solver", 0, solvers, &s->dense) ||
-      fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps))
+      fmb_get_choice(p, node, "error_control", 0, controls, &s->positions_only) ||
+      fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
+      fmb_get_int(p, node, "max_order", 0, 1, 5, &s->max_order))
     return -1;
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->max_steps_per_output = max_steps;
@@ -75,6 +79,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
   if (n == 0) return fmbp_error_at(p, list, "'bodies' is empty: a scene needs at least one body");
   m->body = calloc((size_t)n + 1, sizeof *m->body);
   if (!m->body) return fmbp_error_at(p, list, "out of memory");
+  m->bdf_order_cap = 5;
   /* body 0: the fixed world frame */
   snprintf(m->body[0].name, FMB_NAME_MAX, "ground");
   m->nbody = 1;
@@ -111,6 +116,10 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     b->nwork = b->type->nwork ? b->type->nwork(b->self) : 0;
     m->nwork += b->nwork;
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
+    if (b->type->max_bdf_order) {
+      const int k = b->type->max_bdf_order(b->self);
+      if (k >= 1 && k < m->bdf_order_cap) m->bdf_order_cap = k;
+    }
   }
   return 0;
 }
@@ -180,6 +189,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
     return fmbp_error_at(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
                          m->nc, m->nq);
   m->ny = 2 * m->nq + 2 * m->nc;
+  if (m->solver.max_order == 0) m->solver.max_order = m->bdf_order_cap;
   if (outputs >= 0) {
     if (fmb_outputs_resolve(p, m, outputs)) return -1;
   } else {
