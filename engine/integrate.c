@@ -97,8 +97,8 @@ static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
   const fmbBodyInst* b = &m->body[bad - 1];
   const char* hint = (b->type && b->type->indefinite_mass) ? b->type->indefinite_mass(b->self) : NULL;
   fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-               "stopped at t = %.6g: the mass matrix is no longer positive definite on the constraint manifold "
-               "(body '%s')%s%s",
+               "stopped at t = %.6g: the mass matrix is no longer positive definite (singular or indefinite) on the "
+               "constraint manifold (body '%s')%s%s",
                t, b->name, hint ? ": " : "", hint ? hint : "");
 }
 
@@ -143,7 +143,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     fprintf(stderr, "initial conditions: position correction %.3g, velocity correction %.3g\n",
             st->ic_position_correction, st->ic_velocity_correction);
 
-  int bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq);
+  int bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 0.0);
   if (bad) {
     mass_failure(m, bad, t, diag);
     rc = FMB_EXIT_SOLVER;
@@ -213,7 +213,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     int flag = IDASolve(ida, tout, &tret, y, yp, IDA_NORMAL);
     if (flag < 0) {
       t = tret;
-      bad = fmb_check_mass(m, ctx.w, tret, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq);
+      bad = fmb_check_mass(m, ctx.w, tret, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 1e-5);
       if (bad) {
         mass_failure(m, bad, tret, diag);
       } else {
@@ -228,7 +228,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       break;
     }
     t = tret;
-    bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq);
+    bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 0.0);
     if (bad) {
       mass_failure(m, bad, t, diag);
       rc = FMB_EXIT_SOLVER;

@@ -164,8 +164,10 @@ void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const do
 double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y);
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
-/* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1 */
-int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v);
+/* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1.
+   singular_tol > 0 also flags a nearly singular matrix (a pivot^2 below singular_tol times its
+   diagonal entry): used to explain a solver failure at the crossing itself. */
+int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double singular_tol);
 
 /* ---- pattern.c ---- */
 int fmb_pattern_build(fmbModel* m);

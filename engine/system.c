@@ -436,7 +436,7 @@ void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, c
  * definite on null(Phi_q) iff M + r Phi_q^T Phi_q is positive definite for r large enough; a
  * Cholesky factorization with r = 1e8 (relative to M's diagonal) tells. Runs only when a body
  * declares its model can lose definiteness (FOAC). */
-int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v) {
+int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double singular_tol) {
   if (!m->check_definiteness) return 0;
   const int nq = m->nq;
   memset(w->Mg, 0, (size_t)nq * nq * sizeof(double));
@@ -460,7 +460,15 @@ int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q
         w->Mg[(size_t)k * nq + i] += r * s;
       }
   }
+  for (int i = 0; i < nq; ++i) w->Qg[i] = w->Mg[(size_t)i * nq + i]; /* diagonal before factoring */
   int bad = fmb_cholesky(nq, w->Mg);
+  if (!bad && singular_tol > 0.0) {
+    /* squared pivot over its diagonal entry: 1 for a diagonal matrix, -> 0 as M becomes singular */
+    for (int i = 0; i < nq && !bad; ++i) {
+      const double d = w->Mg[(size_t)i * nq + i];
+      if (w->Qg[i] > 0.0 && d * d < singular_tol * w->Qg[i]) bad = i + 1;
+    }
+  }
   if (!bad) return 0;
   /* name the body whose model can lose definiteness and whose coordinates hold the failing pivot */
   for (int b = 1; b < m->nbody; ++b) {
