@@ -2,6 +2,7 @@
  *   flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet]
  *   flexmbd check SCENE.yaml [--set PATH=VALUE]...     load, validate, describe; no run
  *   flexmbd types                                       the registered body and joint types
+ *   flexmbd compare OUT.csv REF.csv [--columns a,b,...]  max and end error per column (tools/compare.c)
  * Exit codes: 0 ok, 2 bad input, 3 solver failure. The last stderr line of `run` is the stats line. */
 #include <stdio.h>
 #include <stdlib.h>
@@ -12,10 +13,13 @@
 
 #define MAX_OVERRIDES 256
 
+int fmb_compare_main(int argc, char** argv); /* tools/compare.c */
+
 static void usage(FILE* f) {
   fprintf(f,
           "usage: flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet]\n"
           "       flexmbd check SCENE.yaml [--set PATH=VALUE]...\n"
+          "       flexmbd compare OUT.csv REF.csv [--columns a,b,...]   error of a run against a reference\n"
           "       flexmbd types\n"
           "PATH addresses any scene value, bodies and joints by name: solver.rtol=1e-8, bodies.beam.elements=32\n");
 }
@@ -60,6 +64,7 @@ int main(int argc, char** argv) {
     list_types(reg);
     return 0;
   }
+  if (strcmp(cmd, "compare") == 0) return fmb_compare_main(argc, argv); /* tools/compare.c */
   if (strcmp(cmd, "run") != 0 && strcmp(cmd, "check") != 0) {
     fprintf(stderr, "flexmbd: unknown command '%s'\n", cmd);
     usage(stderr);
