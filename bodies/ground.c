@@ -2,6 +2,7 @@
  * coordinates; joints attach to it through its marker. The world frame "ground" is always
  * defined by the engine; declare a `type: ground` body only to name another fixed frame. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "flexmbd.h"
@@ -43,10 +44,16 @@ static int ground_marker(const void* self, const double* q, const double local[2
   return 0;
 }
 
+static void ground_describe(const void* self, FILE* out) {
+  const Ground* g = self;
+  fprintf(out, "fixed frame at (%g, %g), angle %g\n", g->pos[0], g->pos[1], g->angle);
+}
+
 const fmbBodyType fmb_body_ground = {
     .name = "ground",
     .abi = FMB_ABI_VERSION,
     .parse = ground_parse,
+    .describe = ground_describe,
     .destroy = ground_destroy,
     .ncoord = ground_ncoord,
     .initial = ground_initial,

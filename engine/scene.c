@@ -244,19 +244,13 @@ void fmb_describe(const fmbModel* m, FILE* f) {
   fprintf(f, "gravity: %s\n", m->env.has_gravity ? "on" : "off (no gravity terms evaluated)");
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    fprintf(f, "body '%s' (%s, %d coordinates): ", bi->name, bi->type->name, bi->nq);
-    if (bi->type->describe)
-      bi->type->describe(bi->self, f);
-    else
-      fprintf(f, "\n");
+    fprintf(f, "body '%s' (%s, %d coordinates)%s", bi->name, bi->type->name, bi->nq, bi->type->describe ? ": " : "\n");
+    if (bi->type->describe) bi->type->describe(bi->self, f);
   }
   for (int j = 0; j < m->njoint; ++j) {
     const fmbJointInst* ji = &m->joint[j];
-    fprintf(f, "joint '%s' (%s, %d constraint rows): ", ji->name, ji->type->name, ji->nrows);
-    if (ji->type->describe)
-      ji->type->describe(ji->self, f);
-    else
-      fprintf(f, "\n");
+    fprintf(f, "joint '%s' (%s, %d constraint rows)%s", ji->name, ji->type->name, ji->nrows, ji->type->describe ? ": " : "\n");
+    if (ji->type->describe) ji->type->describe(ji->self, f);
   }
   fprintf(f, "outputs:");
   for (int i = 0; i < m->noutput; ++i) fprintf(f, " %s", m->output[i].name);

@@ -1,6 +1,7 @@
 /* fixed.c — a weld: point1 and point2 coincide and the relative angle stays `angle` (default 0):
  * Phi = [p1 - p2; (angle2 - angle1) - angle] (3 rows). A beam on a hub is a fixed joint between
  * the hub and the beam's root. */
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "two_point.h"
@@ -46,10 +47,16 @@ static int fixed_constraint(const void* self, const fmbJointEval* ev, double* ph
   return rc;
 }
 
+static void fixed_describe(const void* self, FILE* out) {
+  const Fixed* f = self;
+  fprintf(out, "points coincide, relative angle held at %g rad\n", f->angle);
+}
+
 const fmbJointType fmb_joint_fixed = {
     .name = "fixed",
     .abi = FMB_ABI_VERSION,
     .parse = fixed_parse,
+    .describe = fixed_describe,
     .destroy = fixed_destroy,
     .bodies = fixed_bodies,
     .nrows = fixed_nrows,

@@ -1,5 +1,6 @@
 /* force.c — a constant applied load: force [fx, fy] (global frame) at `point` on `body`, and a
  * torque. Generalized force Q = (dp/dq)^T F + (dangle/dq)^T torque. */
+#include <stdio.h>
 #include <stdlib.h>
 
 #include "flexmbd.h"
@@ -42,10 +43,16 @@ static int load_force(const void* self, const fmbJointEval* ev, double* Q) {
   return rc;
 }
 
+static void load_describe(const void* self, FILE* out) {
+  const Load* l = self;
+  fprintf(out, "constant load (%g, %g) N and %g N m\n", l->force[0], l->force[1], l->torque);
+}
+
 const fmbJointType fmb_joint_force = {
     .name = "force",
     .abi = FMB_ABI_VERSION,
     .parse = load_parse,
+    .describe = load_describe,
     .destroy = load_destroy,
     .bodies = load_bodies,
     .force = load_force,

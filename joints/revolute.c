@@ -1,4 +1,5 @@
 /* revolute.c — a pin: point1 on body1 and point2 on body2 coincide, Phi = p1 - p2 (2 rows). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -51,10 +52,16 @@ static int revolute_output(const void* self, int id, const fmbJointEval* ev, dou
   return rc;
 }
 
+static void revolute_describe(const void* self, FILE* out) {
+  (void)self;
+  fprintf(out, "the two points coincide\n");
+}
+
 const fmbJointType fmb_joint_revolute = {
     .name = "revolute",
     .abi = FMB_ABI_VERSION,
     .parse = revolute_parse,
+    .describe = revolute_describe,
     .destroy = revolute_destroy,
     .bodies = revolute_bodies,
     .nrows = revolute_nrows,

@@ -2,6 +2,7 @@
  * tension f = k (l - l0) + c dl/dt along the line of the points, Q = (dp/dq)^T (force on each
  * point); potential energy k (l - l0)^2 / 2. */
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -92,10 +93,16 @@ static int spring_output(const void* self, int id, const fmbJointEval* ev, doubl
   return rc;
 }
 
+static void spring_describe(const void* self, FILE* out) {
+  const Spring* s = self;
+  fprintf(out, "spring-damper k = %g N/m, c = %g N s/m, rest length %g m\n", s->stiffness, s->damping, s->rest_length);
+}
+
 const fmbJointType fmb_joint_spring = {
     .name = "spring",
     .abi = FMB_ABI_VERSION,
     .parse = spring_parse,
+    .describe = spring_describe,
     .destroy = spring_destroy,
     .bodies = spring_bodies,
     .force = spring_force,
