@@ -1,8 +1,9 @@
 /* fd.c — difference derivatives of a body's residual over its own coordinates, used when a
  * plugin provides no analytic `jacobian`. R = M a - Q is linear in a, so the M columns are exact
  * differences with a unit step; K uses forward differences with IDA's own increment rule
- * inc = max(sqrt(eps) |q|, 1/ewt); C uses central differences (exact for R quadratic in v).
- * Four residuals per column: a plugin whose residual is O(n) gets an O(n^2) Jacobian. */
+ * inc = max(sqrt(eps) |q|, 1/ewt); C uses central differences (exact for R quadratic in v),
+ * and the same pair of evaluations carries the unit acceleration step for M.
+ * Three residuals per column: a plugin whose residual is O(n) gets an O(n^2) Jacobian. */
 #include <math.h>
 #include <string.h>
 
@@ -42,27 +43,27 @@ int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* 
       if (rc) return rc;
       for (int i = 0; i < n; ++i) K[(size_t)j * n + i] = (R1[i] - R0[i]) / h;
     }
-    if (C) {
-      /* central: R is quadratic in v for mechanical systems (Coriolis, centrifugal, damping),
-         so the difference has no truncation error and the step can be large enough that
-         roundoff from big elastic forces in R does not swamp the small velocity terms */
-      double h = 6.0e-6 * fmax(fmax(fabs(v[j]), vmax), 1.0 / ewt_v[j]);
+    if (C || M) {
+      /* R = M(q) a + g(q, v) + f(q) with g quadratic in v: one pair of evaluations at
+         (v +- h e_j, a + e_j) gives C_j exactly from their difference and M_j from their mean,
+         (R+ + R-)/2 - R0 = M_j + h^2 g_vjvj / 2, an error of order 1e-11 relative. The step is
+         large enough that roundoff from big elastic forces in R does not swamp the velocity
+         terms. */
+      const double h = 6.0e-6 * fmax(fmax(fabs(v[j]), vmax), 1.0 / ewt_v[j]);
+      aa[j] = a[j] + 1.0;
       vv[j] = v[j] + h;
-      rc = b->type->residual(b->self, env, q, vv, a, R1, work);
+      rc = b->type->residual(b->self, env, q, vv, aa, R1, work);
       if (!rc) {
         vv[j] = v[j] - h;
-        rc = b->type->residual(b->self, env, q, vv, a, Rm, work);
+        rc = b->type->residual(b->self, env, q, vv, aa, Rm, work);
       }
       vv[j] = v[j];
-      if (rc) return rc;
-      for (int i = 0; i < n; ++i) C[(size_t)j * n + i] = (R1[i] - Rm[i]) / (2.0 * h);
-    }
-    if (M) {
-      aa[j] = a[j] + 1.0;
-      rc = b->type->residual(b->self, env, q, v, aa, R1, work);
       aa[j] = a[j];
       if (rc) return rc;
-      for (int i = 0; i < n; ++i) M[(size_t)j * n + i] = R1[i] - R0[i];
+      if (C)
+        for (int i = 0; i < n; ++i) C[(size_t)j * n + i] = (R1[i] - Rm[i]) / (2.0 * h);
+      if (M)
+        for (int i = 0; i < n; ++i) M[(size_t)j * n + i] = 0.5 * (R1[i] + Rm[i]) - R0[i];
     }
   }
   return 0;
