@@ -21,25 +21,32 @@ vg="valgrind --tool=memcheck --error-exitcode=99 --leak-check=full --show-leak-k
 fails=0
 runs=0
 
-check() { # NAME EXPECTED_EXIT ARGS...
-  name=$1 want=$2
-  shift 2
-  # shellcheck disable=SC2086
-  $vg "$bin" "$@" >/dev/null 2>"$out/$name.log"
-  rc=$?
-  runs=$((runs + 1))
-  if [ "$rc" = 99 ] || grep -q '^==[0-9]*== ' "$out/$name.log"; then
-    echo "FAIL $name: memcheck errors:" >&2
-    grep '^==' "$out/$name.log" | head -40 >&2
-    fails=$((fails + 1))
-  elif [ "$rc" != "$want" ]; then
-    echo "FAIL $name: exit code $rc, expected $want" >&2
-    tail -3 "$out/$name.log" >&2
-    fails=$((fails + 1))
-  else
-    echo "ok   $name: exit $rc, $(grep -o 'steps=[0-9]*' "$out/$name.log" | tail -n 1), no memcheck errors"
+# check NAME EXPECTED_EXIT ARGS...: one memcheck run, in the background, JOBS at a time; the
+# verdict goes to $out/NAME.result
+check() {
+  (
+    name=$1 want=$2
+    shift 2
+    # shellcheck disable=SC2086
+    $vg "$bin" "$@" >/dev/null 2>"$out/$name.log"
+    rc=$?
+    if [ "$rc" = 99 ] || grep -q '^==[0-9]*== ' "$out/$name.log"; then
+      { echo "FAIL $name: memcheck errors:"; grep '^==' "$out/$name.log" | head -40; } >"$out/$name.result"
+    elif [ "$rc" != "$want" ]; then
+      { echo "FAIL $name: exit code $rc, expected $want"; tail -3 "$out/$name.log"; } >"$out/$name.result"
+    else
+      echo "ok   $name: exit $rc, $(grep -o 'steps=[0-9]*' "$out/$name.log" | tail -n 1), no memcheck errors" \
+        >"$out/$name.result"
+    fi
+  ) &
+  running=$((running + 1))
+  if [ "$running" -ge "$jobs" ]; then
+    wait
+    running=0
   fi
 }
+jobs=${JOBS:-2}
+running=0
 
 n=0
 for scene in "$src"/scenes/paper/*.yaml; do
@@ -59,13 +66,18 @@ for scene in "$src"/scenes/paper/*.yaml; do
   done
 done
 if [ "$n" -eq 0 ]; then
-  echo "FAIL: no scenes in $src/scenes/paper" >&2
-  fails=$((fails + 1))
+  echo "FAIL: no scenes in $src/scenes/paper" >"$out/no-paper-scenes.result"
 fi
 check bad-scene 2 run "$src/tests/bad_scenes/63-negative-area.yaml" -o "$out/bad.csv"
-check bad-override 2 run "$src/tests/bad_scenes/98-set-self-alias.yaml" -o "$out/bad.csv" --set 'bodies.beam.length=&a [*a]'
+check bad-override 2 run "$src/tests/bad_scenes/98-set-self-alias.yaml" -o "$out/bad-override.csv" --set 'bodies.beam.length=&a [*a]'
 check solver-failure 3 run "$src/tests/failures/singular_fourbar.yaml" -o "$out/fail.csv"
 
+wait
+for r in "$out"/*.result; do
+  runs=$((runs + 1))
+  cat "$r"
+  case $(sed -n 1p "$r") in FAIL*) fails=$((fails + 1)) ;; esac
+done
 rm -rf "$out"
 echo "valgrind: $runs runs, $fails failures"
 [ "$fails" -eq 0 ]
