@@ -130,6 +130,10 @@ typedef struct fmbBodyType {
      modes inside their instability wedge and the error test then forces tiny steps. NULL = 5.
      The engine uses the minimum over bodies unless the scene sets solver.max_order. */
   int (*max_bdf_order)(const void* self);
+  /* NULL when the state is within the model's validity; otherwise why not and what to do (a
+     beam whose deformation exceeds its length is diverging). Checked at every output time:
+     the run stops there with exit 3 instead of integrating a runaway solution. */
+  const char* (*invalid_state)(const void* self, const double* q, const double* v);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

@@ -78,7 +78,8 @@ static const char* failure_advice(int flag) {
              "has become unstable. Try a smaller solver.max_step or a tighter rtol";
     case IDA_LSETUP_FAIL:
       return "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
-             "(a dead point) or a mass matrix that lost definiteness";
+             "(a dead point, where the joints no longer fix the motion) or a mass matrix that lost definiteness. "
+             "Check the mechanism's geometry; a drive that forces it through a dead point cannot be integrated";
     case IDA_LSOLVE_FAIL: return "the linear solver failed: the Newton matrix is singular or ill-conditioned";
     case IDA_REP_RES_ERR:
       return "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
@@ -100,6 +101,20 @@ static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
                "stopped at t = %.6g: the mass matrix is no longer positive definite (singular or indefinite) on the "
                "constraint manifold (body '%s')%s%s",
                t, b->name, hint ? ": " : "", hint ? hint : "");
+}
+
+/* a body's own validity check (e.g. a beam deforming beyond its length: a runaway solution) */
+static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* diag) {
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->type->invalid_state) continue;
+    const char* why = bi->type->invalid_state(bi->self, y + bi->qadr, y + m->nq + bi->qadr);
+    if (why) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "stopped at t = %.6g: body '%s': %s", t, bi->name, why);
+      return 1;
+    }
+  }
+  return 0;
 }
 
 int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* diag) {
@@ -153,7 +168,10 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   int wr = fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp));
   if (wr) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-                 wr < 0 ? "writing the output failed at t = %g (disk full?)" : "an output is not finite at t = %g", t);
+                 wr < 0 ? "writing the output failed at t = %g (disk full?)"
+                        : "an output is not finite at t = %g: check the initial values and parameters (a zero-length "
+                          "spring, a huge or tiny value)",
+                 t);
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
@@ -228,6 +246,10 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       break;
     }
     t = tret;
+    if (invalid_state(m, t, N_VGetArrayPointer(y), diag)) {
+      rc = FMB_EXIT_SOLVER;
+      break;
+    }
     bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 0.0);
     if (bad) {
       mass_failure(m, bad, t, diag);
@@ -238,7 +260,8 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     if (wr) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                    wr < 0 ? "writing the output failed at t = %.6g (disk full?)"
-                          : "stopped at t = %.6g: an output is not finite (the solution blew up)",
+                          : "stopped at t = %.6g: an output is not finite (the solution blew up): try a tighter rtol "
+                            "or a smaller solver.max_step, and check the model for instability",
                    t);
       rc = FMB_EXIT_SOLVER;
       break;

@@ -408,6 +408,11 @@ static int apply_override(fmbParser* p, int ov) {
   }
   yaml_parser_delete(&parser);
 
+  if (path[0] == '.' || path[plen - 1] == '.' || strstr(path, "..")) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: empty name in the path (write names separated by single dots, e.g. solver.rtol)", text);
+    yaml_document_delete(&vdoc);
+    return -1;
+  }
   int node = fmbp_root(p);
   char* save = NULL;
   char* seg = strtok_r(path, ".", &save);
