@@ -666,6 +666,20 @@ static int beam_max_bdf_order(const void* self) {
   return 2;
 }
 
+/* A small-strain finite-element beam whose nodal displacement exceeds its own length is no longer
+   a beam: the solution is running away (ZOAC above the first bending frequency). */
+static const char* beam_invalid_state(const void* self, const double* q, const double* v) {
+  (void)v;
+  const Beam* b = self;
+  for (int i = 0; i < b->ne; ++i)
+    if (!(fabs(q[3 + 3 * i]) <= b->L && fabs(q[3 + 3 * i + 1]) <= b->L))
+      return b->model == BEAM_ZOAC
+                 ? "its deformation exceeds its length: the solution is diverging. ZOAC has no dynamic stiffening and "
+                   "is unstable when spun above its first bending frequency; use model: foac or complete"
+                 : "its deformation exceeds its length: the solution is diverging (check the loads and parameters)";
+  return NULL;
+}
+
 const fmbBodyType fmb_body_beam = {
     .name = "beam",
     .abi = FMB_ABI_VERSION,
@@ -684,4 +698,5 @@ const fmbBodyType fmb_body_beam = {
     .describe = beam_describe,
     .indefinite_mass = beam_indefinite_mass,
     .max_bdf_order = beam_max_bdf_order,
+    .invalid_state = beam_invalid_state,
 };
