@@ -483,10 +483,10 @@ static int beam_marker(const void* self, const double* q, const double local[2],
 /* ---------------------------------------------------------------------------------------------
  * Energy: each model's own kinetic energy, strain energy 1/2 p^T K p, gravity -int rho g.r.
  * ------------------------------------------------------------------------------------------- */
-static void beam_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
-                        double* work) {
-  (void)work;
-  const Beam* b = self;
+/* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
+   momentum about the frame origin for the complete model) in one pass */
+static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                           double* ptheta) {
   const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
   const double le = b->le;
   const double* p = q + 3;
@@ -499,7 +499,7 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
     f[0] = c * env->gravity[0] + s * env->gravity[1];
     f[1] = -s * env->gravity[0] + c * env->gravity[1];
   }
-  double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0;
+  double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0, pth = 0.0;
   double Ipp = 0.0, Ipv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
   for (int e = 0; e < ne; ++e) {
@@ -532,16 +532,23 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
         double vD[2] = {-uD[1] * om + uDd[0], uD[0] * om + uDd[1]};
         double vC[2] = {wcd, wc * om};
         double vRD[2] = {vR[0] + vD[0], vR[1] + vD[1]};
+        /* d v / d theta' of the parts: I~(rho0 + u_D), I~ rho0, I~ e1 w_c */
+        double gRD[2] = {-(y + uD[1]), x + uD[0]}, gR[2] = {-y, x};
         switch (model) {
           case BEAM_ZOAC:
             T += 0.5 * m * (vRD[0] * vRD[0] + vRD[1] * vRD[1]);
+            pth += m * (gRD[0] * vRD[0] + gRD[1] * vRD[1]);
             break;
           case BEAM_FOAC:
             T += m * (0.5 * (vRD[0] * vRD[0] + vRD[1] * vRD[1]) + vR[0] * vC[0] + vR[1] * vC[1]);
+            pth += m * (gRD[0] * vRD[0] + gRD[1] * vRD[1] + gR[0] * vC[0] + gR[1] * vC[1] + wc * vR[1]);
             break;
-          default:
-            T += 0.5 * m * ((vRD[0] + vC[0]) * (vRD[0] + vC[0]) + (vRD[1] + vC[1]) * (vRD[1] + vC[1]));
+          default: {
+            double vt[2] = {vRD[0] + vC[0], vRD[1] + vC[1]};
+            T += 0.5 * m * (vt[0] * vt[0] + vt[1] * vt[1]);
+            pth += m * (gRD[0] * vt[0] + (gRD[1] + wc) * vt[1]);
             break;
+          }
         }
         /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
         if (grav) Ug -= m * (f[0] * (x + uD[0] + wc) + f[1] * (y + uD[1]));
@@ -565,17 +572,24 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
   en->strain = Ue;
   en->gravity = Ug;
   en->spring = 0.0;
+  if (ptheta) *ptheta = pth;
+}
+
+static void beam_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                        double* work) {
+  (void)work;
+  beam_integrals(self, env, q, v, en, NULL);
 }
 
 /* ---------------------------------------------------------------------------------------------
  * Outputs.
  * ------------------------------------------------------------------------------------------- */
-enum { OUT_TIP_U, OUT_TIP_V, OUT_TIP_U_RATE, OUT_TIP_V_RATE, OUT_TIP_X, OUT_TIP_Y, OUT_NTIP };
+enum { OUT_TIP_U, OUT_TIP_V, OUT_TIP_U_RATE, OUT_TIP_V_RATE, OUT_TIP_X, OUT_TIP_Y, OUT_ANG_MOMENTUM, OUT_NTIP };
 enum { OUT_NODE_BASE = 1000, OUT_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
 
-static const char* const beam_output_names[] = {"tip_u",  "tip_v",  "tip_u_rate", "tip_v_rate",
-                                                "tip_x",  "tip_y",  "nodeK_u",    "nodeK_v",
-                                                "nodeK_x", "nodeK_y", NULL};
+static const char* const beam_output_names[] = {"tip_u",   "tip_v",   "tip_u_rate", "tip_v_rate", "tip_x",
+                                                "tip_y",   "ang_momentum", "nodeK_u", "nodeK_v", "nodeK_x",
+                                                "nodeK_y", NULL};
 
 static int beam_output_lookup(const void* self, const char* quantity) {
   const Beam* b = self;
@@ -627,6 +641,10 @@ static int beam_output(const void* self, int id, const double* q, const double* 
     comp = comp == 0 ? OUT_TIP_U : comp == 1 ? OUT_TIP_V : comp == 2 ? OUT_TIP_X : OUT_TIP_Y;
   } else if (id < 0 || id >= OUT_NTIP) {
     return -1;
+  } else if (id == OUT_ANG_MOMENTUM) {
+    fmbEnergy en;
+    beam_integrals(b, NULL, q, v, &en, value);
+    return 0;
   }
   double u[2], ud[2];
   deformation_at(b, q + 3, v + 3, x, u, ud);

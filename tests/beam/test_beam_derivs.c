@@ -7,7 +7,7 @@
  * - the kinetic energy from `energy` is 1/2 v^T M(q) v with M taken from the residual;
  * - U_e = 1/2 p^T K p with K p = R(q, 0, 0) without gravity;
  * - outputs: tip_x/tip_y agree with the marker at (L, 0); tip rates are d/dt of tip_u/tip_v;
- *   nodeNE_u/v equal tip_u/v; node0 is the frame origin;
+ *   nodeNE_u/v equal tip_u/v; node0 is the frame origin; ang_momentum = dT/dtheta';
  * - the plugin's jacobian op, if any, against central differences of the residual.
  */
 #include "beamtest.h"
@@ -152,6 +152,20 @@ int main(void) {
         for (int i = 0; i < nc; ++i) qp[i] = q[i] - h * v[i];
         double fm = out(b, pairs[k][0], qp, v);
         BT_NEAR(out(b, pairs[k][1], q, v), (fp - fm) / (2.0 * h), 1e-8);
+      }
+      /* ang_momentum = dT/dtheta' */
+      {
+        double h = 1e-5, vp[64], tp, tm;
+        memcpy(vp, v, sizeof(double) * (size_t)nc);
+        fmbEnergy en;
+        vp[2] = v[2] + h;
+        beam_energy(b, &env0, q, vp, &en, NULL);
+        tp = en.kinetic;
+        vp[2] = v[2] - h;
+        beam_energy(b, &env0, q, vp, &en, NULL);
+        tm = en.kinetic;
+        double pth = out(b, "ang_momentum", q, v);
+        BT_NEAR(pth, (tp - tm) / (2.0 * h), 1e-8 * fabs(pth));
       }
       BT_ENSURE(beam_output_lookup(b, "node99_u") == -1);
       BT_ENSURE(beam_output_lookup(b, "node1_") == -1);
