@@ -40,6 +40,7 @@ typedef struct Beam {
      nested rule of each outer point [g][k][j] and of the full element [k][j] */
   double nd_in[FMB_GAUSS_MAX][INNER][4];
   double nd_full[INNER][4];
+  double ns_out[FMB_GAUSS_MAX][4], nd_out[FMB_GAUSS_MAX][4]; /* shape and slope at the outer points */
   double kb[4][4], ka; /* element bending stiffness, axial stiffness EA/le */
 } Beam;
 
@@ -106,6 +107,7 @@ static void beam_setup(Beam* b) {
   for (int g = 0; g < b->ng; ++g)
     for (int k = 0; k < INNER; ++k) hermite(b->xg[g] * b->xi3[k], b->le, NULL, b->nd_in[g][k]);
   for (int k = 0; k < INNER; ++k) hermite(b->xi3[k], b->le, NULL, b->nd_full[k]);
+  for (int g = 0; g < b->ng; ++g) hermite(b->xg[g], b->le, b->ns_out[g], b->nd_out[g]);
   double le = b->le, ei = b->Emod * b->Izz / (le * le * le);
   double kb[4][4] = {{12.0, 6.0 * le, -12.0, 6.0 * le},
                      {6.0 * le, 4.0 * le * le, -6.0 * le, 2.0 * le * le},
@@ -243,8 +245,8 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
     }
     for (int g = 0; g < ng; ++g) {
       double xi = b->xg[g], x = xe + xi * le;
-      double ns[4], nd[4];
-      hermite(xi, le, ns, nd);
+      const double* ns = b->ns_out[g];
+      const double* nd = b->nd_out[g];
       double n1[2] = {1.0 - xi, xi};
       double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
       double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
@@ -508,8 +510,8 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
     gather(pd, e, uda, dd);
     for (int g = 0; g < ng; ++g) {
       double xi = b->xg[g], x = e * le + xi * le;
-      double ns[4], nd[4];
-      hermite(xi, le, ns, nd);
+      const double* ns = b->ns_out[g];
+      const double* nd = b->nd_out[g];
       double n1[2] = {1.0 - xi, xi};
       double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
       double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
