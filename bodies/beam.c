@@ -675,8 +675,10 @@ static void beam_describe(const void* self, FILE* f) {
 static const char* beam_indefinite_mass(const void* self) {
   const Beam* b = self;
   if (b->model != BEAM_FOAC) return NULL;
-  return "the FOAC beam's kinetic energy is not positive definite at large deformation (its mass matrix keeps "
-         "-p^T D p in M22 without the high-order terms that balance it); use `model: complete`";
+  return "the FOAC beam's kinetic energy is not positive definite: with its angle free (a pendulum, a free beam) "
+         "its mass matrix loses definiteness once the deflection exceeds a few tenths of a percent of the length, "
+         "less on finer meshes (it keeps -p^T D p in M22 without the high-order terms that balance it); use "
+         "`model: complete` (FOAC is usable only under prescribed rotation)";
 }
 
 /* Undamped axial and bending modes up to ~1e5 rad/s: only A-stable BDF (order <= 2) steps over
