@@ -43,7 +43,14 @@ int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* 
       if (rc) return rc;
       for (int i = 0; i < n; ++i) K[(size_t)j * n + i] = (R1[i] - R0[i]) / h;
     }
-    if (C || M) {
+    if (M && !C) {
+      /* mass matrix alone (initial conditions, definiteness checks): R is linear in a */
+      aa[j] = a[j] + 1.0;
+      rc = b->type->residual(b->self, env, q, v, aa, R1, work);
+      aa[j] = a[j];
+      if (rc) return rc;
+      for (int i = 0; i < n; ++i) M[(size_t)j * n + i] = R1[i] - R0[i];
+    } else if (C) {
       /* R = M(q) a + g(q, v) + f(q) with g quadratic in v: one pair of evaluations at
          (v +- h e_j, a + e_j) gives C_j exactly from their difference and M_j from their mean,
          (R+ + R-)/2 - R0 = M_j + h^2 g_vjvj / 2, an error of order 1e-11 relative. The step is

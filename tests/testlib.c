@@ -3,6 +3,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 int fmbt_failures = 0, fmbt_checks = 0;
 
@@ -16,9 +17,10 @@ const char* fmbt_path(const char* rel, char* buf, size_t len) {
   return buf;
 }
 
+/* one file per process: concurrent ctest runs on the same build never share an output file */
 const char* fmbt_out_path(const char* name, char* buf, size_t len) {
   mkdir(FLEXMBD_TEST_OUT, 0755);
-  snprintf(buf, len, "%s/%s", FLEXMBD_TEST_OUT, name);
+  snprintf(buf, len, "%s/%ld-%s", FLEXMBD_TEST_OUT, (long)getpid(), name);
   return buf;
 }
 
