@@ -103,6 +103,19 @@ static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
                t, b->name, hint ? ": " : "", hint ? hint : "");
 }
 
+/* a CSV row that could not be written (wr < 0) or held a non-finite value (wr > 0) */
+static int row_failed(const fmbModel* m, int wr, double t, fmbDiag* diag) {
+  if (wr < 0)
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "writing the output failed at t = %.6g (disk full?)", t);
+  else if (wr > 0)
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                 "stopped at t = %.6g: an output is not finite (the solution blew up): check the initial values "
+                 "and parameters for a zero-length spring or an extreme value, try a tighter rtol or a smaller "
+                 "solver.max_step, and check the model for instability",
+                 t);
+  return wr != 0;
+}
+
 /* a body's own validity check (e.g. a beam deforming beyond its length: a runaway solution) */
 static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* diag) {
   for (int b = 1; b < m->nbody; ++b) {
@@ -165,13 +178,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     goto done;
   }
   fmb_csv_header(csv, m);
-  int wr = fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp));
-  if (wr) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-                 wr < 0 ? "writing the output failed at t = %g (disk full?)"
-                        : "an output is not finite at t = %g: check the initial values and parameters (a zero-length "
-                          "spring, a huge or tiny value)",
-                 t);
+  if (row_failed(m, fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
@@ -256,13 +263,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       rc = FMB_EXIT_SOLVER;
       break;
     }
-    wr = fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp));
-    if (wr) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-                   wr < 0 ? "writing the output failed at t = %.6g (disk full?)"
-                          : "stopped at t = %.6g: an output is not finite (the solution blew up): try a tighter rtol "
-                            "or a smaller solver.max_step, and check the model for instability",
-                   t);
+    if (row_failed(m, fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
       rc = FMB_EXIT_SOLVER;
       break;
     }

@@ -5,13 +5,6 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-int fmbt_failures = 0, fmbt_checks = 0;
-
-int fmbt_finish(const char* name) {
-  printf("%s: %d passed, %d failed\n", name, fmbt_checks - fmbt_failures, fmbt_failures);
-  return fmbt_failures ? 1 : 0;
-}
-
 const char* fmbt_path(const char* rel, char* buf, size_t len) {
   snprintf(buf, len, "%s/%s", FLEXMBD_SOURCE_DIR, rel);
   return buf;

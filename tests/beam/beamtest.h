@@ -15,34 +15,7 @@
 
 #include "../../bodies/beam.c"
 
-static int bt_failures = 0;
-
-#define BT_ENSURE(cond)                                                         \
-  do {                                                                          \
-    if (!(cond)) {                                                              \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond);  \
-      ++bt_failures;                                                            \
-    }                                                                           \
-  } while (0)
-
-#define BT_NEAR(a, b, tol)                                                                              \
-  do {                                                                                                  \
-    double bt_a_ = (a), bt_b_ = (b), bt_t_ = (tol);                                                     \
-    if (!(fabs(bt_a_ - bt_b_) <= bt_t_)) {                                                              \
-      fprintf(stderr, "%s:%d: %s = %.12g, expected %s = %.12g within %.3g (off by %.3g)\n", __FILE__,   \
-              __LINE__, #a, bt_a_, #b, bt_b_, bt_t_, fabs(bt_a_ - bt_b_));                              \
-      ++bt_failures;                                                                                    \
-    }                                                                                                   \
-  } while (0)
-
-static inline int bt_finish(const char* name) {
-  if (bt_failures) {
-    fprintf(stderr, "%s: %d check(s) failed\n", name, bt_failures);
-    return 1;
-  }
-  printf("%s: all checks passed\n", name);
-  return 0;
-}
+#include "check.h"
 
 /* the seed beam (Liu, Hong & Liu 2009, section 4.1) */
 #define SEED_RHO 2767.0

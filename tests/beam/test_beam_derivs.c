@@ -21,9 +21,9 @@ static double energy_pot(const Beam* b, const fmbEnv* env, const double* q, cons
 
 static double out(const Beam* b, const char* name, const double* q, const double* v) {
   int id = beam_output_lookup(b, name);
-  BT_ENSURE(id >= 0);
+  ENSURE(id >= 0);
   double val = NAN;
-  BT_ENSURE(beam_output(b, id, q, v, &val, NULL) == 0);
+  ENSURE(beam_output(b, id, q, v, &val, NULL) == 0);
   return val;
 }
 
@@ -56,8 +56,8 @@ int main(void) {
     double worst_pos = 0.0, worst_ang = 0.0;
     for (size_t k = 0; k < sizeof pts / sizeof pts[0]; ++k) {
       double pos[2], ang, dpos[2 * 64], dang[64];
-      BT_ENSURE(nc <= 64);
-      BT_ENSURE(beam_marker(b, q, pts[k], pos, &ang, dpos, dang, NULL) == 0);
+      ENSURE(nc <= 64);
+      ENSURE(beam_marker(b, q, pts[k], pos, &ang, dpos, dang, NULL) == 0);
       for (int j = 0; j < nc; ++j) {
         double h = 1e-6, pp[2], pm[2], ap, am;
         memcpy(qp, q, sizeof(double) * (size_t)nc);
@@ -70,8 +70,8 @@ int main(void) {
       }
     }
     printf("  marker: worst |dpos/dq - FD| = %.2e, |dangle/dq - FD| = %.2e\n", worst_pos, worst_ang);
-    BT_ENSURE(worst_pos < 1e-8);
-    BT_ENSURE(worst_ang < 1e-8);
+    ENSURE(worst_pos < 1e-8);
+    ENSURE(worst_ang < 1e-8);
 
     /* R(q, 0, 0) = grad (U_e + U_g), each part on its own: the elastic part without gravity,
        the gravity part as the difference of residuals with and without it */
@@ -97,7 +97,7 @@ int main(void) {
         scale = fmax(scale, fabs(R[j]));
       }
       printf("  R(q,0,0) vs grad %s: worst %.2e of %.2e\n", g ? "U_g (gravity part)" : "U_e", worst, scale);
-      BT_ENSURE(worst < (g ? 1e-8 : 1e-6) * scale);
+      ENSURE(worst < (g ? 1e-8 : 1e-6) * scale);
     }
 
     /* U_e = 1/2 p^T K p, K p = R(q, 0, 0) without gravity */
@@ -107,8 +107,8 @@ int main(void) {
       for (int i = 3; i < nc; ++i) pkp += q[i] * R[i];
       fmbEnergy en;
       beam_energy(b, &env0, q, v, &en, NULL);
-      BT_NEAR(en.strain, 0.5 * pkp, 1e-12 * en.strain);
-      BT_ENSURE(R[0] == 0.0 && R[1] == 0.0);
+      ENSURE_NEAR(en.strain, 0.5 * pkp, 1e-12 * en.strain);
+      ENSURE(R[0] == 0.0 && R[1] == 0.0);
     }
 
     /* T = 1/2 v^T M v */
@@ -121,7 +121,7 @@ int main(void) {
       fmbEnergy en;
       beam_energy(b, &env, q, v, &en, NULL);
       printf("  T = %.12g, 1/2 v^T M v = %.12g\n", en.kinetic, 0.5 * vMv);
-      BT_NEAR(en.kinetic, 0.5 * vMv, 1e-9 * en.kinetic);
+      ENSURE_NEAR(en.kinetic, 0.5 * vMv, 1e-9 * en.kinetic);
       free(M);
     }
 
@@ -129,20 +129,20 @@ int main(void) {
     {
       double tipl[2] = {SEED_L, 0.0}, pos[2], ang;
       beam_marker(b, q, tipl, pos, &ang, NULL, NULL, NULL);
-      BT_NEAR(out(b, "tip_x", q, v), pos[0], 1e-14);
-      BT_NEAR(out(b, "tip_y", q, v), pos[1], 1e-14);
+      ENSURE_NEAR(out(b, "tip_x", q, v), pos[0], 1e-14);
+      ENSURE_NEAR(out(b, "tip_y", q, v), pos[1], 1e-14);
       char nm[32];
       snprintf(nm, sizeof nm, "node%d_u", b->ne);
-      BT_NEAR(out(b, nm, q, v), out(b, "tip_u", q, v), 1e-15);
+      ENSURE_NEAR(out(b, nm, q, v), out(b, "tip_u", q, v), 1e-15);
       snprintf(nm, sizeof nm, "node%d_v", b->ne);
-      BT_NEAR(out(b, nm, q, v), out(b, "tip_v", q, v), 1e-15);
-      BT_NEAR(out(b, "node0_x", q, v), q[0], 1e-15);
-      BT_NEAR(out(b, "node0_y", q, v), q[1], 1e-15);
-      BT_NEAR(out(b, "node2_v", q, v), q[3 + 3 * 1 + 1], 1e-15);
+      ENSURE_NEAR(out(b, nm, q, v), out(b, "tip_v", q, v), 1e-15);
+      ENSURE_NEAR(out(b, "node0_x", q, v), q[0], 1e-15);
+      ENSURE_NEAR(out(b, "node0_y", q, v), q[1], 1e-15);
+      ENSURE_NEAR(out(b, "node2_v", q, v), q[3 + 3 * 1 + 1], 1e-15);
       double uL = q[3 + 3 * (b->ne - 1)], vL = q[3 + 3 * (b->ne - 1) + 1];
-      if (model == BEAM_ZOAC) BT_NEAR(out(b, "tip_u", q, v), uL, 1e-15);
-      else BT_ENSURE(out(b, "tip_u", q, v) < uL); /* w_c shortens */
-      BT_NEAR(out(b, "tip_v", q, v), vL, 1e-15);
+      if (model == BEAM_ZOAC) ENSURE_NEAR(out(b, "tip_u", q, v), uL, 1e-15);
+      else ENSURE(out(b, "tip_u", q, v) < uL); /* w_c shortens */
+      ENSURE_NEAR(out(b, "tip_v", q, v), vL, 1e-15);
       /* rates: d/dt along v */
       const char* pairs[2][2] = {{"tip_u", "tip_u_rate"}, {"tip_v", "tip_v_rate"}};
       for (int k = 0; k < 2; ++k) {
@@ -151,7 +151,7 @@ int main(void) {
         double fp = out(b, pairs[k][0], qp, v);
         for (int i = 0; i < nc; ++i) qp[i] = q[i] - h * v[i];
         double fm = out(b, pairs[k][0], qp, v);
-        BT_NEAR(out(b, pairs[k][1], q, v), (fp - fm) / (2.0 * h), 1e-8);
+        ENSURE_NEAR(out(b, pairs[k][1], q, v), (fp - fm) / (2.0 * h), 1e-8);
       }
       /* ang_momentum = dT/dtheta' */
       {
@@ -165,13 +165,13 @@ int main(void) {
         beam_energy(b, &env0, q, vp, &en, NULL);
         tm = en.kinetic;
         double pth = out(b, "ang_momentum", q, v);
-        BT_NEAR(pth, (tp - tm) / (2.0 * h), 1e-8 * fabs(pth));
+        ENSURE_NEAR(pth, (tp - tm) / (2.0 * h), 1e-8 * fabs(pth));
       }
-      BT_ENSURE(beam_output_lookup(b, "node99_u") == -1);
-      BT_ENSURE(beam_output_lookup(b, "node1_") == -1);
-      BT_ENSURE(beam_output_lookup(b, "node1_q") == -1);
-      BT_ENSURE(beam_output_lookup(b, "nodex_u") == -1);
-      BT_ENSURE(beam_output_lookup(b, "tip") == -1);
+      ENSURE(beam_output_lookup(b, "node99_u") == -1);
+      ENSURE(beam_output_lookup(b, "node1_") == -1);
+      ENSURE(beam_output_lookup(b, "node1_q") == -1);
+      ENSURE(beam_output_lookup(b, "nodex_u") == -1);
+      ENSURE(beam_output_lookup(b, "tip") == -1);
     }
 
     /* the plugin's analytic jacobian, if it has one */
@@ -182,7 +182,7 @@ int main(void) {
       double* K = malloc(sizeof(double) * nn * 3);
       double *C = K + nn, *Mj = C + nn;
       double* w = bt_work(b);
-      BT_ENSURE(fmb_body_beam.jacobian(b, &env, q, v, a, K, C, Mj, w) == 0);
+      ENSURE(fmb_body_beam.jacobian(b, &env, q, v, a, K, C, Mj, w) == 0);
       double* Rp = malloc(sizeof(double) * (size_t)nc * 2);
       double* Rm = Rp + nc;
       const double* args[3] = {q, v, a};
@@ -205,7 +205,7 @@ int main(void) {
           }
         }
         printf("  jacobian %s: worst %.2e of %.2e\n", bn[which], worst, scale);
-        BT_ENSURE(worst < 1e-6 * scale);
+        ENSURE(worst < 1e-6 * scale);
         free(x);
       }
       free(w);
@@ -216,5 +216,5 @@ int main(void) {
     free(q);
     free(b);
   }
-  return bt_finish("test_beam_derivs");
+  return fmbt_finish("test_beam_derivs");
 }

@@ -367,7 +367,7 @@ int main(void) {
       slow_build(b, e, q, v, &S);
       char what[128];
       snprintf(what, sizeof what, "%s, %d elements, fast vs slow", names[model], ne);
-      BT_ENSURE(compare(b, &S, q, v, a, Rf, what) < 1e-12);
+      ENSURE(compare(b, &S, q, v, a, Rf, what) < 1e-12);
       /* the extracted mass matrix is symmetric */
       double* M = malloc(sizeof(double) * (size_t)nc * (size_t)nc);
       bt_mass(b, q, v, M);
@@ -377,7 +377,7 @@ int main(void) {
           asym = fmax(asym, fabs(M[i + j * nc] - M[j + i * nc]));
           mx = fmax(mx, fabs(M[i + j * nc]));
         }
-      BT_ENSURE(asym <= 1e-12 * mx);
+      ENSURE(asym <= 1e-12 * mx);
       /* 2. seed constant-matrix form (ZOAC, FOAC) */
       if (model != BEAM_COMPLETE && b->beta == 0.0) {
         double* Rs = malloc(sizeof(double) * (size_t)nc);
@@ -391,7 +391,7 @@ int main(void) {
           worst = fmax(worst, fabs(Rs[i] - Rf[i]) / sc);
         }
         printf("  %-44s worst row error / row scale = %.2e\n", what, worst);
-        BT_ENSURE(worst < 1e-12);
+        ENSURE(worst < 1e-12);
         free(Rs);
       }
       /* 3. quadrature: more Gauss points, same residual */
@@ -400,7 +400,7 @@ int main(void) {
       double* R10 = malloc(sizeof(double) * (size_t)nc);
       bt_residual(b10, e, q, v, a, R10);
       snprintf(what, sizeof what, "%s, %d elements, %d vs %d Gauss points", names[model], ne, b->ng, FMB_GAUSS_MAX);
-      BT_ENSURE(compare(b10, &S, q, v, a, R10, what) < 1e-12);
+      ENSURE(compare(b10, &S, q, v, a, R10, what) < 1e-12);
       free(R10);
       free(b10);
       free(M);
@@ -424,10 +424,10 @@ int main(void) {
       sc = fmax(sc, fabs(R6[i]));
     }
     printf("  complete, 3 Gauss points (too few): relative change %.2e (must be visible)\n", d / sc);
-    BT_ENSURE(d / sc > 1e-10);
+    ENSURE(d / sc > 1e-10);
     free(q);
     free(b);
     free(b3);
   }
-  return bt_finish("test_beam_residual");
+  return fmbt_finish("test_beam_residual");
 }
