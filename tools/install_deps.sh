@@ -1,7 +1,11 @@
 #!/usr/bin/env bash
 # Install what flexmbd needs on Debian 12, only if something is missing.
+#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox)
+if [ "${1:-}" = "--ci" ]; then
+  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux)
+fi
 missing=()
 for p in "${pkgs[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
