@@ -10,10 +10,10 @@ F=${FLEXMBD:-$ROOT/build/flexmbd}
 RES=${RESULTS:-$ROOT/bench/results}
 OUT=${STAB_WORK:-/tmp/flexmbd-stability}
 mkdir -p "$RES" "$OUT"
-CASES="slender_I1e-14 slender_I1e-12 slender_I1e-10 slender_I1e-8 slender_I1e-6 stiff_E100 omega30 omega50 abrupt
-overspeed flex_pendulum deadpoint pendulum5 tight_fine elements128 elements256 pendulum200"
-[ "${1:-}" = --quick ] && CASES="slender_I1e-12 slender_I1e-8 omega30 abrupt overspeed deadpoint"
-: > "$RES/stability.txt"
+CASES=${CASES:-"slender_I1e-14 slender_I1e-12 slender_I1e-10 slender_I1e-8 slender_I1e-6 stiff_E100 omega30 omega50 abrupt_w1
+abrupt_w15 overspeed flex_pendulum deadpoint pendulum5 tight_fine elements128 elements256 pendulum200"}
+[ "${1:-}" = --quick ] && CASES="slender_I1e-12 slender_I1e-10 omega30 abrupt_w1 abrupt_w15 deadpoint"
+[ -n "${APPEND:-}" ] || : > "$RES/stability.txt"
 for c in $CASES; do
   line=$(timeout 1200 sh tests/stability/run_case.sh "$F" tests/stability "$OUT" "$c" --check 2> "$OUT/$c.check")
   verdict=$(grep -E '^(FAIL|ok)' "$OUT/$c.check" | head -1)

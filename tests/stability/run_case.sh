@@ -18,19 +18,26 @@ SPIN_OUT='outputs=[beam.tip_v,beam.tip_u,beam.theta,beam.omega,spin.power,energy
 PEND_OUT='outputs=[beam.tip_v,beam.tip_u,beam.theta,beam.omega,energy.kinetic,energy.strain,energy.gravity,energy.total,constraint.position,constraint.velocity]'
 # per case: scene, overrides, kind (driven|conservative), expected exit (0, 3, or "0|3"),
 # energy tolerance (relative), constraint tolerance, max tip deflection / L
-KIND=driven; EXPECT=0; ETOL=1e-3; CTOL=1e-6; TIPMAX=1; POWER=spin.power
+KIND=driven; EXPECT=0; ETOL=1e-3; CTOL=1e-6; TIPMAX=1; POWER=spin.power; TIPU=""
 set --
 case $CASE in
   slender_I*)   # I from the name, e.g. slender_I1e-14, on the 4 rad/s spin-up
     I=${CASE#slender_I}; SCENE=$P/spinup_w4.yaml
-    set -- --set "bodies.beam.second_moment=$I" --set "$SPIN_OUT"; EXPECT="0|3"; ETOL=2e-3; TIPMAX=0.5 ;;
+    set -- --set "bodies.beam.second_moment=$I" --set "$SPIN_OUT"; EXPECT="0|3"; ETOL=2e-3; CTOL=1e-5; TIPMAX=1 ;;
   stiff_E100)   SCENE=$P/spinup_w15.yaml; set -- --set bodies.beam.youngs_modulus=68.95e11 --set "$SPIN_OUT"; TIPMAX=0.01 ;;
   omega30)      SCENE=$P/spinup_w15.yaml; set -- --set joints.spin.omega0=30 --set "$SPIN_OUT"; TIPMAX=0.2 ;;
-  omega50)      SCENE=$P/spinup_w15.yaml; set -- --set joints.spin.omega0=50 --set "$SPIN_OUT"; TIPMAX=0.2 ;;
-  abrupt)       SCENE=$P/spinup_w15.yaml; set -- --set joints.spin.ramp_time=0.5 --set solver.t_end=5 --set "$SPIN_OUT"; TIPMAX=0.2 ;;
-  overspeed)    SCENE=$S/constant_overspeed.yaml; TIPMAX=0.1 ;;
+  omega50)      SCENE=$P/spinup_w15.yaml; set -- --set joints.spin.omega0=50 --set "$SPIN_OUT"; TIPMAX=0.3 ;;
+  abrupt_w1)    # Tn = 0.5 s to 1 rad/s: peak angular acceleration 4 rad/s^2, tip lag ~0.3 L
+    SCENE=$P/spinup_w1.yaml; set -- --set joints.spin.ramp_time=0.5 --set solver.t_end=5 --set "$SPIN_OUT"; TIPMAX=0.4 ;;
+  abrupt_w15)   # Tn = 0.5 s to 15 rad/s: 60 rad/s^2; the static lag estimate 11 q L^4 / (120 EI) is ~8 m,
+    # far beyond a beam of 1.8 m: the run must stop cleanly (or, if the model could follow, balance energy)
+    SCENE=$P/spinup_w15.yaml; EXPECT="0|3"; ETOL=2e-2
+    set -- --set joints.spin.ramp_time=0.5 --set solver.t_end=5 --set "$SPIN_OUT"; TIPMAX=1 ;;
+  overspeed)    # positions-only error control: the abrupt start rings every axial mode (docs/stability.md)
+    SCENE=$S/constant_overspeed.yaml; ETOL=2e-3; TIPMAX=0.01; TIPU=1.2482e-4
+    set -- --set solver.t_end=2 --set solver.error_control=positions --set solver.output_step=0.001 ;;
   flex_pendulum) SCENE=$P/pendulum.yaml; KIND=conservative
-    set -- --set bodies.beam.second_moment=2.604e-11 --set "$PEND_OUT"; ETOL=2e-3; TIPMAX=0.5 ;;
+    set -- --set bodies.beam.second_moment=2.604e-11 --set "$PEND_OUT"; EXPECT="0|3"; ETOL=1e-2; TIPMAX=1 ;;
   elements128)  SCENE=$P/spinup_w15.yaml; set -- --set bodies.beam.elements=128 --set "$SPIN_OUT"; TIPMAX=0.2 ;;
   elements256)  SCENE=$P/spinup_w15.yaml; set -- --set bodies.beam.elements=256 --set "$SPIN_OUT"; TIPMAX=0.2 ;;
   pendulum200)  SCENE=$P/pendulum.yaml; KIND=conservative
@@ -64,9 +71,10 @@ METRICS=$( [ -s "$CSV" ] && awk -F, -v kind="$KIND" -v power="$POWER" '
     if (k > km) km = k
     if (("constraint.position" in c) && $c["constraint.position"] > cp) cp = $c["constraint.position"]
     if (("constraint.velocity" in c) && $c["constraint.velocity"] > cv) cv = $c["constraint.velocity"]
-    if ("beam.tip_v" in c) { v = $c["beam.tip_v"]; if (v < 0) v = -v; if (v > tm) tm = v } }
-  END { printf "rows=%d bad_rows=%d energy_err=%.3e cpos=%.3e cvel=%.3e tip_max=%.4g last_t=%s", rows, bad, (km > 0 ? de / km : de), cp, cv, tm / 1.8, t }' "$CSV" ||
-  echo "rows=0 bad_rows=0 energy_err=nan cpos=nan cvel=nan tip_max=nan last_t=nan")
+    if ("beam.tip_v" in c) { v = $c["beam.tip_v"]; if (v < 0) v = -v; if (v > tm) tm = v }
+    if ("beam.tip_u" in c) su += $c["beam.tip_u"] }
+  END { printf "rows=%d bad_rows=%d energy_err=%.3e cpos=%.3e cvel=%.3e tip_max=%.4g tip_u_mean=%.5e last_t=%s", rows, bad, (km > 0 ? de / km : de), cp, cv, tm / 1.8, (rows ? su / rows : 0), t }' "$CSV" ||
+  echo "rows=0 bad_rows=0 energy_err=nan cpos=nan cvel=nan tip_max=nan tip_u_mean=nan last_t=nan")
 LINE="case=$CASE exit=$RC status=$(kv status) t_reached=$(kv t_reached) t_end=${T_END:-?} steps=$(kv steps) jacobians=$(kv jacobians) cpu_s=$(kv cpu_s) $METRICS msg=\"$MSG\""
 echo "$LINE"
 [ "$CHECK" = --check ] || exit 0
@@ -78,8 +86,12 @@ get() { echo "$LINE" | sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
 case "|$EXPECT|" in *"|$RC|"*) ;; *) fail "exit $RC, expected $EXPECT: $MSG" ;; esac
 [ "$(get bad_rows)" = 0 ] || fail "$(get bad_rows) rows with a non-finite or non-numeric value"
 le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a + 0 <= b + 0 && a == a + 0) }'; }
+# energy balance up to the end or the stop
+[ "$(get rows)" = 0 ] || le "$(get energy_err)" "$ETOL" || fail "energy balance error $(get energy_err) > $ETOL"
+if [ -n "$TIPU" ]; then # mean axial tip stretch of a rod spinning at 40 rad/s: rho Omega^2 L^3 / (3 E)
+  awk -v a="$(get tip_u_mean)" -v b="$TIPU" 'BEGIN { d = (a - b) / b; exit !(d < 0.02 && d > -0.02) }' || fail "mean tip_u $(get tip_u_mean) vs centrifugal stretch $TIPU"
+fi
 if [ "$RC" = 0 ]; then
-  le "$(get energy_err)" "$ETOL" || fail "energy balance error $(get energy_err) > $ETOL"
   le "$(get cpos)" "$CTOL" || fail "constraint drift $(get cpos) > $CTOL"
   awk -v a="$(get t_reached)" -v b="$T_END" 'BEGIN { d = a - b; exit !(d < 1e-9 && d > -1e-9) }' || fail "exit 0 but t_reached $(get t_reached) != t_end $T_END"
   le "$(get tip_max)" "$TIPMAX" || fail "tip deflection $(get tip_max) L > $TIPMAX L"
