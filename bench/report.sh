@@ -66,14 +66,14 @@ command -v gnuplot > /dev/null || { echo "report.sh: gnuplot not found, no plots
 for s in $scenes; do
   plot=""
   for grp in rtol foac zoac elements dense errctl order; do
-    awk -F, -v s="$s" -v g="$grp" '$1 == s && $2 == g && $10 == "ok" && $21 != "nan" && $21 + 0 > 0 && $17 + 0 > 0 { print $17, $21, ($2 == "elements" ? "n=" $4 : ($2 == "order" ? "k=" $9 " " $5 : $5)) }' "$RUNS" > "$DAT/$s.$grp"
+    awk -F, -v s="$s" -v g="$grp" '$1 == s && $2 == g && !(g == "dense" && $4 != "16" && $4 != "-") && $10 == "ok" && $21 != "nan" && $21 + 0 > 0 && $17 + 0 > 0 { print $17, $21, ($2 == "elements" ? "n=" $4 : ($2 == "order" ? "k=" $9 " " $5 : $5)) }' "$RUNS" > "$DAT/$s.$grp"
     [ -s "$DAT/$s.$grp" ] || continue
     case $grp in
       rtol) t="complete, 16 el., KLU: rtol sweep"; [ "$s" = fourbar ] && t="rigid, KLU, BDF order <= 5: rtol sweep" ;;
       foac) t="FOAC, 16 el." ;;
       zoac) t="ZOAC, 16 el." ;;
       elements) t="complete: element sweep" ;;
-      dense) t="complete, dense LU" ;;
+      dense) t="complete, 16 el., dense LU"; [ "$s" = fourbar ] && t="rigid, dense LU" ;;
       errctl) t="other error control" ;;
       order) t="other BDF order cap (k)"; [ "$s" = fourbar ] && t="BDF order <= 2" ;;
     esac
