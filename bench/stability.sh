@@ -15,8 +15,9 @@ abrupt_w15 overspeed flex_pendulum deadpoint pendulum5 tight_fine elements128 el
 [ "${1:-}" = --quick ] && CASES="slender_I1e-12 slender_I1e-10 omega30 abrupt_w1 abrupt_w15 deadpoint"
 [ -n "${APPEND:-}" ] || : > "$RES/stability.txt"
 for c in $CASES; do
-  line=$(timeout 1200 sh tests/stability/run_case.sh "$F" tests/stability "$OUT" "$c" --check 2> "$OUT/$c.check")
-  verdict=$(grep -E '^(FAIL|ok)' "$OUT/$c.check" | head -1)
+  timeout 1200 sh tests/stability/run_case.sh "$F" tests/stability "$OUT" "$c" --check > "$OUT/$c.out" 2> "$OUT/$c.check"
+  line=$(grep "^case=" "$OUT/$c.out")
+  verdict=$(cat "$OUT/$c.out" "$OUT/$c.check" | grep -E "^(FAIL|ok)" | head -1)
   [ -n "$line" ] || line="case=$c TIMEOUT (1200 s)"
   echo "$line check=\"${verdict:-$(tail -1 "$OUT/$c.check")}\"" | tee -a "$RES/stability.txt"
 done
