@@ -73,6 +73,7 @@ struct fmbModel {
   fmbOutput* output;
   int need_energy, need_constraint, check_definiteness;
   int bdf_order_cap; /* min over bodies' max_bdf_order */
+  int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
   /* sparsity pattern of the iteration matrix, CSC, fixed at load */
   int nblock;
   fmbBlock* block;
@@ -144,9 +145,10 @@ double* fmb_workspace_plugin(fmbWorkspace* w);
 int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
                         double* F);
 /* J = dF/dy + cj dF/dyp into a CSC matrix with the model's pattern (data only), or a dense
-   column-major ny x ny matrix when dense != NULL. ewt: IDA's error weights (for FD steps). */
+   column-major ny x ny matrix when dense != NULL. ewt: IDA's error weights (for FD steps).
+   reuse_blocks: assemble with the bodies' K, C, M from the last fresh call (only cj changed). */
 int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj, const double* y,
-                        const double* yp, const double* ewt, double* csc_data, double* dense);
+                        const double* yp, const double* ewt, int reuse_blocks, double* csc_data, double* dense);
 /* building blocks shared by the residual, Jacobian and initial conditions */
 int fmb_joint_constraint(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                          double* phi, double* phi_q, double* phi_t, double* phi_tt);

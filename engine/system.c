@@ -23,13 +23,21 @@ struct fmbWorkspace {
   double *phi, *phi_q, *phi_q2, *phi_t, *phi_tt, *jq, *jv, *jQ, *jQ2;
   int* cols;
   /* body scratch: dense blocks and FD */
-  double *K, *C, *M, *fd, *mk, *js;
+  double *K, *C, *M, *fdcol, *fd, *mk, *js;
   double *qpert, *vpert;
   double* ewt_default;
   /* global scratch */
   double *Mg, *PhiQ, *Qg;
   int max_rows, max_nq;
+  /* the bodies' K, C, M blocks of the last fresh Jacobian, kept so that a new cj (IDA asks
+     whenever the step size changes enough) costs a re-assembly, not new differences; NULL when
+     they would take more than FMB_BLOCK_CACHE_BYTES */
+  double* cache;
+  size_t* cache_adr;
+  int cache_valid;
 };
+
+#define FMB_BLOCK_CACHE_BYTES ((size_t)256 << 20)
 
 static size_t max_body_nq(const fmbModel* m) {
   int mx = 1;
@@ -63,6 +71,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->K = calloc(nb * nb, sizeof(double));
   w->C = calloc(nb * nb, sizeof(double));
   w->M = calloc(nb * nb, sizeof(double));
+  w->fdcol = calloc(nb * nb, sizeof(double));
   w->fd = calloc(7 * nb, sizeof(double));
   w->mk = calloc(3 * nb, sizeof(double));
   w->js = calloc(2 * mc, sizeof(double));
@@ -71,9 +80,24 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->ewt_default = calloc(2 * nq, sizeof(double));
   w->Qg = calloc(nq, sizeof(double));
   if (!w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
-      !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
+      !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fdcol || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
     fmb_workspace_free(w);
     return NULL;
+  }
+  size_t ncache = 0;
+  for (int b = 1; b < m->nbody; ++b) ncache += 3 * (size_t)m->body[b].nq * (size_t)m->body[b].nq;
+  if (ncache * sizeof(double) <= FMB_BLOCK_CACHE_BYTES) {
+    w->cache = malloc((ncache + 1) * sizeof(double));
+    w->cache_adr = calloc((size_t)m->nbody + 1, sizeof(size_t));
+    if (!w->cache || !w->cache_adr) {
+      fmb_workspace_free(w);
+      return NULL;
+    }
+    size_t adr = 0;
+    for (int b = 1; b < m->nbody; ++b) {
+      w->cache_adr[b] = adr;
+      adr += 3 * (size_t)m->body[b].nq * (size_t)m->body[b].nq;
+    }
   }
   if (m->check_definiteness) {
     w->Mg = calloc(nq * nq, sizeof(double));
@@ -88,8 +112,9 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
 
 void fmb_workspace_free(fmbWorkspace* w) {
   if (!w) return;
-  double* bufs[] = {w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
-                    w->K, w->C, w->M, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
+  free(w->cache_adr);
+  double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
+                    w->K, w->C, w->M, w->fdcol, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
   free(w->cols);
   free(w);
@@ -264,7 +289,7 @@ int fmb_body_blocks(const fmbModel* m, fmbWorkspace* w, int b, const double* q, 
 }
 
 int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj, const double* y, const double* yp,
-                        const double* ewt, double* csc_data, double* dense) {
+                        const double* ewt, int reuse_blocks, double* csc_data, double* dense) {
   const int nq = m->nq, nc = m->nc;
   const int Fq = 0, Fv = nq, Fl = 2 * nq, Fm = 2 * nq + nc;
   const int Yq = 0, Yv = nq, Yl = 2 * nq, Ym = 2 * nq + nc;
@@ -279,16 +304,30 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     sink_add(&s, Fq + i, Yq + i, cj);
     sink_add(&s, Fq + i, Yv + i, -1.0);
   }
+  const int reuse = reuse_blocks && w->cache && w->cache_valid;
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     const int n = bi->nq, a0 = bi->qadr;
-    int rc = fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, w->K, w->C, w->M);
-    if (rc) return rc;
+    const size_t nn = (size_t)n * (size_t)n;
+    double *K = w->K, *C = w->C, *M = w->M;
+    if (w->cache) {
+      K = w->cache + w->cache_adr[b];
+      C = K + nn;
+      M = C + nn;
+    }
+    if (!reuse) {
+      int rc = fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, K, C, M);
+      if (rc) {
+        w->cache_valid = 0;
+        return rc;
+      }
+    }
     /* dR/dq under q, dR/dv + cj dR/da under v */
-    for (size_t k = 0; k < (size_t)n * (size_t)n; ++k) w->C[k] += cj * w->M[k];
-    sink_block(&s, Fv + a0, n, Yq + a0, n, w->K, n, 1.0);
-    sink_block(&s, Fv + a0, n, Yv + a0, n, w->C, n, 1.0);
+    for (size_t k = 0; k < nn; ++k) w->fdcol[k] = C[k] + cj * M[k];
+    sink_block(&s, Fv + a0, n, Yq + a0, n, K, n, 1.0);
+    sink_block(&s, Fv + a0, n, Yv + a0, n, w->fdcol, n, 1.0);
   }
+  if (w->cache) w->cache_valid = 1;
 
   memcpy(w->qpert, q, (size_t)nq * sizeof(double));
   memcpy(w->vpert, v, (size_t)nq * sizeof(double));
