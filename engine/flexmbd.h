@@ -130,6 +130,12 @@ typedef struct fmbBodyType {
      modes inside their instability wedge and the error test then forces tiny steps. NULL = 5.
      The engine uses the minimum over bodies unless the scene sets solver.max_order. */
   int (*max_bdf_order)(const void* self);
+  /* 0 when this body's velocities should stay out of the error test unless the scene says
+     otherwise (solver.error_control): after any sudden load a finite-element body carries every
+     undamped mode, whose velocity amplitude falls only like 1/omega (its displacement like
+     1/omega^2), so a velocity error test makes the steps resolve modes at 1e5 rad/s that the
+     positions do not notice. NULL = 1 (positions and velocities tested). */
+  int (*velocity_error_test)(const void* self);
   /* NULL when the state is within the model's validity; otherwise why not and what to do (a
      beam whose deformation exceeds its length is diverging). Checked at every output time:
      the run stops there with exit 3 instead of integrating a runaway solution. */
@@ -208,6 +214,8 @@ typedef struct fmbStats {
   int status_ok;
   double t_reached;
   long steps, residuals, jacobians, newton_iters, error_test_fails;
+  long conv_fails;       /* Newton convergence failures */
+  long jacobians_reused; /* of `jacobians`: reassembled for a new cj from the last body blocks */
   double cpu_s;
   double ic_position_correction, ic_velocity_correction; /* norms of the initial projection */
   long rows_written;

@@ -38,6 +38,7 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", NULL};
   static const char* const controls[] = {"full", "positions", NULL};
+  s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
   if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
@@ -116,6 +117,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     b->nwork = b->type->nwork ? b->type->nwork(b->self) : 0;
     m->nwork += b->nwork;
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
+    if (b->type->velocity_error_test && !b->type->velocity_error_test(b->self)) m->bodies_prefer_positions = 1;
     if (b->type->max_bdf_order) {
       const int k = b->type->max_bdf_order(b->self);
       if (k >= 1 && k < m->bdf_order_cap) m->bdf_order_cap = k;
@@ -190,6 +192,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
                          m->nc, m->nq);
   m->ny = 2 * m->nq + 2 * m->nc;
   if (m->solver.max_order == 0) m->solver.max_order = m->bdf_order_cap;
+  if (m->solver.positions_only < 0) m->solver.positions_only = m->bodies_prefer_positions;
   if (outputs >= 0) {
     if (fmb_outputs_resolve(p, m, outputs)) return -1;
   } else {
