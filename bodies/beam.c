@@ -230,7 +230,6 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
   /* prefix integrals over inboard elements: int w2'^2, w2' w2d', w2' w2dd', w2d'^2 */
   double Ipp = 0.0, Ipv = 0.0, Ipa = 0.0, Ivv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
-  const double ys[2] = {-b->r, b->r};
 
   for (int e = 0; e < ne; ++e) {
     double ua[2], d[4], uda[2], dd[4], udda[2], ddd[4];
@@ -269,30 +268,35 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
         wcd = -(Ipv + Ppv);       /* dw_c/dt = -p^T H pd */
         hacc = Ipa + Ppa + Ivv + Pvv; /* h^T pdd + pd^T H pd */
       }
-      for (int iy = 0; iy < 2; ++iy) {
-        double y = ys[iy], m = mhalf * b->wg[g];
-        double uD[2] = {w1 - y * w2s, w2};
-        double uDd[2] = {w1d - y * w2sd, w2d};
-        double uDdd[2] = {w1dd - y * w2sdd, w2dd};
-        double rx = x + uD[0], ry = y + uD[1];
-        double aR[2] = {a0[0] - y * al - x * om2, a0[1] + x * al - y * om2};
-        double aRD[2] = {a0[0] - ry * al - rx * om2 - 2.0 * uDd[1] * om + uDdd[0],
-                         a0[1] + rx * al - ry * om2 + 2.0 * uDd[0] * om + uDdd[1]};
-        double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
-        double FR[2], FD[2], FC[2];
-        point_forces(model, m, aRD, aR, aC, f, FR, FD, FC);
-        Fr[0] += FR[0];
-        Fr[1] += FR[1];
-        /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C */
-        Rth += x * FR[1] - y * FR[0] + uD[0] * FD[1] - uD[1] * FD[0] + wc * FC[1];
-        /* p rows: S_D^T F_D (local) */
-        rp_a[0] += n1[0] * FD[0];
-        rp_a[1] += n1[1] * FD[0];
-        for (int j = 0; j < 4; ++j) rp_t[j] += ns[j] * FD[1] - y * nd[j] * FD[0];
+      /* The cross-section's two points y = -r, +r (weights m each): every force below is affine
+         in y, F = F0 + y F1, so the sums over the pair are exact in closed form,
+         sum (A + yB)(C + yD) = 2 (AC + r^2 BD); with M2 = 2m folded into F0 and F1, one pass
+         gives what the two points gave. The accelerations split the same way:
+           a_RD = a_RD0 + y a_RD1,  a_R = a_R0 + y a_R1,  a_C and f do not depend on y. */
+      {
+        const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
+        const double aRD0[2] = {a0[0] - w2 * al - (x + w1) * om2 - 2.0 * w2d * om + w1dd,
+                                a0[1] + (x + w1) * al - w2 * om2 + 2.0 * w1d * om + w2dd};
+        const double aRD1[2] = {-al + w2s * om2 - w2sdd, -w2s * al - om2 - 2.0 * w2sd * om};
+        const double aR0[2] = {a0[0] - x * om2, a0[1] + x * al};
+        const double aR1[2] = {-al, -om2};
+        const double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
+        const double zero[2] = {0.0, 0.0};
+        double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
+        point_forces(model, M2, aRD0, aR0, aC, f, FR0, FD0, FC0);
+        point_forces(model, M2, aRD1, aR1, zero, zero, FR1, FD1, FC1);
+        Fr[0] += FR0[0];
+        Fr[1] += FR0[1];
+        /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
+        Rth += x * FR0[1] - r2 * FR1[0] + w1 * FD0[1] - r2 * w2s * FD1[1] - w2 * FD0[0] + wc * FC0[1];
+        /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
+        rp_a[0] += n1[0] * FD0[0];
+        rp_a[1] += n1[1] * FD0[0];
+        for (int j = 0; j < 4; ++j) rp_t[j] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0];
         if (coupled) {
           /* p rows: -h F_C[0]; h's own element part now, the inboard part by tail sums */
-          csum[e] += FC[0];
-          for (int j = 0; j < 4; ++j) pv[4 * e + j] += FC[0] * Pv[j];
+          csum[e] += FC0[0];
+          for (int j = 0; j < 4; ++j) pv[4 * e + j] += FC0[0] * Pv[j];
         }
       }
     }
