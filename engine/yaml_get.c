@@ -289,38 +289,40 @@ int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_
   return 0;
 }
 
-int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+/* a body or joint by name: index into the model's bodies (all parsed before any joint) or into
+   the joints parsed so far */
+static const char* body_name_at(const fmbModel* m, int i) { return m->body[i].name; }
+static const char* joint_name_at(const fmbModel* m, int i) { return m->joint[i].name; }
+
+static int get_named(fmbParser* p, fmbNode map, const char* key, unsigned flags, int joints, int* out) {
+  const char* what = joints ? "joint" : "body";
   fmbNode n = fmb_find_key(p, map, key);
-  if (n < 0) return absent(p, map, key, flags, "a body name");
+  if (n < 0) return absent(p, map, key, flags, joints ? "a joint name" : "a body name");
+  const fmbModel* m = p->model;
+  const int count = joints ? m->njoint : m->nbody;
+  const char* (*name_at)(const fmbModel*, int) = joints ? joint_name_at : body_name_at;
   const char* s = fmbp_scalar(p, n);
-  fmbModel* m = p->model;
   if (s)
-    for (int b = 0; b < m->nbody; ++b)
-      if (strcmp(m->body[b].name, s) == 0) {
-        *out = b;
+    for (int i = 0; i < count; ++i)
+      if (strcmp(name_at(m, i), s) == 0) {
+        *out = i;
         return 0;
       }
   char list[400] = "";
   size_t used = 0;
-  for (int b = 0; b < m->nbody && used + 70 < sizeof list; ++b)
-    used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", b ? ", " : "", m->body[b].name);
-  return fmbp_error_at(p, n, "no body named %s%s%s for '%s' (bodies: %s)", s ? "'" : "", s ? s : "(not a name)",
-                       s ? "'" : "", key, list);
+  for (int i = 0; i < count && used + 70 < sizeof list; ++i)
+    used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", name_at(m, i));
+  return fmbp_error_at(p, n, "no %s named %s%s%s for '%s' (%s%s)", what, s ? "'" : "", s ? s : "(not a name)", s ? "'" : "",
+                       key, joints ? "a joint must be defined above the one that uses it; defined: " : "bodies: ",
+                       used ? list : "none");
+}
+
+int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  return get_named(p, map, key, flags, 0, out);
 }
 
 int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
-  fmbNode n = fmb_find_key(p, map, key);
-  if (n < 0) return absent(p, map, key, flags, "a joint name");
-  const char* s = fmbp_scalar(p, n);
-  fmbModel* m = p->model;
-  if (s)
-    for (int j = 0; j < m->njoint; ++j)
-      if (strcmp(m->joint[j].name, s) == 0) {
-        *out = j;
-        return 0;
-      }
-  return fmbp_error_at(p, n, "no joint named %s%s%s for '%s' (a joint must be defined above the one that uses it)",
-                       s ? "'" : "", s ? s : "(not a name)", s ? "'" : "", key);
+  return get_named(p, map, key, flags, 1, out);
 }
 
 int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]) {
