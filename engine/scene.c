@@ -73,6 +73,38 @@ static int type_names(const fmbRegistry* reg, int bodies, const char** names) {
   return n;
 }
 
+/* What every body and joint item shares: a mapping with a fresh name and a registered type, read
+   by its plugin with no key left unread. On success *self belongs to the caller; on error
+   nothing is left allocated. */
+static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints, const char* const* names,
+                      char name[FMB_NAME_MAX], int* t, void** self) {
+  const char* kind = joints ? "joint" : "body";
+  *self = NULL;
+  if (!fmbp_is_map(p, item)) return fmbp_error_at(p, item, "expected a mapping for a %s (with name and type)", kind);
+  fmbp_begin_item(p);
+  if (fmbp_get_name(p, item, "name", name)) return -1;
+  if (name_taken(m, name))
+    return fmbp_error_at(p, fmb_find_key(p, item, "name"),
+                         "duplicate or reserved name '%s': every body and joint needs its own name", name);
+  if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
+  const char* type_name = joints ? p->reg->joints[*t]->name : p->reg->bodies[*t]->name;
+  const int abi = joints ? p->reg->joints[*t]->abi : p->reg->bodies[*t]->abi;
+  int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : p->reg->bodies[*t]->parse;
+  void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : p->reg->bodies[*t]->destroy;
+  if (abi != FMB_ABI_VERSION)
+    return fmbp_error_at(p, item, "%s type '%s' was built for plugin ABI %d, the engine has %d", kind, type_name, abi,
+                         FMB_ABI_VERSION);
+  char what[FMB_NAME_MAX + 40];
+  snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
+  if (parse(p, item, self) || fmbp_check_unknown(p, item, what)) {
+    if (*self) destroy(*self); /* also a parse that failed after setting *self */
+    *self = NULL;
+    if (!p->diag->code) fmbp_error_at(p, item, "%s could not be set up", what);
+    return -1;
+  }
+  return 0;
+}
+
 static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
   if (list < 0) return fmbp_error_at(p, fmbp_root(p), "missing required key 'bodies' (a list of bodies, each with name and type)");
   if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list for 'bodies' (each item a mapping with name and type)");
@@ -87,29 +119,11 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
   const char* names[FMB_MAX_TYPES];
   type_names(p->reg, 1, names);
   for (int i = 0; i < n; ++i) {
-    fmbNode item = fmbp_seq_item(p, list, i);
-    if (!fmbp_is_map(p, item)) return fmbp_error_at(p, item, "expected a mapping for a body (with name and type)");
-    fmbp_begin_item(p);
     fmbBodyInst* b = &m->body[m->nbody];
     int t = 0;
-    if (fmbp_get_name(p, item, "name", b->name)) return -1;
-    if (name_taken(m, b->name))
-      return fmbp_error_at(p, fmb_find_key(p, item, "name"), "duplicate or reserved name '%s': every body and joint needs its own name", b->name);
-    if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, &t)) return -1;
+    if (parse_item(p, m, fmbp_seq_item(p, list, i), 0, names, b->name, &t, &b->self)) return -1;
     b->type = p->reg->bodies[t];
-    if (b->type->abi != FMB_ABI_VERSION)
-      return fmbp_error_at(p, item, "body type '%s' was built for plugin ABI %d, the engine has %d", b->type->name,
-                           b->type->abi, FMB_ABI_VERSION);
-    if (b->type->parse(p, item, &b->self)) {
-      if (b->self) b->type->destroy(b->self); /* a parse that failed after setting *self */
-      b->self = NULL;
-      if (!p->diag->code) fmbp_error_at(p, item, "body '%s' (type %s) could not be set up", b->name, b->type->name);
-      return -1;
-    }
     m->nbody++; /* owns self from here on, freed by fmb_free */
-    char what[FMB_NAME_MAX + 40];
-    snprintf(what, sizeof what, "body '%s' (type %s)", b->name, b->type->name);
-    if (fmbp_check_unknown(p, item, what)) return -1;
     b->qadr = m->nq;
     b->nq = b->type->ncoord(b->self);
     m->nq += b->nq;
@@ -136,28 +150,11 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
   type_names(p->reg, 0, names);
   for (int i = 0; i < n; ++i) {
     fmbNode item = fmbp_seq_item(p, list, i);
-    if (!fmbp_is_map(p, item)) return fmbp_error_at(p, item, "expected a mapping for a joint (with name and type)");
-    fmbp_begin_item(p);
     fmbJointInst* j = &m->joint[m->njoint];
     int t = 0;
-    if (fmbp_get_name(p, item, "name", j->name)) return -1;
-    if (name_taken(m, j->name))
-      return fmbp_error_at(p, fmb_find_key(p, item, "name"), "duplicate or reserved name '%s': every body and joint needs its own name", j->name);
-    if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, &t)) return -1;
+    if (parse_item(p, m, item, 1, names, j->name, &t, &j->self)) return -1;
     j->type = p->reg->joints[t];
-    if (j->type->abi != FMB_ABI_VERSION)
-      return fmbp_error_at(p, item, "joint type '%s' was built for plugin ABI %d, the engine has %d", j->type->name,
-                           j->type->abi, FMB_ABI_VERSION);
-    if (j->type->parse(p, item, &j->self)) {
-      if (j->self) j->type->destroy(j->self); /* a parse that failed after setting *self */
-      j->self = NULL;
-      if (!p->diag->code) fmbp_error_at(p, item, "joint '%s' (type %s) could not be set up", j->name, j->type->name);
-      return -1;
-    }
     m->njoint++;
-    char what[FMB_NAME_MAX + 40];
-    snprintf(what, sizeof what, "joint '%s' (type %s)", j->name, j->type->name);
-    if (fmbp_check_unknown(p, item, what)) return -1;
     j->type->bodies(j->self, j->body);
     if (j->body[0] == j->body[1])
       return fmbp_error_at(p, item, "joint '%s' connects body '%s' to itself", j->name, m->body[j->body[0]].name);
