@@ -144,9 +144,12 @@ static void usage(FILE* f) {
 int fmb_compare_main(int argc, char** argv) {
   const char* files[2] = {NULL, NULL};
   const char* cols = NULL;
+  const char* tag = NULL; /* appended to every line: `flexmbd run --reference` adds the run's cost */
   int nf = 0;
   for (int i = 2; i < argc; ++i) {
-    if (strcmp(argv[i], "--columns") == 0 || strcmp(argv[i], "-c") == 0) {
+    if (strcmp(argv[i], "--tag") == 0 && i + 1 < argc) {
+      tag = argv[++i];
+    } else if (strcmp(argv[i], "--columns") == 0 || strcmp(argv[i], "-c") == 0) {
       if (++i >= argc) {
         fprintf(stderr, "flexmbd compare: --columns needs a comma-separated list\n");
         return 2;
@@ -258,8 +261,8 @@ int fmb_compare_main(int argc, char** argv) {
     if (nonfinite) emax = NAN;
     const double sc = scale > 0.0 ? scale : 1.0;
     printf("compare: column=%s rows=%ld t_last=%.10g max_abs=%.6e t_max=%.10g max_rel=%.6e end_abs=%.6e end_rel=%.6e "
-           "ref_scale=%.6e\n",
-           out.name[a], rows, tlast, emax, tmax, emax / sc, eend, eend / sc, scale);
+           "ref_scale=%.6e%s%s\n",
+           out.name[a], rows, tlast, emax, tmax, emax / sc, eend, eend / sc, scale, tag ? " " : "", tag ? tag : "");
   }
 done:
   free(list);

@@ -1,5 +1,5 @@
 /* flexmbd.c — the command line.
- *   flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet]
+ *   flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet] [--reference REF.csv [--columns a,b]]
  *   flexmbd check SCENE.yaml [--set PATH=VALUE]...     load, validate, describe; no run
  *   flexmbd types                                       the registered body and joint types
  *   flexmbd compare OUT.csv REF.csv [--columns a,b,...]  max and end error per column (tools/compare.c)
@@ -18,6 +18,7 @@ int fmb_compare_main(int argc, char** argv); /* tools/compare.c */
 static void usage(FILE* f) {
   fprintf(f,
           "usage: flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet]\n"
+          "                  [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
           "       flexmbd check SCENE.yaml [--set PATH=VALUE]...\n"
           "       flexmbd compare OUT.csv REF.csv [--columns a,b,...]   error of a run against a reference\n"
           "       flexmbd types\n"
@@ -73,6 +74,8 @@ int main(int argc, char** argv) {
   const int run = strcmp(cmd, "run") == 0;
   const char* scene = NULL;
   const char* out = NULL;
+  const char* reference = NULL; /* run --reference REF.csv: error against REF and the run's cost */
+  const char* columns = NULL;
   const char* overrides[MAX_OVERRIDES];
   int nover = 0, quiet = 0;
   for (int i = 2; i < argc; ++i) {
@@ -83,6 +86,15 @@ int main(int argc, char** argv) {
         return FMB_EXIT_BAD_INPUT;
       }
       out = argv[i];
+    } else if ((strcmp(a, "--reference") == 0 || strcmp(a, "--columns") == 0) && run) {
+      if (++i >= argc) {
+        fprintf(stderr, "flexmbd: %s needs an argument\n", a);
+        return FMB_EXIT_BAD_INPUT;
+      }
+      if (a[2] == 'r')
+        reference = argv[i];
+      else
+        columns = argv[i];
     } else if (strcmp(a, "--set") == 0) {
       if (++i >= argc) {
         fprintf(stderr, "flexmbd: --set needs PATH=VALUE\n");
@@ -108,6 +120,10 @@ int main(int argc, char** argv) {
       return FMB_EXIT_BAD_INPUT;
     }
   }
+  if (reference && (!out || strcmp(out, "-") == 0)) {
+    fprintf(stderr, "flexmbd: --reference needs the run's CSV in a file (-o OUT.csv)\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
   if (!scene) {
     fprintf(stderr, "flexmbd: no scene file given\n");
     usage(stderr);
@@ -131,6 +147,19 @@ int main(int argc, char** argv) {
   fmbRunOptions opt = {out, quiet};
   int rc = fmb_run(m, &opt, &stats, &diag);
   if (rc) print_diag(&diag);
+  if (reference) {
+    /* one line per column on stdout: the error against the reference and what the run cost */
+    char tag[160];
+    snprintf(tag, sizeof tag, "status=%s cpu_s=%.4f steps=%ld", rc ? "failed" : "ok", stats.cpu_s, stats.steps);
+    char* cargv[8] = {argv[0], "compare", (char*)out, (char*)reference, "--tag", tag, NULL, NULL};
+    int cargc = 6;
+    if (columns) {
+      cargv[cargc++] = "--columns";
+      cargv[cargc++] = (char*)columns;
+    }
+    int crc = fmb_compare_main(cargc, cargv);
+    if (crc && !rc) rc = crc;
+  }
   fmb_print_stats(&stats, stderr);
   fmb_free(m);
   return rc;

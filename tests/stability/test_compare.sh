@@ -44,4 +44,17 @@ if "$F" compare "$D/ref.csv" "$D/ref.csv" --columns nope > /dev/null 2>&1; then 
 "$F" compare "$D/ref.csv" "$D/ref.csv" --columns nope 2> "$D/err.txt" > /dev/null || [ $? -eq 2 ] || fail "unknown column: exit not 2"
 grep -q "no column 'nope'" "$D/err.txt" || fail "unknown column: message"
 if "$F" compare "$D/missing.csv" "$D/ref.csv" > /dev/null 2>&1; then fail "missing file accepted"; fi
+# run --reference: a run compared with itself has zero error, and the line carries its cost
+SC="$(dirname "$0")/../../scenes/pendulum.yaml"
+"$F" run "$SC" -o "$D/run.csv" --quiet --set solver.t_end=0.5 2> /dev/null || fail "pendulum run exited $?"
+"$F" run "$SC" -o "$D/run2.csv" --quiet --set solver.t_end=0.5 --reference "$D/run.csv" --columns bob.x \
+  > "$D/runref.txt" 2> "$D/runref.err" || fail "run --reference exited $?"
+[ "$(wc -l < "$D/runref.txt")" -eq 1 ] || fail "run --reference --columns bob.x: expected one line"
+[ "$(field "$D/runref.txt" bob.x max_abs)" = "0.000000e+00" ] || fail "run --reference against itself: max_abs not 0"
+grep -q " status=ok cpu_s=[0-9.]* steps=[0-9]*$" "$D/runref.txt" || fail "run --reference: the line lacks the run's cost"
+tail -n 1 "$D/runref.err" | grep -q "^stats: status=ok" || fail "run --reference: the stats line is not last on stderr"
+# a wrong tolerance shows up as a non-zero error
+"$F" run "$SC" -o "$D/run3.csv" --quiet --set solver.t_end=0.5 --set solver.rtol=1e-3 --reference "$D/run.csv" \
+  --columns bob.x > "$D/runref3.txt" 2> /dev/null || fail "run --reference (rtol 1e-3) exited $?"
+awk -v e="$(field "$D/runref3.txt" bob.x max_abs)" 'BEGIN { exit !(e > 1e-8) }' || fail "a looser run shows no error"
 echo "compare: all checks passed"
