@@ -114,11 +114,6 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
 void fmbp_close(fmbParser* p);
 fmbNode fmbp_root(fmbParser* p);
 yaml_node_t* fmbp_node(fmbParser* p, fmbNode n);
-int fmbp_error_at(fmbParser* p, fmbNode node, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
 /* start a new item (resets the looked-up key list); check that every key of `map` was looked up */
 void fmbp_begin_item(fmbParser* p);
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what);

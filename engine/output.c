@@ -30,10 +30,10 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
   snprintf(o->name, sizeof o->name, "%s", text);
   const char* dot = strchr(text, '.');
   if (!dot || dot == text || !dot[1])
-    return fmbp_error_at(p, node, "expected an output name NAME.quantity (e.g. beam.tip_v, energy.total), got '%s'", text);
+    return fmb_parse_error(p, node, "expected an output name NAME.quantity (e.g. beam.tip_v, energy.total), got '%s'", text);
   char owner[FMB_NAME_MAX];
   size_t len = (size_t)(dot - text);
-  if (len >= sizeof owner) return fmbp_error_at(p, node, "no body or joint named '%.*s...'", 20, text);
+  if (len >= sizeof owner) return fmb_parse_error(p, node, "no body or joint named '%.*s...'", 20, text);
   memcpy(owner, text, len);
   owner[len] = '\0';
   const char* qty = dot + 1;
@@ -55,7 +55,7 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
     for (int i = 0; i < m->njoint; ++i)
       if (strcmp(m->joint[i].name, owner) == 0) j = i;
     if (b < 0 && j < 0)
-      return fmbp_error_at(p, node, "output '%s': no body or joint named '%s' (outputs are NAME.quantity, energy.*, constraint.*)",
+      return fmb_parse_error(p, node, "output '%s': no body or joint named '%s' (outputs are NAME.quantity, energy.*, constraint.*)",
                            text, owner);
     o->id = -1;
     if (b >= 0) {
@@ -81,24 +81,24 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
       list_names(avail, sizeof avail, ji->type->output_names);
     }
   }
-  if (o->id < 0) return fmbp_error_at(p, node, "output '%s': unknown quantity '%s' (available: %s)", text, qty, avail);
+  if (o->id < 0) return fmb_parse_error(p, node, "output '%s': unknown quantity '%s' (available: %s)", text, qty, avail);
   return 0;
 }
 
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
-  if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list of output names for 'outputs', e.g. [beam.tip_v, energy.total]");
+  if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list of output names for 'outputs', e.g. [beam.tip_v, energy.total]");
   int n = fmbp_seq_len(p, list);
   m->output = calloc((size_t)n + 1, sizeof *m->output);
-  if (!m->output) return fmbp_error_at(p, list, "out of memory");
+  if (!m->output) return fmb_parse_error(p, list, "out of memory");
   m->output[0].kind = FMB_OUT_TIME;
   snprintf(m->output[0].name, sizeof m->output[0].name, "t");
   m->noutput = 1;
   for (int i = 0; i < n; ++i) {
     fmbNode item = fmbp_seq_item(p, list, i);
     const char* s = fmbp_scalar(p, item);
-    if (!s) return fmbp_error_at(p, item, "expected an output name NAME.quantity in 'outputs'");
+    if (!s) return fmb_parse_error(p, item, "expected an output name NAME.quantity in 'outputs'");
     for (int k = 1; k < m->noutput; ++k)
-      if (strcmp(m->output[k].name, s) == 0) return fmbp_error_at(p, item, "output '%s' is listed twice", s);
+      if (strcmp(m->output[k].name, s) == 0) return fmb_parse_error(p, item, "output '%s' is listed twice", s);
     if (resolve_one(p, m, item, s, &m->output[m->noutput])) return -1;
     m->noutput++;
   }

@@ -33,8 +33,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->max_step = 0.0;
   s->dense = 0;
   s->max_steps_per_output = 100000;
-  if (node < 0) return fmbp_error_at(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmbp_error_at(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, max_order, error_control, linear_solver, max_steps)");
+  if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
+  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, max_order, error_control, linear_solver, max_steps)");
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", NULL};
   static const char* const controls[] = {"full", "positions", NULL};
@@ -54,13 +54,13 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->max_steps_per_output = max_steps;
   if (s->rtol >= 0.1)
-    return fmbp_error_at(p, fmb_find_key(p, node, "rtol"), "expected rtol below 0.1 (a relative tolerance), got %g", s->rtol);
+    return fmb_parse_error(p, fmb_find_key(p, node, "rtol"), "expected rtol below 0.1 (a relative tolerance), got %g", s->rtol);
   if (s->output_step == 0.0) s->output_step = s->t_end / 1000.0;
   if (s->output_step > s->t_end)
-    return fmbp_error_at(p, fmb_find_key(p, node, "output_step"), "output_step (%g) is longer than t_end (%g)",
+    return fmb_parse_error(p, fmb_find_key(p, node, "output_step"), "output_step (%g) is longer than t_end (%g)",
                          s->output_step, s->t_end);
   if (s->t_end / s->output_step > (double)FMB_MAX_ROWS)
-    return fmbp_error_at(p, fmb_find_key(p, node, "output_step"),
+    return fmb_parse_error(p, fmb_find_key(p, node, "output_step"),
                          "output_step %g with t_end %g asks for more than %ld rows", s->output_step, s->t_end, FMB_MAX_ROWS);
   return 0;
 }
@@ -80,11 +80,11 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
                       char name[FMB_NAME_MAX], int* t, void** self) {
   const char* kind = joints ? "joint" : "body";
   *self = NULL;
-  if (!fmbp_is_map(p, item)) return fmbp_error_at(p, item, "expected a mapping for a %s (with name and type)", kind);
+  if (!fmbp_is_map(p, item)) return fmb_parse_error(p, item, "expected a mapping for a %s (with name and type)", kind);
   fmbp_begin_item(p);
   if (fmbp_get_name(p, item, "name", name)) return -1;
   if (name_taken(m, name))
-    return fmbp_error_at(p, fmb_find_key(p, item, "name"),
+    return fmb_parse_error(p, fmb_find_key(p, item, "name"),
                          "duplicate or reserved name '%s': every body and joint needs its own name", name);
   if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
   const char* type_name = joints ? p->reg->joints[*t]->name : p->reg->bodies[*t]->name;
@@ -92,26 +92,26 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : p->reg->bodies[*t]->parse;
   void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : p->reg->bodies[*t]->destroy;
   if (abi != FMB_ABI_VERSION)
-    return fmbp_error_at(p, item, "%s type '%s' was built for plugin ABI %d, the engine has %d", kind, type_name, abi,
+    return fmb_parse_error(p, item, "%s type '%s' was built for plugin ABI %d, the engine has %d", kind, type_name, abi,
                          FMB_ABI_VERSION);
   char what[FMB_NAME_MAX + 40];
   snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
   if (parse(p, item, self) || fmbp_check_unknown(p, item, what)) {
     if (*self) destroy(*self); /* also a parse that failed after setting *self */
     *self = NULL;
-    if (!p->diag->code) fmbp_error_at(p, item, "%s could not be set up", what);
+    if (!p->diag->code) fmb_parse_error(p, item, "%s could not be set up", what);
     return -1;
   }
   return 0;
 }
 
 static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
-  if (list < 0) return fmbp_error_at(p, fmbp_root(p), "missing required key 'bodies' (a list of bodies, each with name and type)");
-  if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list for 'bodies' (each item a mapping with name and type)");
+  if (list < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'bodies' (a list of bodies, each with name and type)");
+  if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list for 'bodies' (each item a mapping with name and type)");
   int n = fmbp_seq_len(p, list);
-  if (n == 0) return fmbp_error_at(p, list, "'bodies' is empty: a scene needs at least one body");
+  if (n == 0) return fmb_parse_error(p, list, "'bodies' is empty: a scene needs at least one body");
   m->body = calloc((size_t)n + 1, sizeof *m->body);
-  if (!m->body) return fmbp_error_at(p, list, "out of memory");
+  if (!m->body) return fmb_parse_error(p, list, "out of memory");
   m->bdf_order_cap = 5;
   /* body 0: the fixed world frame */
   snprintf(m->body[0].name, FMB_NAME_MAX, "ground");
@@ -142,10 +142,10 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
 
 static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
   if (list < 0) return 0;
-  if (!fmbp_is_seq(p, list)) return fmbp_error_at(p, list, "expected a list for 'joints' (each item a mapping with name and type)");
+  if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list for 'joints' (each item a mapping with name and type)");
   int n = fmbp_seq_len(p, list);
   m->joint = calloc((size_t)n + 1, sizeof *m->joint);
-  if (!m->joint) return fmbp_error_at(p, list, "out of memory");
+  if (!m->joint) return fmb_parse_error(p, list, "out of memory");
   const char* names[FMB_MAX_TYPES];
   type_names(p->reg, 0, names);
   for (int i = 0; i < n; ++i) {
@@ -157,7 +157,7 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
     m->njoint++;
     j->type->bodies(j->self, j->body);
     if (j->body[0] == j->body[1])
-      return fmbp_error_at(p, item, "joint '%s' connects body '%s' to itself", j->name, m->body[j->body[0]].name);
+      return fmb_parse_error(p, item, "joint '%s' connects body '%s' to itself", j->name, m->body[j->body[0]].name);
     j->ncol = 0;
     for (int k = 0; k < 2; ++k)
       if (j->body[k] >= 0) j->ncol += m->body[j->body[k]].nq;
@@ -183,9 +183,9 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   m->env.gravity[1] = g[1];
   m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);
   if (parse_solver(p, m, solver) || parse_bodies(p, m, bodies) || parse_joints(p, m, joints)) return -1;
-  if (m->nq == 0) return fmbp_error_at(p, bodies, "the scene has no moving body (no generalized coordinates)");
+  if (m->nq == 0) return fmb_parse_error(p, bodies, "the scene has no moving body (no generalized coordinates)");
   if (m->nc > m->nq)
-    return fmbp_error_at(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
+    return fmb_parse_error(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
                          m->nc, m->nq);
   m->ny = 2 * m->nq + 2 * m->nc;
   if (m->solver.max_order == 0) m->solver.max_order = m->bdf_order_cap;
@@ -195,7 +195,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   } else {
     fmb_outputs_default(m);
   }
-  if (fmb_pattern_build(m)) return fmbp_error_at(p, root, "out of memory building the sparsity pattern");
+  if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
   return 0;
 }
 

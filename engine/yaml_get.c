@@ -56,14 +56,6 @@ static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
   return -1;
 }
 
-int fmbp_error_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
-  va_list ap;
-  va_start(ap, fmt);
-  verror_at(p, node, fmt, ap);
-  va_end(ap);
-  return -1;
-}
-
 int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
   va_list ap;
   va_start(ap, fmt);
@@ -144,8 +136,8 @@ int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
     size_t used = 0;
     for (int i = 0; i < p->nlooked && used + 40 < sizeof expected; ++i)
       used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s", i ? ", " : "", p->looked[i]);
-    if (!k) return fmbp_error_at(p, pr->key, "keys must be plain words in %s", what);
-    return fmbp_error_at(p, pr->key, "unknown key '%s' in %s (expected one of: %s)", k, what, expected);
+    if (!k) return fmb_parse_error(p, pr->key, "keys must be plain words in %s", what);
+    return fmb_parse_error(p, pr->key, "unknown key '%s' in %s (expected one of: %s)", k, what, expected);
   }
   return 0;
 }
@@ -158,12 +150,12 @@ static int check_duplicates(fmbParser* p) {
     if (nd->type != YAML_MAPPING_NODE) continue;
     for (yaml_node_pair_t* a = nd->data.mapping.pairs.start; a < nd->data.mapping.pairs.top; ++a) {
       const char* ka = fmbp_scalar(p, a->key);
-      if (!ka) return fmbp_error_at(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
+      if (!ka) return fmb_parse_error(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
       for (yaml_node_pair_t* b = nd->data.mapping.pairs.start; b < a; ++b) {
         const char* kb = fmbp_scalar(p, b->key);
         if (kb && strcmp(ka, kb) == 0) {
           yaml_node_t* first = fmbp_node(p, b->key);
-          return fmbp_error_at(p, a->key, "duplicate key '%s' (first given at line %d)", ka,
+          return fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka,
                                (int)first->start_mark.line + 1);
         }
       }
@@ -196,22 +188,22 @@ static int number_at(fmbParser* p, fmbNode n, const char* key, unsigned flags, d
   yaml_node_t* nd = fmbp_node(p, n);
   if (!nd || nd->type != YAML_SCALAR_NODE || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
       nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
-    return fmbp_error_at(p, n, "expected a number for '%s', found %s", key, node_kind(nd));
+    return fmb_parse_error(p, n, "expected a number for '%s', found %s", key, node_kind(nd));
   const char* s = (const char*)nd->data.scalar.value;
   double v = 0;
   int rc = parse_number(s, &v);
-  if (rc == -2) return fmbp_error_at(p, n, "expected a finite number for '%s', got '%s'", key, s);
-  if (rc) return fmbp_error_at(p, n, "expected a number for '%s', got '%s'", key, s);
+  if (rc == -2) return fmb_parse_error(p, n, "expected a finite number for '%s', got '%s'", key, s);
+  if (rc) return fmb_parse_error(p, n, "expected a number for '%s', got '%s'", key, s);
   if ((flags & FMB_POSITIVE) && !(v > 0))
-    return fmbp_error_at(p, n, "expected a positive number for '%s', got %s", key, s);
+    return fmb_parse_error(p, n, "expected a positive number for '%s', got %s", key, s);
   if ((flags & FMB_NONNEGATIVE) && !(v >= 0))
-    return fmbp_error_at(p, n, "expected a non-negative number for '%s', got %s", key, s);
+    return fmb_parse_error(p, n, "expected a non-negative number for '%s', got %s", key, s);
   *out = v;
   return 0;
 }
 
 static int absent(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* what) {
-  if (flags & FMB_REQUIRED) return fmbp_error_at(p, map, "missing required key '%s' (%s)", key, what);
+  if (flags & FMB_REQUIRED) return fmb_parse_error(p, map, "missing required key '%s' (%s)", key, what);
   return 0;
 }
 
@@ -231,10 +223,10 @@ int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long
   long v = s ? strtol(s, &end, 10) : 0;
   if (!s || !*s || *end != '\0' || errno == ERANGE || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
       nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
-    return fmbp_error_at(p, n, "expected a whole number for '%s', found %s%s%s%s", key, s ? "'" : "",
+    return fmb_parse_error(p, n, "expected a whole number for '%s', found %s%s%s%s", key, s ? "'" : "",
                          s ? s : node_kind(nd), s ? "'" : "", "");
   if (v < lo || v > hi)
-    return fmbp_error_at(p, n, "expected a whole number from %ld to %ld for '%s', got %ld", lo, hi, key, v);
+    return fmb_parse_error(p, n, "expected a whole number from %ld to %ld for '%s', got %ld", lo, hi, key, v);
   *out = (int)v;
   return 0;
 }
@@ -243,7 +235,7 @@ int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, dou
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a list of two numbers [x, y]");
   if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != 2)
-    return fmbp_error_at(p, n, "expected a list of two numbers [x, y] for '%s', found %s", key,
+    return fmb_parse_error(p, n, "expected a list of two numbers [x, y] for '%s', found %s", key,
                          fmbp_is_seq(p, n) ? "a list of another length" : node_kind(fmbp_node(p, n)));
   double v[2];
   for (int i = 0; i < 2; ++i)
@@ -261,7 +253,7 @@ int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, c
   for (int i = 0; choices[i] && used + 40 < sizeof list; ++i)
     used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", choices[i]);
   if (n < 0) {
-    if (flags & FMB_REQUIRED) return fmbp_error_at(p, map, "missing required key '%s' (one of: %s)", key, list);
+    if (flags & FMB_REQUIRED) return fmb_parse_error(p, map, "missing required key '%s' (one of: %s)", key, list);
     return 0;
   }
   const char* s = fmbp_scalar(p, n);
@@ -271,20 +263,20 @@ int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, c
         *out = i;
         return 0;
       }
-  return fmbp_error_at(p, n, "expected one of %s for '%s', got %s%s%s", list, key, s ? "'" : "",
+  return fmb_parse_error(p, n, "expected one of %s for '%s', got %s%s%s", list, key, s ? "'" : "",
                        s ? s : node_kind(fmbp_node(p, n)), s ? "'" : "");
 }
 
 int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]) {
   fmbNode n = fmb_find_key(p, map, key);
-  if (n < 0) return fmbp_error_at(p, map, "missing required key '%s' (a name)", key);
+  if (n < 0) return fmb_parse_error(p, map, "missing required key '%s' (a name)", key);
   const char* s = fmbp_scalar(p, n);
-  if (!s || !*s) return fmbp_error_at(p, n, "expected a name for '%s', found %s", key, node_kind(fmbp_node(p, n)));
+  if (!s || !*s) return fmb_parse_error(p, n, "expected a name for '%s', found %s", key, node_kind(fmbp_node(p, n)));
   size_t len = strlen(s);
-  if (len >= FMB_NAME_MAX) return fmbp_error_at(p, n, "name '%.20s...' is too long (at most %d characters)", s, FMB_NAME_MAX - 1);
+  if (len >= FMB_NAME_MAX) return fmb_parse_error(p, n, "name '%.20s...' is too long (at most %d characters)", s, FMB_NAME_MAX - 1);
   for (const char* c = s; *c; ++c)
     if (!(isalnum((unsigned char)*c) || *c == '_' || *c == '-'))
-      return fmbp_error_at(p, n, "name '%s' may contain only letters, digits, '_' and '-'", s);
+      return fmb_parse_error(p, n, "name '%s' may contain only letters, digits, '_' and '-'", s);
   memcpy(out, s, len + 1);
   return 0;
 }
@@ -312,7 +304,7 @@ static int get_named(fmbParser* p, fmbNode map, const char* key, unsigned flags,
   size_t used = 0;
   for (int i = 0; i < count && used + 70 < sizeof list; ++i)
     used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", name_at(m, i));
-  return fmbp_error_at(p, n, "no %s named %s%s%s for '%s' (%s%s)", what, s ? "'" : "", s ? s : "(not a name)", s ? "'" : "",
+  return fmb_parse_error(p, n, "no %s named %s%s%s for '%s' (%s%s)", what, s ? "'" : "", s ? s : "(not a name)", s ? "'" : "",
                        key, joints ? "a joint must be defined above the one that uses it; defined: " : "bodies: ",
                        used ? list : "none");
 }
@@ -590,7 +582,7 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
     return -1;
   }
   if (!fmbp_is_map(p, fmbp_root(p)))
-    return fmbp_error_at(p, fmbp_root(p),
+    return fmb_parse_error(p, fmbp_root(p),
                          "expected a mapping with keys solver, bodies, gravity, joints, outputs at the top, found %s",
                          node_kind(fmbp_node(p, fmbp_root(p))));
   grow_override_marks(p);
