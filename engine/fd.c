@@ -9,7 +9,8 @@
 
 #include "internal.h"
 
-static double increment(double y, double ewt) {
+/* IDA's difference increment: sqrt(eps) |y|, but never below the error tolerance 1/ewt */
+double fmb_fd_increment(double y, double ewt) {
   const double srur = 1.4901161193847656e-08; /* sqrt(DBL_EPSILON) */
   double inc = srur * fabs(y);
   double floor_ = ewt > 0 ? 1.0 / ewt : srur;
@@ -35,7 +36,7 @@ int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* 
   if (rc) return rc;
   for (int j = 0; j < n; ++j) {
     if (K) {
-      double h = increment(q[j], ewt_q[j]);
+      double h = fmb_fd_increment(q[j], ewt_q[j]);
       qq[j] = q[j] + h;
       h = qq[j] - q[j]; /* the step actually taken */
       rc = b->type->residual(b->self, env, qq, v, a, R1, work);

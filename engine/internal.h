@@ -191,6 +191,7 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
 void fmb_csv_close(fmbCsv* c);
 
 /* ---- fd.c ---- */
+double fmb_fd_increment(double y, double ewt);
 /* dense column-major derivative of a body's residual: K = dR/dq, C = dR/dv, M = dR/da */
 int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
                          const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,

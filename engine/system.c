@@ -274,12 +274,6 @@ static void sink_block(const Sink* s, int r0, int nr, int c0, int nc, const doub
     for (int i = 0; i < nr; ++i) s->dense[(size_t)(c0 + j) * (size_t)s->m->ny + (size_t)(r0 + i)] += scale * vals[(size_t)j * ld + i];
 }
 
-static double fd_increment(double y, double ewt) {
-  const double srur = 1.4901161193847656e-08;
-  double inc = srur * fabs(y), fl = 1.0 / ewt;
-  return inc > fl ? inc : fl;
-}
-
 int fmb_body_blocks(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, const double* a,
                     const double* ewt, double* K, double* C, double* M) {
   const fmbBodyInst* bi = &m->body[b];
@@ -346,7 +340,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
         for (int c = 0; c < ncol; ++c) {
           const int gc = cols[c];
           const double x0 = x[gc];
-          double h = fd_increment(x0, ew[gc]);
+          double h = fmb_fd_increment(x0, ew[gc]);
           x[gc] = x0 + h;
           h = x[gc] - x0;
           rc = joint_force(m, w, j, t, w->qpert, w->vpert, w->jQ2);
@@ -372,7 +366,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     for (int c = 0; c < ncol; ++c) {
       const int gc = cols[c];
       const double x0 = w->qpert[gc];
-      double h = fd_increment(x0, ewt[gc]);
+      double h = fmb_fd_increment(x0, ewt[gc]);
       w->qpert[gc] = x0 + h;
       h = w->qpert[gc] - x0;
       rc = joint_eval(m, w, j, t, w->qpert, v, w->jq, w->phi_q2, w->jv, w->jQ2);
