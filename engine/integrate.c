@@ -71,7 +71,9 @@ static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N
   if (m->solver.dense)
     return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
                                N_VGetArrayPointer(c->ewt), reuse, NULL, SUNDenseMatrix_Data(J));
-  /* the pattern is fixed; rewrite it in case the solver touched the index arrays */
+  /* the pattern is fixed at load, but IDA zeroes the matrix before each call and SUNDIALS'
+     sparse zero clears the index arrays too (copying them out here is measured necessary:
+     without it every run fails its first Newton step), O(nnz) next to the assembly */
   sunindextype* colptr = SUNSparseMatrix_IndexPointers(J);
   sunindextype* rowind = SUNSparseMatrix_IndexValues(J);
   for (int i = 0; i <= m->ny; ++i) colptr[i] = (sunindextype)m->colptr[i];
