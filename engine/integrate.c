@@ -1,5 +1,6 @@
 /* integrate.c — run a model with SUNDIALS IDA (BDF, variable order and step) on the GGL system
  * of system.c, with KLU (default) or SUNDIALS' dense solver for the Newton systems.
+ * The default solver eliminates the position rows first (schur.c).
  * The BDF order is capped by the bodies (fmbBodyType.max_bdf_order) or solver.max_order: BDF2 is
  * A-stable, while orders 3-5 have an instability wedge at the imaginary axis that amplifies
  * undamped structural modes (a 16-element beam has modes from 4 to 1e5 rad/s); the error test
@@ -68,7 +69,7 @@ static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N
   const fmbModel* m = c->m;
   IDAGetErrWeights(c->ida, c->ewt);
   const int reuse = reuse_body_blocks(c);
-  if (m->solver.dense)
+  if (m->solver.linear_solver == FMB_LS_DENSE)
     return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
                                N_VGetArrayPointer(c->ewt), reuse, NULL, SUNDenseMatrix_Data(J));
   /* the pattern is fixed at load, but IDA zeroes the matrix before each call and SUNDIALS'
@@ -244,12 +245,12 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  if (m->solver.dense) {
+  if (m->solver.linear_solver == FMB_LS_DENSE) {
     A = SUNDenseMatrix(ny, ny, sun);
     LS = A ? SUNLinSol_Dense(y, A, sun) : NULL;
   } else {
     A = SUNSparseMatrix(ny, ny, m->nnz, CSC_MAT, sun);
-    LS = A ? SUNLinSol_KLU(y, A, sun) : NULL;
+    if (A) LS = m->solver.linear_solver == FMB_LS_KLU_FULL ? SUNLinSol_KLU(y, A, sun) : fmb_schur_klu_new(m, sun);
   }
   if (!A || !LS || IDASetLinearSolver(ida, LS, A) != IDA_SUCCESS || IDASetJacFn(ida, jacobian_fn) != IDA_SUCCESS) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up the linear solver");

@@ -46,7 +46,9 @@ typedef struct fmbOutput {
 
 typedef struct fmbSolverSettings {
   double t0, t_end, rtol, atol, output_step, max_step;
-  int dense; /* linear solver: 0 KLU (sparse), 1 SUNDIALS dense */
+  /* Newton systems: KLU on the Schur complement of the position rows (schur.c, default), KLU on
+     the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
+  enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
   int max_order; /* BDF order cap */
   int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
@@ -171,6 +173,11 @@ int fmb_pattern_build(fmbModel* m);
 void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals,
                        int ld, double scale);
 void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v);
+
+/* ---- schur.c: KLU on the GGL Newton systems with the position rows eliminated ---- */
+struct _generic_SUNLinearSolver;
+struct _SUNContext;
+struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
 
 /* ---- dense.c: small dense linear algebra (initial conditions, checks) ---- */
 int fmb_lu_factor(int n, double* A, int* piv);             /* column-major, in place; 0 ok */

@@ -31,28 +31,29 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->atol = 1e-8;
   s->output_step = 0.0;
   s->max_step = 0.0;
-  s->dense = 0;
+  s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
   if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, max_order, error_control, linear_solver, max_steps)");
   fmbp_begin_item(p);
-  static const char* const solvers[] = {"klu", "dense", NULL};
+  static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   s->positions_only = -1; /* unset: chosen from the bodies */
-  int max_steps = 100000;
+  int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
   if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
       fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) ||
       fmb_get_double(p, node, "atol", FMB_POSITIVE, &s->atol) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
       fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
-      fmb_get_choice(p, node, "linear_solver", 0, solvers, &s->dense) ||
+      fmb_get_choice(p, node, "linear_solver", 0, solvers, &linear_solver) ||
       fmb_get_choice(p, node, "error_control", 0, controls, &s->positions_only) ||
       fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
       fmb_get_int(p, node, "max_order", 0, 1, 5, &s->max_order))
     return -1;
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->max_steps_per_output = max_steps;
+  s->linear_solver = linear_solver;
   if (s->rtol >= 0.1)
     return fmb_parse_error(p, fmb_find_key(p, node, "rtol"), "expected rtol below 0.1 (a relative tolerance), got %g", s->rtol);
   if (s->output_step == 0.0) s->output_step = s->t_end / 1000.0;

@@ -94,7 +94,10 @@ int main(void) {
   ENSURE_REL(T_big, T_exact, 1e-6);
   /* a wrong period by the small-angle formula would be off by 140 %: the test discriminates */
   ENSURE(fabs(T_big / (2 * M_PI * sqrt(Leq / g)) - 1) > 0.5);
-  ENSURE(de < 1e-6);  /* rtol 1e-8 */
+  /* rtol 1e-8. Near the separatrix the energy error of a 10 s run is about 100 rtol whatever the
+     Newton solver: 0.8e-6 to 2.3e-6 measured with the reduced KLU, full KLU and dense solvers, and
+     it falls with rtol (4e-8 at 1e-10); a wrong force term drifts by orders of magnitude more */
+  ENSURE(de < 3e-6);
   ENSURE(dc < 1e-8);  /* atol 1e-10 on positions */
   return fmbt_finish("test_pendulum");
 }
