@@ -22,7 +22,6 @@
 #include "flexmbd.h"
 
 enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
-enum { INNER = 3 }; /* Gauss points of the nested rule for slope products (degree 4: exact) */
 enum { MAX_ELEMENTS = 4096 };
 
 typedef struct Beam {
@@ -33,14 +32,15 @@ typedef struct Beam {
   /* derived */
   double le, r;   /* element length, cross-section point offset sqrt(I/A) */
   int n;          /* 3 * ne deformation coordinates */
-  /* quadrature: outer points along an element, and the nested rule on [0, xi_g] */
+  /* quadrature points along an element; shape and slope functions there */
   double xg[FMB_GAUSS_MAX], wg[FMB_GAUSS_MAX];
-  double xi3[INNER], wi3[INNER];
-  /* Hermite slope shape functions (d/dx of [H1, le H2, H3, le H4]) at the inner points of the
-     nested rule of each outer point [g][k][j] and of the full element [k][j] */
-  double nd_in[FMB_GAUSS_MAX][INNER][4];
-  double nd_full[INNER][4];
-  double ns_out[FMB_GAUSS_MAX][4], nd_out[FMB_GAUSS_MAX][4]; /* shape and slope at the outer points */
+  double ns_out[FMB_GAUSS_MAX][4], nd_out[FMB_GAUSS_MAX][4];
+  /* The coupling integrals int_0^x of slope products, in closed form (see slope_poly): the
+     weights of xi^k over [0, xi_g] (pw_out) and over a whole element (pw_full), and the weights
+     G[j][i] that give h_j = int N2j' w2' from the slope coefficients */
+  double nslope[4][3];
+  double pw_out[FMB_GAUSS_MAX][5], pw_full[5];
+  double G_full[4][3];
   double kb[4][4], ka; /* element bending stiffness, axial stiffness EA/le */
 } Beam;
 
@@ -92,6 +92,42 @@ static int adof(int e, int j) {
 }
 
 static double dot4(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+static double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
+static double dot5(const double* a, const double* b) {
+  return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4];
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * The coupling deformation's integrals in closed form. On an element the slope w2' = N2' d is a
+ * quadratic in xi, w2'(xi) = c0 + c1 xi + c2 xi^2 (c = slope_poly(d)), so a product of two slopes
+ * is a quartic (poly_mul) and its integral over [0, xi] in x is the dot product of its five
+ * coefficients with pw_k = le xi^(k+1) / (k+1) (int_weights): exact, no nested quadrature. The
+ * same holds for h_j = int_0^x N2j' w2', whose weights G[j][i] (h_weights) act on c.
+ * ------------------------------------------------------------------------------------------- */
+static void slope_poly(const Beam* b, const double d[4], double c[3]) {
+  for (int i = 0; i < 3; ++i) c[i] = b->nslope[0][i] * d[0] + b->nslope[1][i] * d[1] + b->nslope[2][i] * d[2] + b->nslope[3][i] * d[3];
+}
+
+static void h_weights(const Beam* b, const double pw[5], double G[4][3]) {
+  for (int j = 0; j < 4; ++j)
+    for (int i = 0; i < 3; ++i) G[j][i] = b->nslope[j][0] * pw[i] + b->nslope[j][1] * pw[i + 1] + b->nslope[j][2] * pw[i + 2];
+}
+
+static void poly_mul(const double a[3], const double c[3], double out[5]) {
+  out[0] = a[0] * c[0];
+  out[1] = a[0] * c[1] + a[1] * c[0];
+  out[2] = a[0] * c[2] + a[1] * c[1] + a[2] * c[0];
+  out[3] = a[1] * c[2] + a[2] * c[1];
+  out[4] = a[2] * c[2];
+}
+
+static void int_weights(double le, double xi, double pw[5]) {
+  double xk = xi;
+  for (int k = 0; k < 5; ++k) {
+    pw[k] = le * xk / (k + 1);
+    xk *= xi;
+  }
+}
 
 /* ---------------------------------------------------------------------------------------------
  * Parse.
@@ -103,12 +139,15 @@ static void beam_setup(Beam* b) {
   b->r = sqrt(b->Izz / b->A);
   b->n = 3 * b->ne;
   fmb_gauss_legendre01(b->ng, b->xg, b->wg);
-  fmb_gauss_legendre01(INNER, b->xi3, b->wi3);
-  for (int g = 0; g < b->ng; ++g)
-    for (int k = 0; k < INNER; ++k) hermite(b->xg[g] * b->xi3[k], b->le, NULL, b->nd_in[g][k]);
-  for (int k = 0; k < INNER; ++k) hermite(b->xi3[k], b->le, NULL, b->nd_full[k]);
   for (int g = 0; g < b->ng; ++g) hermite(b->xg[g], b->le, b->ns_out[g], b->nd_out[g]);
-  double le = b->le, ei = b->Emod * b->Izz / (le * le * le);
+  double le = b->le;
+  /* coefficients of xi^0..2 in the slope functions d/dx [H1, le H2, H3, le H4] (hermite's nd) */
+  const double nslope[4][3] = {{0.0, -6.0 / le, 6.0 / le}, {1.0, -4.0, 3.0}, {0.0, 6.0 / le, -6.0 / le}, {0.0, -2.0, 3.0}};
+  memcpy(b->nslope, nslope, sizeof nslope);
+  for (int g = 0; g < b->ng; ++g) int_weights(le, b->xg[g], b->pw_out[g]);
+  int_weights(le, 1.0, b->pw_full);
+  h_weights(b, b->pw_full, b->G_full);
+  double ei = b->Emod * b->Izz / (le * le * le);
   double kb[4][4] = {{12.0, 6.0 * le, -12.0, 6.0 * le},
                      {6.0 * le, 4.0 * le * le, -6.0 * le, 2.0 * le * le},
                      {-12.0, -6.0 * le, 12.0, -6.0 * le},
@@ -181,7 +220,7 @@ static void beam_initial(const void* self, double* q0, double* v0) {
    ZOAC      J_RD^T (a_RD - f)
    FOAC      J_RD^T (a_RD - f) + J_R^T a_C + J_C^T (a_R - f)
    complete  J^T (a_RD + a_C - f)                                                            */
-static void point_forces(int model, double m, const double aRD[2], const double aR[2], const double aC[2],
+static inline void point_forces(int model, double m, const double aRD[2], const double aR[2], const double aC[2],
                          const double f[2], double FR[2], double FD[2], double FC[2]) {
   for (int i = 0; i < 2; ++i) {
     switch (model) {
@@ -227,8 +266,8 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
 
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   double Fr[2] = {0.0, 0.0}, Rth = 0.0;
-  /* prefix integrals over inboard elements: int w2'^2, w2' w2d', w2' w2dd', w2d'^2 */
-  double Ipp = 0.0, Ipv = 0.0, Ipa = 0.0, Ivv = 0.0;
+  /* prefix integrals over inboard elements: int w2'^2, w2' w2d', w2' w2dd' + w2d'^2 */
+  double Ipp = 0.0, Ipv = 0.0, Iha = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
 
   for (int e = 0; e < ne; ++e) {
@@ -238,9 +277,20 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
     gather(pdd, e, udda, ddd);
     double xe = e * le;
     double rp_a[2] = {0.0, 0.0}, rp_t[4] = {0.0, 0.0, 0.0, 0.0};
+    /* slope polynomials of p, pd, pdd and the quartic products the coupling needs:
+       w2'^2, w2' w2d', and w2' w2dd' + w2d'^2 (what h^T pdd + pd^T H pd integrates) */
+    double cp[3], pp[5], pv5[5], ha[5], fc_moment[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
     if (coupled) {
-      for (int j = 0; j < 4; ++j) pv[4 * e + j] = 0.0;
       csum[e] = 0.0;
+      double cv[3], ca[3], vv[5];
+      slope_poly(b, d, cp);
+      slope_poly(b, dd, cv);
+      slope_poly(b, ddd, ca);
+      poly_mul(cp, cp, pp);
+      poly_mul(cp, cv, pv5);
+      poly_mul(cp, ca, ha);
+      poly_mul(cv, cv, vv);
+      for (int k = 0; k < 5; ++k) ha[k] += vv[k];
     }
     for (int g = 0; g < ng; ++g) {
       double xi = b->xg[g], x = xe + xi * le;
@@ -250,23 +300,13 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
       double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
       double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
       double w1dd = n1[0] * udda[0] + n1[1] * udda[1], w2dd = dot4(ns, ddd), w2sdd = dot4(nd, ddd);
-      double wc = 0.0, wcd = 0.0, hacc = 0.0, Pv[4] = {0.0, 0.0, 0.0, 0.0};
+      double wc = 0.0, wcd = 0.0, hacc = 0.0;
       if (coupled) {
-        /* partial integrals over [0, xi] of this element (nested rule, exact for degree 4) */
-        double Ppp = 0.0, Ppv = 0.0, Ppa = 0.0, Pvv = 0.0;
-        for (int k = 0; k < INNER; ++k) {
-          const double* ndk = b->nd_in[g][k];
-          double wk = b->wi3[k] * xi * le;
-          double sp = dot4(ndk, d), sv = dot4(ndk, dd), sa = dot4(ndk, ddd);
-          Ppp += wk * sp * sp;
-          Ppv += wk * sp * sv;
-          Ppa += wk * sp * sa;
-          Pvv += wk * sv * sv;
-          for (int j = 0; j < 4; ++j) Pv[j] += wk * ndk[j] * sp;
-        }
-        wc = -0.5 * (Ipp + Ppp);  /* w_c = -1/2 p^T H p */
-        wcd = -(Ipv + Ppv);       /* dw_c/dt = -p^T H pd */
-        hacc = Ipa + Ppa + Ivv + Pvv; /* h^T pdd + pd^T H pd */
+        /* inboard integrals + this element's part over [0, xi], in closed form */
+        const double* pw = b->pw_out[g];
+        wc = -0.5 * (Ipp + dot5(pp, pw)); /* w_c = -1/2 p^T H p */
+        wcd = -(Ipv + dot5(pv5, pw));     /* dw_c/dt = -p^T H pd */
+        hacc = Iha + dot5(ha, pw);        /* h^T pdd + pd^T H pd */
       }
       /* The cross-section's two points y = -r, +r (weights m each): every force below is affine
          in y, F = F0 + y F1, so the sums over the pair are exact in closed form,
@@ -294,9 +334,10 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
         rp_a[1] += n1[1] * FD0[0];
         for (int j = 0; j < 4; ++j) rp_t[j] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0];
         if (coupled) {
-          /* p rows: -h F_C[0]; h's own element part now, the inboard part by tail sums */
+          /* p rows: -h F_C[0]; h's own element part through the F_C-weighted moments of the
+             partial-integral weights (pv below), the inboard part by tail sums */
           csum[e] += FC0[0];
-          for (int j = 0; j < 4; ++j) pv[4 * e + j] += FC0[0] * Pv[j];
+          for (int k = 0; k < 5; ++k) fc_moment[k] += FC0[0] * b->pw_out[g][k];
         }
       }
     }
@@ -311,17 +352,15 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
     if (coupled) {
       /* full-element integrals: prefix scalars and F_e = int N2' w2' */
       double* F = Fe + 4 * e;
-      F[0] = F[1] = F[2] = F[3] = 0.0;
-      for (int k = 0; k < INNER; ++k) {
-        const double* ndk = b->nd_full[k];
-        double wk = b->wi3[k] * le;
-        double sp = dot4(ndk, d), sv = dot4(ndk, dd), sa = dot4(ndk, ddd);
-        Ipp += wk * sp * sp;
-        Ipv += wk * sp * sv;
-        Ipa += wk * sp * sa;
-        Ivv += wk * sv * sv;
-        for (int j = 0; j < 4; ++j) F[j] += wk * ndk[j] * sp;
+      double Gm[4][3]; /* sum over points of F_C[0] G(xi_g) */
+      h_weights(b, fc_moment, Gm);
+      for (int j = 0; j < 4; ++j) {
+        F[j] = dot3(b->G_full[j], cp);
+        pv[4 * e + j] = dot3(Gm[j], cp);
       }
+      Ipp += dot5(pp, b->pw_full);
+      Ipv += dot5(pv5, b->pw_full);
+      Iha += dot5(ha, b->pw_full);
     }
   }
   if (coupled) {
@@ -369,18 +408,21 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
 /* w_c(x), and optionally dw_c/dt, by the same prefix + nested rule as the residual (element e
    at xi); model must be coupled */
 static void coupling_at(const Beam* b, const double* p, const double* pd, int e, double xi, double* wc, double* wcd) {
-  double Ipp = 0.0, Ipv = 0.0;
+  double Ipp = 0.0, Ipv = 0.0, pw_part[5];
   double ua[2], d[4], dd[4] = {0.0, 0.0, 0.0, 0.0};
+  int_weights(b->le, xi, pw_part);
   for (int k = 0; k <= e; ++k) {
     gather(p, k, ua, d);
     if (pd) gather(pd, k, ua, dd);
-    double span = (k == e) ? xi : 1.0;
-    for (int i = 0; i < INNER; ++i) {
-      double nd[4];
-      hermite(span * b->xi3[i], b->le, NULL, nd);
-      double wk = b->wi3[i] * span * b->le, sp = dot4(nd, d), sv = dot4(nd, dd);
-      Ipp += wk * sp * sp;
-      Ipv += wk * sp * sv;
+    const double* pw = (k == e) ? pw_part : b->pw_full;
+    double cp[3], cv[3], prod[5];
+    slope_poly(b, d, cp);
+    poly_mul(cp, cp, prod);
+    Ipp += dot5(prod, pw);
+    if (pd) {
+      slope_poly(b, dd, cv);
+      poly_mul(cp, cv, prod);
+      Ipv += dot5(prod, pw);
     }
   }
   *wc = -0.5 * Ipp;
@@ -463,16 +505,14 @@ static int beam_marker(const void* self, const double* q, const double local[2],
       }
       if (b->model != BEAM_ZOAC) {
         /* -h(x): h_j = int_0^x N2j' w2' over the inboard elements and [0, xi] of e */
+        double pw_part[5], G_part[4][3];
+        int_weights(b->le, xi, pw_part);
+        h_weights(b, pw_part, G_part);
         for (int k = 0; k <= e; ++k) {
-          double ua[2], d[4];
+          double ua[2], d[4], cp[3], h[4];
           gather(p, k, ua, d);
-          double span = (k == e) ? xi : 1.0, h[4] = {0.0, 0.0, 0.0, 0.0};
-          for (int i = 0; i < INNER; ++i) {
-            double ndi[4];
-            hermite(span * b->xi3[i], b->le, NULL, ndi);
-            double wk = b->wi3[i] * span * b->le, sp = dot4(ndi, d);
-            for (int j = 0; j < 4; ++j) h[j] += wk * ndi[j] * sp;
-          }
+          slope_poly(b, d, cp);
+          for (int j = 0; j < 4; ++j) h[j] = dot3(k == e ? G_part[j] : b->G_full[j], cp);
           for (int j = 0; j < 4; ++j) {
             int i = tdof(k, j);
             if (i < 0) continue;
@@ -509,9 +549,16 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   double Ipp = 0.0, Ipv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
   for (int e = 0; e < ne; ++e) {
-    double ua[2], d[4], uda[2], dd[4];
+    double ua[2], d[4], uda[2], dd[4], pp[5], pv5[5];
     gather(p, e, ua, d);
     gather(pd, e, uda, dd);
+    if (coupled) {
+      double cp[3], cv[3];
+      slope_poly(b, d, cp);
+      slope_poly(b, dd, cv);
+      poly_mul(cp, cp, pp);
+      poly_mul(cp, cv, pv5);
+    }
     for (int g = 0; g < ng; ++g) {
       double xi = b->xg[g], x = e * le + xi * le;
       const double* ns = b->ns_out[g];
@@ -521,53 +568,44 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
       double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
       double wc = 0.0, wcd = 0.0;
       if (coupled) {
-        double Ppp = 0.0, Ppv = 0.0;
-        for (int k = 0; k < INNER; ++k) {
-          const double* ndk = b->nd_in[g][k];
-          double wk = b->wi3[k] * xi * le, sp = dot4(ndk, d), sv = dot4(ndk, dd);
-          Ppp += wk * sp * sp;
-          Ppv += wk * sp * sv;
-        }
-        wc = -0.5 * (Ipp + Ppp);
-        wcd = -(Ipv + Ppv);
+        wc = -0.5 * (Ipp + dot5(pp, b->pw_out[g]));
+        wcd = -(Ipv + dot5(pv5, b->pw_out[g]));
       }
-      for (int iy = 0; iy < 2; ++iy) {
-        double y = iy ? b->r : -b->r, m = mhalf * b->wg[g];
-        double uD[2] = {w1 - y * w2s, w2}, uDd[2] = {w1d - y * w2sd, w2d};
-        double vR[2] = {v0[0] - y * om, v0[1] + x * om};
-        double vD[2] = {-uD[1] * om + uDd[0], uD[0] * om + uDd[1]};
-        double vC[2] = {wcd, wc * om};
-        double vRD[2] = {vR[0] + vD[0], vR[1] + vD[1]};
-        /* d v / d theta' of the parts: I~(rho0 + u_D), I~ rho0, I~ e1 w_c */
-        double gRD[2] = {-(y + uD[1]), x + uD[0]}, gR[2] = {-y, x};
-        switch (model) {
-          case BEAM_ZOAC:
-            T += 0.5 * m * (vRD[0] * vRD[0] + vRD[1] * vRD[1]);
-            pth += m * (gRD[0] * vRD[0] + gRD[1] * vRD[1]);
-            break;
-          case BEAM_FOAC:
-            T += m * (0.5 * (vRD[0] * vRD[0] + vRD[1] * vRD[1]) + vR[0] * vC[0] + vR[1] * vC[1]);
-            pth += m * (gRD[0] * vRD[0] + gRD[1] * vRD[1] + gR[0] * vC[0] + gR[1] * vC[1] + wc * vR[1]);
-            break;
-          default: {
-            double vt[2] = {vRD[0] + vC[0], vRD[1] + vC[1]};
-            T += 0.5 * m * (vt[0] * vt[0] + vt[1] * vt[1]);
-            pth += m * (gRD[0] * vt[0] + (gRD[1] + wc) * vt[1]);
-            break;
-          }
+      /* The cross-section pair y = -r, +r (mass m each): every velocity and lever arm below is
+         affine in y, X = X0 + y X1, so the pair sums in closed form as in the residual:
+         sum m (A + yB).(C + yD) = M2 (A.C + r^2 B.D), M2 = 2m; terms linear in y cancel. */
+      const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
+      const double vR0[2] = {v0[0], v0[1] + x * om}, vR1[2] = {-om, 0.0};
+      const double vRD0[2] = {vR0[0] - w2 * om + w1d, vR0[1] + w1 * om + w2d};
+      const double vRD1[2] = {vR1[0] - w2sd, -w2s * om};
+      const double vC[2] = {wcd, wc * om};
+      /* d v / d theta' of the parts: I~(rho0 + u_D) = gRD0 + y gRD1, I~ rho0 = [-y, x] */
+      const double gRD0[2] = {-w2, x + w1}, gRD1[2] = {-1.0, -w2s};
+      switch (model) {
+        case BEAM_ZOAC:
+          T += 0.5 * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
+          pth += M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
+          break;
+        case BEAM_FOAC:
+          T += M2 * (0.5 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
+                     vR0[0] * vC[0] + vR0[1] * vC[1]);
+          pth += M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) +
+                       x * vC[1] + wc * vR0[1]);
+          break;
+        default: {
+          const double vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
+          T += 0.5 * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
+          pth += M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
+          break;
         }
-        /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
-        if (grav) Ug -= m * (f[0] * (x + uD[0] + wc) + f[1] * (y + uD[1]));
-        mtot += m;
       }
+      /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
+      if (grav) Ug -= M2 * (f[0] * (x + w1 + wc) + f[1] * w2);
+      mtot += M2;
     }
     if (coupled) {
-      for (int k = 0; k < INNER; ++k) {
-        const double* ndk = b->nd_full[k];
-        double wk = b->wi3[k] * le, sp = dot4(ndk, d), sv = dot4(ndk, dd);
-        Ipp += wk * sp * sp;
-        Ipv += wk * sp * sv;
-      }
+      Ipp += dot5(pp, b->pw_full);
+      Ipv += dot5(pv5, b->pw_full);
     }
     /* strain energy of the element */
     Ue += 0.5 * b->ka * (ua[1] - ua[0]) * (ua[1] - ua[0]);
