@@ -179,6 +179,10 @@ struct _generic_SUNLinearSolver;
 struct _SUNContext;
 struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
 
+/* ---- vector.c: optimized serial N_Vector arithmetic for IDA ---- */
+struct _generic_N_Vector;
+void fmb_vector_use_fast_ops(struct _generic_N_Vector* v);
+
 /* ---- dense.c: small dense linear algebra (initial conditions, checks) ---- */
 int fmb_lu_factor(int n, double* A, int* piv);             /* column-major, in place; 0 ok */
 void fmb_lu_solve(int n, const double* LU, const int* piv, double* b);
