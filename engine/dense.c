@@ -32,16 +32,20 @@ int fmb_lu_factor(int n, double* A, int* piv) {
   return 0;
 }
 
+/* fmb_lu_factor swaps whole rows, the multipliers of earlier columns included (P A = L U), so all
+   the swaps apply to b before the forward substitution; interleaving them with it (LINPACK's
+   order, where only the trailing columns are swapped) pairs rows with the wrong multipliers */
 void fmb_lu_solve(int n, const double* LU, const int* piv, double* b) {
   for (int k = 0; k < n; ++k) {
     const int p = piv[k];
     if (p != k) {
-      double t = b[k];
+      const double t = b[k];
       b[k] = b[p];
       b[p] = t;
     }
-    for (int i = k + 1; i < n; ++i) b[i] -= LU[(size_t)k * n + i] * b[k];
   }
+  for (int k = 0; k < n; ++k)
+    for (int i = k + 1; i < n; ++i) b[i] -= LU[(size_t)k * n + i] * b[k];
   for (int k = n - 1; k >= 0; --k) {
     b[k] /= LU[(size_t)k * n + k];
     for (int i = 0; i < k; ++i) b[i] -= LU[(size_t)k * n + i] * b[k];
