@@ -10,7 +10,8 @@
 #   3. runs FOAC and ZOAC on the same rtol sweep — groups "foac", "zoac" (error vs the complete
 #      reference = the error each simplification carries);
 #   4. sweeps the element count at a fixed tight rtol — group "elements";
-#   5. repeats a subset with linear_solver=dense ("dense"), the other error_control ("errctl")
+#   5. repeats a subset with linear_solver=dense ("dense"), KLU on the whole GGL matrix instead of
+#      the Schur complement ("klu_full"), the other error_control ("errctl")
 #      and other BDF order caps ("order").
 # Every run is repeated REPS times (CPU time = median of cpu_s from the stats line; steps and
 # counters are deterministic) and compared with `flexmbd compare` against the reference.
@@ -158,6 +159,7 @@ spinup() {
   for m in foac zoac; do for r in $MODEL_RTOLS; do run_case $id "$m" "$ref" - "$m" 16 "$r" klu - -; done; done
   for n in $ELEMS; do run_case $id elements "$ref" - complete "$n" $erc klu - -; done
   for r in $SUB_RTOLS; do run_case $id dense "$ref" "$same" complete 16 "$r" dense - -; done
+  for r in $SUB_RTOLS; do run_case $id klu_full "$ref" "$same" complete 16 "$r" klu_full - -; done
   [ $QUICK = 1 ] || run_case $id dense "$ref" - complete 64 1e-6 dense - -
   [ $QUICK = 1 ] || run_case $id klu64 "$ref" - complete 64 1e-6 klu - -
   for r in $SUB_RTOLS; do run_case $id errctl "$ref" "$same" complete 16 "$r" klu positions -; done
@@ -186,6 +188,7 @@ pendulum() {
   for m in foac zoac; do for r in $rt; do run_case pend "$m" "$ref" - "$m" 16 "$r" klu - -; done; done
   for n in $el; do run_case pend elements "$ref" - complete "$n" 1e-6 klu - -; done
   run_case pend dense "$ref" "$same" complete 16 1e-6 dense - -
+  run_case pend klu_full "$ref" "$same" complete 16 1e-6 klu_full - -
   [ $QUICK = 1 ] || run_case pend dense "$ref" "$same" complete 16 1e-4 dense - -
   # the pendulum's scene controls positions only; the full error test on velocities too:
   RUN_TIMEOUT=60 run_case pend errctl "$ref" "$same" complete 16 1e-4 klu full -
@@ -206,6 +209,7 @@ fourbar() {
   for r in $RTOLS; do run_case fourbar rtol "$ref" - - - "$r" klu - -; done
   for r in $RTOLS; do run_case fourbar order "$ref" - - - "$r" klu - 2; done
   for r in $RTOLS; do run_case fourbar dense "$ref" - - - "$r" dense - -; done
+  for r in $SUB_RTOLS; do run_case fourbar klu_full "$ref" - - - "$r" klu_full - -; done
   for r in $SUB_RTOLS; do run_case fourbar errctl "$ref" - - - "$r" klu positions -; done
 }
 

@@ -49,14 +49,18 @@ scenes=$(awk -F, 'NR > 1 && !seen[$1]++ { print $1 }' "$RUNS")
     fi
     if awk -F, -v s="$s" '$1 == s && $7 == "dense" { f = 1 } END { exit !f }' "$RUNS"; then
       echo
-      echo "KLU against dense LU on the same runs (CPU ratio dense / KLU, steps equal when the solutions agree):"
+      echo "The linear solvers on the same runs: KLU on the Schur complement of the position rows (the"
+      echo "default), KLU on the whole GGL matrix, SUNDIALS' dense LU on the whole matrix (CPU medians, s):"
       echo
-      echo "| elements | rtol | KLU CPU | dense CPU | dense / KLU | KLU steps | dense steps |"
-      echo "|---|---|---|---|---|---|---|"
-      awk -F, -v s="$s" '$1 == s && $7 == "klu" && ($2 == "rtol" || $2 == "klu64" || $2 == "elements") && $8 == "-" && $9 == "-" { k = $4 "/" $5; kc[k] = $17; ks[k] = $12 }
+      echo "| elements | rtol | KLU (Schur) | KLU full | dense | full / Schur | dense / Schur | steps Schur / full / dense |"
+      echo "|---|---|---|---|---|---|---|---|"
+      awk -F, -v s="$s" 'function r(a, b) { return (a > 0 && b > 0) ? sprintf("%.2f", b / a) : "–" }
+        function v(x) { return x == "" ? "–" : x }
+        $1 == s && $7 == "klu" && ($2 == "rtol" || $2 == "klu64" || $2 == "elements") && $8 == "-" && $9 == "-" { k = $4 "/" $5; kc[k] = $17; ks[k] = $12 }
+        $1 == s && $2 == "klu_full" { k = $4 "/" $5; fc[k] = $17; fs[k] = $12 }
         $1 == s && $2 == "dense" { d[++n] = $4 "/" $5; dc[$4 "/" $5] = $17; ds[$4 "/" $5] = $12 }
         END { for (i = 1; i <= n; ++i) { k = d[i]; split(k, p, "/")
-                printf "| %s | %s | %s | %s | %s | %s | %s |\n", p[1], p[2], kc[k], dc[k], (kc[k] > 0 ? sprintf("%.2f", dc[k] / kc[k]) : "–"), ks[k], ds[k] } }' "$RUNS"
+                printf "| %s | %s | %s | %s | %s | %s | %s | %s / %s / %s |\n", p[1], p[2], v(kc[k]), v(fc[k]), v(dc[k]), r(kc[k], fc[k]), r(kc[k], dc[k]), v(ks[k]), v(fs[k]), v(ds[k]) } }' "$RUNS"
     fi
   done
 } > "$TAB"
