@@ -57,7 +57,7 @@ static int once(Ctx* c) {
       return rc;
     }
     default: {
-      int rc = fmb_system_jacobian(m, c->w, 1.0, 1e3, c->y, c->yp, c->ewt, c->csc, NULL);
+      int rc = fmb_system_jacobian(m, c->w, 1.0, 1e3, c->y, c->yp, c->ewt, 0, c->csc, NULL); /* fresh blocks */
       sink += c->csc[0];
       return rc;
     }

@@ -84,6 +84,12 @@ static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N
                              reuse, SUNSparseMatrix_Data(J), NULL);
 }
 
+/* A step this small (relative to the whole run) means IDA is closing in on a singularity it
+   cannot pass rather than resolving dynamics: the FOAC pendulum approached its mass matrix's
+   singular crossing with steps of 1e-14 s, 100,000 of them per output (47 s) before giving up.
+   With a floor, the first failure there ends the run and the usual diagnosis says why. */
+#define FMB_MIN_STEP_FRACTION 1e-12
+
 static void ida_error_handler(int code, const char* module, const char* function, char* msg, void* ud) {
   (void)code;
   (void)module;
@@ -247,7 +253,8 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       IDASetErrHandlerFn(ida, ida_error_handler, &ctx) != IDA_SUCCESS || IDASetId(ida, id) != IDA_SUCCESS ||
       IDASetSuppressAlg(ida, m->solver.positions_only ? SUNTRUE : SUNFALSE) != IDA_SUCCESS || IDASetMaxOrd(ida, m->solver.max_order) != IDA_SUCCESS ||
       IDASetMaxNumSteps(ida, m->solver.max_steps_per_output) != IDA_SUCCESS ||
-      (m->solver.max_step > 0 && IDASetMaxStep(ida, m->solver.max_step) != IDA_SUCCESS)) {
+      (m->solver.max_step > 0 && IDASetMaxStep(ida, m->solver.max_step) != IDA_SUCCESS) ||
+      IDASetMinStep(ida, FMB_MIN_STEP_FRACTION * (m->solver.t_end - m->solver.t0)) != IDA_SUCCESS) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up IDA: %s", ctx.ida_msg);
     rc = FMB_EXIT_SOLVER;
     goto done;
