@@ -114,7 +114,10 @@ ref_run() {
   timeout "${REF_TIMEOUT:-600}" "$F" run "$SCENE_FILE" -o "$WORK/${id}_ref_$name.csv" --quiet "${sets[@]}" 2> "$WORK/${id}_ref_$name.err" ||
     { echo "bench.sh: reference $id/$name failed:" >&2; cat "$WORK/${id}_ref_$name.err" >&2; exit 3; }
   local s; s=$(tail -1 "$WORK/${id}_ref_$name.err")
-  echo "$id,reference,$name,$ne,$rtol,$atol,klu,-,-,ok,$(sed -n 's/.* t_reached=\([^ ]*\) steps=\([^ ]*\) residuals=\([^ ]*\) jacobians=\([^ ]*\) newton_iters=\([^ ]*\) error_test_fails=\([^ ]*\) cpu_s=\([^ ]*\).*/\1,\2,\3,\4,\5,\6,\7,\7,\7/p' <<< "$s"),1,0,0,0,0,0,0,nan" >> "$RUNS"
+  # the stats line's fields by name (keys may be added before cpu_s)
+  local fields; fields=$(awk '{ for (i = 2; i <= NF; ++i) { split($i, kv, "="); f[kv[1]] = kv[2] }
+    printf "%s,%s,%s,%s,%s,%s,%s,%s,%s", f["t_reached"], f["steps"], f["residuals"], f["jacobians"], f["newton_iters"], f["error_test_fails"], f["cpu_s"], f["cpu_s"], f["cpu_s"] }' <<< "$s")
+  echo "$id,reference,$name,$ne,$rtol,$atol,klu,-,-,ok,$fields,1,0,0,0,0,0,0,nan" >> "$RUNS"
 }
 # the reference's own convergence: a coarser reference compared with the finest one
 refconv() {

@@ -32,7 +32,10 @@ for n in $RUNNS; do
   timeout 900 "$F" run scenes/paper/spinup_w15.yaml -o "$B/scaling_$n.csv" --quiet --set bodies.beam.elements=$n 2> "$B/scaling_$n.err" || true
   s=$(grep '^stats:' "$B/scaling_$n.err" | tail -1)
   tip=$(tail -1 "$B/scaling_$n.csv" | cut -d, -f2)
-  echo "$n,$(sed -n 's/.*status=\([^ ]*\) t_reached=\([^ ]*\) steps=\([^ ]*\) residuals=\([^ ]*\) jacobians=\([^ ]*\) newton_iters=\([^ ]*\) error_test_fails=[^ ]* cpu_s=\([^ ]*\).*/\1,\2,\3,\4,\5,\6,\7/p' <<< "$s"),$tip" | tee -a "$RES/scaling_runs.csv"
+  # the stats line's fields by name (keys may be added before cpu_s)
+  fields=$(awk '{ for (i = 2; i <= NF; ++i) { split($i, kv, "="); f[kv[1]] = kv[2] }
+                  printf "%s,%s,%s,%s,%s,%s,%s", f["status"], f["t_reached"], f["steps"], f["residuals"], f["jacobians"], f["newton_iters"], f["cpu_s"] }' <<< "$s")
+  echo "$n,$fields,$tip" | tee -a "$RES/scaling_runs.csv"
 done
 if command -v gnuplot > /dev/null; then
   gnuplot <<GP
