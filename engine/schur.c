@@ -36,9 +36,10 @@ typedef struct {
   double* data;
   /* the blocks the solves need, copied at setup with D^-1 applied and kept-row indices made
      relative (a tight loop: the solves run once per Newton iteration, setups rarely) */
-  int *rq_ptr, *rq_run_ptr, *run_row, *run_len; double* rq_val; /* J_Rq D^-1, by q column, in runs
-                                                                      of consecutive rows */
-  int *qr_ptr, *qr_row; double* qr_val; /* D^-1 J_qR, by kept column */
+  int *rq_ptr, *rq_run_ptr, *run_row, *run_len; /* J_Rq D^-1 by q column, in runs of consecutive */
+  double* rq_val;                                 /* rows (the inner loop vectorizes) */
+  int *qr_ptr, *qr_row;                           /* D^-1 J_qR by kept column */
+  double* qr_val;
   double* acc;         /* dense column / vector scratch, nr */
   double* dq;
   klu_l_common common;
@@ -298,6 +299,7 @@ SUNLinearSolver fmb_schur_klu_new(const fmbModel* m, SUNContext sun) {
   s->acc = calloc((size_t)s->nr + 1, sizeof(double));
   s->dq = calloc((size_t)m->nq + 1, sizeof(double));
   if (!s->first_kept || !s->diag_pos || !s->dinv || !s->acc || !s->dq) goto fail;
+  for (int c = 0; c < m->nq; ++c) s->diag_pos[c] = -1;
   for (int c = 0; c < m->ny; ++c) {
     long k = m->colptr[c];
     while (k < m->colptr[c + 1] && m->rowind[k] < m->nq) {
@@ -306,6 +308,8 @@ SUNLinearSolver fmb_schur_klu_new(const fmbModel* m, SUNContext sun) {
     }
     s->first_kept[c] = k;
   }
+  for (int c = 0; c < m->nq; ++c)
+    if (s->diag_pos[c] < 0) goto fail; /* pattern.c always holds F_q's diagonal */
   if (schur_pattern(s) || schur_blocks(s)) goto fail;
   klu_l_defaults(&s->common);
   s->symbolic = klu_l_analyze(s->nr, s->colptr, s->rowind, &s->common);
