@@ -121,6 +121,16 @@ static void poly_mul(const double a[3], const double c[3], double out[5]) {
   out[4] = a[2] * c[2];
 }
 
+/* an element's slope polynomials of p and pd (cp, cv) and the quartics w2'^2 (pp) and w2' w2d'
+   (pv), whose integrals give w_c = -1/2 int w2'^2 and its rate -int w2' w2d' */
+static void slope_products(const Beam* b, const double d[4], const double dd[4], double cp[3], double cv[3],
+                           double pp[5], double pv[5]) {
+  slope_poly(b, d, cp);
+  slope_poly(b, dd, cv);
+  poly_mul(cp, cp, pp);
+  poly_mul(cp, cv, pv);
+}
+
 static void int_weights(double le, double xi, double pw[5]) {
   double xk = xi;
   for (int k = 0; k < 5; ++k) {
@@ -283,11 +293,8 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
     if (coupled) {
       csum[e] = 0.0;
       double cv[3], ca[3], vv[5];
-      slope_poly(b, d, cp);
-      slope_poly(b, dd, cv);
+      slope_products(b, d, dd, cp, cv, pp, pv5);
       slope_poly(b, ddd, ca);
-      poly_mul(cp, cp, pp);
-      poly_mul(cp, cv, pv5);
       poly_mul(cp, ca, ha);
       poly_mul(cv, cv, vv);
       for (int k = 0; k < 5; ++k) ha[k] += vv[k];
@@ -405,7 +412,7 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
  * Kinematics of one material point: element, shape and coupling at reference x.
  * ------------------------------------------------------------------------------------------- */
 
-/* w_c(x), and optionally dw_c/dt, by the same prefix + nested rule as the residual (element e
+/* w_c(x), and optionally dw_c/dt, by the same closed-form integrals as the residual (element e
    at xi); model must be coupled */
 static void coupling_at(const Beam* b, const double* p, const double* pd, int e, double xi, double* wc, double* wcd) {
   double Ipp = 0.0, Ipv = 0.0, pw_part[5];
@@ -415,15 +422,10 @@ static void coupling_at(const Beam* b, const double* p, const double* pd, int e,
     gather(p, k, ua, d);
     if (pd) gather(pd, k, ua, dd);
     const double* pw = (k == e) ? pw_part : b->pw_full;
-    double cp[3], cv[3], prod[5];
-    slope_poly(b, d, cp);
-    poly_mul(cp, cp, prod);
-    Ipp += dot5(prod, pw);
-    if (pd) {
-      slope_poly(b, dd, cv);
-      poly_mul(cp, cv, prod);
-      Ipv += dot5(prod, pw);
-    }
+    double cp[3], cv[3], pp[5], pv[5];
+    slope_products(b, d, dd, cp, cv, pp, pv); /* dd = 0 without pd */
+    Ipp += dot5(pp, pw);
+    Ipv += dot5(pv, pw);
   }
   *wc = -0.5 * Ipp;
   if (wcd) *wcd = -Ipv;
@@ -554,10 +556,7 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
     gather(pd, e, uda, dd);
     if (coupled) {
       double cp[3], cv[3];
-      slope_poly(b, d, cp);
-      slope_poly(b, dd, cv);
-      poly_mul(cp, cp, pp);
-      poly_mul(cp, cv, pv5);
+      slope_products(b, d, dd, cp, cv, pp, pv5);
     }
     for (int g = 0; g < ng; ++g) {
       double xi = b->xg[g], x = e * le + xi * le;
