@@ -59,6 +59,13 @@ static int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void*
   return fmb_system_residual(c->m, c->w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(F));
 }
 
+void fmb_sparse_pattern_into(const fmbModel* m, SUNMatrix J) {
+  sunindextype* colptr = SUNSparseMatrix_IndexPointers(J);
+  sunindextype* rowind = SUNSparseMatrix_IndexValues(J);
+  for (int i = 0; i <= m->ny; ++i) colptr[i] = (sunindextype)m->colptr[i];
+  for (long k = 0; k < m->nnz; ++k) rowind[k] = (sunindextype)m->rowind[k];
+}
+
 static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* ud,
                        N_Vector t1, N_Vector t2, N_Vector t3) {
   (void)r;
@@ -75,10 +82,7 @@ static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N
   /* the pattern is fixed at load, but IDA zeroes the matrix before each call and SUNDIALS'
      sparse zero clears the index arrays too (copying them out here is measured necessary:
      without it every run fails its first Newton step), O(nnz) next to the assembly */
-  sunindextype* colptr = SUNSparseMatrix_IndexPointers(J);
-  sunindextype* rowind = SUNSparseMatrix_IndexValues(J);
-  for (int i = 0; i <= m->ny; ++i) colptr[i] = (sunindextype)m->colptr[i];
-  for (long k = 0; k < m->nnz; ++k) rowind[k] = (sunindextype)m->rowind[k];
+  fmb_sparse_pattern_into(m, J);
   return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(c->ewt),
                              reuse, SUNSparseMatrix_Data(J), NULL);
 }

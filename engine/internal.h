@@ -179,6 +179,10 @@ struct _generic_SUNLinearSolver;
 struct _SUNContext;
 struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
 
+/* ---- integrate.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
+struct _generic_SUNMatrix;
+void fmb_sparse_pattern_into(const fmbModel* m, struct _generic_SUNMatrix* J);
+
 /* ---- vector.c: optimized serial N_Vector arithmetic for IDA ---- */
 struct _generic_N_Vector;
 void fmb_vector_use_fast_ops(struct _generic_N_Vector* v);

@@ -144,9 +144,7 @@ static double schur_backward_error(SUNContext sun, const fmbModel* m, double mu_
   for (int i = 0; i < ny; ++i) ewt[i] = 1.0 / (1e-6 * fabs(y[i]) + 1e-8);
   const double cj = 250.0;
   SUNMatrix A = SUNSparseMatrix(ny, ny, m->nnz, CSC_MAT, sun);
-  sunindextype *cp = SUNSparseMatrix_IndexPointers(A), *ri = SUNSparseMatrix_IndexValues(A);
-  for (int i = 0; i <= ny; ++i) cp[i] = (sunindextype)m->colptr[i];
-  for (long k = 0; k < m->nnz; ++k) ri[k] = (sunindextype)m->rowind[k];
+  fmb_sparse_pattern_into(m, A);
   ENSURE(fmb_system_jacobian(m, w, 0.3, cj, y, yp, ewt, 0, SUNSparseMatrix_Data(A), NULL) == 0);
   ENSURE(fmb_system_jacobian(m, w, 0.3, cj, y, yp, ewt, 0, NULL, Jd) == 0);
   N_Vector b = N_VNew_Serial(ny, sun), x = N_VNew_Serial(ny, sun);
