@@ -101,11 +101,11 @@ expect keep-old-output 2 "$src/tests/bad_scenes/24-number-word.yaml:7:11: error:
 rm -f "$out"
 
 # command-line mistakes
-expect no-scene 2 "flexmbd: no scene file given" "no scene file" -- run -o "$out"
-expect o-without-name 2 "flexmbd: -o needs a file name" "needs a file name" -- run "$scene" -o
-expect set-without-value 2 "flexmbd: --set needs PATH=VALUE" "PATH=VALUE" -- run "$scene" --set
-expect two-scenes 2 "flexmbd: one scene file at a time" "one scene file at a time" -- check "$scene" "$scene"
-expect unknown-option 2 "flexmbd: unknown option '--frobnicate'" "unknown option" -- run "$scene" --frobnicate
+expect no-scene 2 "flexmbd run: no scene file given" "no scene file" -- run -o "$out"
+expect o-without-name 2 "flexmbd run: -o needs a file name" "needs a file name" -- run "$scene" -o
+expect set-without-value 2 "flexmbd run: --set needs PATH=VALUE" "PATH=VALUE" -- run "$scene" --set
+expect two-scenes 2 "flexmbd check: one scene file at a time" "one scene file at a time" -- check "$scene" "$scene"
+expect unknown-option 2 "flexmbd run: unknown option '--frobnicate'" "unknown option" -- run "$scene" --frobnicate
 [ ! -e "$out" ] || fail cli "left $out behind"
 
 # and a good run writes its rows (the checks above can tell success from failure)

@@ -1,4 +1,4 @@
-/* compare.c — `flexmbd compare OUT.csv REF.csv [--columns a,b,...]`: the error of one run
+/* cmd_compare.c — `flexmbd compare OUT.csv REF.csv [--columns a,b,...]`: the error of one run
  * against a reference run, per column, one machine-readable line each.
  *
  * The reference is interpolated linearly in time at every row of OUT inside the reference's time
@@ -18,7 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-int fmb_compare_main(int argc, char** argv); /* called by flexmbd.c */
+#include "cli.h"
 
 typedef struct {
   int ncol;
@@ -141,7 +141,7 @@ static void usage(FILE* f) {
   fprintf(f, "usage: flexmbd compare OUT.csv REF.csv [--columns a,b,...]\n");
 }
 
-int fmb_compare_main(int argc, char** argv) {
+int fmb_cmd_compare(int argc, char** argv) {
   const char* files[2] = {NULL, NULL};
   const char* cols = NULL;
   const char* tag = NULL; /* appended to every line: `flexmbd run --reference` adds the run's cost */

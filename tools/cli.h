@@ -1,0 +1,33 @@
+/* cli.h — what the command files of the `flexmbd` program share (tools/cmd_*.c).
+ * One command is one file exporting `int fmb_cmd_NAME(int argc, char** argv)` (argv[1] is the
+ * command's name), listed once in the table of tools/flexmbd.c. */
+#ifndef FLEXMBD_CLI_H
+#define FLEXMBD_CLI_H
+#include "flexmbd.h"
+
+#define FMB_CLI_MAX_OVERRIDES 256
+
+/* a scene and its --set overrides, as `run`, `check` and the analysis commands take them */
+typedef struct fmbCliScene {
+  const char* scene;
+  const char* overrides[FMB_CLI_MAX_OVERRIDES];
+  int nover;
+} fmbCliScene;
+
+/* Takes argv[*i] if it is `--set PATH=VALUE`, `--set=PATH=VALUE` or (when no scene was given yet)
+   the scene file; returns 1 when taken (advancing *i past an argument), 0 when not ours, or
+   FMB_EXIT_BAD_INPUT after printing why (prefixed by `cmd`). */
+int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
+/* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
+const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
+/* file:line:col: error: msg (or the shorter forms when no location is known) */
+void fmb_cli_print_diag(const fmbDiag* d);
+/* the registry every command loads scenes with */
+const fmbRegistry* fmb_cli_registry(void);
+
+/* the commands */
+int fmb_cmd_run(int argc, char** argv);
+int fmb_cmd_check(int argc, char** argv);
+int fmb_cmd_types(int argc, char** argv);
+int fmb_cmd_compare(int argc, char** argv);
+#endif
