@@ -1,204 +1,129 @@
-/* cmd_compare.c — `flexmbd compare OUT.csv REF.csv [--columns a,b,...]`: the error of one run
- * against a reference run, per column, one machine-readable line each.
- *
- * The reference is interpolated linearly in time at every row of OUT inside the reference's time
- * span (rows at the same time, as when both runs share solver.output_step, are compared exactly,
- * without interpolation). For each column:
+/* cmd_compare.c — `flexmbd compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A] [--common]`:
+ * the error of one run against a reference run, per column, one machine-readable line each:
  *
  *   compare: column=NAME rows=N t_last=T max_abs=E t_max=T max_rel=E end_abs=E end_rel=E ref_scale=S
+ *            [range=D tol=E status=ok|beyond]
  *
- * max_abs is max |out - ref| over the rows, t_max where it occurred, end_abs the error at the last
- * compared row (t_last), ref_scale = max |ref| over the reference's rows, and the _rel values are
- * the errors divided by ref_scale (or equal to the absolute ones when ref_scale is 0). A non-finite
- * value in OUT gives max_abs=nan. Default columns: every column of OUT other than t that REF also
- * has. Exit 0, or 2 for a missing file, a malformed CSV, an unknown column or no common time. */
-#include <ctype.h>
+ * REF is interpolated linearly in time at every row of OUT inside REF's time span (rows at the same
+ * time, as when both runs share solver.output_step, are compared exactly). max_abs is max |OUT - REF|,
+ * t_max where it occurred, end_abs the error at the last compared row t_last, ref_scale = max |REF|,
+ * and the _rel values are the errors divided by ref_scale. A non-finite value gives max_abs=nan.
+ *
+ * With --rtol and/or --atol a column passes when max_abs <= atol + rtol * range, range = max - min of
+ * REF's column (docs/regression.md), and OUT must reach REF's last time. Without --columns or
+ * --common, both files must have the same columns: one missing or extra is a failure.
+ * Exit 0 all within tolerance (or no tolerance asked), 1 a column beyond tolerance, a missing or
+ * extra column, or OUT shorter than REF; 2 bad input (unreadable or malformed CSV, unknown option,
+ * an unknown --columns name, no common time). */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "cli.h"
-
-typedef struct {
-  int ncol;
-  char** name;
-  long nrow, cap;
-  double* v; /* row-major nrow x ncol, column 0 = t */
-} Table;
-
-static void table_free(Table* tb) {
-  for (int i = 0; i < tb->ncol; ++i) free(tb->name[i]);
-  free(tb->name);
-  free(tb->v);
-  memset(tb, 0, sizeof *tb);
-}
-
-/* read a whole line (any length) into *buf; returns its length or -1 at EOF */
-static long read_line(FILE* f, char** buf, size_t* cap) {
-  size_t n = 0;
-  int c;
-  while ((c = fgetc(f)) != EOF && c != '\n') {
-    if (n + 2 > *cap) {
-      size_t nc = *cap ? 2 * *cap : 256;
-      char* nb = realloc(*buf, nc);
-      if (!nb) return -1;
-      *buf = nb;
-      *cap = nc;
-    }
-    (*buf)[n++] = (char)c;
-  }
-  if (c == EOF && n == 0) return -1;
-  if (!*buf) {
-    *buf = malloc(1);
-    if (!*buf) return -1;
-    *cap = 1;
-  }
-  if (n > 0 && (*buf)[n - 1] == '\r') --n;
-  (*buf)[n] = '\0';
-  return (long)n;
-}
-
-static int load_csv(const char* path, Table* tb) {
-  memset(tb, 0, sizeof *tb);
-  FILE* f = fopen(path, "r");
-  if (!f) {
-    fprintf(stderr, "flexmbd compare: cannot open '%s'\n", path);
-    return -1;
-  }
-  char* line = NULL;
-  size_t cap = 0;
-  int rc = -1;
-  if (read_line(f, &line, &cap) < 0) {
-    fprintf(stderr, "flexmbd compare: '%s' is empty (no header row)\n", path);
-    goto out;
-  }
-  /* header */
-  for (char *s = line, *tok; (tok = strsep(&s, ",")) != NULL;) {
-    char** nn = realloc(tb->name, (size_t)(tb->ncol + 1) * sizeof *nn);
-    if (!nn) goto out;
-    tb->name = nn;
-    while (isspace((unsigned char)*tok)) ++tok;
-    size_t len = strlen(tok);
-    while (len > 0 && isspace((unsigned char)tok[len - 1])) tok[--len] = '\0';
-    tb->name[tb->ncol] = strdup(tok);
-    if (!tb->name[tb->ncol]) goto out;
-    tb->ncol++;
-  }
-  if (strcmp(tb->name[0], "t") != 0) {
-    fprintf(stderr, "flexmbd compare: '%s': the first column must be 't' (a flexmbd CSV), got '%s'\n", path,
-            tb->name[0]);
-    goto out;
-  }
-  long lineno = 1;
-  while (read_line(f, &line, &cap) >= 0) {
-    ++lineno;
-    if (line[0] == '\0') continue;
-    if (tb->nrow == tb->cap) {
-      long nc = tb->cap ? 2 * tb->cap : 1024;
-      double* nv = realloc(tb->v, (size_t)nc * (size_t)tb->ncol * sizeof *nv);
-      if (!nv) goto out;
-      tb->v = nv;
-      tb->cap = nc;
-    }
-    double* row = tb->v + (size_t)tb->nrow * (size_t)tb->ncol;
-    char* s = line;
-    for (int k = 0; k < tb->ncol; ++k) {
-      char* end;
-      row[k] = strtod(s, &end);
-      if (end == s || (*end != ',' && *end != '\0') || (k < tb->ncol - 1 && *end != ',') ||
-          (k == tb->ncol - 1 && *end != '\0')) {
-        fprintf(stderr, "flexmbd compare: %s:%ld: expected %d comma-separated numbers\n", path, lineno, tb->ncol);
-        goto out;
-      }
-      s = end + 1;
-    }
-    if (!isfinite(row[0]) || (tb->nrow > 0 && row[0] < row[-tb->ncol])) {
-      fprintf(stderr, "flexmbd compare: %s:%ld: times must be finite and non-decreasing\n", path, lineno);
-      goto out;
-    }
-    tb->nrow++;
-  }
-  if (tb->nrow == 0) {
-    fprintf(stderr, "flexmbd compare: '%s' has no data rows\n", path);
-    goto out;
-  }
-  rc = 0;
-out:
-  free(line);
-  fclose(f);
-  if (rc) table_free(tb);
-  return rc;
-}
-
-static int find_col(const Table* tb, const char* name) {
-  for (int i = 1; i < tb->ncol; ++i)
-    if (strcmp(tb->name[i], name) == 0) return i;
-  return -1;
-}
+#include "csv_table.h"
 
 static void usage(FILE* f) {
-  fprintf(f, "usage: flexmbd compare OUT.csv REF.csv [--columns a,b,...]\n");
+  fprintf(f, "usage: flexmbd compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A] [--common]\n"
+             "  --rtol R, --atol A  fail (exit 1) when a column's max error exceeds A + R * (its range in REF)\n"
+             "  --columns a,b       compare only these columns\n"
+             "  --common            compare the columns both files have (a missing or extra one is no failure)\n");
+}
+
+/* a non-negative finite number from an option's argument, or -1 after saying why */
+static int tolerance_arg(const char* opt, const char* s, double* out) {
+  char* end;
+  double x = s ? strtod(s, &end) : NAN;
+  if (!s || end == s || *end || !isfinite(x) || x < 0.0) {
+    fprintf(stderr, "flexmbd compare: %s needs a number >= 0, got '%s'\n", opt, s ? s : "");
+    return -1;
+  }
+  *out = x;
+  return 0;
+}
+
+/* are the column sets the same? prints each difference; returns the number of differences */
+static int column_set_differences(const fmbTable* out, const fmbTable* ref, const char* fo, const char* fr) {
+  int nd = 0;
+  for (int a = 1; a < out->ncol; ++a)
+    if (fmb_table_col(ref, out->name[a]) < 0) {
+      fprintf(stderr, "flexmbd compare: column '%s' of %s is not in %s (an extra column)\n", out->name[a], fo, fr);
+      ++nd;
+    }
+  for (int b = 1; b < ref->ncol; ++b)
+    if (fmb_table_col(out, ref->name[b]) < 0) {
+      fprintf(stderr, "flexmbd compare: column '%s' of %s is missing from %s\n", ref->name[b], fr, fo);
+      ++nd;
+    }
+  return nd;
 }
 
 int fmb_cmd_compare(int argc, char** argv) {
   const char* files[2] = {NULL, NULL};
   const char* cols = NULL;
   const char* tag = NULL; /* appended to every line: `flexmbd run --reference` adds the run's cost */
-  int nf = 0;
+  double rtol = 0.0, atol = 0.0;
+  int check = 0, common = 0, nf = 0;
   for (int i = 2; i < argc; ++i) {
-    if (strcmp(argv[i], "--tag") == 0 && i + 1 < argc) {
+    const char* a = argv[i];
+    if (strcmp(a, "--tag") == 0 && i + 1 < argc) {
       tag = argv[++i];
-    } else if (strcmp(argv[i], "--columns") == 0 || strcmp(argv[i], "-c") == 0) {
-      if (++i >= argc) {
-        fprintf(stderr, "flexmbd compare: --columns needs a comma-separated list\n");
-        return 2;
-      }
-      cols = argv[i];
-    } else if (strncmp(argv[i], "--columns=", 10) == 0) {
-      cols = argv[i] + 10;
-    } else if (strcmp(argv[i], "--help") == 0 || strcmp(argv[i], "-h") == 0) {
+    } else if (strcmp(a, "--columns") == 0 || strcmp(a, "-c") == 0) {
+      if (!(cols = fmb_cli_value("compare", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strncmp(a, "--columns=", 10) == 0) {
+      cols = a + 10;
+    } else if (strcmp(a, "--rtol") == 0 || strcmp(a, "--atol") == 0) {
+      const char* v = fmb_cli_value("compare", argc, argv, &i, "a number");
+      if (!v || tolerance_arg(a, v, a[2] == 'r' ? &rtol : &atol)) return FMB_EXIT_BAD_INPUT;
+      check = 1;
+    } else if (strcmp(a, "--common") == 0) {
+      common = 1;
+    } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       usage(stdout);
       return 0;
-    } else if (argv[i][0] == '-' && argv[i][1] != '\0') {
-      fprintf(stderr, "flexmbd compare: unknown option '%s'\n", argv[i]);
+    } else if (a[0] == '-' && a[1] != '\0') {
+      fprintf(stderr, "flexmbd compare: unknown option '%s'\n", a);
       usage(stderr);
-      return 2;
+      return FMB_EXIT_BAD_INPUT;
     } else if (nf < 2) {
-      files[nf++] = argv[i];
+      files[nf++] = a;
     } else {
-      fprintf(stderr, "flexmbd compare: two CSV files, OUT and REF (got a third, '%s')\n", argv[i]);
-      return 2;
+      fprintf(stderr, "flexmbd compare: two CSV files, OUT and REF (got a third, '%s')\n", a);
+      return FMB_EXIT_BAD_INPUT;
     }
   }
   if (nf != 2) {
     usage(stderr);
-    return 2;
+    return FMB_EXIT_BAD_INPUT;
   }
-  Table out, ref;
-  if (load_csv(files[0], &out)) return 2;
-  if (load_csv(files[1], &ref)) {
-    table_free(&out);
-    return 2;
+  fmbTable out, ref;
+  char err[600];
+  if (fmb_table_load(files[0], &out, err, sizeof err)) {
+    fprintf(stderr, "flexmbd compare: %s\n", err);
+    return FMB_EXIT_BAD_INPUT;
   }
-  int rc = 0;
-  /* column pairs */
+  if (fmb_table_load(files[1], &ref, err, sizeof err)) {
+    fprintf(stderr, "flexmbd compare: %s\n", err);
+    fmb_table_free(&out);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  int rc = 0, beyond = 0;
   int npair = 0;
   int* po = malloc((size_t)out.ncol * sizeof *po);
   int* pr = malloc((size_t)out.ncol * sizeof *pr);
   char* list = cols ? strdup(cols) : NULL;
   if (!po || !pr || (cols && !list)) {
     fprintf(stderr, "flexmbd compare: out of memory\n");
-    rc = 2;
+    rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }
   if (list) {
     for (char *s = list, *tok; (tok = strsep(&s, ",")) != NULL;) {
       if (!*tok) continue;
-      int a = find_col(&out, tok), b = find_col(&ref, tok);
+      int a = fmb_table_col(&out, tok), b = fmb_table_col(&ref, tok);
       if (a < 0 || b < 0) {
         fprintf(stderr, "flexmbd compare: no column '%s' in '%s'\n", tok, a < 0 ? files[0] : files[1]);
-        rc = 2;
+        rc = FMB_EXIT_BAD_INPUT;
         goto done;
       }
       if (npair == out.ncol) break;
@@ -206,8 +131,9 @@ int fmb_cmd_compare(int argc, char** argv) {
       pr[npair++] = b;
     }
   } else {
+    if (!common && column_set_differences(&out, &ref, files[0], files[1])) beyond = 1;
     for (int a = 1; a < out.ncol; ++a) {
-      int b = find_col(&ref, out.name[a]);
+      int b = fmb_table_col(&ref, out.name[a]);
       if (b >= 0) {
         po[npair] = a;
         pr[npair++] = b;
@@ -216,59 +142,46 @@ int fmb_cmd_compare(int argc, char** argv) {
   }
   if (npair == 0) {
     fprintf(stderr, "flexmbd compare: no column to compare\n");
-    rc = 2;
+    rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }
-  const double t_lo = ref.v[0], t_hi = ref.v[(size_t)(ref.nrow - 1) * (size_t)ref.ncol];
-  const double tol_t = 1e-9 * fmax(1.0, fmax(fabs(t_lo), fabs(t_hi)));
   for (int p = 0; p < npair; ++p) {
-    const int a = po[p], b = pr[p];
-    double scale = 0.0;
-    for (long k = 0; k < ref.nrow; ++k) scale = fmax(scale, fabs(ref.v[(size_t)k * (size_t)ref.ncol + (size_t)b]));
-    double emax = 0.0, tmax = 0.0, eend = 0.0, tlast = 0.0;
-    int nonfinite = 0;
-    long rows = 0, j = 0; /* j: reference interval start */
-    for (long k = 0; k < out.nrow; ++k) {
-      const double* row = out.v + (size_t)k * (size_t)out.ncol;
-      const double t = row[0];
-      if (t < t_lo - tol_t || t > t_hi + tol_t) continue;
-      while (j + 1 < ref.nrow && ref.v[(size_t)(j + 1) * (size_t)ref.ncol] <= t + tol_t) ++j;
-      const double* r0 = ref.v + (size_t)j * (size_t)ref.ncol;
-      double rv;
-      if (fabs(r0[0] - t) <= tol_t || j + 1 >= ref.nrow) {
-        rv = r0[b];
-      } else {
-        const double* r1 = r0 + ref.ncol;
-        const double s = (t - r0[0]) / (r1[0] - r0[0]);
-        rv = (1.0 - s) * r0[b] + s * r1[b];
-      }
-      double e = fabs(row[a] - rv);
-      if (!isfinite(e)) nonfinite = 1;
-      if (e > emax || rows == 0) {
-        emax = e;
-        tmax = t;
-      }
-      eend = e;
-      tlast = t;
-      ++rows;
-    }
-    if (rows == 0) {
-      fprintf(stderr, "flexmbd compare: no row of '%s' lies in the reference's time span [%g, %g]\n", files[0],
-              t_lo, t_hi);
-      rc = 2;
+    fmbColumnError e;
+    fmb_table_column_error(&out, po[p], &ref, pr[p], &e);
+    if (e.rows == 0) {
+      fprintf(stderr, "flexmbd compare: no row of '%s' lies in the time span [%g, %g] of '%s'\n", files[0],
+              fmb_table_at(&ref, 0, 0), fmb_table_t_end(&ref), files[1]);
+      rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
-    if (nonfinite) emax = NAN;
+    double range, scale;
+    fmb_table_column_scale(&ref, pr[p], &range, &scale);
     const double sc = scale > 0.0 ? scale : 1.0;
     printf("compare: column=%s rows=%ld t_last=%.10g max_abs=%.6e t_max=%.10g max_rel=%.6e end_abs=%.6e end_rel=%.6e "
-           "ref_scale=%.6e%s%s\n",
-           out.name[a], rows, tlast, emax, tmax, emax / sc, eend, eend / sc, scale, tag ? " " : "", tag ? tag : "");
+           "ref_scale=%.6e",
+           out.name[po[p]], e.rows, e.t_last, e.max_abs, e.t_max, e.max_abs / sc, e.end_abs, e.end_abs / sc, scale);
+    if (check) {
+      const double tol = atol + rtol * range;
+      const int ok = e.max_abs <= tol; /* false for NaN */
+      printf(" range=%.6e tol=%.6e status=%s", range, tol, ok ? "ok" : "beyond");
+      if (!ok) beyond = 1;
+    }
+    printf("%s%s\n", tag ? " " : "", tag ? tag : "");
   }
+  if (check) {
+    const double t_out = fmb_table_t_end(&out), t_ref = fmb_table_t_end(&ref);
+    if (t_out < t_ref - 1e-9 * fmax(1.0, fabs(t_ref))) {
+      fprintf(stderr, "flexmbd compare: %s ends at t = %.10g, before %s (t = %.10g): a shorter run\n", files[0], t_out,
+              files[1], t_ref);
+      beyond = 1;
+    }
+  }
+  if (beyond) rc = 1;
 done:
   free(list);
   free(po);
   free(pr);
-  table_free(&out);
-  table_free(&ref);
+  fmb_table_free(&out);
+  fmb_table_free(&ref);
   return rc;
 }

@@ -55,8 +55,8 @@ int fmb_cmd_run(int argc, char** argv) {
     /* one line per column on stdout: the error against the reference and what the run cost */
     char tag[160];
     snprintf(tag, sizeof tag, "status=%s cpu_s=%.4f steps=%ld", rc ? "failed" : "ok", stats.cpu_s, stats.steps);
-    char* cargv[8] = {argv[0], "compare", (char*)out, (char*)reference, "--tag", tag, NULL, NULL};
-    int cargc = 6;
+    char* cargv[10] = {argv[0], "compare", (char*)out, (char*)reference, "--tag", tag, "--common", NULL, NULL};
+    int cargc = 7;
     if (columns) {
       cargv[cargc++] = "--columns";
       cargv[cargc++] = (char*)columns;

@@ -15,7 +15,7 @@ near() { awk -v a="$1" -v b="$2" -v tol="$3" 'BEGIN { d = a - b; if (d < 0) d = 
 awk 'BEGIN { print "t,a,b,energy.total"; for (k = 0; k <= 100; ++k) { t = k / 100; printf "%.17g,%.17g,%.17g,%.17g\n", t, sin(3 * t), t * t, 2 + t } }' > "$D/ref.csv"
 awk -F, 'NR == 1 { print; next } { b = $3; if ($1 >= 0.5) b -= 0.25; printf "%.17g,%.17g,%.17g,%.17g\n", $1, $2 + 0.001, b, $4 }' "$D/ref.csv" > "$D/shift.csv"
 # a coarse run on other times (every 0.035 s) of the linear column; the quadratic one gets a bounded error
-awk 'BEGIN { print "t,energy.total,b"; for (t = 0; t <= 1.0; t += 0.035) printf "%.17g,%.17g,%.17g\n", t, 2 + t, t * t }' > "$D/coarse.csv"
+awk 'BEGIN { print "t,energy.total,b"; for (t = 0; t <= 1.0; t += 0.035) printf "%.17g,%.17g,%.17g\n", t, 2 + t, t * t; print "1,3,1" }' > "$D/coarse.csv"
 
 "$F" compare "$D/ref.csv" "$D/ref.csv" > "$D/self.txt" || fail "compare self exited $?"
 [ "$(wc -l < "$D/self.txt")" -eq 3 ] || fail "expected 3 lines for 3 columns"
@@ -34,11 +34,44 @@ near "$(field "$D/shift.txt" b t_max)" 0.5 1e-12 || fail "b: t_max != 0.5"
 near "$(field "$D/shift.txt" b max_rel)" 0.25 1e-12 || fail "b: max_rel != 0.25 (ref_scale 1)"
 near "$(field "$D/shift.txt" a ref_scale)" "$(awk -F, 'NR > 1 && $2 > m { m = $2 } END { print m }' "$D/ref.csv")" 1e-6 || fail "a: ref_scale != max sin(3t)"
 
-"$F" compare "$D/coarse.csv" "$D/ref.csv" > "$D/coarse.txt" || fail "compare coarse exited $?"
+# coarse.csv lacks column a: a failure (exit 1) that names it, unless --common
+rc=0; "$F" compare "$D/coarse.csv" "$D/ref.csv" > /dev/null 2> "$D/cols.err" || rc=$?
+[ "$rc" -eq 1 ] || fail "a missing column: exit $rc, not 1"
+grep -q "column 'a' of .*ref.csv is missing from .*coarse.csv" "$D/cols.err" || fail "missing column: message"
+"$F" compare "$D/coarse.csv" "$D/ref.csv" --common > "$D/coarse.txt" || fail "compare coarse exited $?"
 near "$(field "$D/coarse.txt" energy.total max_abs)" 0 1e-14 || fail "linear column not interpolated exactly"
 # linear interpolation of t^2 on a 0.01 grid: error <= h^2/4 = 2.5e-5, and > 0 off the grid
 e=$(field "$D/coarse.txt" b max_abs)
 awk -v e="$e" 'BEGIN { exit !(e > 1e-7 && e <= 2.5e-5 + 1e-15) }' || fail "quadratic column interpolation error $e"
+
+# tolerances: pass when max_abs <= atol + rtol * range(REF column), exit 1 beyond
+ex() { rc=0; "$F" compare "$@" > "$D/tol.txt" 2> "$D/tol.err" || rc=$?; echo "$rc"; }
+[ "$(ex "$D/shift.csv" "$D/ref.csv" --columns a --atol 0.0011)" = 0 ] || fail "a within atol: not exit 0"
+grep -q "status=ok" "$D/tol.txt" || fail "within tolerance: no status=ok"
+[ "$(ex "$D/shift.csv" "$D/ref.csv" --columns a --atol 0.0009)" = 1 ] || fail "a beyond atol: not exit 1"
+grep -q "status=beyond" "$D/tol.txt" || fail "beyond tolerance: no status=beyond"
+[ "$(ex "$D/shift.csv" "$D/ref.csv" --columns b --rtol 0.26)" = 0 ] || fail "b (range 1) within rtol 0.26: not exit 0"
+[ "$(ex "$D/shift.csv" "$D/ref.csv" --columns b --rtol 0.24)" = 1 ] || fail "b (range 1) beyond rtol 0.24: not exit 1"
+[ "$(ex "$D/shift.csv" "$D/ref.csv" --rtol 0.3 --atol 0.002)" = 0 ] || fail "all columns within: not exit 0"
+# different time grids: interpolated, so the tolerance sees the interpolation error (<= 2.5e-5 on b)
+[ "$(ex "$D/coarse.csv" "$D/ref.csv" --common --atol 2.6e-5)" = 0 ] || fail "coarse grid within 2.6e-5: not exit 0"
+[ "$(ex "$D/coarse.csv" "$D/ref.csv" --common --atol 1e-7)" = 1 ] || fail "coarse grid beyond 1e-7: not exit 1"
+# a shorter run fails with its own message; so does a renamed column
+head -n 51 "$D/ref.csv" > "$D/short.csv"
+[ "$(ex "$D/short.csv" "$D/ref.csv" --atol 1)" = 1 ] || fail "a shorter run: not exit 1"
+grep -q "ends at t = 0.49.*a shorter run" "$D/tol.err" || fail "shorter run: message"
+sed '1s/energy.total/energy.kinetic/' "$D/ref.csv" > "$D/renamed.csv"
+[ "$(ex "$D/renamed.csv" "$D/ref.csv" --atol 1)" = 1 ] || fail "a renamed column: not exit 1"
+grep -q "column 'energy.kinetic' .*an extra column" "$D/tol.err" && grep -q "column 'energy.total' .* missing" "$D/tol.err" ||
+  fail "renamed column: messages"
+[ "$(ex "$D/ref.csv" "$D/ref.csv" --rtol -1)" = 2 ] || fail "negative --rtol: not exit 2"
+[ "$(ex "$D/ref.csv" "$D/ref.csv" --atol x)" = 2 ] || fail "--atol x: not exit 2"
+# a line longer than the bound is refused, not read forever
+awk 'BEGIN { printf "t"; for (i = 0; i < 200000; ++i) printf ",c%d", i; print "" }' > "$D/wide.csv"
+[ "$(ex "$D/wide.csv" "$D/ref.csv")" = 2 ] || fail "an over-long line: not exit 2"
+grep -q "line longer than" "$D/tol.err" || fail "over-long line: message"
+[ "$(ex /dev/null "$D/ref.csv")" = 2 ] || fail "a device as input: not exit 2"
+grep -q "not a regular file" "$D/tol.err" || fail "non-regular input: message"
 
 if "$F" compare "$D/ref.csv" "$D/ref.csv" --columns nope > /dev/null 2>&1; then fail "unknown column accepted"; fi
 "$F" compare "$D/ref.csv" "$D/ref.csv" --columns nope 2> "$D/err.txt" > /dev/null || [ $? -eq 2 ] || fail "unknown column: exit not 2"
