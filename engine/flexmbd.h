@@ -234,6 +234,12 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
    (FMB_EXIT_SOLVER) with *diag saying when and why it stopped. */
 int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* stats, fmbDiag* diag);
 void fmb_free(fmbModel* m);
+/* the solver settings a loaded scene runs with (its values after --set overrides) */
+typedef struct fmbSolverInfo {
+  double t0, t_end, rtol, atol, output_step;
+} fmbSolverInfo;
+/* 0, or -1 when an argument is NULL */
+int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
 /* one line per body and joint: type and active terms */
 void fmb_describe(const fmbModel* m, FILE* f);
 void fmb_print_stats(const fmbStats* s, FILE* f);

@@ -239,6 +239,13 @@ void fmb_free(fmbModel* m) {
   free(m);
 }
 
+int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
+  if (!m || !out) return -1;
+  const fmbSolverSettings* s = &m->solver;
+  *out = (fmbSolverInfo){s->t0, s->t_end, s->rtol, s->atol, s->output_step};
+  return 0;
+}
+
 void fmb_describe(const fmbModel* m, FILE* f) {
   fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
           m->path, m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);

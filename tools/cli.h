@@ -30,4 +30,5 @@ int fmb_cmd_run(int argc, char** argv);
 int fmb_cmd_check(int argc, char** argv);
 int fmb_cmd_types(int argc, char** argv);
 int fmb_cmd_compare(int argc, char** argv);
+int fmb_cmd_regress(int argc, char** argv);
 #endif

@@ -19,6 +19,8 @@ static const Command commands[] = {
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run"},
     {"compare", fmb_cmd_compare,
      "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance"},
+    {"regress", fmb_cmd_regress,
+     "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references"},
     {"types", fmb_cmd_types, "types   the registered body and joint types"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
