@@ -3,6 +3,7 @@
 #   1. the test suite under ASan + UBSan + LSan (tools/sanitize.sh; all tests but `long`)
 #   2. both libFuzzer harnesses side by side for FUZZ_SECONDS (default 60) (tools/fuzz.sh)
 #   3. valgrind memcheck on the paper scenes and the error paths (tools/valgrind_paper.sh)
+#   4. the scene regression suite under other compilers and optimization levels (tools/regress_builds.sh)
 # Build directories go under CI_BUILD_ROOT (default: the source tree, build-ci-*). About 8-10
 # minutes on 2 cores from a clean tree. Exits non-zero if any step fails; runs every step.
 set -u
@@ -31,6 +32,9 @@ if cmake -S "$src" -B "$root/build-ci-valgrind" -DCMAKE_BUILD_TYPE=RelWithDebInf
 else
   failed="$failed valgrind-build"
 fi
+
+step "regression suite under gcc -O0/-O3, clang and FMA builds"
+sh "$src/tools/regress_builds.sh" "$root" || failed="$failed regress-builds"
 
 step "done"
 if [ -n "$failed" ]; then
