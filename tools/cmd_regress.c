@@ -192,7 +192,7 @@ static void walk(const char* dir, int depth, int all, List* out) {
     list_push(&here, p);
   }
   closedir(d);
-  qsort(here.v, (size_t)here.n, sizeof *here.v, by_name);
+  if (here.n > 1) qsort(here.v, (size_t)here.n, sizeof *here.v, by_name);
   for (int i = 0; i < here.n; ++i) {
     struct stat st;
     char* p = here.v[i];
@@ -828,68 +828,72 @@ static void remove_tmpdir(const char* dir) {
   rmdir(dir);
 }
 
-int fmb_cmd_regress(int argc, char** argv) {
-  Options o;
-  memset(&o, 0, sizeof o);
-  o.jobs = 1;
-  o.rows = DEFAULT_ROWS;
-  o.slow = 3.0;
-  o.sets = xcalloc((size_t)argc, sizeof *o.sets);
-  List paths = {0};
+static int regress(const Options* op, const List* sc);
+
+/* options and the scenes to run; returns -1 to go on, or an exit code (everything it allocates
+   hangs off o, paths and scenes, which the caller frees) */
+static int parse_arguments(int argc, char** argv, Options* op, List* pathsp, List* scenesp) {
+  Options o = *op;
+  List paths = {0}, scenes = {0};
+  int rc = -1;
+#define return_code(c) \
+  do {                  \
+    rc = (c);           \
+    goto out;           \
+  } while (0)
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     const char* v;
     if (strcmp(a, "--bless") == 0) {
       o.bless = 1;
     } else if (strcmp(a, "--junit") == 0) {
-      if (!(o.junit = fmb_cli_value("regress", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
+      if (!(o.junit = fmb_cli_value("regress", argc, argv, &i, "a file name"))) return_code(FMB_EXIT_BAD_INPUT);
     } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
       if (!(v = fmb_cli_value("regress", argc, argv, &i, "a number")) || positive_int(v, 1, 256, &o.jobs)) {
         fprintf(stderr, "flexmbd regress: -j needs a whole number from 1 to 256\n");
-        return FMB_EXIT_BAD_INPUT;
+        return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (strncmp(a, "-j", 2) == 0 && a[2]) {
       if (positive_int(a + 2, 1, 256, &o.jobs)) {
         fprintf(stderr, "flexmbd regress: -j needs a whole number from 1 to 256\n");
-        return FMB_EXIT_BAD_INPUT;
+        return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (strcmp(a, "--rows") == 0) {
       if (!(v = fmb_cli_value("regress", argc, argv, &i, "a number")) || positive_int(v, 2, 100000, &o.rows)) {
         fprintf(stderr, "flexmbd regress: --rows needs a whole number from 2 to 100000\n");
-        return FMB_EXIT_BAD_INPUT;
+        return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (strcmp(a, "--slow") == 0) {
       char* end;
       if (!(v = fmb_cli_value("regress", argc, argv, &i, "a factor")) || (o.slow = strtod(v, &end), *end) ||
           !(o.slow >= 1.0) || !isfinite(o.slow)) {
         fprintf(stderr, "flexmbd regress: --slow needs a factor >= 1\n");
-        return FMB_EXIT_BAD_INPUT;
+        return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (strcmp(a, "--set") == 0) {
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "PATH=VALUE"))) return FMB_EXIT_BAD_INPUT;
-      o.sets[o.nsets++] = v;
+      if (!(v = fmb_cli_value("regress", argc, argv, &i, "PATH=VALUE"))) return_code(FMB_EXIT_BAD_INPUT);
+      op->sets[o.nsets++] = v;
     } else if (strncmp(a, "--set=", 6) == 0) {
-      o.sets[o.nsets++] = a + 6;
+      op->sets[o.nsets++] = a + 6;
     } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       usage(stdout);
-      return 0;
+      return_code(0);
     } else if (a[0] == '-' && a[1]) {
       fprintf(stderr, "flexmbd regress: unknown option '%s'\n", a);
       usage(stderr);
-      return FMB_EXIT_BAD_INPUT;
+      return_code(FMB_EXIT_BAD_INPUT);
     } else {
       list_push(&paths, (char*)a);
     }
   }
   if (paths.n == 0) list_push(&paths, ".");
   /* the scenes */
-  List scenes = {0};
   for (int i = 0; i < paths.n; ++i) {
     struct stat st;
     const char* p = paths.v[i];
     if (stat(p, &st) != 0) {
       fprintf(stderr, "flexmbd regress: %s: %s\n", p, strerror(errno));
-      return FMB_EXIT_BAD_INPUT;
+      return_code(FMB_EXIT_BAD_INPUT);
     }
     if (S_ISDIR(st.st_mode)) {
       int before = scenes.n;
@@ -897,15 +901,46 @@ int fmb_cmd_regress(int argc, char** argv) {
       if (scenes.n == before) {
         fprintf(stderr, "flexmbd regress: no scene %sunder %s%s\n", o.bless ? "" : "with a reference ", p,
                 o.bless ? "" : " (make references with: flexmbd regress --bless PATH)");
-        return FMB_EXIT_BAD_INPUT;
+        return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (S_ISREG(st.st_mode)) {
       list_push(&scenes, xstrdup(p));
     } else {
       fprintf(stderr, "flexmbd regress: %s: not a scene file or a folder\n", p);
-      return FMB_EXIT_BAD_INPUT;
+      return_code(FMB_EXIT_BAD_INPUT);
     }
   }
+out:
+#undef return_code
+  o.sets = op->sets;
+  *op = o;
+  *pathsp = paths;
+  *scenesp = scenes;
+  return rc;
+}
+
+int fmb_cmd_regress(int argc, char** argv) {
+  Options o;
+  memset(&o, 0, sizeof o);
+  o.jobs = 1;
+  o.rows = DEFAULT_ROWS;
+  o.slow = 3.0;
+  o.sets = xcalloc((size_t)argc, sizeof *o.sets);
+  List paths = {0}, scenes = {0};
+  int rc = parse_arguments(argc, argv, &o, &paths, &scenes);
+  if (rc < 0) rc = regress(&o, &scenes);
+  for (int i = 0; i < scenes.n; ++i) free(scenes.v[i]);
+  free(scenes.v);
+  free(paths.v);
+  free(o.sets);
+  return rc;
+}
+
+/* run (or bless) every scene; the exit code */
+static int regress(const Options* op, const List* sc) {
+  Options o = *op;
+  const List scenes = *sc;
+  int rc = 0;
   /* with --bless each scene's job is followed by its companions (same scene, neighbouring rtol) */
   const int per = o.bless ? 1 + NCOMPANION : 1;
   Job* all = xcalloc((size_t)scenes.n * (size_t)per, sizeof *all);
@@ -937,7 +972,8 @@ int fmb_cmd_regress(int argc, char** argv) {
   snprintf(o.tmpdir, sizeof o.tmpdir, "%s/flexmbd-regress-XXXXXX", tmp && *tmp ? tmp : "/tmp");
   if (!mkdtemp(o.tmpdir)) {
     fprintf(stderr, "flexmbd regress: cannot make a temporary folder %s: %s\n", o.tmpdir, strerror(errno));
-    return FMB_EXIT_BAD_INPUT;
+    rc = FMB_EXIT_BAD_INPUT;
+    goto out;
   }
   run_all(all, scenes.n * per, &o);
   int nfail = 0, bad = 0;
@@ -957,18 +993,15 @@ int fmb_cmd_regress(int argc, char** argv) {
   }
   print_table(jobs, scenes.n, &o);
   printf("regress: %d passed, %d failed\n", scenes.n - nfail, nfail);
-  int rc = bad ? FMB_EXIT_BAD_INPUT : nfail ? 1 : 0;
+  rc = bad ? FMB_EXIT_BAD_INPUT : nfail ? 1 : 0;
   if (o.junit && write_junit(o.junit, jobs, scenes.n)) rc = FMB_EXIT_BAD_INPUT;
   remove_tmpdir(o.tmpdir);
+out:
   for (int i = 0; i < scenes.n; ++i) {
     reference_free(&jobs[i]->ref);
     free(jobs[i]->ref_path);
-    free(jobs[i]->scene);
   }
   free(jobs);
   free(all);
-  free(scenes.v);
-  free(paths.v);
-  free(o.sets);
   return rc;
 }
