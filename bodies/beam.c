@@ -753,6 +753,28 @@ static int beam_velocity_error_test(const void* self) {
   return 0;
 }
 
+static const fmbParam beam_params[] = {
+    {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "undeformed length"},
+    {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = MAX_ELEMENTS,
+     .doc = "finite elements along the length"},
+    {.key = "density", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg/m^3", .doc = "mass density"},
+    {.key = "area", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^2", .doc = "cross-section area"},
+    {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",
+     .doc = "second moment of area of the cross-section"},
+    {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa", .doc = "Young's modulus"},
+    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "complete", .choices = model_names,
+     .doc = "coupling deformation kept in full, to first order, or left out (docs/beam.md)"},
+    {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial root of the floating frame"},
+    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"},
+    {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial root velocity"},
+    {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial frame angular velocity"},
+    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .fallback = "0",
+     .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
+    {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 1,
+     .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element"},
+    {.key = NULL},
+};
+
 const fmbBodyType fmb_body_beam = {
     .name = "beam",
     .abi = FMB_ABI_VERSION,
@@ -773,4 +795,8 @@ const fmbBodyType fmb_body_beam = {
     .max_bdf_order = beam_max_bdf_order,
     .invalid_state = beam_invalid_state,
     .velocity_error_test = beam_velocity_error_test,
+    .params = beam_params,
+    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
+               "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",
+    .example_damped = "damping: 0.05\n",
 };

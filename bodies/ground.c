@@ -37,9 +37,8 @@ static int ground_marker(const void* self, const double* q, const double local[2
                          double* dpos_dq, double* dangle_dq, double* work) {
   (void)q, (void)dpos_dq, (void)dangle_dq, (void)work;
   const Ground* g = self;
-  const double c = cos(g->angle), s = sin(g->angle);
-  pos[0] = g->pos[0] + c * local[0] - s * local[1];
-  pos[1] = g->pos[1] + s * local[0] + c * local[1];
+  const double frame[3] = {g->pos[0], g->pos[1], g->angle};
+  fmb_frame_point(frame, local, pos, NULL);
   if (angle) *angle = g->angle;
   return 0;
 }
@@ -48,6 +47,12 @@ static void ground_describe(const void* self, FILE* out) {
   const Ground* g = self;
   fprintf(out, "fixed frame at (%g, %g), angle %g\n", g->pos[0], g->pos[1], g->angle);
 }
+
+static const fmbParam ground_params[] = {
+    {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "origin of the fixed frame"},
+    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "orientation of the fixed frame"},
+    {.key = NULL},
+};
 
 const fmbBodyType fmb_body_ground = {
     .name = "ground",
@@ -59,4 +64,6 @@ const fmbBodyType fmb_body_ground = {
     .initial = ground_initial,
     .residual = ground_residual,
     .marker = ground_marker,
+    .params = ground_params,
+    .example = "position: [0.5, 0.2]\nangle: 0.1\n",
 };

@@ -74,18 +74,8 @@ static int rigid_marker(const void* self, const double* q, const double local[2]
                         double* dpos_dq, double* dangle_dq, double* work) {
   (void)self;
   (void)work;
-  const double c = cos(q[2]), s = sin(q[2]);
-  pos[0] = q[0] + c * local[0] - s * local[1];
-  pos[1] = q[1] + s * local[0] + c * local[1];
+  fmb_frame_point(q, local, pos, dpos_dq); /* q is the frame: the body is its frame */
   if (angle) *angle = q[2];
-  if (dpos_dq) {
-    dpos_dq[0] = 1.0;
-    dpos_dq[1] = 0.0;
-    dpos_dq[2] = -s * local[0] - c * local[1];
-    dpos_dq[3] = 0.0;
-    dpos_dq[4] = 1.0;
-    dpos_dq[5] = c * local[0] - s * local[1];
-  }
   if (dangle_dq) {
     dangle_dq[0] = dangle_dq[1] = 0.0;
     dangle_dq[2] = 1.0;
@@ -106,6 +96,17 @@ static void rigid_describe(const void* self, FILE* f) {
   fprintf(f, "mass %g kg, inertia %g kg m^2 about the centre of mass\n", r->mass, r->inertia);
 }
 
+static const fmbParam rigid_params[] = {
+    {.key = "mass", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg", .doc = "mass"},
+    {.key = "inertia", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg m^2",
+     .doc = "moment of inertia about the centre of mass"},
+    {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial centre of mass"},
+    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial orientation"},
+    {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial velocity of the centre of mass"},
+    {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial angular velocity"},
+    {.key = NULL},
+};
+
 const fmbBodyType fmb_body_rigid = {
     .name = "rigid",
     .abi = FMB_ABI_VERSION,
@@ -118,4 +119,6 @@ const fmbBodyType fmb_body_rigid = {
     .jacobian = rigid_jacobian,
     .energy = rigid_energy,
     .describe = rigid_describe,
+    .params = rigid_params,
+    .example = "mass: 2\ninertia: 0.3\nposition: [0.1, 0.2]\nangle: 0.3\nvelocity: [0.5, 1.0]\nangular_velocity: 2.0\n",
 };

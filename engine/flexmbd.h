@@ -20,7 +20,23 @@
 extern "C" {
 #endif
 
-#define FMB_ABI_VERSION 1
+/* The plugin ABI: the layout of fmbPlugin, fmbBodyType, fmbJointType, fmbParam and the signatures
+   of every function below. A plugin built for another number is refused when it is loaded
+   (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags. */
+#define FMB_ABI_VERSION 2
+
+/* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
+#if defined(__GNUC__)
+#define FMB_API __attribute__((visibility("default")))
+#else
+#define FMB_API
+#endif
+/* what a plugin exports: its one entry point, fmb_plugin_descriptor */
+#ifdef __cplusplus
+#define FMB_PLUGIN_EXPORT extern "C" FMB_API
+#else
+#define FMB_PLUGIN_EXPORT FMB_API
+#endif
 
 /* ---------------------------------------------------------------------------------------------
  * Diagnostics: the first error wins; file/line/col are 1-based, 0 when not applicable.
@@ -52,26 +68,26 @@ enum {
   FMB_NONNEGATIVE = 1 << 2  /* >= 0 */
 };
 
-int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
-int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out);
-int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]);
+FMB_API int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
+FMB_API int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out);
+FMB_API int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]);
 /* one of a NULL-terminated list of words; *out is the index */
-int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
+FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out);
 /* a body by name ("ground" is always defined); *out is the body index */
-int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
+FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
 /* a joint defined earlier in the file, by name; *out is the joint index */
-int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
+FMB_API int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
 /* body index and local point of attachment k (0 or 1) of an already parsed joint */
-int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]);
+FMB_API int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]);
 /* a plugin-level check failed at `node` (a value node or the item's mapping) */
-int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
+FMB_API int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
 /* the value node of `key` in `map`, or -1 if absent (marks the key known) */
-fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key);
+FMB_API fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key);
 
 /* ---------------------------------------------------------------------------------------------
  * Evaluation environment shared by all plugins.
@@ -84,6 +100,38 @@ typedef struct fmbEnv {
 typedef struct fmbEnergy {
   double kinetic, strain, gravity, spring;
 } fmbEnergy;
+
+/* ---------------------------------------------------------------------------------------------
+ * Parameter declarations. A type lists the keys its parse reads, with units, defaults and ranges:
+ * `flexmbd types` prints them and `flexmbd conform` generates a bad scene from every range
+ * (a value outside it must be refused at its file:line:column naming the key), so a new type
+ * never edits the engine's test lists. The list ends with an entry whose key is NULL.
+ * ------------------------------------------------------------------------------------------- */
+typedef enum {
+  FMB_PARAM_NUMBER, /* fmb_get_double; range from flags FMB_POSITIVE / FMB_NONNEGATIVE */
+  FMB_PARAM_INT,    /* fmb_get_int; range [lo, hi] */
+  FMB_PARAM_VEC2,   /* fmb_get_vec2 */
+  FMB_PARAM_CHOICE, /* fmb_get_choice; the words in `choices` */
+  FMB_PARAM_BODY,   /* fmb_get_body */
+  FMB_PARAM_JOINT   /* fmb_get_joint */
+} fmbParamKind;
+
+typedef struct fmbParam {
+  const char* key;
+  fmbParamKind kind;
+  unsigned flags;               /* FMB_REQUIRED, FMB_POSITIVE, FMB_NONNEGATIVE as the parse passes them */
+  const char* unit;             /* SI unit, "1" for a pure number or count, NULL for words and names */
+  const char* fallback;         /* the default as a scene would write it; NULL when required or none */
+  long lo, hi;                  /* FMB_PARAM_INT: the accepted range */
+  const char* const* choices;   /* FMB_PARAM_CHOICE: NULL-terminated */
+  const char* doc;              /* one line */
+} fmbParam;
+
+/* type flags (fmbBodyType.flags, fmbJointType.flags) */
+enum {
+  FMB_TYPE_DOES_WORK = 1 << 0 /* feeds energy in (a prescribed motion, an applied load): conform
+                                 skips the energy-conservation run */
+};
 
 /* ---------------------------------------------------------------------------------------------
  * Body plugins. A body owns `ncoord` generalized coordinates q (frame x, y, theta first when the
@@ -140,6 +188,13 @@ typedef struct fmbBodyType {
      beam whose deformation exceeds its length is diverging). Checked at every output time:
      the run stops there with exit 3 instead of integrating a runaway solution. */
   const char* (*invalid_state)(const void* self, const double* q, const double* v);
+  /* declarations (ABI 2): the keys parse reads; a valid instance as YAML lines `key: value`
+     (without name and type) that conform runs free under gravity; extra lines that make it
+     dissipate energy (NULL when it cannot); FMB_TYPE_* flags */
+  const fmbParam* params;
+  const char* example;
+  const char* example_damped;
+  unsigned flags;
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -170,22 +225,29 @@ typedef struct fmbJointType {
   int (*output_lookup)(const void* self, const char* quantity);
   int (*output)(const void* self, int id, const fmbJointEval* ev, double* value);
   void (*describe)(const void* self, FILE* f);
+  /* declarations (ABI 2), as for bodies. conform's fixture has two rigid bodies `a` (centre at
+     [0.5, 0], pinned to ground at its end [-0.5, 0]) and `b` (centre at [1.5, 0]), 1 m long each,
+     and a revolute joint `pin` (ground to a): the example refers to them by these names. */
+  const fmbParam* params;
+  const char* example;
+  const char* example_damped;
+  unsigned flags;
 } fmbJointType;
 
 /* what a joint may ask of the evaluation context */
-double fmb_eval_time(const fmbJointEval* ev);
-int fmb_eval_ncoord(const fmbJointEval* ev, int k);      /* coordinates of body k (0 for ground) */
-const double* fmb_eval_q(const fmbJointEval* ev, int k);
-const double* fmb_eval_v(const fmbJointEval* ev, int k);
+FMB_API double fmb_eval_time(const fmbJointEval* ev);
+FMB_API int fmb_eval_ncoord(const fmbJointEval* ev, int k);      /* coordinates of body k (0 for ground) */
+FMB_API const double* fmb_eval_q(const fmbJointEval* ev, int k);
+FMB_API const double* fmb_eval_v(const fmbJointEval* ev, int k);
 /* position and angle of body k's material point `local`; derivatives wrt body k's coordinates
    go to dpos_dq (row 0 at dpos_dq[0..nk), row 1 at dpos_dq[ld..ld+nk)) and dangle_dq[0..nk);
    either may be NULL. Use ld = the joint's column count to write straight into phi_q rows. */
-int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle,
+FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle,
                double* dpos_dq, int ld, double* dangle_dq);
 /* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
-double* fmb_eval_scratch(const fmbJointEval* ev);
+FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
 /* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1) */
-int fmb_eval_col0(const fmbJointEval* ev, int k);
+FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 
 /* ---------------------------------------------------------------------------------------------
  * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
@@ -193,17 +255,49 @@ int fmb_eval_col0(const fmbJointEval* ev, int k);
 #define FMB_GAUSS_MAX 10
 /* n-point Gauss-Legendre rule on [0, 1] (1 <= n <= FMB_GAUSS_MAX); exact to degree 2n-1.
    Returns 0, or -1 for an unsupported n. */
-int fmb_gauss_legendre01(int n, double* x, double* w);
+FMB_API int fmb_gauss_legendre01(int n, double* x, double* w);
+
+/* Rigid-frame kinematics (engine/frame.c): the global position of the point `local` of a planar
+   frame at frame = [x, y, theta] (p = r + A(theta) local), and dp/dframe (2 x 3 row-major, may
+   be NULL). A body whose first three coordinates are its frame answers `marker` with it. */
+FMB_API void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* dpos_dframe);
 
 /* ---------------------------------------------------------------------------------------------
- * Registry: the types a loader knows. The engine names no type; the program hands it a table.
+ * Plugins and the registry. A plugin is a set of types behind one descriptor; the built-in types
+ * are one too (fmb_builtin_plugin), and every type enters a registry through fmb_registry_add,
+ * which checks the ABI and the required ops. A shared object exports the descriptor as
+ *     FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void);
+ * The engine names no type; the program hands fmb_load a registry.
  * ------------------------------------------------------------------------------------------- */
-typedef struct fmbRegistry {
-  const fmbBodyType* const* bodies;
-  int nbodies;
+typedef struct fmbPlugin {
+  int abi;                          /* FMB_ABI_VERSION: first, never moves */
+  const char* name;                 /* for messages and `flexmbd types` */
+  const char* version;
+  const fmbBodyType* const* bodies; /* NULL-terminated; NULL = none */
   const fmbJointType* const* joints;
-  int njoints;
-} fmbRegistry;
+} fmbPlugin;
+#define FMB_PLUGIN_ENTRY "fmb_plugin_descriptor"
+typedef const fmbPlugin* (*fmbPluginEntry)(void);
+
+typedef struct fmbRegistry fmbRegistry; /* growable, any number of types */
+FMB_API fmbRegistry* fmb_registry_new(void);       /* empty; NULL when out of memory */
+FMB_API void fmb_registry_free(fmbRegistry* reg);  /* types and loaded code stay valid */
+/* register every type of `plugin` (origin: "built-in" or the file, for messages). Refuses, with
+   *diag filled (exit code 2), another ABI, a type without a name or a required op, and a name
+   already registered by another table; the same table twice is a no-op. */
+FMB_API int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* origin, fmbDiag* diag);
+/* dlopen a shared object (a path without '/' is taken in the current folder, never searched for),
+   look up fmb_plugin_descriptor and add it. Loaded code is never unloaded. */
+FMB_API int fmb_registry_load(fmbRegistry* reg, const char* path, fmbDiag* diag);
+FMB_API int fmb_registry_nbodies(const fmbRegistry* reg);
+FMB_API int fmb_registry_njoints(const fmbRegistry* reg);
+FMB_API const fmbBodyType* fmb_registry_body(const fmbRegistry* reg, int i);
+FMB_API const fmbJointType* fmb_registry_joint(const fmbRegistry* reg, int i);
+/* where type i came from: "built-in" or the plugin's file */
+FMB_API const char* fmb_registry_body_origin(const fmbRegistry* reg, int i);
+FMB_API const char* fmb_registry_joint_origin(const fmbRegistry* reg, int i);
+/* the types shipped with flexmbd (tools/builtin.c), registered like any plugin */
+FMB_API const fmbPlugin* fmb_builtin_plugin(void);
 
 /* ---------------------------------------------------------------------------------------------
  * Loading and running.
@@ -228,21 +322,31 @@ typedef struct fmbRunOptions {
 
 /* Load `path`, applying "PATH=VALUE" overrides (e.g. "solver.rtol=1e-8",
    "bodies.beam.elements=32"). Returns NULL with *diag filled on error. */
-fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
+FMB_API fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
                    fmbDiag* diag);
 /* Integrate from the scene's t0 to t_end, writing CSV rows as it goes. Returns 0 or an exit code
    (FMB_EXIT_SOLVER) with *diag saying when and why it stopped. */
-int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* stats, fmbDiag* diag);
-void fmb_free(fmbModel* m);
+FMB_API int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* stats, fmbDiag* diag);
+FMB_API void fmb_free(fmbModel* m);
 /* the solver settings a loaded scene runs with (its values after --set overrides) */
 typedef struct fmbSolverInfo {
   double t0, t_end, rtol, atol, output_step;
 } fmbSolverInfo;
 /* 0, or -1 when an argument is NULL */
-int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
+FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
 /* one line per body and joint: type and active terms */
-void fmb_describe(const fmbModel* m, FILE* f);
-void fmb_print_stats(const fmbStats* s, FILE* f);
+FMB_API void fmb_describe(const fmbModel* m, FILE* f);
+FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
+
+/* ---------------------------------------------------------------------------------------------
+ * Conformance (engine/conform.c): the checks every registered type must pass, run on its
+ * declared example: bad parameters refused with a located message, declared keys = keys read,
+ * analytic Jacobian against finite differences, mass matrix symmetric positive definite, marker
+ * and constraint derivatives, energy kept by a free run and lost by a damped one, outputs finite,
+ * gravity left out when the scene has none. One line per check on `report`; returns the number
+ * of failed checks (0 = conforming), or -1 when no type has that name.
+ * ------------------------------------------------------------------------------------------- */
+FMB_API int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, FILE* report);
 
 #ifdef __cplusplus
 }

@@ -96,6 +96,22 @@ struct fmbJointEval {
   double* js;      /* 2 x max joint columns: the joint's own scratch */
 };
 
+/* ---- registry.c: a growable registry of types; plugin.c: loading plugins ---- */
+struct fmbRegistry {
+  int nbodies, njoints, cap_bodies, cap_joints;
+  const fmbBodyType** bodies;
+  const fmbJointType** joints;
+  const char** body_names;  /* NULL-terminated, for fmb_get_choice */
+  const char** joint_names;
+  char** body_origin;       /* owned copies */
+  char** joint_origin;
+};
+/* a copy of reg that a scene's plugins can be added to */
+fmbRegistry* fmb_registry_clone(const fmbRegistry* reg);
+/* the scene's `plugins:` list (a node, or -1 when absent): each path, relative to the scene's
+   folder, is loaded into a copy of p->reg that p->reg then points to (p->own_reg) */
+int fmb_scene_plugins(fmbParser* p, fmbNode list);
+
 /* ---- yaml_get.c: document, overrides, accessors ---- */
 struct fmbParser {
   yaml_document_t doc;
@@ -110,6 +126,7 @@ struct fmbParser {
   int nlooked;
   fmbModel* model;          /* under construction */
   const fmbRegistry* reg;
+  fmbRegistry* own_reg;     /* the scene's plugins: a copy of the caller's registry, or NULL */
 };
 
 int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag);

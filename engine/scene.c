@@ -8,7 +8,6 @@
 
 #include "internal.h"
 
-#define FMB_MAX_TYPES 64
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
 
 static const char* const reserved_names[] = {"ground", "energy", "constraint", "t", NULL};
@@ -66,14 +65,6 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   return 0;
 }
 
-static int type_names(const fmbRegistry* reg, int bodies, const char** names) {
-  int n = bodies ? reg->nbodies : reg->njoints;
-  if (n > FMB_MAX_TYPES - 1) n = FMB_MAX_TYPES - 1;
-  for (int i = 0; i < n; ++i) names[i] = bodies ? reg->bodies[i]->name : reg->joints[i]->name;
-  names[n] = NULL;
-  return n;
-}
-
 /* What every body and joint item shares: a mapping with a fresh name and a registered type, read
    by its plugin with no key left unread. On success *self belongs to the caller; on error
    nothing is left allocated. */
@@ -89,12 +80,8 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
                          "duplicate or reserved name '%s': every body and joint needs its own name", name);
   if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
   const char* type_name = joints ? p->reg->joints[*t]->name : p->reg->bodies[*t]->name;
-  const int abi = joints ? p->reg->joints[*t]->abi : p->reg->bodies[*t]->abi;
   int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : p->reg->bodies[*t]->parse;
   void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : p->reg->bodies[*t]->destroy;
-  if (abi != FMB_ABI_VERSION)
-    return fmb_parse_error(p, item, "%s type '%s' was built for plugin ABI %d, the engine has %d", kind, type_name, abi,
-                         FMB_ABI_VERSION);
   char what[FMB_NAME_MAX + 40];
   snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
   if (parse(p, item, self) || fmbp_check_unknown(p, item, what)) {
@@ -117,8 +104,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
   /* body 0: the fixed world frame */
   snprintf(m->body[0].name, FMB_NAME_MAX, "ground");
   m->nbody = 1;
-  const char* names[FMB_MAX_TYPES];
-  type_names(p->reg, 1, names);
+  const char* const* names = p->reg->body_names;
   for (int i = 0; i < n; ++i) {
     fmbBodyInst* b = &m->body[m->nbody];
     int t = 0;
@@ -147,8 +133,7 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
   int n = fmbp_seq_len(p, list);
   m->joint = calloc((size_t)n + 1, sizeof *m->joint);
   if (!m->joint) return fmb_parse_error(p, list, "out of memory");
-  const char* names[FMB_MAX_TYPES];
-  type_names(p->reg, 0, names);
+  const char* const* names = p->reg->joint_names;
   for (int i = 0; i < n; ++i) {
     fmbNode item = fmbp_seq_item(p, list, i);
     fmbJointInst* j = &m->joint[m->njoint];
@@ -177,13 +162,14 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode bodies = fmb_find_key(p, root, "bodies");
   fmbNode joints = fmb_find_key(p, root, "joints");
   fmbNode outputs = fmb_find_key(p, root, "outputs");
+  fmbNode plugins = fmb_find_key(p, root, "plugins");
   double g[2] = {0.0, 0.0};
   if (fmb_get_vec2(p, root, "gravity", 0, g)) return -1;
   if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
   m->env.gravity[0] = g[0];
   m->env.gravity[1] = g[1];
   m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);
-  if (parse_solver(p, m, solver) || parse_bodies(p, m, bodies) || parse_joints(p, m, joints)) return -1;
+  if (fmb_scene_plugins(p, plugins) || parse_solver(p, m, solver) || parse_bodies(p, m, bodies) || parse_joints(p, m, joints)) return -1;
   if (m->nq == 0) return fmb_parse_error(p, bodies, "the scene has no moving body (no generalized coordinates)");
   if (m->nc > m->nq)
     return fmb_parse_error(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
@@ -216,6 +202,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
   int rc = fmbp_open(&p, path, overrides, noverrides, diag);
   if (rc == 0) rc = parse_scene(&p, m);
   fmbp_close(&p);
+  fmb_registry_free(p.own_reg); /* the types stay: their code is never unloaded */
   if (rc) {
     if (!diag->code) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "invalid scene");
     fmb_free(m);

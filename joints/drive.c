@@ -13,6 +13,7 @@
 #include "flexmbd.h"
 
 enum { PROFILE_CONSTANT, PROFILE_HARMONIC, PROFILE_SPINUP };
+static const char* const profiles[] = {"constant", "harmonic", "spinup", NULL}; /* order of PROFILE_* */
 
 typedef struct {
   int body[2];
@@ -25,7 +26,6 @@ static int drive_parse(fmbParser* p, fmbNode item, void** self) {
   Drive* d = calloc(1, sizeof *d);
   if (!d) return fmb_parse_error(p, item, "out of memory");
   *self = d;
-  static const char* const profiles[] = {"constant", "harmonic", "spinup", NULL};
   int joint = -1;
   if (fmb_get_joint(p, item, "joint", FMB_REQUIRED, &joint)) return -1;
   for (int k = 0; k < 2; ++k)
@@ -131,6 +131,19 @@ static void drive_describe(const void* self, FILE* f) {
   fprintf(f, "%s profile\n", names[d->profile]);
 }
 
+static const fmbParam drive_params[] = {
+    {.key = "joint", .kind = FMB_PARAM_JOINT, .flags = FMB_REQUIRED, .doc = "the revolute joint whose angle is prescribed"},
+    {.key = "profile", .kind = FMB_PARAM_CHOICE, .flags = FMB_REQUIRED, .choices = profiles, .doc = "f(t), see below"},
+    {.key = "angle0", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "relative angle at f = 0"},
+    {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .doc = "constant: f = speed t (required)"},
+    {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = "rad", .doc = "harmonic: f = amplitude sin(frequency t + phase) (required)"},
+    {.key = "frequency", .kind = FMB_PARAM_NUMBER, .flags = FMB_POSITIVE, .unit = "rad/s", .doc = "harmonic (required)"},
+    {.key = "phase", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "harmonic"},
+    {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .doc = "spinup: final speed (required)"},
+    {.key = "ramp_time", .kind = FMB_PARAM_NUMBER, .flags = FMB_POSITIVE, .unit = "s", .doc = "spinup: time to reach omega0 (required)"},
+    {.key = NULL},
+};
+
 const fmbJointType fmb_joint_drive = {
     .name = "drive",
     .abi = FMB_ABI_VERSION,
@@ -143,4 +156,7 @@ const fmbJointType fmb_joint_drive = {
     .output_lookup = drive_lookup,
     .output = drive_output,
     .describe = drive_describe,
+    .params = drive_params,
+    .example = "joint: pin\nprofile: harmonic\namplitude: 0.2\nfrequency: 3\n",
+    .flags = FMB_TYPE_DOES_WORK,
 };

@@ -52,6 +52,12 @@ static void fixed_describe(const void* self, FILE* out) {
   fprintf(out, "points coincide, relative angle held at %g rad\n", f->angle);
 }
 
+static const fmbParam fixed_params[] = {
+    FMBJ_TWO_POINT_PARAMS,
+    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "angle of body2 relative to body1"},
+    {.key = NULL},
+};
+
 const fmbJointType fmb_joint_fixed = {
     .name = "fixed",
     .abi = FMB_ABI_VERSION,
@@ -62,4 +68,6 @@ const fmbJointType fmb_joint_fixed = {
     .nrows = fixed_nrows,
     .attachment = fixed_attachment,
     .constraint = fixed_constraint,
+    .params = fixed_params,
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\n",
 };

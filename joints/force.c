@@ -48,6 +48,14 @@ static void load_describe(const void* self, FILE* out) {
   fprintf(out, "constant load (%g, %g) N and %g N m\n", l->force[0], l->force[1], l->torque);
 }
 
+static const fmbParam load_params[] = {
+    {.key = "body", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "the loaded body (not ground)"},
+    {.key = "point", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point of application, body frame"},
+    {.key = "force", .kind = FMB_PARAM_VEC2, .unit = "N", .fallback = "[0, 0]", .doc = "constant force, global frame"},
+    {.key = "torque", .kind = FMB_PARAM_NUMBER, .unit = "N m", .fallback = "0", .doc = "constant torque"},
+    {.key = NULL},
+};
+
 const fmbJointType fmb_joint_force = {
     .name = "force",
     .abi = FMB_ABI_VERSION,
@@ -56,4 +64,7 @@ const fmbJointType fmb_joint_force = {
     .destroy = load_destroy,
     .bodies = load_bodies,
     .force = load_force,
+    .params = load_params,
+    .example = "body: b\npoint: [0.5, 0]\nforce: [1, 2]\ntorque: 0.5\n",
+    .flags = FMB_TYPE_DOES_WORK,
 };

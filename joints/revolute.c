@@ -57,6 +57,8 @@ static void revolute_describe(const void* self, FILE* out) {
   fprintf(out, "the two points coincide\n");
 }
 
+static const fmbParam revolute_params[] = {FMBJ_TWO_POINT_PARAMS, {.key = NULL}};
+
 const fmbJointType fmb_joint_revolute = {
     .name = "revolute",
     .abi = FMB_ABI_VERSION,
@@ -70,4 +72,6 @@ const fmbJointType fmb_joint_revolute = {
     .output_names = revolute_outputs,
     .output_lookup = revolute_lookup,
     .output = revolute_output,
+    .params = revolute_params,
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\n",
 };

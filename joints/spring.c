@@ -98,6 +98,14 @@ static void spring_describe(const void* self, FILE* out) {
   fprintf(out, "spring-damper k = %g N/m, c = %g N s/m, rest length %g m\n", s->stiffness, s->damping, s->rest_length);
 }
 
+static const fmbParam spring_params[] = {
+    FMBJ_TWO_POINT_PARAMS,
+    {.key = "stiffness", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_NONNEGATIVE, .unit = "N/m", .doc = "spring rate k"},
+    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "N s/m", .fallback = "0", .doc = "damper rate c"},
+    {.key = "rest_length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_NONNEGATIVE, .unit = "m", .doc = "unstretched length l0"},
+    {.key = NULL},
+};
+
 const fmbJointType fmb_joint_spring = {
     .name = "spring",
     .abi = FMB_ABI_VERSION,
@@ -110,4 +118,7 @@ const fmbJointType fmb_joint_spring = {
     .output_names = spring_outputs,
     .output_lookup = spring_lookup,
     .output = spring_output,
+    .params = spring_params,
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0.1]\nstiffness: 50\nrest_length: 0.3\n",
+    .example_damped = "damping: 2\n",
 };

@@ -1,7 +1,11 @@
-/* builtin.c — the built-in body and joint types: the one place a type is registered.
- * Adding a type: write bodies/NAME.c (or joints/NAME.c) exporting its ops table, add one line
- * here, and list the file in CMakeLists.txt (docs/plugins.md). */
+/* builtin.c — the types shipped with flexmbd, as one plugin descriptor: they enter a registry
+ * through fmb_registry_add exactly as a loaded plugin does (engine/registry.c), so the engine has
+ * one path. A new type is best written out of tree as a plugin (docs/plugins.md); to ship one
+ * with flexmbd, add its file to CMakeLists.txt and one line here. */
 #include "builtin.h"
+
+#include <stddef.h>
+#include <stdio.h>
 
 extern const fmbBodyType fmb_body_ground, fmb_body_rigid, fmb_body_beam;
 extern const fmbJointType fmb_joint_revolute, fmb_joint_fixed, fmb_joint_drive, fmb_joint_spring, fmb_joint_force;
@@ -10,6 +14,7 @@ static const fmbBodyType* const builtin_bodies[] = {
     &fmb_body_ground,
     &fmb_body_rigid,
     &fmb_body_beam,
+    NULL,
 };
 
 static const fmbJointType* const builtin_joints[] = {
@@ -18,11 +23,29 @@ static const fmbJointType* const builtin_joints[] = {
     &fmb_joint_drive,
     &fmb_joint_spring,
     &fmb_joint_force,
+    NULL,
 };
 
-static const fmbRegistry builtin_registry = {
-    builtin_bodies, (int)(sizeof builtin_bodies / sizeof builtin_bodies[0]),
-    builtin_joints, (int)(sizeof builtin_joints / sizeof builtin_joints[0]),
+static const fmbPlugin builtin_plugin = {
+    .abi = FMB_ABI_VERSION,
+    .name = "built-in",
+    .version = "flexmbd",
+    .bodies = builtin_bodies,
+    .joints = builtin_joints,
 };
 
-const fmbRegistry* fmb_builtin_registry(void) { return &builtin_registry; }
+const fmbPlugin* fmb_builtin_plugin(void) { return &builtin_plugin; }
+
+const fmbRegistry* fmb_builtin_registry(void) {
+  static fmbRegistry* reg; /* built once, kept for the process: tests and tools share it */
+  if (!reg) {
+    fmbDiag d;
+    reg = fmb_registry_new();
+    if (reg && fmb_registry_add(reg, &builtin_plugin, "built-in", &d)) {
+      fprintf(stderr, "flexmbd: the built-in types do not register: %s\n", d.msg);
+      fmb_registry_free(reg);
+      reg = NULL;
+    }
+  }
+  return reg;
+}

@@ -4,9 +4,19 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "builtin.h"
-
-const fmbRegistry* fmb_cli_registry(void) { return fmb_builtin_registry(); }
+fmbRegistry* fmb_cli_registry(void) {
+  static fmbRegistry* reg; /* the built-ins, then every --plugin in command-line order */
+  if (!reg) {
+    fmbDiag d;
+    reg = fmb_registry_new();
+    if (reg && fmb_registry_add(reg, fmb_builtin_plugin(), "built-in", &d)) {
+      fmb_cli_print_diag(&d);
+      fmb_registry_free(reg);
+      reg = NULL;
+    }
+  }
+  return reg;
+}
 
 void fmb_cli_print_diag(const fmbDiag* d) {
   if (d->line > 0)
@@ -28,6 +38,17 @@ const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const 
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s) {
   const char* a = argv[*i];
   const char* ov = NULL;
+  if (strcmp(a, "--plugin") == 0 || strncmp(a, "--plugin=", 9) == 0) {
+    const char* so = a[8] == '=' ? a + 9 : fmb_cli_value(cmd, argc, argv, i, "a plugin file (x.so)");
+    fmbDiag d;
+    fmbRegistry* reg = fmb_cli_registry();
+    if (!so || !reg) return FMB_EXIT_BAD_INPUT;
+    if (fmb_registry_load(reg, so, &d)) {
+      fmb_cli_print_diag(&d);
+      return FMB_EXIT_BAD_INPUT;
+    }
+    return 1;
+  }
   if (strcmp(a, "--set") == 0) {
     if (!(ov = fmb_cli_value(cmd, argc, argv, i, "PATH=VALUE"))) return FMB_EXIT_BAD_INPUT;
   } else if (strncmp(a, "--set=", 6) == 0) {

@@ -14,16 +14,16 @@ typedef struct fmbCliScene {
   int nover;
 } fmbCliScene;
 
-/* Takes argv[*i] if it is `--set PATH=VALUE`, `--set=PATH=VALUE` or (when no scene was given yet)
-   the scene file; returns 1 when taken (advancing *i past an argument), 0 when not ours, or
-   FMB_EXIT_BAD_INPUT after printing why (prefixed by `cmd`). */
+/* Takes argv[*i] if it is `--set PATH=VALUE`, `--set=PATH=VALUE`, `--plugin x.so` (loaded into
+   fmb_cli_registry() at once) or (when no scene was given yet) the scene file; returns 1 when
+   taken (advancing *i past an argument), 0 when not ours, or FMB_EXIT_BAD_INPUT after printing why (prefixed by `cmd`). */
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
 /* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
 /* file:line:col: error: msg (or the shorter forms when no location is known) */
 void fmb_cli_print_diag(const fmbDiag* d);
-/* the registry every command loads scenes with */
-const fmbRegistry* fmb_cli_registry(void);
+/* the registry every command loads scenes with: the built-ins and the --plugin files */
+fmbRegistry* fmb_cli_registry(void);
 
 /* the commands */
 int fmb_cmd_run(int argc, char** argv);
@@ -31,4 +31,5 @@ int fmb_cmd_check(int argc, char** argv);
 int fmb_cmd_types(int argc, char** argv);
 int fmb_cmd_compare(int argc, char** argv);
 int fmb_cmd_regress(int argc, char** argv);
+int fmb_cmd_conform(int argc, char** argv);
 #endif

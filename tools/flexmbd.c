@@ -14,14 +14,16 @@ typedef struct {
 
 static const Command commands[] = {
     {"run", fmb_cmd_run,
-     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet]\n"
+     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet]\n"
      "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost"},
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run"},
     {"compare", fmb_cmd_compare,
      "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance"},
     {"regress", fmb_cmd_regress,
      "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references"},
-    {"types", fmb_cmd_types, "types   the registered body and joint types"},
+    {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs"},
+    {"conform", fmb_cmd_conform,
+     "conform [--plugin x.so]... [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 
