@@ -146,10 +146,11 @@ static int valid_name(const char* name) {
 
 static int check_abi(const char* origin, const char* what, const char* name, int abi, fmbDiag* diag) {
   if (abi == FMB_ABI_VERSION) return 0;
+  /* the name is not read from a table of another layout: it may not be where this ABI has it */
   fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0,
-               "%s '%s' was built for flexmbd plugin ABI %d; this flexmbd has ABI %d: rebuild it against this "
+               "%s%s%s%s was built for flexmbd plugin ABI %d; this flexmbd has ABI %d: rebuild it against this "
                "version's headers",
-               what, name ? name : "?", abi, FMB_ABI_VERSION);
+               what, name ? " '" : "", name ? name : "", name ? "'" : "", abi, FMB_ABI_VERSION);
   return -1;
 }
 
@@ -157,14 +158,14 @@ int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* orig
   memset(diag, 0, sizeof *diag);
   if (!origin) origin = "?";
   /* the descriptor's abi is read before anything else of it (the field never moves) */
-  if (check_abi(origin, "plugin", plugin->abi == FMB_ABI_VERSION ? plugin->name : NULL, plugin->abi, diag)) return -1;
+  if (check_abi(origin, "plugin", NULL, plugin->abi, diag)) return -1;
   /* validate every table before registering any, so a refused plugin leaves the registry as it was */
   for (int k = 0; k < 2; ++k) {
     for (int i = 0; k ? (plugin->joints && plugin->joints[i]) : (plugin->bodies && plugin->bodies[i]); ++i) {
       const char* kind = k ? "joint type" : "body type";
       const int abi = k ? plugin->joints[i]->abi : plugin->bodies[i]->abi;
       const char* name = k ? plugin->joints[i]->name : plugin->bodies[i]->name;
-      if (check_abi(origin, kind, abi == FMB_ABI_VERSION ? name : "?", abi, diag)) return -1;
+      if (check_abi(origin, kind, NULL, abi, diag)) return -1;
       if (!valid_name(name)) {
         fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0,
                      "%s %d of plugin '%s' has no valid name (letters, digits and '_')", kind, i + 1,

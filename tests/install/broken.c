@@ -1,0 +1,131 @@
+/* broken.c — a plugin that breaks one rule, chosen at compile time (-DBREAK_...), to prove the
+ * loader and `flexmbd conform` catch each (tests/install/run.sh). Without a BREAK_ macro it is a
+ * correct 3-dof oscillator: a rigid body tied to its rest pose by springs,
+ *     R = diag(m, m, J) a + k q - m g,     U = k |q|^2 / 2. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <flexmbd.h>
+
+typedef struct {
+  double mass, inertia, stiffness;
+} Osc;
+
+static int osc_parse(fmbParser* p, fmbNode item, void** self) {
+  Osc* o = calloc(1, sizeof *o);
+  if (!o) return fmb_parse_error(p, item, "out of memory");
+  *self = o;
+  return fmb_get_double(p, item, "mass", FMB_REQUIRED | FMB_POSITIVE, &o->mass) ||
+                 fmb_get_double(p, item, "inertia", FMB_REQUIRED | FMB_POSITIVE, &o->inertia) ||
+                 fmb_get_double(p, item, "stiffness", FMB_REQUIRED | FMB_POSITIVE, &o->stiffness)
+             ? -1
+             : 0;
+}
+static void osc_destroy(void* self) { free(self); }
+static int osc_ncoord(const void* self) {
+  (void)self;
+  return 3;
+}
+static void osc_initial(const void* self, double* q, double* v) {
+  (void)self;
+  q[0] = 0.1, q[1] = -0.05, q[2] = 0.2;
+  v[0] = 0.3, v[1] = 0.1, v[2] = -0.5;
+}
+
+#ifdef BREAK_MASS
+#define M01 0.1 /* a mass matrix that is not symmetric: M[0][1] = 0.1, M[1][0] = 0 */
+#else
+#define M01 0.0
+#endif
+
+static int osc_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                        double* R, double* work) {
+  (void)work, (void)v;
+  const Osc* o = self;
+  R[0] = o->mass * a[0] + M01 * a[1] + o->stiffness * q[0];
+  R[1] = o->mass * a[1] + o->stiffness * q[1];
+  R[2] = o->inertia * a[2] + o->stiffness * q[2];
+#ifdef BREAK_ENERGY
+  R[2] += 0.05 * v[2]; /* a friction the energy does not account for: energy leaks */
+#endif
+  if (env->has_gravity) R[0] -= o->mass * env->gravity[0], R[1] -= o->mass * env->gravity[1];
+  return 0;
+}
+
+static int osc_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                        double* K, double* C, double* M, double* work) {
+  (void)env, (void)q, (void)v, (void)a, (void)work;
+  const Osc* o = self;
+  memset(K, 0, 9 * sizeof(double)), memset(C, 0, 9 * sizeof(double)), memset(M, 0, 9 * sizeof(double));
+  K[0] = K[4] = K[8] = o->stiffness;
+#ifdef BREAK_JACOBIAN
+  K[8] = 2 * o->stiffness; /* wrong: dR_theta/dtheta is k */
+#endif
+#ifdef BREAK_ENERGY
+  C[8] = 0.05;
+#endif
+  M[0] = M[4] = o->mass, M[8] = o->inertia;
+  M[3] = M01; /* column 1, row 0 */
+  return 0;
+}
+
+static int osc_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
+                      double* dpos_dq, double* dangle_dq, double* work) {
+  (void)self, (void)work;
+  fmb_frame_point(q, local, pos, dpos_dq);
+  if (angle) *angle = q[2];
+  if (dangle_dq) dangle_dq[0] = dangle_dq[1] = 0.0, dangle_dq[2] = 1.0;
+  return 0;
+}
+
+static void osc_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
+                       double* work) {
+  (void)work;
+  const Osc* o = self;
+  e->kinetic = 0.5 * o->mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * o->inertia * v[2] * v[2];
+  e->strain = 0.5 * o->stiffness * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+  e->gravity = env->has_gravity ? -o->mass * (env->gravity[0] * q[0] + env->gravity[1] * q[1]) : 0.0;
+}
+
+static const fmbParam osc_params[] = {
+    {.key = "mass", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg"},
+    {.key = "inertia", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg m^2"},
+    {.key = "stiffness", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "N/m"},
+    {.key = NULL},
+};
+
+static const fmbBodyType oscillator = {
+#ifdef BREAK_NAME
+    .name = "rigid", /* a built-in type's name */
+#else
+    .name = "oscillator",
+#endif
+    .abi = FMB_ABI_VERSION,
+    .parse = osc_parse,
+    .destroy = osc_destroy,
+    .ncoord = osc_ncoord,
+    .initial = osc_initial,
+#ifndef BREAK_OPS
+    .residual = osc_residual, /* BREAK_OPS: a required op left out */
+#endif
+    .marker = osc_marker,
+    .jacobian = osc_jacobian,
+    .energy = osc_energy,
+    .params = osc_params,
+    .example = "mass: 2\ninertia: 0.5\nstiffness: 30\n",
+};
+
+static const fmbBodyType* const bodies[] = {&oscillator, NULL};
+#ifdef BREAK_ABI
+#define ABI (FMB_ABI_VERSION + 1) /* built, say, for the next flexmbd */
+#else
+#define ABI FMB_ABI_VERSION
+#endif
+static const fmbPlugin plugin = {.abi = ABI, .name = "broken", .version = "0", .bodies = bodies};
+
+#ifndef BREAK_ENTRY
+FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void) { return &plugin; }
+#else
+FMB_PLUGIN_EXPORT const fmbPlugin* plugin_descriptor(void) { return &plugin; } /* the wrong name */
+#endif

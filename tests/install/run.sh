@@ -1,0 +1,134 @@
+#!/bin/sh
+# run.sh SOURCE_DIR BUILD_DIR WORK_DIR — the installed package, as a user outside the tree has it:
+#  1. `cmake --install` into a temporary prefix: the library (shared, soname = plugin ABI, and
+#     static), the one public header and no private one, the program, the CMake package, flexmbd.pc;
+#     the shared library exports only fmb_* API symbols;
+#  2. the public header compiles alone, strictly, as C11 (and as C++ when g++ is there);
+#  3. examples/plugin/ copied out of the tree and built with find_package(flexmbd) (plugin and the
+#     embedding check program) and again with pkg-config;
+#  4. the plugin loaded by `--plugin` and by the scene's `plugins:` list; `flexmbd types` lists it;
+#     `flexmbd conform` passes on it and on every built-in type; its scene agrees with the analytic
+#     solution (check_foundation);
+#  5. deliberately broken plugins (tests/install/broken.c) are each caught, with a clear message:
+#     wrong ABI, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
+#     matrix that is not symmetric, energy that leaks (conform, exit 1);
+#  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc).
+set -u
+src=$1
+build=$2
+work=$3
+rm -rf "$work"
+mkdir -p "$work" || exit 1
+fails=0
+fail() {
+  echo "FAIL: $*" >&2
+  fails=$((fails + 1))
+}
+# run CMD... expecting exit code $1 and a stderr/stdout line matching $2 (grep -E)
+expect() {
+  code=$1 pattern=$2
+  shift 2
+  "$@" >"$work/out" 2>&1
+  rc=$?
+  [ "$rc" = "$code" ] || fail "$* exited $rc, expected $code: $(tail -n 3 "$work/out")"
+  grep -Eq -- "$pattern" "$work/out" || fail "$*: no line matching '$pattern' in: $(head -n 5 "$work/out")"
+  echo "ok: $* -> exit $rc, '$(grep -E -m1 -- "$pattern" "$work/out")'"
+}
+
+T=$work/prefix
+cmake --install "$build" --prefix "$T" >/dev/null || { echo "FAIL: cmake --install" >&2; exit 1; }
+libdir=$(ls -d "$T"/lib*/ | head -n 1)
+libdir=${libdir%/}
+abi=$(sed -n 's/^#define FMB_ABI_VERSION \([0-9]*\).*/\1/p' "$src/engine/flexmbd.h")
+
+# 1. the installed tree
+for f in include/flexmbd.h bin/flexmbd; do [ -e "$T/$f" ] || fail "$f not installed"; done
+[ -e "$libdir/libflexmbd.so.$abi" ] || fail "libflexmbd.so.$abi (soname = plugin ABI $abi) not installed"
+[ -e "$libdir/libflexmbd.a" ] || fail "static libflexmbd.a not installed"
+[ -e "$libdir/pkgconfig/flexmbd.pc" ] || fail "flexmbd.pc not installed"
+[ -e "$libdir/cmake/flexmbd/flexmbdConfig.cmake" ] || fail "CMake package not installed"
+[ "$(ls "$T/include")" = flexmbd.h ] || fail "headers other than flexmbd.h installed: $(ls "$T/include")"
+exported=$(nm -D --defined-only "$libdir/libflexmbd.so" | awk '$2 == "T" {print $3}')
+n_exported=$(echo "$exported" | wc -l)
+bad=$(echo "$exported" | grep -v '^fmb_' | tr '\n' ' ')
+[ -z "$bad" ] || fail "the shared library exports non-API symbols: $bad"
+echo "$exported" | grep -q '^fmb_system_residual$' && fail "the shared library exports engine internals (fmb_system_residual)"
+echo "ok: installed into $T: $n_exported exported functions, all fmb_*; soname ABI $abi"
+
+# 2. the header alone
+echo '#include <flexmbd.h>
+int main(void) { return FMB_ABI_VERSION == 0; }' >"$work/hdr.c"
+cc -std=c11 -Wall -Wextra -Werror -pedantic -I"$T/include" -c "$work/hdr.c" -o "$work/hdr.o" || fail "flexmbd.h does not compile alone as strict C11"
+if command -v g++ >/dev/null; then
+  cp "$work/hdr.c" "$work/hdr.cpp"
+  g++ -Wall -Wextra -Werror -I"$T/include" -c "$work/hdr.cpp" -o "$work/hdrpp.o" || fail "flexmbd.h does not compile as C++"
+fi
+
+# 3. the example out of the tree: CMake package, then pkg-config
+ex=$work/example
+mkdir -p "$ex"
+cp "$src"/examples/plugin/*.c "$src"/examples/plugin/CMakeLists.txt "$src"/examples/plugin/*.yaml "$ex"/
+(cmake -S "$ex" -B "$ex/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$ex/build") \
+  >"$work/cmake.log" 2>&1 || fail "examples/plugin does not build with find_package(flexmbd): $(tail -n 5 "$work/cmake.log")"
+pc=$work/pkgconfig-build
+mkdir -p "$pc"
+export PKG_CONFIG_PATH="$libdir/pkgconfig"
+mkdir -p "$pc/build"
+cp "$ex/foundation.yaml" "$pc/" # its plugins: line names build/foundation.so beside it
+cc -std=c11 -O2 -shared -fPIC "$ex/foundation.c" $(pkg-config --cflags --libs flexmbd) -lm -o "$pc/build/foundation.so" ||
+  fail "the plugin does not build with pkg-config"
+cc -std=c11 -O2 "$ex/check_foundation.c" $(pkg-config --cflags --libs flexmbd) -lm -o "$pc/check_foundation" ||
+  fail "check_foundation does not build with pkg-config"
+# static linking through pkg-config --static
+cc -std=c11 -O2 "$ex/check_foundation.c" $(pkg-config --static --cflags --libs flexmbd) -o "$pc/check_foundation_static" ||
+  fail "check_foundation does not link statically with pkg-config --static"
+
+# 4. loading and using the plugin with the installed program
+F=$T/bin/flexmbd
+expect 0 'status=ok' "$F" run "$ex/foundation.yaml" -o "$work/plugins_list.csv"
+grep -v '^plugins:' "$ex/foundation.yaml" >"$work/noplugins.yaml"
+expect 0 'status=ok' "$F" run "$work/noplugins.yaml" --plugin "$pc/build/foundation.so" -o "$work/option.csv"
+expect 2 "noplugins.yaml:[0-9]+:[0-9]+: error: .*foundation_bar" "$F" run "$work/noplugins.yaml" -o "$work/none.csv"
+expect 0 "foundation_bar +\\($pc/build/foundation.so\\)" "$F" types --plugin "$pc/build/foundation.so"
+expect 0 'N/m\^2 > 0, required' "$F" types --plugin "$pc/build/foundation.so"
+expect 0 'ok   foundation_bar: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$ex/build/foundation.so" foundation_bar
+expect 0 'conform: 8 types, 0 failed checks' "$F" conform --work "$work/conform"
+expect 0 'agrees with the analytic solution' "$ex/build/check_foundation" "$ex/foundation.yaml" "$work/check.csv"
+expect 0 'agrees with the analytic solution' env LD_LIBRARY_PATH="$libdir" "$pc/check_foundation" "$pc/foundation.yaml" "$work/check_pc.csv"
+cat "$work/out"
+# a scene naming a plugin that is not there: located error
+printf 'plugins: [nowhere.so]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\n' >"$work/missing.yaml"
+expect 2 'missing.yaml:1:11: error: plugin .*nowhere.so: cannot load plugin' "$F" check "$work/missing.yaml"
+
+# 5. broken plugins
+for b in ABI OPS ENTRY NAME JACOBIAN MASS ENERGY; do
+  cc -std=c11 -shared -fPIC -DBREAK_$b "$src/tests/install/broken.c" $(pkg-config --cflags --libs flexmbd) -lm \
+    -o "$work/broken_$b.so" 2>/dev/null || fail "broken.c does not build with BREAK_$b"
+done
+cc -std=c11 -shared -fPIC "$src/tests/install/broken.c" $(pkg-config --cflags --libs flexmbd) -lm -o "$work/unbroken.so"
+expect 0 'ok   oscillator: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$work/unbroken.so" oscillator
+expect 2 "broken_ABI.so: error: plugin was built for flexmbd plugin ABI $((abi + 1)); this flexmbd has ABI $abi: rebuild it" \
+  "$F" conform --plugin "$work/broken_ABI.so"
+expect 2 "broken_OPS.so: error: body type 'oscillator' has no residual op \\(required\\)" \
+  "$F" run "$ex/foundation.yaml" --plugin "$work/broken_OPS.so"
+expect 2 "broken_ENTRY.so: error: not a flexmbd plugin: it has no symbol fmb_plugin_descriptor" \
+  "$F" types --plugin "$work/broken_ENTRY.so"
+expect 1 'FAIL oscillator jacobian: analytic vs central differences: K 1, C 0, M 0' \
+  "$F" conform --work "$work/conform" --plugin "$work/broken_JACOBIAN.so" oscillator
+expect 1 'FAIL oscillator mass: M symmetric' "$F" conform --work "$work/conform" --plugin "$work/broken_MASS.so" oscillator
+expect 1 'FAIL oscillator energy: a free run keeps the total energy' \
+  "$F" conform --work "$work/conform" --plugin "$work/broken_ENERGY.so" oscillator
+expect 2 "broken_NAME.so: error: body type 'rigid' is already registered \\(from built-in\\)" \
+  "$F" types --plugin "$work/broken_NAME.so"
+expect 0 'oscillator' "$F" types --plugin "$work/unbroken.so" --plugin "$work/unbroken.so" # the same file twice: a no-op
+
+# 6. relocatable: the prefix moved, pkg-config still points into it
+mv "$T" "$work/moved"
+mlib=$work/moved/${libdir#"$T"/}
+PKG_CONFIG_PATH="$mlib/pkgconfig" cc -std=c11 "$ex/check_foundation.c" \
+  $(PKG_CONFIG_PATH="$mlib/pkgconfig" pkg-config --cflags --libs flexmbd) -lm -o "$work/moved_check" ||
+  fail "pkg-config after moving the prefix"
+expect 0 'agrees with the analytic solution' env LD_LIBRARY_PATH="$mlib" "$work/moved_check" "$pc/foundation.yaml" "$work/moved.csv"
+
+echo "install: $fails failures"
+[ "$fails" -eq 0 ]
