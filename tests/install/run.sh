@@ -9,6 +9,7 @@
 #  4. the plugin loaded by `--plugin` and by the scene's `plugins:` list; `flexmbd types` lists it;
 #     `flexmbd conform` passes on it and on every built-in type; its scene agrees with the analytic
 #     solution (check_foundation);
+#     docs/plugins.md's tutorial, extracted from the page, builds and passes conform the same way;
 #  5. deliberately broken plugins (tests/install/broken.c) are each caught, with a clear message:
 #     wrong ABI, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
 #     matrix that is not symmetric, energy that leaks (conform, exit 1);
@@ -99,6 +100,22 @@ cat "$work/out"
 # a scene naming a plugin that is not there: located error
 printf 'plugins: [nowhere.so]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\n' >"$work/missing.yaml"
 expect 2 'missing.yaml:1:11: error: plugin .*nowhere.so: cannot load plugin' "$F" check "$work/missing.yaml"
+
+# 4b. docs/plugins.md's tutorial, extracted verbatim (the blocks marked <!-- file: NAME -->), from an
+# empty folder: CMake and pkg-config builds, its scene, conform
+tut=$work/tutorial
+mkdir -p "$tut"
+awk -v dir="$tut" '
+  /^<!-- file: .* -->$/ { name = $3; next }
+  name != "" && /^```/ { if (out) { close(out); out = ""; name = "" } else out = dir "/" name; next }
+  out { print > out }' "$src/docs/plugins.md"
+for f in point_mass.c CMakeLists.txt throw.yaml; do [ -s "$tut/$f" ] || fail "docs/plugins.md: no block for $f"; done
+(cmake -S "$tut" -B "$tut/build" -DCMAKE_PREFIX_PATH="$T" && cmake --build "$tut/build") >"$work/tut.log" 2>&1 ||
+  fail "the tutorial does not build as written: $(tail -n 5 "$work/tut.log")"
+expect 0 'status=ok' "$F" run "$tut/throw.yaml" -o "$work/throw.csv"
+expect 0 'ok   point_mass: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$tut/build/point_mass.so" point_mass
+cc -std=c11 -O2 -shared -fPIC "$tut/point_mass.c" $(pkg-config --cflags --libs flexmbd) -o "$work/point_mass_pc.so" ||
+  fail "the tutorial's pkg-config line"
 
 # 5. broken plugins
 for b in ABI OPS ENTRY NAME JACOBIAN MASS ENERGY; do
