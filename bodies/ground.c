@@ -38,8 +38,7 @@ static int ground_marker(const void* self, const double* q, const double local[2
   (void)q, (void)dpos_dq, (void)dangle_dq, (void)work;
   const Ground* g = self;
   const double frame[3] = {g->pos[0], g->pos[1], g->angle};
-  fmb_frame_point(frame, local, pos, NULL);
-  if (angle) *angle = g->angle;
+  fmb_frame_point(frame, local, pos, angle, NULL, NULL);
   return 0;
 }
 

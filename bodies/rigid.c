@@ -74,12 +74,7 @@ static int rigid_marker(const void* self, const double* q, const double local[2]
                         double* dpos_dq, double* dangle_dq, double* work) {
   (void)self;
   (void)work;
-  fmb_frame_point(q, local, pos, dpos_dq); /* q is the frame: the body is its frame */
-  if (angle) *angle = q[2];
-  if (dangle_dq) {
-    dangle_dq[0] = dangle_dq[1] = 0.0;
-    dangle_dq[2] = 1.0;
-  }
+  fmb_frame_point(q, local, pos, angle, dpos_dq, dangle_dq); /* q is the frame: the body is its frame */
   return 0;
 }
 

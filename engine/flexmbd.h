@@ -257,10 +257,12 @@ FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
    Returns 0, or -1 for an unsupported n. */
 FMB_API int fmb_gauss_legendre01(int n, double* x, double* w);
 
-/* Rigid-frame kinematics (engine/frame.c): the global position of the point `local` of a planar
-   frame at frame = [x, y, theta] (p = r + A(theta) local), and dp/dframe (2 x 3 row-major, may
-   be NULL). A body whose first three coordinates are its frame answers `marker` with it. */
-FMB_API void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* dpos_dframe);
+/* Rigid-frame kinematics (engine/frame.c): the global position and angle of the point `local` of
+   a planar frame at frame = [x, y, theta] (p = r + A(theta) local, angle = theta), dp/dframe
+   (2 x 3 row-major) and dangle/dframe (3); angle and the derivatives may be NULL. A rigid body
+   (q = its frame) answers `marker` with exactly this call. */
+FMB_API void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* angle,
+                             double* dpos_dframe, double* dangle_dframe);
 
 /* ---------------------------------------------------------------------------------------------
  * Plugins and the registry. A plugin is a set of types behind one descriptor; the built-in types

@@ -117,9 +117,7 @@ static int bar_jacobian(const void* self, const fmbEnv* env, const double* q, co
 static int bar_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
                       double* dpos_dq, double* dangle_dq, double* work) {
   (void)self, (void)work;
-  fmb_frame_point(q, local, pos, dpos_dq); /* the bar is rigid: its coordinates are its frame */
-  if (angle) *angle = q[2];
-  if (dangle_dq) dangle_dq[0] = dangle_dq[1] = 0.0, dangle_dq[2] = 1.0;
+  fmb_frame_point(q, local, pos, angle, dpos_dq, dangle_dq); /* the bar is rigid: its coordinates are its frame */
   return 0;
 }
 

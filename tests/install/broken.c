@@ -73,9 +73,7 @@ static int osc_jacobian(const void* self, const fmbEnv* env, const double* q, co
 static int osc_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
                       double* dpos_dq, double* dangle_dq, double* work) {
   (void)self, (void)work;
-  fmb_frame_point(q, local, pos, dpos_dq);
-  if (angle) *angle = q[2];
-  if (dangle_dq) dangle_dq[0] = dangle_dq[1] = 0.0, dangle_dq[2] = 1.0;
+  fmb_frame_point(q, local, pos, angle, dpos_dq, dangle_dq);
   return 0;
 }
 
