@@ -177,6 +177,11 @@ int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* orig
         fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0, "%s '%s' has no %s op (required)", kind, name, op);
         return -1;
       }
+      for (int e = 0; e < i; ++e)
+        if (strcmp(name, k ? plugin->joints[e]->name : plugin->bodies[e]->name) == 0) {
+          fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0, "%s '%s' is listed twice in the plugin", kind, name);
+          return -1;
+        }
       int same = 0;
       const char* other = taken_by(reg, k, name, k ? (const void*)plugin->joints[i] : (const void*)plugin->bodies[i], &same);
       if (other) {

@@ -2,7 +2,7 @@
  *  - 300 body types registered (copies of the rigid table under other names, as 300 plugins
  *    would bring) and a scene using the 250th loads and runs like one using `rigid`;
  *  - fmb_registry_add refuses another ABI (in the descriptor or in one table), a missing required
- *    op and a name taken by another table, leaving the registry as it was; the same table twice
+ *    op, a name taken by another table and a name listed twice, leaving the registry as it was; the same table twice
  *    is a no-op. */
 #include <stdlib.h>
 #include <string.h>
@@ -82,6 +82,12 @@ int main(void) {
   bad = *rigid; /* a different table named rigid */
   ENSURE(fmb_registry_add(reg, &p, "p.so", &d) != 0);
   ENSURE(strstr(d.msg, "'rigid' is already registered (from built-in)") != NULL);
+  fmbBodyType twin = *rigid;
+  twin.name = "twin";
+  const fmbBodyType* twice[] = {&twin, &twin, NULL};
+  const fmbPlugin p2 = {.abi = FMB_ABI_VERSION, .name = "p2", .bodies = twice};
+  ENSURE(fmb_registry_add(reg, &p2, "p2.so", &d) != 0);
+  ENSURE(strstr(d.msg, "'twin' is listed twice") != NULL);
   p.abi = FMB_ABI_VERSION - 1;
   ENSURE(fmb_registry_add(reg, &p, "p.so", &d) != 0);
   ENSURE(fmb_registry_nbodies(reg) == n0);
