@@ -775,6 +775,17 @@ static const fmbParam beam_params[] = {
     {.key = NULL},
 };
 
+/* stations equally spaced from the clamped root to the tip; by default one per node */
+static int beam_centreline(const void* self, int n, double* local) {
+  const Beam* b = self;
+  if (!local) return b->ne + 1;
+  for (int i = 0; i < n; ++i) {
+    local[2 * i] = n > 1 ? b->L * (double)i / (double)(n - 1) : 0.0;
+    local[2 * i + 1] = 0.0;
+  }
+  return n;
+}
+
 const fmbBodyType fmb_body_beam = {
     .name = "beam",
     .abi = FMB_ABI_VERSION,
@@ -799,4 +810,6 @@ const fmbBodyType fmb_body_beam = {
     .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
                "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",
     .example_damped = "damping: 0.05\n",
+
+    .centreline = beam_centreline,
 };

@@ -22,7 +22,8 @@ extern "C" {
 
 /* The plugin ABI: the layout of fmbPlugin, fmbBodyType, fmbJointType, fmbParam and the signatures
    of every function below. A plugin built for another number is refused when it is loaded
-   (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags. */
+   (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
+   the optional centreline op (added to 2 before any release of it). */
 #define FMB_ABI_VERSION 2
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
@@ -65,12 +66,16 @@ enum {
   FMB_OPTIONAL = 0,
   FMB_REQUIRED = 1 << 0,
   FMB_POSITIVE = 1 << 1,    /* > 0 */
-  FMB_NONNEGATIVE = 1 << 2  /* >= 0 */
+  FMB_NONNEGATIVE = 1 << 2, /* >= 0 */
+  FMB_POSE = 1 << 3         /* fmb_get_angle: an orientation, where |angle| > 2 pi is suspicious */
 };
 
 FMB_API int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
 FMB_API int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out);
 FMB_API int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]);
+/* an angle in radians: a bare number is radians, `120 deg` / `2.1 rad` say their unit. With
+   FMB_POSE a bare number beyond 2*pi in magnitude draws a warning (degrees written as radians?) */
+FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
 /* one of a NULL-terminated list of words; *out is the index */
 FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out);
@@ -78,7 +83,8 @@ FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned 
 FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
 /* a joint defined earlier in the file, by name; *out is the joint index */
 FMB_API int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
-/* body index and local point of attachment k (0 or 1) of an already parsed joint */
+/* body index and local point of attachment k (0 or 1) of an already parsed joint with
+   constraint rows (a pivot, a weld; not a spring's ends) */
 FMB_API int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]);
 /* a plugin-level check failed at `node` (a value node or the item's mapping) */
 FMB_API int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
@@ -195,6 +201,12 @@ typedef struct fmbBodyType {
   const char* example;
   const char* example_damped;
   unsigned flags;
+  /* A body with a deformable centreline (a beam) names points along it for drawing and for the
+     `BODY.shape` output: the reference points (body frame, as `marker` takes them) of n stations
+     from root to tip into local[2n]. With local == NULL it only returns the station count it
+     draws with by default (a beam: its nodes). The engine asks `marker` where they are now.
+     NULL = a body without a centreline (drawn from its frame and joint points). */
+  int (*centreline)(const void* self, int n, double* local);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -320,6 +332,11 @@ typedef struct fmbStats {
 typedef struct fmbRunOptions {
   const char* csv_path; /* NULL or "-" = stdout */
   int quiet;            /* no progress lines on stderr */
+  /* a progress line on stderr (t, % of t_end, steps, elapsed, remaining), from progress_after_s
+     of wall time on: rewritten in place on a terminal, one line per update otherwise */
+  int progress;
+  double progress_after_s;
+  const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
 } fmbRunOptions;
 
 /* Load `path`, applying "PATH=VALUE" overrides (e.g. "solver.rtol=1e-8",

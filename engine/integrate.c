@@ -21,6 +21,7 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "internal.h"
 
@@ -154,6 +155,49 @@ static int row_failed(const fmbModel* m, int wr, double t, fmbDiag* diag) {
   return wr != 0;
 }
 
+/* the CSV row, then the animation's frame (if any): what row_failed reads */
+static int write_outputs(fmbCsv* csv, fmbVtk* vtk, const fmbModel* m, fmbWorkspace* w, double t, const double* y,
+                         const double* yp) {
+  int wr = fmb_csv_row(csv, m, w, t, y, yp);
+  if (wr == 0 && vtk && fmb_vtk_step(vtk, m, w, t, y)) wr = -1;
+  return wr;
+}
+
+/* The progress line: silent for the first `after` seconds of wall time (short runs print
+   nothing), then at most 5 updates a second. On a terminal the line is rewritten in place and
+   ended with a newline when the run ends, so the stats line stays the last line; elsewhere
+   (--progress into a file or pipe) one line per second. */
+typedef struct {
+  int on, tty, shown;
+  double after, start, last;
+} Progress;
+
+static double wall_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void progress_update(Progress* pr, const fmbModel* m, double t, void* ida) {
+  if (!pr->on) return;
+  const double now = wall_seconds(), elapsed = now - pr->start;
+  if (elapsed < pr->after || now - pr->last < (pr->tty ? 0.2 : 1.0)) return;
+  long steps = 0;
+  if (ida) IDAGetNumSteps(ida, &steps);
+  const double done = (t - m->solver.t0) / (m->solver.t_end - m->solver.t0);
+  char remaining[32] = "?";
+  if (done > 0.0) snprintf(remaining, sizeof remaining, "%.1f s", elapsed * (1.0 - done) / done);
+  fprintf(stderr, "%sprogress: t = %.6g of %g (%.0f %%), %ld steps, %.1f s elapsed, ~%s remaining%s",
+          pr->tty ? "\r" : "", t, m->solver.t_end, 100.0 * done, steps, elapsed, remaining, pr->tty ? "\033[K" : "\n");
+  fflush(stderr);
+  pr->last = now;
+  pr->shown = 1;
+}
+
+static void progress_end(Progress* pr) {
+  if (pr->on && pr->tty && pr->shown) fputc('\n', stderr);
+}
+
 /* a body's own validity check (e.g. a beam deforming beyond its length: a runaway solution) */
 static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* diag) {
   for (int b = 1; b < m->nbody; ++b) {
@@ -176,6 +220,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   const int ny = m->ny;
   fmbCsv* csv = fmb_csv_open(opt ? opt->csv_path : NULL, diag);
   if (!csv) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
+  const char* vtk_dir = (opt && opt->vtk_dir) ? opt->vtk_dir : (m->vtk_dir[0] ? m->vtk_dir : NULL);
+  fmbVtk* vtk = NULL;
+  if (vtk_dir && !(vtk = fmb_vtk_open(m, vtk_dir, diag))) {
+    fmb_csv_close(csv);
+    return diag->code ? diag->code : FMB_EXIT_SOLVER;
+  }
+  Progress progress = {opt && opt->progress && !opt->quiet, isatty(fileno(stderr)), 0, opt ? opt->progress_after_s : 0.0,
+                       wall_seconds(), 0.0};
 
   RunCtx ctx;
   memset(&ctx, 0, sizeof ctx);
@@ -219,7 +271,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     goto done;
   }
   fmb_csv_header(csv, m);
-  if (row_failed(m, fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
+  if (row_failed(m, write_outputs(csv, vtk, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
@@ -305,12 +357,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       rc = FMB_EXIT_SOLVER;
       break;
     }
-    if (row_failed(m, fmb_csv_row(csv, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
+    if (row_failed(m, write_outputs(csv, vtk, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
       rc = FMB_EXIT_SOLVER;
       break;
     }
     st->rows_written++;
+    progress_update(&progress, m, t, ida);
   }
+  progress_end(&progress);
 
 done:
   st->t_reached = t;
@@ -336,6 +390,7 @@ done:
   if (sun) SUNContext_Free(&sun);
   fmb_workspace_free(ctx.w);
   fmb_csv_close(csv);
+  fmb_vtk_close(vtk);
   st->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
   return rc;
 }

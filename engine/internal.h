@@ -34,7 +34,8 @@ typedef enum {
   FMB_OUT_JOINT,       /* joint plugin output */
   FMB_OUT_JOINT_POWER, /* power of a joint's constraint forces, lambda^T Phi_t */
   FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total */
-  FMB_OUT_CONSTRAINT   /* 0 position 1 velocity */
+  FMB_OUT_CONSTRAINT,  /* 0 position 1 velocity */
+  FMB_OUT_SHAPE        /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
 } fmbOutKind;
 
 typedef struct fmbOutput {
@@ -42,6 +43,7 @@ typedef struct fmbOutput {
   fmbOutKind kind;
   int owner; /* body or joint index */
   int id;
+  double local[2]; /* FMB_OUT_SHAPE: the station's reference point in the body frame */
 } fmbOutput;
 
 typedef struct fmbSolverSettings {
@@ -82,6 +84,7 @@ struct fmbModel {
   long nnz;
   long* colptr; /* ny + 1 */
   long* rowind; /* nnz */
+  char vtk_dir[512]; /* the scene's `vtk` key: "" = no animation unless the run asks */
 };
 
 /* evaluation context a joint sees */
@@ -215,12 +218,21 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
 
 /* ---- output.c ---- */
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
+/* global position of a body's material point (its marker); 0 ok */
+int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
+                   double* angle);
 void fmb_outputs_default(fmbModel* m);
 typedef struct fmbCsv fmbCsv;
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
 void fmb_csv_header(fmbCsv* c, const fmbModel* m);
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
 void fmb_csv_close(fmbCsv* c);
+
+/* ---- vtk.c: the run as a ParaView collection (DIR/SCENE.pvd, one .vtu per output row) ---- */
+typedef struct fmbVtk fmbVtk;
+fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag);
+int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const double* y); /* 0 ok, -1 write failed */
+void fmb_vtk_close(fmbVtk* v);
 
 /* ---- fd.c ---- */
 double fmb_fd_increment(double y, double ewt);

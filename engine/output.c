@@ -85,10 +85,74 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
   return 0;
 }
 
+/* `BODY.shape` (the body's own station count) or `BODY.shape_N` (N equally spaced stations): the
+   deformed centreline in one output, expanded into the columns BODY.shapeK_x, BODY.shapeK_y,
+   K = 0 (root) .. N-1 (tip), global frame. Returns 0 when `text` is not a shape output, 1 when
+   expanded, -1 on error. */
+#define FMB_SHAPE_STATIONS_MAX 10000
+static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* text, int* cap) {
+  const char* dot = strchr(text, '.');
+  if (!dot || strncmp(dot + 1, "shape", 5) != 0 || (dot[6] != '\0' && dot[6] != '_')) return 0;
+  int b = -1;
+  for (int i = 1; i < m->nbody; ++i)
+    if (strlen(m->body[i].name) == (size_t)(dot - text) && strncmp(m->body[i].name, text, (size_t)(dot - text)) == 0) b = i;
+  if (b < 0) return 0; /* not a body: resolve_one says what is wrong */
+  const fmbBodyInst* bi = &m->body[b];
+  if (!bi->type->centreline)
+    return fmb_parse_error(p, node, "output '%s': a %s body has no centreline (shape is a beam's output)", text, bi->type->name);
+  int n = bi->type->centreline(bi->self, 0, NULL);
+  if (dot[6] == '_') {
+    char* end = NULL;
+    long v = strtol(dot + 7, &end, 10);
+    if (dot[7] < '0' || dot[7] > '9' || *end != '\0' || v < 2 || v > FMB_SHAPE_STATIONS_MAX)
+      return fmb_parse_error(p, node, "output '%s': expected shape_N with N stations from 2 to %d (or plain 'shape')", text,
+                             FMB_SHAPE_STATIONS_MAX);
+    n = (int)v;
+  }
+  if (m->noutput + 2 * n > *cap) {
+    *cap = m->noutput + 2 * n + 16;
+    fmbOutput* grown = realloc(m->output, (size_t)*cap * sizeof *grown);
+    if (!grown) return fmb_parse_error(p, node, "out of memory");
+    m->output = grown;
+  }
+  char first[sizeof m->output[0].name];
+  snprintf(first, sizeof first, "%s.shape0_x", bi->name);
+  for (int k = 1; k < m->noutput; ++k)
+    if (strcmp(m->output[k].name, first) == 0) return fmb_parse_error(p, node, "output '%s': %s's shape is listed twice", text, bi->name);
+  double* local = malloc(2 * (size_t)n * sizeof *local);
+  if (!local) return fmb_parse_error(p, node, "out of memory");
+  bi->type->centreline(bi->self, n, local);
+  for (int k = 0; k < 2 * n; ++k) {
+    fmbOutput* o = &m->output[m->noutput++];
+    memset(o, 0, sizeof *o);
+    o->kind = FMB_OUT_SHAPE;
+    o->owner = b;
+    o->id = k % 2;
+    o->local[0] = local[2 * (k / 2)];
+    o->local[1] = local[2 * (k / 2) + 1];
+    snprintf(o->name, sizeof o->name, "%s.shape%d_%c", bi->name, k / 2, "xy"[k % 2]);
+  }
+  free(local);
+  return 1;
+}
+
+int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
+                   double* angle) {
+  const fmbBodyInst* bi = &m->body[b];
+  return bi->type->marker(bi->self, q + bi->qadr, local, pos, angle, NULL, NULL, fmb_workspace_plugin(w) + bi->workadr);
+}
+
+static double shape_value(const fmbModel* m, fmbWorkspace* w, const fmbOutput* o, const double* q) {
+  double pos[2];
+  if (fmb_body_point(m, w, o->owner, q, o->local, pos, NULL)) return NAN;
+  return pos[o->id];
+}
+
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
   if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list of output names for 'outputs', e.g. [beam.tip_v, energy.total]");
   int n = fmbp_seq_len(p, list);
-  m->output = calloc((size_t)n + 1, sizeof *m->output);
+  int cap = n + 1;
+  m->output = calloc((size_t)cap, sizeof *m->output);
   if (!m->output) return fmb_parse_error(p, list, "out of memory");
   m->output[0].kind = FMB_OUT_TIME;
   snprintf(m->output[0].name, sizeof m->output[0].name, "t");
@@ -99,6 +163,14 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
     if (!s) return fmb_parse_error(p, item, "expected an output name NAME.quantity in 'outputs'");
     for (int k = 1; k < m->noutput; ++k)
       if (strcmp(m->output[k].name, s) == 0) return fmb_parse_error(p, item, "output '%s' is listed twice", s);
+    const int shape = resolve_shape(p, m, item, s, &cap);
+    if (shape < 0) return -1;
+    if (shape) continue;
+    if (m->noutput == cap) { /* shape columns took the room of the items after them */
+      fmbOutput* grown = realloc(m->output, (size_t)++cap * sizeof *grown);
+      if (!grown) return fmb_parse_error(p, item, "out of memory");
+      m->output = grown;
+    }
     if (resolve_one(p, m, item, s, &m->output[m->noutput])) return -1;
     m->noutput++;
   }
@@ -200,6 +272,7 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
         break;
       }
       case FMB_OUT_CONSTRAINT: val = o->id == 0 ? cpos : cvel; break;
+      case FMB_OUT_SHAPE: val = shape_value(m, w, o, q); break;
     }
     if (!isfinite(val)) return 1;
     c->row[i] = val;

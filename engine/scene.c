@@ -163,9 +163,16 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode joints = fmb_find_key(p, root, "joints");
   fmbNode outputs = fmb_find_key(p, root, "outputs");
   fmbNode plugins = fmb_find_key(p, root, "plugins");
+  fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */
   double g[2] = {0.0, 0.0};
   if (fmb_get_vec2(p, root, "gravity", 0, g)) return -1;
   if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
+  if (vtk >= 0) {
+    const char* dir = fmbp_scalar(p, vtk);
+    if (!dir || !*dir || strlen(dir) >= sizeof m->vtk_dir)
+      return fmb_parse_error(p, vtk, "expected a directory name for 'vtk' (where the ParaView animation goes)");
+    snprintf(m->vtk_dir, sizeof m->vtk_dir, "%s", dir);
+  }
   m->env.gravity[0] = g[0];
   m->env.gravity[1] = g[1];
   m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);

@@ -321,7 +321,8 @@ int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local
   fmbModel* m = p->model;
   if (joint < 0 || joint >= m->njoint) return -1;
   const fmbJointInst* j = &m->joint[joint];
-  if (!j->type->attachment) return -1;
+  /* only a constraining joint: a spring's ends (drawn through the same op) are no pivot to drive */
+  if (!j->type->attachment || j->nrows == 0) return -1;
   return j->type->attachment(j->self, k, body, local);
 }
 

@@ -28,7 +28,7 @@ int fmbt_run(const char* scene_rel, const char* const* overrides, int noverrides
     fprintf(stderr, "%s:%d:%d: error: %s\n", diag->file, diag->line, diag->col, diag->msg);
     return diag->code;
   }
-  fmbRunOptions opt = {out, 1};
+  fmbRunOptions opt = {.csv_path = out, .quiet = 1};
   int rc = fmb_run(m, &opt, st, diag);
   if (rc) fprintf(stderr, "run %s stopped: %s\n", scene_rel, diag->msg);
   fmb_print_stats(st, stderr);

@@ -1,8 +1,9 @@
-/* cmd_run.c — `flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet]
- *                [--reference REF.csv [--columns a,b]]`
+/* cmd_run.c — `flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet] [--progress]
+ *                [--vtk DIR] [--reference REF.csv [--columns a,b]]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
 #include <stdio.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 
@@ -12,7 +13,8 @@ int fmb_cmd_run(int argc, char** argv) {
   const char* out = NULL;
   const char* reference = NULL; /* --reference REF.csv: error against REF and the run's cost */
   const char* columns = NULL;
-  int quiet = 0;
+  int quiet = 0, progress = 0;
+  const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("run", argc, argv, &i, &s);
@@ -26,6 +28,10 @@ int fmb_cmd_run(int argc, char** argv) {
       if (!(columns = fmb_cli_value("run", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = 1;
+    } else if (strcmp(a, "--progress") == 0) {
+      progress = 1;
+    } else if (strcmp(a, "--vtk") == 0) {
+      if (!(vtk = fmb_cli_value("run", argc, argv, &i, "a directory"))) return FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(stderr, "flexmbd run: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -48,7 +54,13 @@ int fmb_cmd_run(int argc, char** argv) {
     fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
-  fmbRunOptions opt = {out, quiet};
+  /* the progress line: on a terminal once a run has taken 2 s; --progress asks for it anywhere
+     and from the start; --quiet wins over both */
+  fmbRunOptions opt = {.csv_path = out,
+                       .quiet = quiet,
+                       .progress = !quiet && (progress || isatty(STDERR_FILENO)),
+                       .progress_after_s = progress ? 0.0 : 2.0,
+                       .vtk_dir = vtk};
   int rc = fmb_run(m, &opt, &stats, &diag);
   if (rc) fmb_cli_print_diag(&diag);
   if (reference) {

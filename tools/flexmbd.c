@@ -14,7 +14,7 @@ typedef struct {
 
 static const Command commands[] = {
     {"run", fmb_cmd_run,
-     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet]\n"
+     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR]\n"
      "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost"},
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run"},
     {"compare", fmb_cmd_compare,
