@@ -2,7 +2,7 @@
 # Install what flexmbd needs on Debian 12, only if something is missing.
 #   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind
 set -euo pipefail
-pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox)
+pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux)
 if [ "${1:-}" = "--ci" ]; then
   pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux)
 fi
