@@ -32,4 +32,6 @@ int fmb_cmd_types(int argc, char** argv);
 int fmb_cmd_compare(int argc, char** argv);
 int fmb_cmd_regress(int argc, char** argv);
 int fmb_cmd_conform(int argc, char** argv);
+int fmb_cmd_plot(int argc, char** argv);
+int fmb_cmd_new(int argc, char** argv);
 #endif

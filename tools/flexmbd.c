@@ -24,6 +24,11 @@ static const Command commands[] = {
     {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs"},
     {"conform", fmb_cmd_conform,
      "conform [--plugin x.so]... [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure"},
+    {"plot", fmb_cmd_plot,
+     "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
+     "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
+     "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)"},
+    {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

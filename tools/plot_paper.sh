@@ -11,7 +11,7 @@
 # Usage: tools/plot_paper.sh [OUTDIR] [FLEXMBD]
 #   OUTDIR   where CSVs and PNGs go (default: plots)
 #   FLEXMBD  the flexmbd program (default: build/flexmbd)
-# Needs gnuplot (Debian: gnuplot-nox). Runs from the repository root.
+# Draws with `flexmbd plot` (gnuplot; Debian: gnuplot-nox). Runs from the repository root.
 set -eu
 
 out=${1:-plots}
@@ -45,47 +45,20 @@ run scenes/paper/pendulum.yaml "$out/pendulum_complete.csv"
 yrange() { # csv
   awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "beam.tip_v") c = i; next }
            { if ($c > mx) mx = $c; if ($c < mn) mn = $c }
-           END { d = 0.25 * (mx - mn); printf "[%g:%g]", mn - d, mx + d }' "$1"
+           END { d = 0.25 * (mx - mn); printf "%g:%g", mn - d, mx + d }' "$1"
 }
 
 for w in 1 4 15; do
-  gnuplot <<EOF
-set terminal pngcairo size 900,560 font "sans,11"
-set output "$out/fig3_w$w.png"
-set termoption noenhanced
-set datafile separator ","
-set key top right
-set grid
-set xlabel "t (s)"
-set ylabel "tip transverse deformation (m)"
-set title "Spin-up, omega0 = $w rad/s, Tn = 15 s (Fig. 3): beam.tip_v"
-set xrange [0:20]
-set yrange $(yrange "$out/spinup_w${w}_complete.csv")
-plot "$out/spinup_w${w}_complete.csv" using "t":"beam.tip_v" with lines lw 2 lc rgb "#1f77b4" title "complete", \
-     "$out/spinup_w${w}_foac.csv" using "t":"beam.tip_v" with lines lw 2 dt 2 lc rgb "#d62728" title "FOAC", \
-     "$out/spinup_w${w}_zoac.csv" using "t":"beam.tip_v" with lines lw 2 dt 3 lc rgb "#2ca02c" title "ZOAC"
-EOF
+  "$flexmbd" plot "$out/spinup_w${w}_complete.csv" "$out/spinup_w${w}_foac.csv" "$out/spinup_w${w}_zoac.csv" beam.tip_v \
+    -o "$out/fig3_w$w.png" --legend complete,FOAC,ZOAC --xlabel "t (s)" --ylabel "tip transverse deformation (m)" \
+    --title "Spin-up, omega0 = $w rad/s, Tn = 15 s (Fig. 3): beam.tip_v" --xrange 0:20 \
+    --yrange "$(yrange "$out/spinup_w${w}_complete.csv")"
 done
 
-gnuplot <<EOF
-set terminal pngcairo size 900,560 font "sans,11"
-set output "$out/fig5_energy.png"
-set datafile separator ","
-set key outside right
-set grid
-set xlabel "t (s)"
-set ylabel "energy (J)"
-set title "Flexible pendulum, complete model (Fig. 5): T + U_e + U_g = const"
-plot "$out/pendulum_complete.csv" using "t":"energy.kinetic" with lines lw 2 title "kinetic T", \
-     "" using "t":"energy.strain" with lines lw 2 title "strain U_e", \
-     "" using "t":"energy.gravity" with lines lw 2 title "gravity U_g", \
-     "" using "t":"energy.total" with lines lw 2 lc rgb "black" title "total"
-set output "$out/fig4_tip.png"
-set key top right
-set ylabel "tip transverse deformation (m)"
-set termoption noenhanced
-set title "Flexible pendulum, complete model (Fig. 4b): beam.tip_v"
-plot "$out/pendulum_complete.csv" using "t":"beam.tip_v" with lines lw 2 title "complete"
-EOF
+"$flexmbd" plot "$out/pendulum_complete.csv" energy.kinetic energy.strain energy.gravity energy.total \
+  -o "$out/fig5_energy.png" --xlabel "t (s)" --ylabel "energy (J)" \
+  --title "Flexible pendulum, complete model (Fig. 5): T + U_e + U_g = const"
+"$flexmbd" plot "$out/pendulum_complete.csv" beam.tip_v -o "$out/fig4_tip.png" --xlabel "t (s)" \
+  --ylabel "tip transverse deformation (m)" --title "Flexible pendulum, complete model (Fig. 4b): beam.tip_v"
 
 echo "plot_paper.sh: wrote $out/fig3_w1.png $out/fig3_w4.png $out/fig3_w15.png $out/fig4_tip.png $out/fig5_energy.png"

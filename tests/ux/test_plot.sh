@@ -1,0 +1,40 @@
+#!/bin/sh
+# test_plot.sh FLEXMBD SOURCE_DIR OUTDIR — `flexmbd plot` makes real figures:
+#   one CSV, every column, default name OUT.png: a PNG (signature) of some size;
+#   three CSVs overlaid into an SVG: one curve per CSV, each with its legend entry;
+#   a log-scale error plot into a PDF; a column no CSV has: exit 2 and no figure.
+set -u
+flexmbd=$1 src=$2 out=$3
+rm -rf "$out" && mkdir -p "$out" && cd "$out" || exit 1
+fail=0
+scene=$src/scenes/paper/spinup_w4.yaml
+for m in complete foac zoac; do
+  $flexmbd run "$scene" -o "$m.csv" --quiet --set bodies.beam.model=$m --set solver.t_end=3 2>/dev/null
+  [ $? -eq 0 ] || { echo "FAIL: run $m"; fail=1; }
+done
+$flexmbd plot complete.csv 2>plot1.err || { echo "FAIL: plot of one CSV: $(cat plot1.err)"; fail=1; }
+[ "$(head -c 8 complete.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] || { echo "FAIL: complete.png is not a PNG"; fail=1; }
+[ "$(wc -c < complete.png)" -gt 5000 ] || { echo "FAIL: complete.png is nearly empty"; fail=1; }
+
+$flexmbd plot complete.csv foac.csv zoac.csv beam.tip_v -o overlay.svg --legend complete,FOAC,ZOAC 2>plot2.err \
+  || { echo "FAIL: overlay: $(cat plot2.err)"; fail=1; }
+for label in complete FOAC ZOAC; do
+  grep -q ">$label<" overlay.svg || { echo "FAIL: overlay.svg has no legend entry $label"; fail=1; }
+done
+# gnuplot's SVG draws each curve as a path of its own colour: three curves, three colours
+ncurves=$(grep -o "stroke='rgb([0-9, ]*)'" overlay.svg | sort -u | wc -l)
+[ "$ncurves" -ge 3 ] || { echo "FAIL: overlay.svg: $ncurves curve colours, expected 3"; fail=1; }
+
+# an error plot: |complete - foac| is not in one CSV, so the log axis shows |tip_v| of two models
+$flexmbd plot complete.csv foac.csv beam.tip_v --abs --logy -o errors.pdf 2>plot3.err || { echo "FAIL: log plot: $(cat plot3.err)"; fail=1; }
+[ "$(head -c 4 errors.pdf)" = "%PDF" ] || { echo "FAIL: errors.pdf is not a PDF"; fail=1; }
+
+$flexmbd plot complete.csv beam.no_such -o bad.png 2>bad.err
+rc=$?
+[ $rc -eq 2 ] || { echo "FAIL: unknown column: exit $rc, expected 2"; fail=1; }
+grep -q "no CSV has a column 'beam.no_such'" bad.err || { echo "FAIL: unknown column message: $(cat bad.err)"; fail=1; }
+[ ! -e bad.png ] || { echo "FAIL: a figure was written for an unknown column"; fail=1; }
+$flexmbd plot complete.csv -o fig.jpg 2>/dev/null
+[ $? -eq 2 ] || { echo "FAIL: .jpg accepted"; fail=1; }
+[ $fail -eq 0 ] && echo "ok: PNG of one CSV ($(wc -c < complete.png) bytes), SVG overlay of 3 CSVs, log-scale PDF, bad column refused"
+exit $fail
