@@ -184,7 +184,7 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   b->model = BEAM_COMPLETE;
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, model_names, &b->model);
   err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
-  err |= fmb_get_double(p, item, "angle", FMB_OPTIONAL, &b->angle0);
+  err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
   err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
   err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
   err |= fmb_get_double(p, item, "damping", FMB_OPTIONAL | FMB_NONNEGATIVE, &b->beta);

@@ -15,7 +15,7 @@ static int ground_parse(fmbParser* p, fmbNode item, void** self) {
   Ground* g = calloc(1, sizeof *g);
   if (!g) return fmb_parse_error(p, item, "out of memory");
   *self = g;
-  return fmb_get_vec2(p, item, "position", 0, g->pos) || fmb_get_double(p, item, "angle", 0, &g->angle) ? -1 : 0;
+  return fmb_get_vec2(p, item, "position", 0, g->pos) || fmb_get_angle(p, item, "angle", FMB_POSE, &g->angle) ? -1 : 0;
 }
 
 static void ground_destroy(void* self) { free(self); }

@@ -18,7 +18,7 @@ static int rigid_parse(fmbParser* p, fmbNode item, void** self) {
   *self = r;
   if (fmb_get_double(p, item, "mass", FMB_REQUIRED | FMB_POSITIVE, &r->mass) ||
       fmb_get_double(p, item, "inertia", FMB_REQUIRED | FMB_POSITIVE, &r->inertia) ||
-      fmb_get_vec2(p, item, "position", 0, r->pos) || fmb_get_double(p, item, "angle", 0, &r->angle) ||
+      fmb_get_vec2(p, item, "position", 0, r->pos) || fmb_get_angle(p, item, "angle", FMB_POSE, &r->angle) ||
       fmb_get_vec2(p, item, "velocity", 0, r->vel) || fmb_get_double(p, item, "angular_velocity", 0, &r->omega))
     return -1;
   return 0;

@@ -127,6 +127,10 @@ struct fmbParser {
   const char* const* overrides;
   const char* looked[64];   /* keys looked up in the current item, for "expected one of" */
   int nlooked;
+  /* named materials and sections (top-level `materials:`/`sections:` maps): while a body or
+     joint item is parsed, keys it does not have are looked up in the entries it names */
+  fmbNode item;             /* the item being parsed, or -1 */
+  fmbNode inherited[2];     /* its material and section entries, or -1 */
   fmbModel* model;          /* under construction */
   const fmbRegistry* reg;
   fmbRegistry* own_reg;     /* the scene's plugins: a copy of the caller's registry, or NULL */

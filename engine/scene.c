@@ -65,6 +65,66 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   return 0;
 }
 
+/* `materials:` and `sections:`: mappings of named entries, each a mapping of keys that the
+   items naming it (`material: steel`, `section: bar`) take unless they give the key themselves */
+static const char* const library_keys[2] = {"materials", "sections"};
+static const char* const reference_keys[2] = {"material", "section"};
+
+static int check_library(fmbParser* p, fmbNode lib, const char* what) {
+  if (lib < 0) return 0;
+  yaml_node_t* nd = fmbp_node(p, lib);
+  if (!fmbp_is_map(p, lib))
+    return fmb_parse_error(p, lib, "expected a mapping of named entries for '%s', e.g. {steel: {density: 7850, youngs_modulus: 2.1e11}}", what);
+  for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr)
+    if (!fmbp_is_map(p, pr->value))
+      return fmb_parse_error(p, pr->value, "expected a mapping of keys for %s entry '%s'", what, fmbp_scalar(p, pr->key));
+  return 0;
+}
+
+/* the entries an item names: p->inherited[k] (or -1) */
+static int resolve_references(fmbParser* p, fmbNode item) {
+  fmbNode root = fmbp_root(p);
+  for (int k = 0; k < 2; ++k) {
+    p->inherited[k] = -1;
+    /* material and section stay out of the item's "expected one of" list: every item takes
+       them, and the list is about the type's own keys (docs/scenes.md lists these) */
+    const int looked = p->nlooked;
+    fmbNode ref = fmb_find_key(p, item, reference_keys[k]);
+    p->nlooked = looked;
+    if (ref < 0) continue;
+    const char* name = fmbp_scalar(p, ref);
+    fmbNode lib = fmb_find_key(p, root, library_keys[k]);
+    fmbNode entry = name && lib >= 0 ? fmb_find_key(p, lib, name) : -1;
+    p->nlooked = looked;
+    if (entry < 0) {
+      char list[400] = "";
+      size_t used = 0;
+      yaml_node_t* nd = fmbp_node(p, lib);
+      for (yaml_node_pair_t* pr = nd ? nd->data.mapping.pairs.start : NULL; nd && pr < nd->data.mapping.pairs.top && used + 70 < sizeof list; ++pr)
+        used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", used ? ", " : "", fmbp_scalar(p, pr->key));
+      return fmb_parse_error(p, ref, "no %s named '%s' (defined under '%s' at the top level: %s)", reference_keys[k],
+                             name ? name : "?", library_keys[k], used ? list : "none");
+    }
+    p->inherited[k] = entry;
+  }
+  return 0;
+}
+
+/* every key of a used material or section must have been read by some item that names it */
+static int check_library_keys(fmbParser* p, fmbNode lib, const char* what) {
+  yaml_node_t* nd = fmbp_node(p, lib);
+  if (!nd) return 0;
+  for (yaml_node_pair_t* e = nd->data.mapping.pairs.start; e < nd->data.mapping.pairs.top; ++e) {
+    if (!(e->key <= p->nnodes_cap && p->known[e->key])) continue; /* never named: nothing to check */
+    yaml_node_t* entry = fmbp_node(p, e->value);
+    for (yaml_node_pair_t* pr = entry->data.mapping.pairs.start; pr < entry->data.mapping.pairs.top; ++pr)
+      if (!(pr->key <= p->nnodes_cap && p->known[pr->key]))
+        return fmb_parse_error(p, pr->key, "unknown key '%s' in %s '%s': no body or joint that names it reads that key",
+                               fmbp_scalar(p, pr->key), what, fmbp_scalar(p, e->key));
+  }
+  return 0;
+}
+
 /* What every body and joint item shares: a mapping with a fresh name and a registered type, read
    by its plugin with no key left unread. On success *self belongs to the caller; on error
    nothing is left allocated. */
@@ -84,7 +144,11 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : p->reg->bodies[*t]->destroy;
   char what[FMB_NAME_MAX + 40];
   snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
-  if (parse(p, item, self) || fmbp_check_unknown(p, item, what)) {
+  if (resolve_references(p, item)) return -1;
+  p->item = item;
+  const int failed = parse(p, item, self) || fmbp_check_unknown(p, item, what);
+  p->item = p->inherited[0] = p->inherited[1] = -1;
+  if (failed) {
     if (*self) destroy(*self); /* also a parse that failed after setting *self */
     *self = NULL;
     if (!p->diag->code) fmb_parse_error(p, item, "%s could not be set up", what);
@@ -163,9 +227,13 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode joints = fmb_find_key(p, root, "joints");
   fmbNode outputs = fmb_find_key(p, root, "outputs");
   fmbNode plugins = fmb_find_key(p, root, "plugins");
-  fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */
   double g[2] = {0.0, 0.0};
   if (fmb_get_vec2(p, root, "gravity", 0, g)) return -1;
+  /* optional conveniences, not listed among the expected top-level keys (docs/scenes.md has them) */
+  const int looked = p->nlooked;
+  fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */
+  fmbNode library[2] = {fmb_find_key(p, root, library_keys[0]), fmb_find_key(p, root, library_keys[1])};
+  p->nlooked = looked;
   if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
   if (vtk >= 0) {
     const char* dir = fmbp_scalar(p, vtk);
@@ -176,7 +244,11 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   m->env.gravity[0] = g[0];
   m->env.gravity[1] = g[1];
   m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);
+  for (int k = 0; k < 2; ++k)
+    if (check_library(p, library[k], library_keys[k])) return -1;
   if (fmb_scene_plugins(p, plugins) || parse_solver(p, m, solver) || parse_bodies(p, m, bodies) || parse_joints(p, m, joints)) return -1;
+  for (int k = 0; k < 2; ++k)
+    if (library[k] >= 0 && check_library_keys(p, library[k], reference_keys[k])) return -1;
   if (m->nq == 0) return fmb_parse_error(p, bodies, "the scene has no moving body (no generalized coordinates)");
   if (m->nc > m->nq)
     return fmb_parse_error(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",

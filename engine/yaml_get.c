@@ -112,8 +112,7 @@ static void remember_key(fmbParser* p, const char* key) {
   if (p->nlooked < (int)(sizeof p->looked / sizeof p->looked[0])) p->looked[p->nlooked++] = key;
 }
 
-fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
-  remember_key(p, key);
+static fmbNode value_of(fmbParser* p, fmbNode map, const char* key) {
   yaml_node_t* nd = fmbp_node(p, map);
   if (!nd || nd->type != YAML_MAPPING_NODE) return -1;
   for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr) {
@@ -124,6 +123,19 @@ fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
     }
   }
   return -1;
+}
+
+/* the item's own key first; an item's missing key comes from the material or section it names
+   (which are searched, and their key marked read, either way: a key the item overrides is not
+   an unknown key of its material) */
+fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
+  remember_key(p, key);
+  fmbNode v = value_of(p, map, key);
+  for (int k = 0; k < 2 && map == p->item && p->item > 0; ++k) {
+    const fmbNode inherited = p->inherited[k] > 0 ? value_of(p, p->inherited[k], key) : -1;
+    if (v < 0) v = inherited;
+  }
+  return v;
 }
 
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
@@ -211,6 +223,64 @@ int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, d
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a number");
   return number_at(p, n, key, flags, out);
+}
+
+/* a warning does not stop the load: FILE:LINE:COL: warning: ... on stderr (or the override) */
+static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
+  char msg[600];
+  va_list ap;
+  va_start(ap, fmt);
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  va_end(ap);
+  yaml_node_t* nd = fmbp_node(p, node);
+  int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
+  if (ov >= 0)
+    fprintf(stderr, "--set %s: warning: %s\n", p->overrides[ov], msg);
+  else if (nd)
+    fprintf(stderr, "%s:%d:%d: warning: %s\n", p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, msg);
+  else
+    fprintf(stderr, "%s: warning: %s\n", p->path, msg);
+}
+
+/* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */
+int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  static const double two_pi = 6.283185307179586;
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "an angle");
+  yaml_node_t* nd = fmbp_node(p, n);
+  const char* s = fmbp_scalar(p, n);
+  if (!s || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE || nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
+    return fmb_parse_error(p, n, "expected an angle for '%s' (radians, or with a unit: 120 deg, 2.1 rad), found %s", key,
+                           node_kind(nd));
+  char num[64];
+  size_t len = strcspn(s, " \tdr"); /* the number ends where the unit (deg, rad) begins */
+  double scale = 1.0;
+  const char* unit = s + len;
+  while (*unit == ' ' || *unit == '\t') ++unit;
+  if (strcmp(unit, "deg") == 0) scale = two_pi / 360.0;
+  else if (*unit && strcmp(unit, "rad") != 0) len = strlen(s); /* not a unit: the whole text is reported */
+  double v = 0.0;
+  int rc = len < sizeof num ? 0 : -1;
+  if (rc == 0) {
+    memcpy(num, s, len);
+    num[len] = '\0';
+    rc = parse_number(num, &v);
+  }
+  if (rc == -2) return fmb_parse_error(p, n, "expected a finite angle for '%s', got '%s'", key, s);
+  if (rc) return fmb_parse_error(p, n, "expected an angle for '%s' (radians, or with a unit: 120 deg, 2.1 rad), got '%s'", key, s);
+  if ((flags & FMB_POSITIVE) && !(v > 0)) return fmb_parse_error(p, n, "expected a positive angle for '%s', got %s", key, s);
+  if ((flags & FMB_NONNEGATIVE) && !(v >= 0))
+    return fmb_parse_error(p, n, "expected a non-negative angle for '%s', got %s", key, s);
+  if ((flags & FMB_POSE) && !*unit && fabs(v) > two_pi)
+    warning_at(p, n, "'%s: %s' is taken as radians (%.3g turns); write '%s deg' if degrees were meant", key, s,
+               fabs(v) / two_pi, s);
+  *out = v * scale;
+  return 0;
 }
 
 int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out) {
@@ -530,6 +600,7 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   p->override_of = NULL;
   p->nnodes_cap = 0;
   p->nlooked = 0;
+  p->item = p->inherited[0] = p->inherited[1] = -1;
   struct stat st;
   if (stat(path, &st) != 0) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));

@@ -32,14 +32,14 @@ static int drive_parse(fmbParser* p, fmbNode item, void** self) {
     if (fmb_joint_attachment(p, joint, k, &d->body[k], d->point[k]))
       return fmb_parse_error(p, fmb_find_key(p, item, "joint"), "a drive needs a revolute joint to drive (one with two attachment points)");
   if (fmb_get_choice(p, item, "profile", FMB_REQUIRED, profiles, &d->profile) ||
-      fmb_get_double(p, item, "angle0", 0, &d->angle0))
+      fmb_get_angle(p, item, "angle0", FMB_POSE, &d->angle0))
     return -1;
   switch (d->profile) {
     case PROFILE_CONSTANT: return fmb_get_double(p, item, "speed", FMB_REQUIRED, &d->speed);
     case PROFILE_HARMONIC:
-      return fmb_get_double(p, item, "amplitude", FMB_REQUIRED, &d->amplitude) ||
+      return fmb_get_angle(p, item, "amplitude", FMB_REQUIRED, &d->amplitude) ||
                      fmb_get_double(p, item, "frequency", FMB_REQUIRED | FMB_POSITIVE, &d->frequency) ||
-                     fmb_get_double(p, item, "phase", 0, &d->phase)
+                     fmb_get_angle(p, item, "phase", 0, &d->phase)
                  ? -1
                  : 0;
     default:

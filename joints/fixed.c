@@ -15,7 +15,7 @@ static int fixed_parse(fmbParser* p, fmbNode item, void** self) {
   Fixed* f = calloc(1, sizeof *f);
   if (!f) return fmb_parse_error(p, item, "out of memory");
   *self = f;
-  return fmbj_parse_two_points(p, item, &f->tp) || fmb_get_double(p, item, "angle", 0, &f->angle) ? -1 : 0;
+  return fmbj_parse_two_points(p, item, &f->tp) || fmb_get_angle(p, item, "angle", FMB_POSE, &f->angle) ? -1 : 0;
 }
 
 static void fixed_destroy(void* self) { free(self); }
