@@ -71,7 +71,7 @@ static const Starter starters[] = {
     {"rotor", "a flexible blade spun up by a motor (dynamic stiffening)",
      "# A flexible rotor blade spun up by a motor: the paper's spin-up (Liu, Hong & Liu 2009), shorter.\n"
      "# The hub's speed rises smoothly from 0 to omega0 over ramp_time, then stays; the blade lags\n"
-     "# behind while the hub accelerates and straightens when the speed is steady.\n"
+     "# behind while the hub accelerates, then swings back and vibrates about its straight shape.\n"
      "#   flexmbd run rotor.yaml -o rotor.csv --vtk rotor-vtk\n"
      "#   flexmbd plot rotor.csv beam.tip_v\n"
      "solver:\n"

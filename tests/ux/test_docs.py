@@ -1,0 +1,122 @@
+#!/usr/bin/env python3
+"""test_docs.py SOURCE_DIR BUILD_DIR OUTDIR — the documentation cannot go stale:
+
+1. Every command in README.md and docs/*.md runs. A fenced block tagged `sh` (or `bash`) is a
+   script; in a block tagged `console`, the lines starting with `$ ` are commands and the others
+   their output. A block that must not run (it installs packages, takes minutes, needs a file
+   the reader brings) is tagged `sh norun` / `console norun`: the convention is explicit, so an
+   untagged block that holds a command is an error too. Each document's commands run in order
+   in one bash (`set -e`, so `cd` and files carry over) in a fresh directory that links the
+   repository's folders (scenes/, tools/, ...; build/ is BUILD_DIR), with build/ on the PATH so
+   that both `./build/flexmbd` and `flexmbd` work; a command that fails names its document and line.
+2. No link points outside the repository: every Markdown link or image target is a file or
+   folder inside it (web addresses included: the documentation travels with the code), and no
+   text refers to the sibling folders the repository was developed beside (`../shared`)."""
+import os
+import re
+import shutil
+import signal
+import subprocess
+import sys
+
+src, build, out = (os.path.abspath(a) for a in sys.argv[1:4])
+shutil.rmtree(out, ignore_errors=True)
+os.makedirs(out)
+docs = ["README.md"] + sorted("docs/" + f for f in os.listdir(os.path.join(src, "docs")) if f.endswith(".md"))
+failures = []
+COMMANDISH = re.compile(r"^\s*(\$ )?(\./)?(build/)?(flexmbd|bash|sh|cmake|ctest|tools/|bench/)\b")
+FENCE = re.compile(r"^(\s*)```+\s*([^`]*)$")
+
+
+def blocks(path):
+    """(line, info words, lines) of every fenced block"""
+    lines = open(path, encoding="utf-8").read().split("\n")
+    i = 0
+    while i < len(lines):
+        m = FENCE.match(lines[i])
+        if not m:
+            i += 1
+            continue
+        start, info, body = i + 1, m.group(2).split(), []
+        i += 1
+        while i < len(lines) and not re.match(r"^\s*```+\s*$", lines[i]):
+            body.append(lines[i])
+            i += 1
+        yield start, info, body
+        i += 1
+
+
+ran = skipped = 0
+for doc in docs:
+    script = ["set -e"]
+    for line, info, body in blocks(os.path.join(src, doc)):
+        lang = info[0] if info else ""
+        if "norun" in info:
+            skipped += 1
+            continue
+        if lang in ("sh", "bash"):
+            cmds = body
+        elif lang == "console":
+            cmds = [l[2:] for l in body if l.startswith("$ ")]
+        else:
+            bad = [l for l in body if COMMANDISH.match(l)] if lang in ("", "text") else []
+            if bad:
+                failures.append(f"{doc}:{line}: an untagged block holds a command ({bad[0].strip()!r}): tag it sh, console, or sh norun")
+            continue
+        if not any(c.strip() and not c.strip().startswith("#") for c in cmds):
+            continue
+        ran += 1
+        script.append(f"echo '### {doc}:{line}' >&2")
+        script.extend(cmds)
+    if len(script) == 1:
+        continue
+    work = os.path.join(out, doc.replace("/", "_").replace(".md", ""))
+    os.makedirs(work)
+    for entry in os.listdir(src):
+        if entry in ("build", ".git") or entry.startswith("."):
+            continue
+        os.symlink(os.path.join(src, entry), os.path.join(work, entry))
+    os.symlink(build, os.path.join(work, "build"))
+    env = dict(os.environ, PATH=build + os.pathsep + os.environ.get("PATH", ""))
+    with open(os.path.join(work, "commands.sh"), "w") as f:
+        f.write("\n".join(script) + "\n")
+    # its own session, so that a command that hangs is ended with everything it started
+    proc = subprocess.Popen(["bash", "commands.sh"], cwd=work, env=env, stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                            text=True, start_new_session=True)
+    try:
+        _, err = proc.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(proc.pid, signal.SIGKILL)
+        _, err = proc.communicate()
+        err += "\ntimed out after 120 s: a block that takes minutes belongs in `sh norun`"
+    r = subprocess.CompletedProcess(proc.args, proc.returncode, None, err)
+    if r.returncode != 0:
+        where = [l for l in r.stderr.splitlines() if l.startswith("### ")]
+        failures.append(f"{where[-1][4:] if where else doc}: a command failed (exit {r.returncode}): "
+                        + " | ".join(l for l in r.stderr.splitlines()[-4:] if not l.startswith("### ")))
+
+# links
+LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
+nlinks = 0
+for doc in docs:
+    text = open(os.path.join(src, doc), encoding="utf-8").read()
+    for n, line in enumerate(text.split("\n"), 1):
+        if "../shared" in line:
+            failures.append(f"{doc}:{n}: refers to ../shared, outside the repository")
+        for target in LINK.findall(line):
+            nlinks += 1
+            if re.match(r"^[a-z]+:", target):
+                failures.append(f"{doc}:{n}: link to {target}: outside the repository")
+                continue
+            if target.startswith("#"):
+                continue
+            path = os.path.normpath(os.path.join(src, os.path.dirname(doc), target.split("#")[0]))
+            if not (path == src or path.startswith(src + os.sep)):
+                failures.append(f"{doc}:{n}: link {target} leaves the repository")
+            elif not os.path.exists(path):
+                failures.append(f"{doc}:{n}: link {target}: no such file")
+
+for f in failures:
+    print("FAIL:", f)
+print(f"{len(docs)} documents: {ran} command blocks run, {skipped} marked norun, {nlinks} links checked")
+sys.exit(1 if failures else 0)
