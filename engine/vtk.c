@@ -58,26 +58,15 @@ static int add_point(fmbVtk* v, int body, const double local[2], int deforms) {
   return v->npoint++;
 }
 
-/* a cell through the points idx[0..count) */
-static void add_cell_of(fmbVtk* v, const int* idx, int count, int type, int part, int owner) {
+/* a cell through the points idx[0..count), or when idx == NULL through first .. first + count - 1 */
+static void add_cell(fmbVtk* v, const int* idx, int first, int count, int type, int part, int owner) {
   VtkCell* c = &v->cell[v->ncell++];
   c->first = v->nconn;
   c->count = count;
   c->type = type;
   c->part = part;
   c->owner = owner;
-  for (int i = 0; i < count; ++i) v->conn[v->nconn++] = idx[i];
-}
-
-/* a cell through the consecutive points first .. first + count - 1 */
-static void add_cell(fmbVtk* v, int first, int count, int type, int part, int owner) {
-  VtkCell* c = &v->cell[v->ncell++];
-  c->first = v->nconn;
-  c->count = count;
-  c->type = type;
-  c->part = part;
-  c->owner = owner;
-  for (int i = 0; i < count; ++i) v->conn[v->nconn++] = first + i;
+  for (int i = 0; i < count; ++i) v->conn[v->nconn++] = idx ? idx[i] : first + i;
 }
 
 /* the attachment points of every joint on body b, in the body frame; returns how many */
@@ -151,7 +140,7 @@ static int build_geometry(fmbVtk* v, const fmbModel* m) {
       bi->type->centreline(bi->self, n, st);
       int first = v->npoint;
       for (int i = 0; i < n; ++i) add_point(v, b, st + 2 * i, 1);
-      add_cell(v, first, n, VTK_POLY_LINE, PART_CENTRELINE, b);
+      add_cell(v, NULL, first, n, VTK_POLY_LINE, PART_CENTRELINE, b);
       free(st);
     } else if (bi->nq >= 3) {
       int n = attachments_of(m, b, local, MAX_ATTACH);
@@ -169,7 +158,7 @@ static int build_geometry(fmbVtk* v, const fmbModel* m) {
         }
         int first = v->npoint, count = n >= 3 ? n + 1 : n;
         for (int i = 0; i < count; ++i) add_point(v, b, local + 2 * i, 0);
-        add_cell(v, first, count, VTK_POLY_LINE, PART_OUTLINE, b);
+        add_cell(v, NULL, first, count, VTK_POLY_LINE, PART_OUTLINE, b);
       }
       /* the frame: axes a fifth of the body's size long (0.1 m for a body with no joints) */
       const double len = size > 0.0 ? 0.2 * size : 0.1;
@@ -178,8 +167,8 @@ static int build_geometry(fmbVtk* v, const fmbModel* m) {
       add_point(v, b, axes[1], 0);
       add_point(v, b, axes[2], 0);
       const int x_axis[2] = {origin, origin + 1}, y_axis[2] = {origin, origin + 2};
-      add_cell_of(v, x_axis, 2, VTK_LINE, PART_FRAME_AXIS, b);
-      add_cell_of(v, y_axis, 2, VTK_LINE, PART_FRAME_AXIS, b);
+      add_cell(v, x_axis, 0, 2, VTK_LINE, PART_FRAME_AXIS, b);
+      add_cell(v, y_axis, 0, 2, VTK_LINE, PART_FRAME_AXIS, b);
     }
   }
   for (int j = 0; j < m->njoint && rc == 0; ++j) {
@@ -191,9 +180,9 @@ static int build_geometry(fmbVtk* v, const fmbModel* m) {
     int first = add_point(v, body[0], pt[0], 0);
     if (ji->nrows == 0 && ji->type->attachment(ji->self, 1, &body[1], pt[1]) == 0) {
       add_point(v, body[1], pt[1], 0);
-      add_cell(v, first, 2, VTK_LINE, PART_FORCE_ELEMENT, j);
+      add_cell(v, NULL, first, 2, VTK_LINE, PART_FORCE_ELEMENT, j);
     } else {
-      add_cell(v, first, 1, VTK_VERTEX, PART_JOINT, j);
+      add_cell(v, NULL, first, 1, VTK_VERTEX, PART_JOINT, j);
     }
   }
   free(local);
