@@ -339,7 +339,7 @@ static void child_run(const Job* job, const Options* o, int fd) {
     fmb_model_solver(m, &res.solver);
     fmbStats st;
     memset(&st, 0, sizeof st);
-    fmbRunOptions ro = {job->csv, 1};
+    fmbRunOptions ro = {.csv_path = job->csv, .quiet = 1};
     res.exit_code = fmb_run(m, &ro, &st, &diag);
     res.status_ok = st.status_ok && res.exit_code == 0;
     res.t_reached = st.t_reached;
