@@ -1,7 +1,8 @@
 /* cmd_plot.c — `flexmbd plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [options]`
  * Any run's columns against t (or --x COLUMN) through gnuplot; several CSVs are overlaid (model
  * or mesh comparisons), --logy/--logx and --abs draw error plots. The columns are checked
- * against the CSV headers first, so a typo is a message (exit 2), not an empty figure. */
+ * against the CSVs first (read by the one CSV reader, tools/csv_table.c), so a typo is a message
+ * (exit 2), not an empty figure. */
 #include <ctype.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -10,9 +11,9 @@
 #include <sys/stat.h>
 
 #include "cli.h"
+#include "csv_table.h"
 
 #define PLOT_MAX 64
-#define HEADER_MAX 65536
 
 typedef struct {
   const char* csv[PLOT_MAX];
@@ -35,32 +36,17 @@ static int is_file(const char* s) {
   return stat(s, &st) == 0 && S_ISREG(st.st_mode);
 }
 
-/* the header row of a CSV, with a trailing newline removed; NULL after printing why */
-static char* read_header(const char* path) {
-  FILE* f = fopen(path, "r");
-  if (!f) {
-    fprintf(stderr, "flexmbd plot: cannot open '%s'\n", path);
-    return NULL;
-  }
-  char* line = malloc(HEADER_MAX);
-  if (!line || !fgets(line, HEADER_MAX, f)) {
-    fprintf(stderr, "flexmbd plot: '%s' is empty (expected a CSV with a header row, as `flexmbd run` writes)\n", path);
-    free(line);
-    fclose(f);
-    return NULL;
-  }
-  fclose(f);
-  line[strcspn(line, "\r\n")] = '\0';
-  return line;
+/* column `name` of a CSV as `flexmbd run` writes it (t is column 0) */
+static int has_column(const fmbTable* tb, const char* name) {
+  return fmb_table_col(tb, name) >= 0 || (tb->ncol > 0 && strcmp(tb->name[0], name) == 0);
 }
 
-static int has_column(const char* header, const char* name) {
-  size_t n = strlen(name);
-  for (const char* s = header; s; s = strchr(s, ',')) {
-    if (*s == ',') ++s;
-    if (strncmp(s, name, n) == 0 && (s[n] == ',' || s[n] == '\0')) return 1;
-  }
-  return 0;
+/* "t, beam.tip_v, ..." for messages */
+static void column_list(const fmbTable* tb, char* out, size_t len) {
+  size_t used = 0;
+  out[0] = '\0';
+  for (int i = 0; i < tb->ncol && used + 80 < len; ++i)
+    used += (size_t)snprintf(out + used, len - used, "%s%s", i ? ", " : "", tb->name[i]);
 }
 
 /* a gnuplot double-quoted string */
@@ -145,38 +131,36 @@ int fmb_cmd_plot(int argc, char** argv) {
   memset(&a, 0, sizeof a);
   int rc = parse_args(argc, argv, &a);
   if (rc) return rc;
-  char* header[PLOT_MAX] = {NULL};
-  char default_out[1024];
-  rc = 0;
-  for (int i = 0; i < a.ncsv && !rc; ++i)
-    if (!(header[i] = read_header(a.csv[i]))) rc = FMB_EXIT_BAD_INPUT;
+  static fmbTable table[PLOT_MAX];
+  char default_out[1024], err[1024], list[4096];
+  int loaded = 0;
+  for (int i = 0; i < a.ncsv && !rc; ++i, ++loaded)
+    if (fmb_table_load(a.csv[i], &table[i], err, sizeof err)) {
+      fprintf(stderr, "flexmbd plot: %s\n", err);
+      rc = FMB_EXIT_BAD_INPUT;
+    }
   /* the x column: --x, else the first column (t) */
-  char xcol[256] = "";
-  if (!rc) {
-    if (a.x) snprintf(xcol, sizeof xcol, "%s", a.x);
-    else snprintf(xcol, sizeof xcol, "%.*s", (int)strcspn(header[0], ","), header[0]);
-  }
+  const char* xcol = rc ? NULL : a.x ? a.x : table[0].name[0];
   for (int i = 0; i < a.ncsv && !rc; ++i)
-    if (!has_column(header[i], xcol)) {
-      fprintf(stderr, "flexmbd plot: '%s' has no column '%s' for the x axis (its columns: %s)\n", a.csv[i], xcol, header[i]);
+    if (!has_column(&table[i], xcol)) {
+      column_list(&table[i], list, sizeof list);
+      fprintf(stderr, "flexmbd plot: '%s' has no column '%s' for the x axis (its columns: %s)\n", a.csv[i], xcol, list);
       rc = FMB_EXIT_BAD_INPUT;
     }
   /* no columns named: every column of the first CSV but x */
-  static char defaults[HEADER_MAX];
+  const int every_column = a.ncolumn == 0;
+  for (int c = 0; !rc && every_column && c < table[0].ncol && a.ncolumn < PLOT_MAX; ++c)
+    if (strcmp(table[0].name[c], xcol) != 0) a.column[a.ncolumn++] = table[0].name[c];
   if (!rc && a.ncolumn == 0) {
-    snprintf(defaults, sizeof defaults, "%s", header[0]);
-    for (char* tok = strtok(defaults, ","); tok && a.ncolumn < PLOT_MAX; tok = strtok(NULL, ","))
-      if (strcmp(tok, xcol) != 0) a.column[a.ncolumn++] = tok;
-    if (a.ncolumn == 0) {
-      fprintf(stderr, "flexmbd plot: '%s' has no column to plot besides '%s'\n", a.csv[0], xcol);
-      rc = FMB_EXIT_BAD_INPUT;
-    }
+    fprintf(stderr, "flexmbd plot: '%s' has no column to plot besides '%s'\n", a.csv[0], xcol);
+    rc = FMB_EXIT_BAD_INPUT;
   }
   for (int c = 0; c < a.ncolumn && !rc; ++c) {
     int found = 0;
-    for (int i = 0; i < a.ncsv; ++i) found |= has_column(header[i], a.column[c]);
+    for (int i = 0; i < a.ncsv; ++i) found |= has_column(&table[i], a.column[c]);
     if (!found) {
-      fprintf(stderr, "flexmbd plot: no CSV has a column '%s' (%s has: %s)\n", a.column[c], a.csv[0], header[0]);
+      column_list(&table[0], list, sizeof list);
+      fprintf(stderr, "flexmbd plot: no CSV has a column '%s' (%s has: %s)\n", a.column[c], a.csv[0], list);
       rc = FMB_EXIT_BAD_INPUT;
     }
   }
@@ -229,7 +213,7 @@ int fmb_cmd_plot(int argc, char** argv) {
       char label[256];
       legend_item(&a, i, label, sizeof label);
       for (int c = 0; c < a.ncolumn; ++c) {
-        if (!has_column(header[i], a.column[c])) continue;
+        if (!has_column(&table[i], a.column[c])) continue;
         fprintf(g, "%s", first ? "" : ", \\\n     ");
         first = 0;
         quoted(g, a.csv[i]);
@@ -255,6 +239,6 @@ int fmb_cmd_plot(int argc, char** argv) {
       fprintf(stderr, "flexmbd plot: wrote %s\n", a.out);
     }
   }
-  for (int i = 0; i < a.ncsv; ++i) free(header[i]);
+  for (int i = 0; i < loaded; ++i) fmb_table_free(&table[i]);
   return rc;
 }

@@ -16,6 +16,11 @@ $flexmbd plot complete.csv 2>plot1.err || { echo "FAIL: plot of one CSV: $(cat p
 [ "$(head -c 8 complete.png | od -An -tx1 | tr -d ' \n')" = "89504e470d0a1a0a" ] || { echo "FAIL: complete.png is not a PNG"; fail=1; }
 [ "$(wc -c < complete.png)" -gt 5000 ] || { echo "FAIL: complete.png is nearly empty"; fail=1; }
 
+# without column names: every column (the spin-up writes 10 besides t; gnuplot cycles 8 colours)
+$flexmbd plot complete.csv -o all.svg 2>/dev/null || { echo "FAIL: plot of every column"; fail=1; }
+nall=$(grep -o "stroke='rgb([0-9, ]*)'" all.svg | sort -u | wc -l)
+[ "$nall" -ge 8 ] || { echo "FAIL: all.svg: $nall curve colours for 10 columns"; fail=1; }
+
 $flexmbd plot complete.csv foac.csv zoac.csv beam.tip_v -o overlay.svg --legend complete,FOAC,ZOAC 2>plot2.err \
   || { echo "FAIL: overlay: $(cat plot2.err)"; fail=1; }
 for label in complete FOAC ZOAC; do
