@@ -41,18 +41,22 @@ fmbNode fmbp_root(fmbParser* p) {
 
 static int node_count(fmbParser* p) { return (int)(p->doc.nodes.top - p->doc.nodes.start); }
 
-static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
-  char msg[900];
-  vsnprintf(msg, sizeof msg, fmt, ap);
+/* where `node` is: file:line:column, or the override that made it */
+static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
   yaml_node_t* nd = fmbp_node(p, node);
   int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
   if (ov >= 0)
-    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", p->overrides[ov], msg);
+    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", p->overrides[ov], msg);
   else if (nd)
-    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1,
-                 (int)nd->start_mark.column + 1, "%s", msg);
+    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s", msg);
   else
-    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "%s", msg);
+    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "%s", msg);
+}
+
+static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
+  char msg[900];
+  vsnprintf(msg, sizeof msg, fmt, ap);
+  diag_at(p, node, p->diag, msg);
   return -1;
 }
 
@@ -237,14 +241,13 @@ static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(msg, sizeof msg, fmt, ap);
   va_end(ap);
-  yaml_node_t* nd = fmbp_node(p, node);
-  int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
-  if (ov >= 0)
-    fprintf(stderr, "--set %s: warning: %s\n", p->overrides[ov], msg);
-  else if (nd)
-    fprintf(stderr, "%s:%d:%d: warning: %s\n", p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, msg);
+  fmbDiag w;
+  memset(&w, 0, sizeof w);
+  diag_at(p, node, &w, msg);
+  if (w.line > 0)
+    fprintf(stderr, "%s:%d:%d: warning: %s\n", w.file, w.line, w.col, w.msg);
   else
-    fprintf(stderr, "%s: warning: %s\n", p->path, msg);
+    fprintf(stderr, "%s: warning: %s\n", w.file, w.msg);
 }
 
 /* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */
