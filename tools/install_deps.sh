@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # Install what flexmbd needs on Debian 12, only if something is missing.
-#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind
+#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; and
+#         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
+#         VTK itself (skipped without it)
+# python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux.
 set -euo pipefail
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux)
 if [ "${1:-}" = "--ci" ]; then
-  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux)
+  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9)
 fi
 missing=()
 for p in "${pkgs[@]}"; do
