@@ -119,6 +119,16 @@ for ds, row in zip(datasets, rows):
     check(pts[3 * a] == 1.0 and pts[3 * a + 1] == 0.5, f"{path}: the spring's fixed end at the anchor")
     npoints_seen += n
 
+# the scene key `vtk` does the same as the option (added here by an override)
+keyed = os.path.join(out, "keyed")
+r = subprocess.run([flexmbd, "run", scene, "-o", os.path.join(out, "keyed.csv"), "--set", "vtk=" + keyed], capture_output=True, text=True)
+check(r.returncode == 0 and len(ET.parse(os.path.join(keyed, stem + ".pvd")).getroot().findall("./Collection/DataSet")) == len(rows),
+      "the scene key vtk writes the same collection")
+# a directory that cannot be made: bad input, said so
+r = subprocess.run([flexmbd, "run", scene, "-o", os.path.join(out, "x.csv"), "--vtk", os.path.join(out, "no", "such", "dir")],
+                   capture_output=True, text=True)
+check(r.returncode == 2 and "cannot create the VTK directory" in r.stderr, f"an impossible --vtk directory: exit {r.returncode}")
+
 # the beam moved: the test is not comparing zeros
 last = rows[-1]
 check(abs(float(last["arm.tip_v"])) > 1e-4, f"the tip deflects ({last['arm.tip_v']})")
