@@ -9,6 +9,7 @@
    in one bash (`set -e`, so `cd` and files carry over) in a fresh directory that links the
    repository's folders (scenes/, tools/, ...; build/ is BUILD_DIR), with build/ on the PATH so
    that both `./build/flexmbd` and `flexmbd` work; a command that fails names its document and line.
+   None may change the repository through those links (git status is compared before and after).
 2. No link points outside the repository: every Markdown link or image target is a file or
    folder inside it (web addresses included: the documentation travels with the code), and no
    text refers to the sibling folders the repository was developed beside (`../shared`)."""
@@ -46,6 +47,17 @@ def blocks(path):
         i += 1
 
 
+def repo_status():
+    """git's view of the working tree (None outside a git checkout): the commands run beside
+    links into the repository, and none of them may change it"""
+    try:
+        r = subprocess.run(["git", "status", "--porcelain", "--ignored=no"], cwd=src, capture_output=True, text=True)
+        return r.stdout if r.returncode == 0 else None
+    except OSError:
+        return None
+
+
+status_before = repo_status()
 ran = skipped = 0
 for doc in docs:
     script = ["set -e"]
@@ -94,6 +106,11 @@ for doc in docs:
         where = [l for l in r.stderr.splitlines() if l.startswith("### ")]
         failures.append(f"{where[-1][4:] if where else doc}: a command failed (exit {r.returncode}): "
                         + " | ".join(l for l in r.stderr.splitlines()[-4:] if not l.startswith("### ")))
+
+status_after = repo_status()
+if status_before is not None and status_after != status_before:
+    failures.append("a documented command changed the repository (git status before/after differ): mark it norun or "
+                    "make it write into the current folder")
 
 # links
 LINK = re.compile(r"!?\[[^\]]*\]\(([^)\s]+)(?:\s+\"[^\"]*\")?\)")
