@@ -427,7 +427,7 @@ static int energy_run(Report* r, const char* scene, const char* csv, const fmbRe
     result(r, 0, "energy", "the run's scene does not load: %s:%d:%d: %s", d.file, d.line, d.col, d.msg);
     return -1;
   }
-  fmbRunOptions opt = {csv, 1};
+  fmbRunOptions opt = {.csv_path = csv, .quiet = 1};
   fmbStats st;
   const int rc = fmb_run(m, &opt, &st, &d);
   fmb_free(m);

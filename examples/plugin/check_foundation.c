@@ -39,7 +39,7 @@ int main(int argc, char** argv) {
     fprintf(stderr, "%s:%d:%d: error: %s\n", d.file, d.line, d.col, d.msg);
     return 2;
   }
-  fmbRunOptions opt = {argv[2], 1};
+  fmbRunOptions opt = {.csv_path = argv[2], .quiet = 1};
   fmbStats st;
   if (fmb_run(m, &opt, &st, &d)) {
     fprintf(stderr, "run failed: %s\n", d.msg);

@@ -52,7 +52,7 @@ int main(void) {
   fmbModel* m = fmb_load(scene, NULL, 0, reg, &d);
   ENSURE(m != NULL);
   if (m) {
-    fmbRunOptions opt = {fmbt_out_path("registry_copy.csv", out, sizeof out), 1};
+    fmbRunOptions opt = {.csv_path = fmbt_out_path("registry_copy.csv", out, sizeof out), .quiet = 1};
     fmbStats st;
     ENSURE(fmb_run(m, &opt, &st, &d) == 0);
     fmb_free(m);

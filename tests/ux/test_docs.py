@@ -9,7 +9,9 @@
    in one bash (`set -e`, so `cd` and files carry over) in a fresh directory that links the
    repository's folders (scenes/, tools/, ...; build/ is BUILD_DIR), with build/ on the PATH so
    that both `./build/flexmbd` and `flexmbd` work; a command that fails names its document and line.
-   None may change the repository through those links (git status is compared before and after).
+   None may change the repository through those links (git status is compared before and after);
+   HOME is the work folder. A page whose commands another test runs within a larger setup says
+   so with `<!-- commands run by: PATH -->` (checked: PATH exists and reads the page).
 2. No link points outside the repository: every Markdown link or image target is a file or
    folder inside it (web addresses included: the documentation travels with the code), and no
    text refers to the sibling folders the repository was developed beside (`../shared`)."""
@@ -58,8 +60,20 @@ def repo_status():
 
 
 status_before = repo_status()
+DELEGATED = re.compile(r"<!-- commands run by: (\S+) -->")
 ran = skipped = 0
 for doc in docs:
+    # a page whose commands another test runs as part of a larger setup (plugins.md: install,
+    # build a plugin against the installed package) says which; the claim is checked: that test
+    # exists and reads this page
+    text = open(os.path.join(src, doc), encoding="utf-8").read()
+    delegated = DELEGATED.search(text)
+    if delegated:
+        runner = os.path.join(src, delegated.group(1))
+        if not (os.path.isfile(runner) and doc in open(runner, encoding="utf-8").read()):
+            failures.append(f"{doc}: its commands are said to be run by {delegated.group(1)}, which does not read {doc}")
+        skipped += sum(1 for _, info, _ in blocks(os.path.join(src, doc)) if info[:1] in (["sh"], ["bash"], ["console"]))
+        continue
     script = ["set -e"]
     for line, info, body in blocks(os.path.join(src, doc)):
         lang = info[0] if info else ""
@@ -89,7 +103,8 @@ for doc in docs:
             continue
         os.symlink(os.path.join(src, entry), os.path.join(work, entry))
     os.symlink(build, os.path.join(work, "build"))
-    env = dict(os.environ, PATH=build + os.pathsep + os.environ.get("PATH", ""))
+    # HOME is the work folder too: a command that installs into $HOME stays in the sandbox
+    env = dict(os.environ, PATH=build + os.pathsep + os.environ.get("PATH", ""), HOME=work)
     with open(os.path.join(work, "commands.sh"), "w") as f:
         f.write("\n".join(script) + "\n")
     # its own session, so that a command that hangs is ended with everything it started
