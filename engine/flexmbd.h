@@ -367,6 +367,73 @@ FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
  * ------------------------------------------------------------------------------------------- */
 FMB_API int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, FILE* report);
 
+/* ---------------------------------------------------------------------------------------------
+ * Analysis beyond time integration (engine/static.c, engine/modes.c; docs/analysis.md).
+ * A state is the DAE's y = [q, v, lambda, mu] and y' = [v, a, 0, 0], fmb_state_size(m) doubles
+ * each, in arrays the caller owns.
+ * ------------------------------------------------------------------------------------------- */
+FMB_API int fmb_state_size(const fmbModel* m); /* 0 for m == NULL */
+
+typedef struct fmbStaticOptions {
+  double t;         /* time at which drives and other rheonomic joints are held, */
+  int has_t;        /* when has_t; otherwise the scene's t0 */
+  int max_iter;     /* Newton iterations per load step; 0 = 30 */
+  int max_halvings; /* how often a load step may be halved; 0 = 12 (down to 1/4096 of the load) */
+  double tol;       /* Newton stops when max |dq_i| <= tol (1 + |q_i|); 0 = 1e-10 */
+  int quiet;        /* no progress lines on stderr */
+} fmbStaticOptions;
+
+typedef struct fmbStaticResult {
+  double t;
+  /* the steady state is a rigid rotation of the whole system at `speed` (rad/s) about `center`
+     (0 = static equilibrium), read from the drives' speeds at t */
+  double speed, center[2];
+  double residual;        /* 2-norm of the equations at the solution (forces and Phi) */
+  double residual_start;  /* the same at the starting point (the out-of-balance load) */
+  int iterations, load_steps;
+} fmbStaticResult;
+
+/* Static equilibrium, or relative equilibrium under a constant-speed drive, at opt->t (NULL
+   options = defaults at the scene's t0), by Newton on the full nonlinear equations with load
+   stepping (homotopy F(x) - (1 - s) F(x0), s: 0 -> 1, steps halved when Newton fails). Starts
+   from the bodies' initial poses. Fills y, yp (fmb_state_size doubles each). Returns 0,
+   FMB_EXIT_BAD_INPUT (the scene has no steady state: gravity on a rotating system, drives that
+   are not one rigid rotation) or FMB_EXIT_SOLVER (no convergence), with *diag saying why. */
+FMB_API int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
+               fmbDiag* diag);
+
+typedef struct fmbModes {
+  int count;              /* modes held, sorted by |frequency| */
+  int nq;                 /* length of a shape */
+  int nreduced;           /* degrees of freedom after the constraints were eliminated */
+  double speed;           /* the rigid rotation the state has (rad/s) */
+  double* frequency;      /* rad/s, |s| of the eigenvalue s; negative -|s| for a divergent mode
+                             (real s > 0, e.g. ZOAC spun above its first bending frequency) */
+  double* damping_ratio;  /* -Re(s)/|s|; -1 for a divergent mode */
+  double* shape_re;       /* count x nq, mode k at k * nq: the generalized coordinates' motion, */
+  double* shape_im;       /* scaled so the largest component is 1 (real) */
+} fmbModes;
+
+/* Linearize the DAE about the state (y, yp) at time t (from fmb_static: the rotating-frame
+   terms of a steady rotation are included), eliminate the constraints by a null-space basis and
+   solve the eigenproblem with LAPACK (dense). Returns 0 with *out (free with fmb_modes_free)
+   holding at most `count` modes (count <= 0: all), or an exit code with *diag. */
+FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, fmbModes** out,
+              fmbDiag* diag);
+FMB_API void fmb_modes_free(fmbModes* modes);
+/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1] */
+FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);
+/* the scene's outputs at state (y, yp), one CSV row (header first) */
+FMB_API int fmb_write_state_row(const fmbModel* m, const char* path, double t, const double* y, const double* yp,
+                        fmbDiag* diag);
+/* each mode's effect on the scene's outputs: d(output)/d(amplitude) along the real shape, one row
+   per mode, columns `mode` then the outputs (put beam.nodeK_v in `outputs` for nodal shapes) */
+FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const double* yp, const fmbModes* modes,
+                          const char* path, fmbDiag* diag);
+/* a table of named numeric columns (row-major values), through the one CSV writer */
+FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
+                    fmbDiag* diag);
+
 #ifdef __cplusplus
 }
 #endif

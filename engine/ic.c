@@ -60,6 +60,14 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
+  if (m->initial_static) {
+    /* `initial: static`: the static or steady state at t0 replaces the bodies' initial poses */
+    fmbStaticOptions so = {t0, 1, 0, 0, 0.0, 1};
+    fmbStaticResult sr;
+    if ((rc = fmb_static_solve(m, w, &so, y, yp, &sr, diag))) goto done;
+    memset(y + nq, 0, (size_t)(m->ny - nq) * sizeof(double));
+    fmb_rigid_rotation(m, sr.speed, sr.center, q, v, yp + nq);
+  }
   memcpy(q0, q, (size_t)nq * sizeof(double));
   memcpy(v0, v, (size_t)nq * sizeof(double));
 

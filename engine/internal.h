@@ -78,6 +78,7 @@ struct fmbModel {
   int need_energy, need_constraint, check_definiteness;
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
+  int initial_static; /* scene `initial: static`: runs start from the static or steady state */
   /* sparsity pattern of the iteration matrix, CSC, fixed at load */
   int nblock;
   fmbBlock* block;
@@ -220,6 +221,17 @@ int fmb_cholesky(int n, double* A);                        /* lower, in place; 0
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
                            fmbDiag* diag);
 
+/* ---- static.c ---- */
+int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
+                     fmbStaticResult* res, fmbDiag* diag);
+/* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
+void fmb_rigid_rotation(const fmbModel* m, double speed, const double center[2], const double* q, double* v,
+                        double* a);
+/* rotating-frame terms of a steady rotation: K += W C E + W^2 M E^2, Cg += 2 W M E (if not NULL);
+   nq x nq column-major with leading dimension ld */
+void fmb_rotation_terms(const fmbModel* m, double speed, const double* C, const double* M, int ld, double* K,
+                        double* Cg);
+
 /* ---- output.c ---- */
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
 /* global position of a body's material point (its marker); 0 ok */
@@ -231,6 +243,11 @@ fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
 void fmb_csv_header(fmbCsv* c, const fmbModel* m);
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
 void fmb_csv_close(fmbCsv* c);
+/* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */
+void fmb_csv_header_names(fmbCsv* c, int n, const char* const* names);
+int fmb_csv_values(fmbCsv* c, const double* values);
+/* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
+int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row);
 
 /* ---- vtk.c: the run as a ParaView collection (DIR/SCENE.pvd, one .vtu per output row) ---- */
 typedef struct fmbVtk fmbVtk;

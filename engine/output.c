@@ -236,8 +236,26 @@ void fmb_csv_header(fmbCsv* c, const fmbModel* m) {
   c->nrow = m->noutput;
 }
 
-/* 0 ok; 1 a value is not finite (nothing written); -1 a write failed */
-int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp) {
+/* a header of arbitrary named columns (tables that are not the scene's outputs: modes, Campbell) */
+void fmb_csv_header_names(fmbCsv* c, int n, const char* const* names) {
+  for (int i = 0; i < n; ++i) fprintf(c->f, "%s%s", i ? "," : "", names[i]);
+  fprintf(c->f, "\n");
+  fflush(c->f);
+  free(c->row);
+  c->row = calloc((size_t)n, sizeof(double));
+  c->nrow = n;
+}
+
+/* one row of as many values as the header has columns; 0 ok, -1 a write failed */
+int fmb_csv_values(fmbCsv* c, const double* values) {
+  for (int i = 0; i < c->nrow; ++i) fprintf(c->f, "%s%.12g", i ? "," : "", values[i]);
+  fprintf(c->f, "\n");
+  if (fflush(c->f) != 0 || ferror(c->f)) return -1;
+  return 0;
+}
+
+/* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
+int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row) {
   const double *q = y, *v = y + m->nq;
   (void)yp;
   fmbEnergy e = {0, 0, 0, 0};
@@ -275,12 +293,15 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
       case FMB_OUT_SHAPE: val = shape_value(m, w, o, q); break;
     }
     if (!isfinite(val)) return 1;
-    c->row[i] = val;
+    row[i] = val;
   }
-  for (int i = 0; i < m->noutput; ++i) fprintf(c->f, "%s%.12g", i ? "," : "", c->row[i]);
-  fprintf(c->f, "\n");
-  if (fflush(c->f) != 0 || ferror(c->f)) return -1;
   return 0;
+}
+
+/* 0 ok; 1 a value is not finite (nothing written); -1 a write failed */
+int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp) {
+  if (fmb_outputs_eval(m, w, t, y, yp, c->row)) return 1;
+  return fmb_csv_values(c, c->row);
 }
 
 void fmb_csv_close(fmbCsv* c) {

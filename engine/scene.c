@@ -233,6 +233,9 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   const int looked = p->nlooked;
   fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */
   fmbNode library[2] = {fmb_find_key(p, root, library_keys[0]), fmb_find_key(p, root, library_keys[1])};
+  /* `initial: static`: runs start from the static or steady state (engine/static.c) */
+  static const char* const initial_choices[] = {"scene", "static", NULL};
+  if (fmb_get_choice(p, root, "initial", 0, initial_choices, &m->initial_static)) return -1;
   p->nlooked = looked;
   if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
   if (vtk >= 0) {

@@ -34,4 +34,10 @@ int fmb_cmd_regress(int argc, char** argv);
 int fmb_cmd_conform(int argc, char** argv);
 int fmb_cmd_plot(int argc, char** argv);
 int fmb_cmd_new(int argc, char** argv);
+int fmb_cmd_static(int argc, char** argv);
+int fmb_cmd_modes(int argc, char** argv);
+int fmb_cmd_campbell(int argc, char** argv);
+/* shared by the analysis commands (cmd_static.c, cmd_modes.c) */
+int fmb_cli_parse_time(const char* cmd, const char* text, double* t);
+void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
 #endif

@@ -29,6 +29,14 @@ static const Command commands[] = {
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
      "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)"},
     {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene"},
+    {"static", fmb_cmd_static,
+     "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive"},
+    {"modes", fmb_cmd_modes,
+     "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv] [--set PATH=VALUE]...\n"
+     "      frequencies, damping ratios and shapes about the static or steady state"},
+    {"campbell", fmb_cmd_campbell,
+     "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-o campbell.csv] [--plot campbell.png]\n"
+     "      modes against the hub speed, followed by shape (MAC)"},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

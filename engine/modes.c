@@ -1,0 +1,524 @@
+/* modes.c — modal analysis about a static or steady state (docs/analysis.md).
+ *
+ * Linearizing the GGL rows about (q*, v*, a*, lambda*) gives, for small motions dq,
+ *     M dq'' + C dq' + K dq + Phi_q^T dlambda = 0,    Phi_q dq = 0,
+ * with K = dF_v/dq (the bodies' stiffness at v*, i.e. with geometric and centrifugal terms, the
+ * joints' curvature Phi_qq lambda*, the force elements), C = dF_v/dv (damping and gyroscopic
+ * terms) and M = dF_v/da, all read from the system Jacobian (fmb_system_jacobian at cj = 0 and
+ * cj = 1). About a steady rotation at speed W the frames' origins turn; writing their
+ * perturbations in the turning frame, dq = T(t) z with T' = W E T, gives the time-invariant
+ *     M z'' + (C + 2 W M E) z' + (K + W C E + W^2 M E^2) z + Phi_q^T dlambda = 0     (M1)
+ * (E: rotation generator on each frame origin; static.c's fmb_rotation_terms). The constraints
+ * are eliminated with an orthonormal null-space basis N of Phi_q (SVD), z = N r:
+ *     Mr r'' + Cr r' + Kr r = 0,   Mr = N^T M N, ...                                  (M2)
+ * Without velocity terms (Cr = 0, as at rest) this is the symmetric-definite problem
+ * Kr x = w^2 Mr x (LAPACK dsygv); otherwise the first-order form
+ *     [0 I; -Mr^-1 Kr  -Mr^-1 Cr] [r; r'] = s [r; r']                                 (M3)
+ * (dgesv, dgeev). A mode reports |s| as its frequency and -Re(s)/|s| as its damping ratio; a
+ * real positive s (divergence: ZOAC spun above w1, where w^2 = w1^2 - W^2 < 0) is reported as
+ * frequency -|s|, so a Campbell curve passes continuously through zero. Dense: O(n^3). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+/* LAPACK / BLAS (Debian's liblapack-dev, libblas-dev), Fortran calling convention */
+extern void dgesvd_(const char* jobu, const char* jobvt, const int* m, const int* n, double* a, const int* lda,
+                    double* s, double* u, const int* ldu, double* vt, const int* ldvt, double* work,
+                    const int* lwork, int* info);
+extern void dsygv_(const int* itype, const char* jobz, const char* uplo, const int* n, double* a, const int* lda,
+                   double* b, const int* ldb, double* w, double* work, const int* lwork, int* info);
+extern void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const int* lda, double* wr,
+                   double* wi, double* vl, const int* ldvl, double* vr, const int* ldvr, double* work,
+                   const int* lwork, int* info);
+extern void dgesv_(const int* n, const int* nrhs, double* a, const int* lda, int* ipiv, double* b, const int* ldb,
+                   int* info);
+extern void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const double* alpha,
+                   const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
+                   const int* ldc);
+
+typedef struct {
+  double freq, zeta;
+  int col;     /* eigenvector column (dsygv: real; dgeev: re at col, im at col + 1 or none) */
+  int complex_;
+} Root;
+
+static int cmp_root(const void* a, const void* b) {
+  const double x = fabs(((const Root*)a)->freq), y = fabs(((const Root*)b)->freq);
+  return x < y ? -1 : x > y;
+}
+
+/* Rt = N^T X N for X nq x nq (leading dimension ldx), N nq x nr; tmp nq x nr */
+static void reduce(int nq, int nr, const double* N, const double* X, int ldx, double* tmp, double* Rt) {
+  const double one = 1.0, zero = 0.0;
+  dgemm_("N", "N", &nq, &nr, &nq, &one, X, &ldx, N, &nq, &zero, tmp, &nq);
+  dgemm_("T", "N", &nr, &nr, &nq, &one, N, &nq, tmp, &nq, &zero, Rt, &nr);
+}
+
+static double fro(const double* X, size_t n) {
+  double s = 0.0;
+  for (size_t i = 0; i < n; ++i) s += X[i] * X[i];
+  return sqrt(s);
+}
+
+/* the speed of the rigid rotation v* describes (0 if v* is not one: then no rotating-frame terms) */
+static double state_speed(const fmbModel* m, const double* q, const double* v) {
+  double speed = NAN;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->type || bi->nq < 3) continue;
+    speed = v[bi->qadr + 2];
+    break;
+  }
+  if (!isfinite(speed) || speed == 0.0) return 0.0;
+  /* center from the first frame: v = W I~ (r - c) -> c = r - I~^T v / W */
+  const fmbBodyInst* b0 = NULL;
+  for (int b = 1; b < m->nbody && !b0; ++b)
+    if (m->body[b].type && m->body[b].nq >= 3) b0 = &m->body[b];
+  const double c[2] = {q[b0->qadr] - v[b0->qadr + 1] / speed, q[b0->qadr + 1] + v[b0->qadr] / speed};
+  double* vr = malloc((size_t)m->nq * 2 * sizeof(double));
+  if (!vr) return 0.0;
+  fmb_rigid_rotation(m, speed, c, q, vr, vr + m->nq);
+  double d = 0.0, s = 0.0;
+  for (int i = 0; i < m->nq; ++i) {
+    d = fmax(d, fabs(vr[i] - v[i]));
+    s = fmax(s, fabs(v[i]));
+  }
+  free(vr);
+  return d <= 1e-9 * s ? speed : 0.0;
+}
+
+void fmb_modes_free(fmbModes* md) {
+  if (!md) return;
+  free(md->frequency);
+  free(md->damping_ratio);
+  free(md->shape_re);
+  free(md->shape_im);
+  free(md);
+}
+
+int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, fmbModes** out,
+              fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (!m || !y || !yp || !out) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_modes: NULL model, state or result");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  *out = NULL;
+  const int nq = m->nq, nc = m->nc, ny = m->ny;
+  const double speed = state_speed(m, y, y + nq);
+  int rc = 0, info = 0;
+  fmbWorkspace* w = fmb_workspace_new(m);
+  double* J0 = calloc((size_t)ny * ny, sizeof(double));
+  double* J1 = calloc((size_t)ny * ny, sizeof(double));
+  double* ewt = calloc((size_t)ny, sizeof(double));
+  double* K = calloc((size_t)nq * nq, sizeof(double));
+  double* C = calloc((size_t)nq * nq, sizeof(double));
+  double* M = calloc((size_t)nq * nq, sizeof(double));
+  double* Cg = calloc((size_t)nq * nq, sizeof(double));
+  double* VT = calloc((size_t)nq * nq, sizeof(double));
+  double* sv = calloc((size_t)nq + 1, sizeof(double));
+  double *N = NULL, *tmp = NULL, *Mr = NULL, *Cr = NULL, *Kr = NULL, *S = NULL, *wr = NULL, *wi = NULL, *V = NULL,
+         *work = NULL;
+  Root* roots = NULL;
+  int* ipiv = NULL;
+  fmbModes* md = NULL;
+  if (!w || !J0 || !J1 || !ewt || !K || !C || !M || !Cg || !VT || !sv) goto oom;
+  for (int i = 0; i < ny; ++i) ewt[i] = 1.0 / (1e-8 * (1.0 + fabs(y[i])));
+  if (fmb_system_jacobian(m, w, t, 0.0, y, yp, ewt, 0, NULL, J0) ||
+      fmb_system_jacobian(m, w, t, 1.0, y, yp, ewt, 1, NULL, J1)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations cannot be differentiated at t = %g", t);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  for (int j = 0; j < nq; ++j)
+    for (int i = 0; i < nq; ++i) {
+      const size_t k = (size_t)j * nq + i;
+      K[k] = J0[(size_t)j * ny + nq + i];
+      C[k] = J0[(size_t)(nq + j) * ny + nq + i];
+      M[k] = J1[(size_t)(nq + j) * ny + nq + i] - C[k];
+      Cg[k] = C[k];
+    }
+  fmb_rotation_terms(m, speed, C, M, nq, K, Cg); /* (M1) */
+
+  /* null space of Phi_q (nc x nq): the right singular vectors beyond its rank */
+  int rank = 0;
+  if (nc > 0) {
+    double* P = calloc((size_t)nc * nq, sizeof(double));
+    if (!P) goto oom;
+    for (int j = 0; j < nq; ++j)
+      for (int r = 0; r < nc; ++r) P[(size_t)j * nc + r] = J0[(size_t)j * ny + 2 * nq + r];
+    int lwork = -1, one = 1;
+    double q1 = 0.0, u1 = 0.0;
+    dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, &q1, &lwork, &info);
+    lwork = (int)q1 + 1;
+    work = malloc((size_t)lwork * sizeof(double));
+    if (!work) {
+      free(P);
+      goto oom;
+    }
+    dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, work, &lwork, &info);
+    free(P);
+    free(work);
+    work = NULL;
+    if (info) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the SVD of the constraint Jacobian failed (LAPACK info %d)", info);
+      rc = FMB_EXIT_SOLVER;
+      goto done;
+    }
+    for (int i = 0; i < (nc < nq ? nc : nq); ++i)
+      if (sv[i] > 1e-10 * sv[0]) rank++;
+  }
+  const int nr = nq - rank;
+  if (nr == 0) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints leave no motion: there are no modes");
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  N = malloc((size_t)nq * nr * sizeof(double));
+  tmp = malloc((size_t)nq * nr * sizeof(double));
+  Mr = malloc((size_t)nr * nr * sizeof(double));
+  Cr = malloc((size_t)nr * nr * sizeof(double));
+  Kr = malloc((size_t)nr * nr * sizeof(double));
+  roots = calloc((size_t)2 * nr, sizeof(Root));
+  ipiv = calloc((size_t)2 * nr, sizeof(int));
+  if (!N || !tmp || !Mr || !Cr || !Kr || !roots || !ipiv) goto oom;
+  for (int k = 0; k < nr; ++k)
+    for (int i = 0; i < nq; ++i) N[(size_t)k * nq + i] = nc > 0 ? VT[(size_t)i * nq + rank + k] : (i == k);
+  reduce(nq, nr, N, M, nq, tmp, Mr); /* (M2) */
+  reduce(nq, nr, N, Cg, nq, tmp, Cr);
+  reduce(nq, nr, N, K, nq, tmp, Kr);
+
+  const size_t nn = (size_t)nr * nr;
+  const double kn = fro(Kr, nn), mn = fro(Mr, nn), cn = fro(Cr, nn);
+  double asym = 0.0;
+  for (int j = 0; j < nr; ++j)
+    for (int i = 0; i < j; ++i) asym = fmax(asym, fabs(Kr[(size_t)j * nr + i] - Kr[(size_t)i * nr + j]));
+  int nroot = 0, symmetric = 0;
+  /* the Ritz basis of the shapes: nr x nvec, eigenvectors in columns */
+  int nvec = 0;
+  if (cn <= 1e-9 * sqrt(kn * mn) && asym <= 1e-6 * kn) {
+    /* symmetric-definite: Kr x = w^2 Mr x, symmetrized against difference noise */
+    S = malloc(nn * sizeof(double));
+    double* B = malloc(nn * sizeof(double));
+    wr = malloc((size_t)nr * sizeof(double));
+    if (!S || !B || !wr) {
+      free(B);
+      goto oom;
+    }
+    for (int j = 0; j < nr; ++j)
+      for (int i = 0; i < nr; ++i) {
+        S[(size_t)j * nr + i] = 0.5 * (Kr[(size_t)j * nr + i] + Kr[(size_t)i * nr + j]);
+        B[(size_t)j * nr + i] = 0.5 * (Mr[(size_t)j * nr + i] + Mr[(size_t)i * nr + j]);
+      }
+    int itype = 1, lwork = -1;
+    double q1 = 0.0;
+    dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, &q1, &lwork, &info);
+    lwork = (int)q1 + 1;
+    work = malloc((size_t)lwork * sizeof(double));
+    if (!work) {
+      free(B);
+      goto oom;
+    }
+    dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, work, &lwork, &info);
+    free(B);
+    if (info == 0) {
+      symmetric = 1;
+      V = S;
+      S = NULL;
+      nvec = nr;
+      for (int k = 0; k < nr; ++k) {
+        const double l = wr[k];
+        roots[nroot++] = (Root){l >= 0 ? sqrt(l) : -sqrt(-l), l >= 0 ? 0.0 : -1.0, k, 0};
+      }
+    } else {
+      free(S); /* Mr not definite (FOAC): the general form below */
+      S = NULL;
+      free(wr);
+      wr = NULL;
+    }
+    free(work);
+    work = NULL;
+  }
+  if (!symmetric) {
+    /* (M3): X = Mr^-1 [Kr Cr] */
+    const int n2 = 2 * nr, nrhs = 2 * nr;
+    double* X = malloc((size_t)nr * n2 * sizeof(double));
+    double* Mf = malloc(nn * sizeof(double));
+    S = calloc((size_t)n2 * n2, sizeof(double));
+    wr = malloc((size_t)n2 * sizeof(double));
+    wi = malloc((size_t)n2 * sizeof(double));
+    V = malloc((size_t)n2 * n2 * sizeof(double));
+    if (!X || !Mf || !S || !wr || !wi || !V) {
+      free(X);
+      free(Mf);
+      goto oom;
+    }
+    memcpy(Mf, Mr, nn * sizeof(double));
+    memcpy(X, Kr, nn * sizeof(double));
+    memcpy(X + nn, Cr, nn * sizeof(double));
+    dgesv_(&nr, &nrhs, Mf, &nr, ipiv, X, &nr, &info);
+    free(Mf);
+    if (info) {
+      free(X);
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "the mass matrix on the free motions is singular at t = %g: no modes (a massless degree of freedom, "
+                   "or a FOAC beam whose mass matrix lost definiteness)", t);
+      rc = FMB_EXIT_SOLVER;
+      goto done;
+    }
+    for (int j = 0; j < nr; ++j) {
+      S[(size_t)(nr + j) * n2 + j] = 1.0;
+      for (int i = 0; i < nr; ++i) {
+        S[(size_t)j * n2 + nr + i] = -X[(size_t)j * nr + i];
+        S[(size_t)(nr + j) * n2 + nr + i] = -X[nn + (size_t)j * nr + i];
+      }
+    }
+    free(X);
+    int lwork = -1, one = 1;
+    double q1 = 0.0, vl = 0.0;
+    dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, V, &n2, &q1, &lwork, &info);
+    lwork = (int)q1 + 1;
+    work = malloc((size_t)lwork * sizeof(double));
+    if (!work) goto oom;
+    dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, V, &n2, work, &lwork, &info);
+    if (info) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the eigenvalue solver did not converge (LAPACK dgeev info %d)", info);
+      rc = FMB_EXIT_SOLVER;
+      goto done;
+    }
+    nvec = n2;
+    double smax = 0.0;
+    for (int k = 0; k < n2; ++k) smax = fmax(smax, hypot(wr[k], wi[k]));
+    const double tiny = 1e-8 * smax;
+    unsigned char* used = calloc((size_t)n2, 1);
+    if (!used) goto oom;
+    for (int k = 0; k < n2; ++k) {
+      const double mag = hypot(wr[k], wi[k]);
+      if (wi[k] > tiny) { /* an oscillating pair: keep the root with Im s > 0 */
+        /* |Re s| below 1e-10 |s| is the eigen-solver's rounding on an undamped gyroscopic
+           system (measured: 1e-14 .. 1e-11), not damping */
+        const double zeta = fabs(wr[k]) <= 1e-10 * mag ? 0.0 : -wr[k] / mag;
+        roots[nroot++] = (Root){mag, zeta, k, 1};
+      } else if (fabs(wi[k]) <= tiny && !used[k]) {
+        used[k] = 1;
+        /* real: a divergent +a pairs with -a; zero roots come in pairs (one rigid motion) */
+        int partner = -1;
+        double best = 1e-6 * smax + 10.0 * tiny;
+        for (int l = 0; l < n2; ++l)
+          if (!used[l] && fabs(wi[l]) <= tiny && fabs(wr[l] + wr[k]) < best) {
+            best = fabs(wr[l] + wr[k]);
+            partner = l;
+          }
+        if (partner >= 0) used[partner] = 1;
+        const int kk = partner >= 0 && wr[partner] > wr[k] ? partner : k;
+        const double s = wr[kk];
+        if (fabs(s) <= tiny)
+          roots[nroot++] = (Root){0.0, 0.0, kk, 0};
+        else if (s > 0.0)
+          roots[nroot++] = (Root){-s, -1.0, kk, 0};
+        else
+          roots[nroot++] = (Root){-s, 1.0, kk, 0}; /* overdamped: decay rate, damping ratio 1 */
+      }
+    }
+    free(used);
+  }
+  qsort(roots, (size_t)nroot, sizeof(Root), cmp_root);
+  if (count <= 0 || count > nroot) count = nroot;
+  md = calloc(1, sizeof *md);
+  if (!md) goto oom;
+  md->count = count;
+  md->nq = nq;
+  md->nreduced = nr;
+  md->speed = speed;
+  md->frequency = calloc((size_t)count + 1, sizeof(double));
+  md->damping_ratio = calloc((size_t)count + 1, sizeof(double));
+  md->shape_re = calloc((size_t)count * nq + 1, sizeof(double));
+  md->shape_im = calloc((size_t)count * nq + 1, sizeof(double));
+  if (!md->frequency || !md->damping_ratio || !md->shape_re || !md->shape_im) goto oom;
+  for (int k = 0; k < count; ++k) {
+    const Root* r = &roots[k];
+    md->frequency[k] = r->freq;
+    md->damping_ratio[k] = r->zeta;
+    /* displacement part of the eigenvector (first nr rows), back to q: N x */
+    const double* xr = V + (size_t)r->col * nvec;
+    const double* xi = r->complex_ ? V + (size_t)(r->col + 1) * nvec : NULL;
+    double* pr = md->shape_re + (size_t)k * nq;
+    double* pi = md->shape_im + (size_t)k * nq;
+    for (int i = 0; i < nq; ++i) {
+      double a = 0.0, b = 0.0;
+      for (int j = 0; j < nr; ++j) {
+        a += N[(size_t)j * nq + i] * xr[j];
+        if (xi) b += N[(size_t)j * nq + i] * xi[j];
+      }
+      pr[i] = a;
+      pi[i] = b;
+    }
+    /* scale by 1/phi_i at the largest component: it becomes 1, real */
+    int at = 0;
+    double big = -1.0;
+    for (int i = 0; i < nq; ++i)
+      if (hypot(pr[i], pi[i]) > big) {
+        big = hypot(pr[i], pi[i]);
+        at = i;
+      }
+    if (big > 0.0) {
+      const double dr = pr[at] / (big * big), di = -pi[at] / (big * big); /* 1 / phi_at */
+      for (int i = 0; i < nq; ++i) {
+        const double a = pr[i] * dr - pi[i] * di, b = pr[i] * di + pi[i] * dr;
+        pr[i] = a;
+        pi[i] = b;
+      }
+    }
+  }
+  *out = md;
+  md = NULL;
+  goto done;
+oom:
+  fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory for the modal analysis (%d coordinates)", nq);
+  rc = FMB_EXIT_SOLVER;
+done:
+  fmb_modes_free(md);
+  fmb_workspace_free(w);
+  free(J0);
+  free(J1);
+  free(ewt);
+  free(K);
+  free(C);
+  free(M);
+  free(Cg);
+  free(VT);
+  free(sv);
+  free(N);
+  free(tmp);
+  free(Mr);
+  free(Cr);
+  free(Kr);
+  free(S);
+  free(wr);
+  free(wi);
+  free(V);
+  free(work);
+  free(roots);
+  free(ipiv);
+  return rc;
+}
+
+double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k) {
+  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return 0.0;
+  const double *ar = a->shape_re + (size_t)i * a->nq, *ai = a->shape_im + (size_t)i * a->nq;
+  const double *br = b->shape_re + (size_t)k * b->nq, *bi = b->shape_im + (size_t)k * b->nq;
+  double re = 0.0, im = 0.0, na = 0.0, nb = 0.0;
+  for (int j = 0; j < a->nq; ++j) {
+    re += ar[j] * br[j] + ai[j] * bi[j]; /* a^H b */
+    im += ar[j] * bi[j] - ai[j] * br[j];
+    na += ar[j] * ar[j] + ai[j] * ai[j];
+    nb += br[j] * br[j] + bi[j] * bi[j];
+  }
+  return na > 0.0 && nb > 0.0 ? (re * re + im * im) / (na * nb) : 0.0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * tables through the one CSV writer (output.c) */
+
+int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
+                    fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  if (ncol <= 0 || !names || (nrow > 0 && !values)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns or no values");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmbCsv* c = fmb_csv_open(path, diag);
+  if (!c) return FMB_EXIT_BAD_INPUT;
+  fmb_csv_header_names(c, ncol, names);
+  int rc = 0;
+  for (int r = 0; r < nrow && !rc; ++r)
+    if (fmb_csv_values(c, values + (size_t)r * ncol)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, path, 0, 0, "writing the table failed (disk full?)");
+      rc = FMB_EXIT_SOLVER;
+    }
+  fmb_csv_close(c);
+  return rc;
+}
+
+int fmb_write_state_row(const fmbModel* m, const char* path, double t, const double* y, const double* yp,
+                        fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  if (!m || !y || !yp) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_state_row: NULL model or state");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmbWorkspace* w = fmb_workspace_new(m);
+  fmbCsv* c = w ? fmb_csv_open(path, diag) : NULL;
+  int rc = 0;
+  if (!c) {
+    if (!w) fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    rc = w ? FMB_EXIT_BAD_INPUT : FMB_EXIT_SOLVER;
+  } else {
+    fmb_csv_header(c, m);
+    const int wr = fmb_csv_row(c, m, w, t, y, yp);
+    if (wr) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, wr > 0 ? "an output is not finite" : "writing the output failed");
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  fmb_csv_close(c);
+  fmb_workspace_free(w);
+  return rc;
+}
+
+int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const double* yp, const fmbModes* md,
+                          const char* path, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  if (!m || !y || !yp || !md || md->nq != m->nq) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  const int nout = m->noutput, nq = m->nq;
+  fmbWorkspace* w = fmb_workspace_new(m);
+  double* yy = malloc((size_t)m->ny * sizeof(double));
+  double* plus = malloc((size_t)nout * sizeof(double));
+  double* minus = malloc((size_t)nout * sizeof(double));
+  double* rows = malloc((size_t)md->count * nout * sizeof(double) + 1);
+  const char** names = malloc((size_t)nout * sizeof(char*));
+  int rc = 0;
+  if (!w || !yy || !plus || !minus || !rows || !names) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  names[0] = "mode"; /* the time column's place */
+  for (int i = 1; i < nout; ++i) names[i] = m->output[i].name;
+  double qmax = 0.0;
+  for (int i = 0; i < nq; ++i) qmax = fmax(qmax, fabs(y[i]));
+  const double h = 1e-6 * (1.0 + qmax);
+  for (int k = 0; k < md->count && !rc; ++k) {
+    /* central difference of the outputs along the real shape: exact for outputs linear in q */
+    const double* phi = md->shape_re + (size_t)k * nq;
+    for (int sgn = 0; sgn < 2; ++sgn) {
+      memcpy(yy, y, (size_t)m->ny * sizeof(double));
+      for (int i = 0; i < nq; ++i) yy[i] += (sgn ? -h : h) * phi[i];
+      if (fmb_outputs_eval(m, w, t, yy, yp, sgn ? minus : plus)) {
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "an output is not finite along mode %d", k + 1);
+        rc = FMB_EXIT_SOLVER;
+      }
+    }
+    rows[(size_t)k * nout] = k + 1;
+    for (int i = 1; i < nout; ++i) rows[(size_t)k * nout + i] = (plus[i] - minus[i]) / (2.0 * h);
+  }
+  if (!rc) rc = fmb_write_table(path, nout, names, md->count, rows, diag);
+done:
+  fmb_workspace_free(w);
+  free(yy);
+  free(plus);
+  free(minus);
+  free(rows);
+  free(names);
+  return rc;
+}

@@ -1,0 +1,412 @@
+/* static.c — static equilibrium and steady rotation (relative equilibrium), docs/analysis.md.
+ *
+ * The unknowns are x = [q, lambda]; the equations are the GGL system's own rows (system.c)
+ *     F_v = M(q) a - Q(q, v, t) + Phi_q^T lambda = 0,    F_lambda = Phi(q, t) = 0,
+ * evaluated at a state that does not change in a frame turning with the drives:
+ *   - static: v = 0, a = 0;
+ *   - steady rotation at speed W about a center c: every body's frame turns rigidly, its own
+ *     (deformation) coordinates stay fixed, so for a frame origin r0
+ *         v_r0 = W I~ (r0 - c),  theta' = W,   a_r0 = -W^2 (r0 - c)          (I~ = [[0,-1],[1,0]])
+ *     and centrifugal stiffening enters through the bodies' own residuals at that v.
+ * W and c are read from the constraints at t: the velocity constraints Phi_q v + Phi_t = 0 must
+ * hold for a rigid rotation, which is linear in (W, W c) (least squares; a residual left over
+ * means the drives are not one rigid rotation, e.g. a drive between two moving bodies).
+ *
+ * Newton on x with the full Jacobian of the system (fmb_system_jacobian: the bodies' analytic or
+ * difference blocks, the joints' curvature terms Phi_qq lambda). With v = v(q), a = a(q):
+ *     dF_v/dq = K + W C E + W^2 M E^2                                             (S1)
+ * with K = dR/dq, C = dR/dv, M = dR/da and E the generator of the rotation (I~ on every body's
+ * frame-origin pair, 0 elsewhere). Large deflections: load stepping by the homotopy
+ *     G(x, s) = F(x) - (1 - s) F(x0),   s = 0 -> 1                                (S2)
+ * which applies the out-of-balance load of the starting point (gravity, loads, centrifugal
+ * forces, a drive's offset) in increments, halving an increment whenever Newton fails on it.
+ * Setup-time code: it allocates. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+int fmb_state_size(const fmbModel* m) { return m ? m->ny : 0; }
+
+static int has_frame(const fmbBodyInst* b) { return b->type && b->nq >= 3; }
+
+void fmb_rigid_rotation(const fmbModel* m, double speed, const double center[2], const double* q, double* v,
+                        double* a) {
+  memset(v, 0, (size_t)m->nq * sizeof(double));
+  memset(a, 0, (size_t)m->nq * sizeof(double));
+  if (speed == 0.0) return;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!has_frame(bi)) continue;
+    const double rx = q[bi->qadr] - center[0], ry = q[bi->qadr + 1] - center[1];
+    v[bi->qadr] = -speed * ry;
+    v[bi->qadr + 1] = speed * rx;
+    v[bi->qadr + 2] = speed;
+    a[bi->qadr] = -speed * speed * rx;
+    a[bi->qadr + 1] = -speed * speed * ry;
+  }
+}
+
+/* K (column-major, leading dimension ld, nq x nq) += W C E + W^2 M E^2 (S1); and, when Cg is
+   not NULL, Cg += 2 W M E: the rotating-frame terms of a linearization about a steady rotation
+   (modes.c). (C E) e_x = C e_y, (C E) e_y = -C e_x, E^2 = -1 on the frame-origin pair. */
+void fmb_rotation_terms(const fmbModel* m, double speed, const double* C, const double* M, int ld, double* K,
+                        double* Cg) {
+  if (speed == 0.0) return;
+  const int nq = m->nq;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!has_frame(bi)) continue;
+    const size_t cx = (size_t)bi->qadr * ld, cy = (size_t)(bi->qadr + 1) * ld;
+    for (int i = 0; i < nq; ++i) {
+      const double Cx = C[cx + i], Cy = C[cy + i], Mx = M[cx + i], My = M[cy + i];
+      K[cx + i] += speed * Cy - speed * speed * Mx;
+      K[cy + i] += -speed * Cx - speed * speed * My;
+      if (Cg) {
+        Cg[cx + i] += 2.0 * speed * My;
+        Cg[cy + i] -= 2.0 * speed * Mx;
+      }
+    }
+  }
+}
+
+static double norm2(const double* x, int n) {
+  double s = 0.0;
+  for (int i = 0; i < n; ++i) s += x[i] * x[i];
+  return sqrt(s);
+}
+
+/* The rigid rotation the constraints prescribe at t, from the least-squares fit of
+   Phi_q v(W, W c) = -Phi_t (module comment). 0, or FMB_EXIT_BAD_INPUT with *diag. */
+static int fit_rotation(const fmbModel* m, fmbWorkspace* w, double t, const double* q, double* speed,
+                        double center[2], fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  *speed = 0.0;
+  center[0] = center[1] = 0.0;
+  if (nc == 0) return 0;
+  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
+  double* phit = calloc((size_t)nc, sizeof(double));
+  double* phitt = calloc((size_t)nc, sizeof(double));
+  double* phi = calloc((size_t)nc, sizeof(double));
+  double* vz = calloc((size_t)nq * 3, sizeof(double)); /* v for W = 1, W cx = 1, W cy = 1 */
+  double* A = calloc((size_t)nc * 3, sizeof(double));
+  int rc = 0;
+  if (!PhiQ || !phit || !phitt || !phi || !vz || !A) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  double* zero = calloc((size_t)nq, sizeof(double));
+  if (!zero || fmb_constraints_all(m, w, t, q, zero, phi, PhiQ, phit, phitt)) {
+    free(zero);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints cannot be evaluated at t = %g", t);
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  free(zero);
+  const double bnorm = norm2(phit, nc);
+  if (bnorm == 0.0) goto done; /* no drive moves: static */
+  int frameless = 0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!has_frame(bi)) {
+      frameless = 1;
+      continue;
+    }
+    const int k = bi->qadr;
+    vz[k] = -q[k + 1]; /* W I~ r0 */
+    vz[k + 1] = q[k];
+    vz[k + 2] = 1.0;
+    vz[nq + k + 1] = -1.0; /* -I~ (W c) */
+    vz[2 * nq + k] = 1.0;
+  }
+  for (int r = 0; r < nc; ++r)
+    for (int j = 0; j < 3; ++j) {
+      double s = 0.0;
+      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * vz[(size_t)j * nq + c];
+      A[(size_t)j * nc + r] = s;
+    }
+  /* normal equations with a tiny regularization: directions the constraints leave free (a
+     center no joint fixes) get 0 */
+  double N[9], z[3] = {0, 0, 0};
+  int piv[3];
+  double tr = 0.0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 3; ++j) {
+      double s = 0.0;
+      for (int r = 0; r < nc; ++r) s += A[(size_t)i * nc + r] * A[(size_t)j * nc + r];
+      N[j * 3 + i] = s;
+      if (i == j) tr += s;
+    }
+  for (int i = 0; i < 3; ++i) {
+    N[i * 3 + i] += 1e-12 * tr + 1e-300;
+    double s = 0.0;
+    for (int r = 0; r < nc; ++r) s -= A[(size_t)i * nc + r] * phit[r];
+    z[i] = s;
+  }
+  if (fmb_lu_factor(3, N, piv) == 0) fmb_lu_solve(3, N, piv, z);
+  double res = 0.0;
+  for (int r = 0; r < nc; ++r) {
+    double s = phit[r];
+    for (int j = 0; j < 3; ++j) s += A[(size_t)j * nc + r] * z[j];
+    res += s * s;
+  }
+  res = sqrt(res);
+  if (res > 1e-8 * bnorm || z[0] == 0.0) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "at t = %g the drives do not turn the whole system as one rigid rotation (velocity constraints left "
+                 "unsatisfied by %.3g): a steady state exists only for constant-speed rotation of everything about one "
+                 "center (drive a hub pinned to the ground)",
+                 t, res);
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  if (frameless) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "a steady rotation needs every body to have a frame (x, y, theta)");
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  if (norm2(phitt, nc) > 1e-9 * bnorm * (1.0 + fabs(z[0]))) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "at t = %g the drives are accelerating (Phi_tt = %.3g): no steady state; take a time after the ramp "
+                 "(--at T) or a constant-speed drive",
+                 t, norm2(phitt, nc));
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  if (m->env.has_gravity) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "gravity turns with respect to a rotating system: a steady rotation at %g rad/s exists only without "
+                 "gravity (set gravity: [0, 0])",
+                 z[0]);
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  *speed = z[0];
+  center[0] = z[1] / z[0];
+  center[1] = z[2] / z[0];
+done:
+  free(PhiQ);
+  free(phit);
+  free(phitt);
+  free(phi);
+  free(vz);
+  free(A);
+  return rc;
+}
+
+typedef struct {
+  const fmbModel* m;
+  fmbWorkspace* w;
+  double t, speed, center[2];
+  int n;            /* nq + nc */
+  double *y, *yp, *F, *ewt, *J0, *J1, *A;
+  int* piv;
+} Newton;
+
+/* y, yp of the steady state at x = [q, lambda] */
+static void make_state(Newton* s, const double* x) {
+  const fmbModel* m = s->m;
+  const int nq = m->nq, nc = m->nc;
+  memset(s->y, 0, (size_t)m->ny * sizeof(double));
+  memset(s->yp, 0, (size_t)m->ny * sizeof(double));
+  memcpy(s->y, x, (size_t)nq * sizeof(double));
+  memcpy(s->y + 2 * nq, x + nq, (size_t)nc * sizeof(double));
+  fmb_rigid_rotation(m, s->speed, s->center, x, s->y + nq, s->yp + nq);
+  memcpy(s->yp, s->y + nq, (size_t)nq * sizeof(double));
+}
+
+/* Fx = [F_v; F_lambda] at x; 0 or the residual's code */
+static int eval_F(Newton* s, const double* x, double* Fx) {
+  const fmbModel* m = s->m;
+  make_state(s, x);
+  int rc = fmb_system_residual(m, s->w, s->t, s->y, s->yp, s->F);
+  if (rc) return rc;
+  memcpy(Fx, s->F + m->nq, (size_t)(m->nq + m->nc) * sizeof(double));
+  return 0;
+}
+
+/* dense [dF_v/dq (S1), Phi_q^T; Phi_q, 0] at x, LU-factored into s->A */
+static int factor_jacobian(Newton* s, const double* x) {
+  const fmbModel* m = s->m;
+  const int nq = m->nq, nc = m->nc, ny = m->ny, n = s->n;
+  make_state(s, x);
+  for (int i = 0; i < ny; ++i) s->ewt[i] = 1.0 / (1e-8 * (1.0 + fabs(s->y[i])));
+  int rc = fmb_system_jacobian(m, s->w, s->t, 0.0, s->y, s->yp, s->ewt, 0, NULL, s->J0);
+  if (!rc && s->speed != 0.0) rc = fmb_system_jacobian(m, s->w, s->t, 1.0, s->y, s->yp, s->ewt, 1, NULL, s->J1);
+  if (rc) return rc;
+  memset(s->A, 0, (size_t)n * n * sizeof(double));
+  for (int j = 0; j < nq; ++j)
+    for (int i = 0; i < nq + nc; ++i) s->A[(size_t)j * n + i] = s->J0[(size_t)j * ny + nq + i];
+  for (int k = 0; k < nc; ++k)
+    for (int i = 0; i < nq; ++i) s->A[(size_t)(nq + k) * n + i] = s->J0[(size_t)(2 * nq + k) * ny + nq + i];
+  if (s->speed != 0.0) {
+    /* C = J0's (F_v, v) block, M = J1's minus C; both nq x nq with leading dimension ny */
+    for (int j = 0; j < nq; ++j)
+      for (int i = 0; i < nq; ++i) {
+        const size_t at = (size_t)(nq + j) * ny + nq + i;
+        s->J1[at] -= s->J0[at];
+      }
+    /* the rotation terms go into A's q block (leading dimension n) */
+    double* Ctmp = s->J0 + (size_t)nq * ny + nq;
+    double* Mtmp = s->J1 + (size_t)nq * ny + nq;
+    double* K = malloc((size_t)nq * nq * sizeof(double));
+    double* Cc = malloc((size_t)nq * nq * sizeof(double));
+    double* Mc = malloc((size_t)nq * nq * sizeof(double));
+    if (!K || !Cc || !Mc) {
+      free(K);
+      free(Cc);
+      free(Mc);
+      return -1;
+    }
+    for (int j = 0; j < nq; ++j)
+      for (int i = 0; i < nq; ++i) {
+        Cc[(size_t)j * nq + i] = Ctmp[(size_t)j * ny + i];
+        Mc[(size_t)j * nq + i] = Mtmp[(size_t)j * ny + i];
+        K[(size_t)j * nq + i] = 0.0;
+      }
+    fmb_rotation_terms(m, s->speed, Cc, Mc, nq, K, NULL);
+    for (int j = 0; j < nq; ++j)
+      for (int i = 0; i < nq; ++i) s->A[(size_t)j * n + i] += K[(size_t)j * nq + i];
+    free(K);
+    free(Cc);
+    free(Mc);
+  }
+  return fmb_lu_factor(n, s->A, s->piv) ? -1 : 0;
+}
+
+int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt_in, double* y, double* yp,
+                     fmbStaticResult* res, fmbDiag* diag) {
+  fmbStaticOptions opt = {0.0, 0, 30, 12, 1e-10, 1};
+  if (opt_in) opt = *opt_in;
+  if (!opt.has_t) opt.t = m->solver.t0;
+  if (opt.max_iter <= 0) opt.max_iter = 30;
+  if (opt.max_halvings <= 0) opt.max_halvings = 12;
+  if (!(opt.tol > 0.0)) opt.tol = 1e-10;
+  const int nq = m->nq, nc = m->nc, n = nq + nc, ny = m->ny;
+  memset(res, 0, sizeof *res);
+  res->t = opt.t;
+  Newton s = {m, w, opt.t, 0.0, {0.0, 0.0}, n, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  s.y = calloc((size_t)ny, sizeof(double));
+  s.yp = calloc((size_t)ny, sizeof(double));
+  s.F = calloc((size_t)ny, sizeof(double));
+  s.ewt = calloc((size_t)ny, sizeof(double));
+  s.J0 = calloc((size_t)ny * ny, sizeof(double));
+  s.J1 = calloc((size_t)ny * ny, sizeof(double));
+  s.A = calloc((size_t)n * n, sizeof(double));
+  s.piv = calloc((size_t)n, sizeof(int));
+  double* x = calloc((size_t)n, sizeof(double));
+  double* xt = calloc((size_t)n, sizeof(double));
+  double* F0 = calloc((size_t)n, sizeof(double));
+  double* G = calloc((size_t)n, sizeof(double));
+  double* v0 = calloc((size_t)nq, sizeof(double));
+  int rc = 0;
+  if (!s.y || !s.yp || !s.F || !s.ewt || !s.J0 || !s.J1 || !s.A || !s.piv || !x || !xt || !F0 || !G || !v0) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory for the static solution (%d unknowns)", n);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    bi->type->initial(bi->self, x + bi->qadr, v0 + bi->qadr);
+  }
+  if ((rc = fit_rotation(m, w, opt.t, x, &s.speed, s.center, diag))) goto done;
+  res->speed = s.speed;
+  res->center[0] = s.center[0];
+  res->center[1] = s.center[1];
+  if (eval_F(&s, x, F0)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the starting point (t = %g)", opt.t);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  res->residual_start = norm2(F0, n);
+  double done_s = 0.0, ds = 1.0;
+  int halvings = 0;
+  while (done_s < 1.0) {
+    const double st = ds >= 1.0 - done_s ? 1.0 : done_s + ds;
+    memcpy(xt, x, (size_t)n * sizeof(double));
+    int converged = 0, it;
+    for (it = 0; it < opt.max_iter; ++it) {
+      if (eval_F(&s, xt, G)) break;
+      for (int i = 0; i < n; ++i) G[i] -= (1.0 - st) * F0[i]; /* (S2) */
+      if (factor_jacobian(&s, xt)) break;
+      fmb_lu_solve(n, s.A, s.piv, G);
+      int finite = 1, small = 1;
+      for (int i = 0; i < n; ++i) {
+        if (!isfinite(G[i])) finite = 0;
+        if (i < nq && fabs(G[i]) > opt.tol * (1.0 + fabs(xt[i]))) small = 0;
+        xt[i] -= G[i];
+      }
+      res->iterations++;
+      if (!finite) break;
+      if (small) {
+        converged = 1;
+        break;
+      }
+    }
+    if (converged) {
+      memcpy(x, xt, (size_t)n * sizeof(double));
+      done_s = st;
+      res->load_steps++;
+      if (!opt.quiet && st < 1.0) fprintf(stderr, "static: load %.4g reached in %d Newton iterations\n", st, it + 1);
+      if (ds < 1.0) ds *= 2.0; /* a step that worked: try a longer one */
+    } else {
+      ds *= 0.5;
+      if (++halvings > opt.max_halvings) {
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                     "no equilibrium found: Newton failed even on a load step of %.3g of the load, at %.4g of it "
+                     "(%d iterations in all). The structure may buckle or snap here, or the load is beyond what the "
+                     "model can carry (a beam bent beyond its length)",
+                     2.0 * ds, done_s, res->iterations);
+        rc = FMB_EXIT_SOLVER;
+        goto done;
+      }
+      if (!opt.quiet) fprintf(stderr, "static: Newton failed at load %.4g; halving the load step to %.3g\n", st, ds);
+    }
+  }
+  if (eval_F(&s, x, G)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the solution");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  res->residual = norm2(G, n);
+  make_state(&s, x);
+  memcpy(y, s.y, (size_t)ny * sizeof(double));
+  memcpy(yp, s.yp, (size_t)ny * sizeof(double));
+done:
+  free(s.y);
+  free(s.yp);
+  free(s.F);
+  free(s.ewt);
+  free(s.J0);
+  free(s.J1);
+  free(s.A);
+  free(s.piv);
+  free(x);
+  free(xt);
+  free(F0);
+  free(G);
+  free(v0);
+  return rc;
+}
+
+int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
+               fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (!m || !y || !yp || !res) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_static: NULL model, state or result");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmbWorkspace* w = fmb_workspace_new(m);
+  if (!w) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    return FMB_EXIT_SOLVER;
+  }
+  int rc = fmb_static_solve(m, w, opt, y, yp, res, diag);
+  fmb_workspace_free(w);
+  return rc;
+}

@@ -1,0 +1,215 @@
+/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K]
+ *                    [--at T] [-o campbell.csv] [--plot campbell.png] [--set PATH=VALUE]...`
+ * For each hub speed (PATH: the scene key that sets it, e.g. joints.spin.speed): the steady state,
+ * then its modes. CSV columns: speed, mode1 ... modeK (rad/s; negative = divergent), the modes
+ * followed from speed to speed by shape (greatest modal assurance criterion, MAC), not by order.
+ * With -o FILE.csv a PNG is drawn beside it (FILE.png, or --plot) with gnuplot. On a failure the
+ * speeds done so far are written and the exit code is run's (2 bad input, 3 solver). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "cli.h"
+
+#define MAX_SPEEDS 10000
+#define MAX_TRACKED 64
+#define EXTRA_MODES 6 /* computed beyond K so that a mode crossing from above can be followed */
+
+
+/* "A:B:N" (N values from A to B) or "S1,S2,..."; returns the count or -1 */
+static int parse_speeds(const char* text, double* out) {
+  double a, b;
+  int n;
+  char tail;
+  if (sscanf(text, "%lf:%lf:%d%c", &a, &b, &n, &tail) == 3) {
+    if (n < 1 || n > MAX_SPEEDS) return -1;
+    for (int i = 0; i < n; ++i) out[i] = n == 1 ? a : a + (b - a) * i / (n - 1);
+    return n;
+  }
+  n = 0;
+  const char* p = text;
+  while (*p && n < MAX_SPEEDS) {
+    char* end;
+    out[n++] = strtod(p, &end);
+    if (end == p || (*end != ',' && *end != '\0')) return -1;
+    p = *end ? end + 1 : end;
+  }
+  return *p ? -1 : n;
+}
+
+/* gnuplot: one curve per tracked mode; a failure here is a warning, the CSV stands */
+static void plot(const char* csv, const char* png, int count, const char* title) {
+  FILE* g = popen("gnuplot 2>/dev/null", "w");
+  if (!g) {
+    fprintf(stderr, "flexmbd campbell: gnuplot not available, no plot\n");
+    return;
+  }
+  fprintf(g, "set terminal pngcairo size 900,650 noenhanced\nset output '%s'\nset datafile separator ','\n"
+             "set key outside right\nset grid\nset xlabel 'hub speed (rad/s)'\nset ylabel 'frequency (rad/s)'\n"
+             "set title '%s'\nplot ",
+          png, title);
+  for (int k = 0; k < count; ++k)
+    fprintf(g, "%s'%s' using 1:%d with linespoints pt 7 ps 0.5 title 'mode %d'", k ? ", " : "", csv, k + 2, k + 1);
+  fprintf(g, ", x with lines dt 2 lc rgb 'gray' title '1x speed'\n");
+  if (pclose(g) != 0) fprintf(stderr, "flexmbd campbell: gnuplot failed, no plot (%s)\n", png);
+}
+
+int fmb_cmd_campbell(int argc, char** argv) {
+  fmbCliScene s;
+  memset(&s, 0, sizeof s);
+  const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
+  int count = 4;
+  fmbStaticOptions opt;
+  memset(&opt, 0, sizeof opt);
+  opt.quiet = 1;
+  for (int i = 2; i < argc; ++i) {
+    const char* a = argv[i];
+    int r = fmb_cli_take_scene_arg("campbell", argc, argv, &i, &s);
+    if (r == 1) continue;
+    if (r) return r;
+    if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+      if (!(out = fmb_cli_value("campbell", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--plot") == 0) {
+      if (!(png = fmb_cli_value("campbell", argc, argv, &i, "a PNG file name"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--speed") == 0) {
+      if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--speeds") == 0) {
+      if (!(speeds_text = fmb_cli_value("campbell", argc, argv, &i, "A:B:N or S1,S2,..."))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--at") == 0) {
+      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a time");
+      if (!v || fmb_cli_parse_time("campbell", v, &opt.t)) return FMB_EXIT_BAD_INPUT;
+      opt.has_t = 1;
+    } else if (strcmp(a, "--count") == 0) {
+      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of modes");
+      char* end;
+      if (!v) return FMB_EXIT_BAD_INPUT;
+      count = (int)strtol(v, &end, 10);
+      if (*end || count < 1 || count > MAX_TRACKED) {
+        fprintf(stderr, "flexmbd campbell: --count needs an integer from 1 to %d, got '%s'\n", MAX_TRACKED, v);
+        return FMB_EXIT_BAD_INPUT;
+      }
+    } else {
+      fprintf(stderr, "flexmbd campbell: unknown option '%s'\n", a);
+      return FMB_EXIT_BAD_INPUT;
+    }
+  }
+  if (!s.scene || !path || !speeds_text) {
+    fprintf(stderr, "flexmbd campbell: needs SCENE, --speed PATH (e.g. joints.spin.speed) and --speeds A:B:N|S1,S2,...\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (s.nover >= FMB_CLI_MAX_OVERRIDES) {
+    fprintf(stderr, "flexmbd campbell: too many --set overrides\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  double* speeds = malloc(MAX_SPEEDS * sizeof(double));
+  const int nspeed = speeds ? parse_speeds(speeds_text, speeds) : -1;
+  if (nspeed < 1) {
+    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,..., got '%s'\n",
+            MAX_SPEEDS, speeds_text);
+    free(speeds);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  const int ncol = count + 1;
+  double* rows = calloc((size_t)nspeed * ncol, sizeof(double));
+  char** names = calloc((size_t)ncol, sizeof(char*));
+  char override[600];
+  int rc = rows && names ? 0 : FMB_EXIT_SOLVER, done = 0;
+  fmbDiag diag;
+  memset(&diag, 0, sizeof diag);
+  fmbModes* prev = NULL;
+  int track[MAX_TRACKED]; /* tracked mode k is mode track[k] of prev */
+  for (int i = 0; rc == 0 && i < nspeed; ++i) {
+    snprintf(override, sizeof override, "%s=%.17g", path, speeds[i]);
+    s.overrides[s.nover] = override;
+    fmbModel* m = fmb_load(s.scene, s.overrides, s.nover + 1, fmb_cli_registry(), &diag);
+    if (!m) {
+      rc = diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
+      break;
+    }
+    const int ny = fmb_state_size(m);
+    double* y = calloc((size_t)ny, sizeof(double));
+    double* yp = calloc((size_t)ny, sizeof(double));
+    fmbStaticResult res;
+    fmbModes* cur = NULL;
+    rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
+    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, &cur, &diag);
+    if (!rc && cur->count < count) {
+      fprintf(stderr, "flexmbd campbell: the scene has only %d modes; --count %d asks for more\n", cur->count, count);
+      rc = FMB_EXIT_BAD_INPUT;
+    }
+    if (!rc) {
+      /* follow the modes: greedy assignment by the largest MAC with the previous speed's shapes */
+      int next[MAX_TRACKED];
+      if (!prev) {
+        for (int k = 0; k < count; ++k) next[k] = k;
+      } else {
+        unsigned char taken_k[MAX_TRACKED] = {0}, taken_j[MAX_TRACKED + EXTRA_MODES] = {0};
+        for (int n = 0; n < count; ++n) {
+          double best = -1.0;
+          int bk = 0, bj = 0;
+          for (int k = 0; k < count; ++k)
+            for (int j = 0; j < cur->count && !taken_k[k]; ++j) {
+              if (taken_j[j]) continue;
+              const double mac = fmb_modes_mac(prev, track[k], cur, j);
+              if (mac > best) {
+                best = mac;
+                bk = k;
+                bj = j;
+              }
+            }
+          taken_k[bk] = taken_j[bj] = 1;
+          next[bk] = bj;
+          if (best < 0.5)
+            fprintf(stderr, "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
+                            "take finer speed steps\n", speeds[i], bk + 1, best);
+        }
+      }
+      rows[(size_t)i * ncol] = speeds[i];
+      for (int k = 0; k < count; ++k) {
+        track[k] = next[k];
+        rows[(size_t)i * ncol + 1 + k] = cur->frequency[next[k]];
+      }
+      fmb_modes_free(prev);
+      prev = cur;
+      cur = NULL;
+      done = i + 1;
+    }
+    fmb_modes_free(cur);
+    free(y);
+    free(yp);
+    fmb_free(m);
+  }
+  fmb_modes_free(prev);
+  if (rc) fmb_cli_print_diag(&diag);
+  int wrc = 0;
+  if (names) {
+    names[0] = "speed";
+    for (int k = 0; k < count; ++k) {
+      names[k + 1] = malloc(16);
+      if (names[k + 1]) snprintf(names[k + 1], 16, "mode%d", k + 1);
+    }
+    fmbDiag wd;
+    memset(&wd, 0, sizeof wd);
+    wrc = fmb_write_table(out, ncol, (const char* const*)names, done, rows, &wd);
+    if (wrc) fmb_cli_print_diag(&wd);
+    for (int k = 0; k < count; ++k) free(names[k + 1]);
+  }
+  char pngbuf[1024];
+  if (!png && out && strcmp(out, "-") != 0) {
+    const size_t len = strlen(out);
+    const int has_csv = len > 4 && strcmp(out + len - 4, ".csv") == 0;
+    snprintf(pngbuf, sizeof pngbuf, "%.*s.png", (int)(has_csv ? len - 4 : len), out);
+    png = pngbuf;
+  }
+  if (!wrc && done > 0 && png && out && strcmp(out, "-") != 0) {
+    char title[700];
+    snprintf(title, sizeof title, "Campbell diagram: %s", s.scene);
+    plot(out, png, count, title);
+  }
+  fprintf(stderr, "stats: status=%s speeds=%d of %d modes=%d\n", rc ? "failed" : "ok", done, nspeed, count);
+  free(names);
+  free(rows);
+  free(speeds);
+  return rc ? rc : wrc;
+}

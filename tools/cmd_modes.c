@@ -1,0 +1,110 @@
+/* cmd_modes.c — `flexmbd modes SCENE [--at T | --static] [--count K] [-o modes.csv]
+ *                 [--shapes shapes.csv] [--set PATH=VALUE]... [--quiet]`
+ * Frequencies, damping ratios and shapes of small motions about the static or steady state
+ * (drives held at t0, or at T with --at). The CSV has one row per mode: mode, frequency (rad/s),
+ * frequency_hz, damping_ratio; without -o it goes to stdout. A table goes to stderr, then
+ * the static solution's stats line. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "cli.h"
+
+int fmb_cli_modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
+  static const char* const names[] = {"mode", "frequency", "frequency_hz", "damping_ratio"};
+  double* rows = malloc((size_t)md->count * 4 * sizeof(double) + 1);
+  if (!rows) return FMB_EXIT_SOLVER;
+  for (int k = 0; k < md->count; ++k) {
+    rows[4 * k] = k + 1;
+    rows[4 * k + 1] = md->frequency[k];
+    rows[4 * k + 2] = md->frequency[k] / (2.0 * M_PI);
+    rows[4 * k + 3] = md->damping_ratio[k];
+  }
+  int rc = fmb_write_table(path, 4, names, md->count, rows, diag);
+  free(rows);
+  return rc;
+}
+
+int fmb_cmd_modes(int argc, char** argv) {
+  fmbCliScene s;
+  memset(&s, 0, sizeof s);
+  const char *out = NULL, *shapes = NULL;
+  int count = 10, quiet = 0, at_given = 0, static_given = 0;
+  fmbStaticOptions opt;
+  memset(&opt, 0, sizeof opt);
+  opt.quiet = 1;
+  for (int i = 2; i < argc; ++i) {
+    const char* a = argv[i];
+    int r = fmb_cli_take_scene_arg("modes", argc, argv, &i, &s);
+    if (r == 1) continue;
+    if (r) return r;
+    if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+      if (!(out = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--shapes") == 0) {
+      if (!(shapes = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--at") == 0) {
+      const char* v = fmb_cli_value("modes", argc, argv, &i, "a time");
+      if (!v || fmb_cli_parse_time("modes", v, &opt.t)) return FMB_EXIT_BAD_INPUT;
+      opt.has_t = at_given = 1;
+    } else if (strcmp(a, "--static") == 0) {
+      static_given = 1;
+    } else if (strcmp(a, "--count") == 0) {
+      const char* v = fmb_cli_value("modes", argc, argv, &i, "a number of modes");
+      char* end;
+      if (!v) return FMB_EXIT_BAD_INPUT;
+      count = (int)strtol(v, &end, 10);
+      if (*end || count < 1) {
+        fprintf(stderr, "flexmbd modes: --count needs a positive integer, got '%s'\n", v);
+        return FMB_EXIT_BAD_INPUT;
+      }
+    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+      quiet = 1;
+    } else {
+      fprintf(stderr, "flexmbd modes: unknown option '%s'\n", a);
+      return FMB_EXIT_BAD_INPUT;
+    }
+  }
+  if (!s.scene) {
+    fprintf(stderr, "flexmbd modes: no scene file given\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (at_given && static_given) {
+    fprintf(stderr, "flexmbd modes: --at T and --static are alternatives (--static: the state at the scene's t0)\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmbDiag diag;
+  fmbStaticResult res;
+  memset(&res, 0, sizeof res);
+  const clock_t c0 = clock();
+  fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
+  if (!m) {
+    fmb_cli_print_diag(&diag);
+    return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
+  }
+  const int ny = fmb_state_size(m);
+  double* y = calloc((size_t)ny, sizeof(double));
+  double* yp = calloc((size_t)ny, sizeof(double));
+  fmbModes* md = NULL;
+  int rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
+  if (!rc) rc = fmb_modes(m, res.t, y, yp, count, &md, &diag);
+  if (!rc) rc = fmb_cli_modes_csv(md, out, &diag);
+  if (!rc && shapes) rc = fmb_write_mode_shapes(m, res.t, y, yp, md, shapes, &diag);
+  if (rc) fmb_cli_print_diag(&diag);
+  if (md && !quiet) {
+    fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints):\n",
+            res.speed != 0.0 ? "steady rotation" : "static equilibrium", res.t, md->nreduced);
+    if (res.speed != 0.0) fprintf(stderr, "  speed %.8g rad/s about (%g, %g)\n", res.speed, res.center[0], res.center[1]);
+    fprintf(stderr, "  %4s %16s %14s %14s\n", "mode", "frequency rad/s", "Hz", "damping ratio");
+    for (int k = 0; k < md->count; ++k)
+      fprintf(stderr, "  %4d %16.8g %14.8g %14.6g%s\n", k + 1, md->frequency[k], md->frequency[k] / (2.0 * M_PI),
+              md->damping_ratio[k], md->frequency[k] < 0 ? "   divergent (unstable)" : "");
+  }
+  fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);
+  fmb_modes_free(md);
+  free(y);
+  free(yp);
+  fmb_free(m);
+  return rc;
+}
