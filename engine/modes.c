@@ -40,8 +40,8 @@ extern void dgemm_(const char* ta, const char* tb, const int* m, const int* n, c
 
 typedef struct {
   double freq, zeta;
-  int col;     /* eigenvector column (dsygv: real; dgeev: re at col, im at col + 1 or none) */
-  int complex_;
+  int col;      /* eigenvector column (dsygv: real; dgeev: re at col, im at col + 1 or none) */
+  int complex_; /* 0 real vector, 1 complex, -1 complex conjugated */
 } Root;
 
 static int cmp_root(const void* a, const void* b) {
@@ -197,11 +197,14 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   double asym = 0.0;
   for (int j = 0; j < nr; ++j)
     for (int i = 0; i < j; ++i) asym = fmax(asym, fabs(Kr[(size_t)j * nr + i] - Kr[(size_t)i * nr + j]));
-  int nroot = 0, symmetric = 0;
-  /* the Ritz basis of the shapes: nr x nvec, eigenvectors in columns */
+  int nroot = 0, symmetric = 0, inverted = 0;
+  /* the Ritz basis of the shapes: eigenvectors in columns of V, nvec rows */
   int nvec = 0;
   if (cn <= 1e-9 * sqrt(kn * mn) && asym <= 1e-6 * kn) {
-    /* symmetric-definite: Kr x = w^2 Mr x, symmetrized against difference noise */
+    /* symmetric-definite, symmetrized against difference noise. Solved inverted when Kr is
+       positive definite, Mr x = (1/w^2) Kr x: the error of a dense eigen-solver is eps times the
+       largest eigenvalue, so the form whose largest eigenvalues are the low modes gives them to
+       full precision (the direct form lost 1e-6 of w1 at 64 elements, where (w_max/w1)^2 ~ 1e10) */
     S = malloc(nn * sizeof(double));
     double* B = malloc(nn * sizeof(double));
     wr = malloc((size_t)nr * sizeof(double));
@@ -209,59 +212,73 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
       free(B);
       goto oom;
     }
-    for (int j = 0; j < nr; ++j)
-      for (int i = 0; i < nr; ++i) {
-        S[(size_t)j * nr + i] = 0.5 * (Kr[(size_t)j * nr + i] + Kr[(size_t)i * nr + j]);
-        B[(size_t)j * nr + i] = 0.5 * (Mr[(size_t)j * nr + i] + Mr[(size_t)i * nr + j]);
+    for (int pass = 0; pass < 2 && !symmetric; ++pass) {
+      const double* A_ = pass == 0 ? Mr : Kr;
+      const double* B_ = pass == 0 ? Kr : Mr;
+      for (int j = 0; j < nr; ++j)
+        for (int i = 0; i < nr; ++i) {
+          S[(size_t)j * nr + i] = 0.5 * (A_[(size_t)j * nr + i] + A_[(size_t)i * nr + j]);
+          B[(size_t)j * nr + i] = 0.5 * (B_[(size_t)j * nr + i] + B_[(size_t)i * nr + j]);
+        }
+      int itype = 1, lwork = -1;
+      double q1 = 0.0;
+      dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, &q1, &lwork, &info);
+      lwork = (int)q1 + 1;
+      free(work);
+      work = malloc((size_t)lwork * sizeof(double));
+      if (!work) {
+        free(B);
+        goto oom;
       }
-    int itype = 1, lwork = -1;
-    double q1 = 0.0;
-    dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, &q1, &lwork, &info);
-    lwork = (int)q1 + 1;
-    work = malloc((size_t)lwork * sizeof(double));
-    if (!work) {
-      free(B);
-      goto oom;
-    }
-    dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, work, &lwork, &info);
-    free(B);
-    if (info == 0) {
+      dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, work, &lwork, &info);
+      if (info) continue; /* B not definite: Kr (unstable, rigid motions) or Mr (FOAC) */
       symmetric = 1;
       V = S;
       S = NULL;
       nvec = nr;
       for (int k = 0; k < nr; ++k) {
-        const double l = wr[k];
+        const double l = pass == 0 ? (wr[k] != 0.0 ? 1.0 / wr[k] : INFINITY) : wr[k]; /* w^2 */
         roots[nroot++] = (Root){l >= 0 ? sqrt(l) : -sqrt(-l), l >= 0 ? 0.0 : -1.0, k, 0};
       }
-    } else {
-      free(S); /* Mr not definite (FOAC): the general form below */
+    }
+    free(B);
+    free(work);
+    work = NULL;
+    if (!symmetric) {
+      free(S);
       S = NULL;
       free(wr);
       wr = NULL;
     }
-    free(work);
-    work = NULL;
   }
   if (!symmetric) {
-    /* (M3): X = Mr^-1 [Kr Cr] */
+    /* (M3), inverted when Kr is regular (as above: the low modes become the largest):
+         B = [-Kr^-1 Cr  -Kr^-1 Mr; I 0],  B [r; r'] = (1/s) [r; r']
+       else direct with X = Mr^-1 [Kr Cr] */
     const int n2 = 2 * nr, nrhs = 2 * nr;
     double* X = malloc((size_t)nr * n2 * sizeof(double));
-    double* Mf = malloc(nn * sizeof(double));
+    double* F = malloc(nn * sizeof(double));
     S = calloc((size_t)n2 * n2, sizeof(double));
     wr = malloc((size_t)n2 * sizeof(double));
     wi = malloc((size_t)n2 * sizeof(double));
     V = malloc((size_t)n2 * n2 * sizeof(double));
-    if (!X || !Mf || !S || !wr || !wi || !V) {
+    if (!X || !F || !S || !wr || !wi || !V) {
       free(X);
-      free(Mf);
+      free(F);
       goto oom;
     }
-    memcpy(Mf, Mr, nn * sizeof(double));
-    memcpy(X, Kr, nn * sizeof(double));
-    memcpy(X + nn, Cr, nn * sizeof(double));
-    dgesv_(&nr, &nrhs, Mf, &nr, ipiv, X, &nr, &info);
-    free(Mf);
+    memcpy(F, Kr, nn * sizeof(double));
+    memcpy(X, Cr, nn * sizeof(double));
+    memcpy(X + nn, Mr, nn * sizeof(double));
+    dgesv_(&nr, &nrhs, F, &nr, ipiv, X, &nr, &info);
+    inverted = info == 0;
+    if (!inverted) {
+      memcpy(F, Mr, nn * sizeof(double));
+      memcpy(X, Kr, nn * sizeof(double));
+      memcpy(X + nn, Cr, nn * sizeof(double));
+      dgesv_(&nr, &nrhs, F, &nr, ipiv, X, &nr, &info);
+    }
+    free(F);
     if (info) {
       free(X);
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
@@ -270,12 +287,22 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
       rc = FMB_EXIT_SOLVER;
       goto done;
     }
-    for (int j = 0; j < nr; ++j) {
-      S[(size_t)(nr + j) * n2 + j] = 1.0;
+    /* inverted: top rows [-X_C  -X_M], bottom [I 0]; direct: top [0 I], bottom [-X_K  -X_C] */
+    for (int j = 0; j < nr; ++j)
       for (int i = 0; i < nr; ++i) {
-        S[(size_t)j * n2 + nr + i] = -X[(size_t)j * nr + i];
-        S[(size_t)(nr + j) * n2 + nr + i] = -X[nn + (size_t)j * nr + i];
+        if (inverted) {
+          S[(size_t)j * n2 + i] = -X[(size_t)j * nr + i];
+          S[(size_t)(nr + j) * n2 + i] = -X[nn + (size_t)j * nr + i];
+        } else {
+          S[(size_t)j * n2 + nr + i] = -X[(size_t)j * nr + i];
+          S[(size_t)(nr + j) * n2 + nr + i] = -X[nn + (size_t)j * nr + i];
+        }
       }
+    for (int j = 0; j < nr; ++j) {
+      if (inverted)
+        S[(size_t)j * n2 + nr + j] = 1.0;
+      else
+        S[(size_t)(nr + j) * n2 + j] = 1.0;
     }
     free(X);
     int lwork = -1, one = 1;
@@ -291,37 +318,59 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
       goto done;
     }
     nvec = n2;
+    /* back to s = 1/mu; the conjugate pair swaps the sign of Im, the stored vector (re at k, im
+       at k + 1) then belongs to Im s < 0: its conjugate is the Im s > 0 root's (sign below) */
+    if (inverted)
+      for (int k = 0; k < n2; ++k) {
+        const double d = wr[k] * wr[k] + wi[k] * wi[k];
+        if (d > 0.0) {
+          wr[k] = wr[k] / d;
+          wi[k] = -wi[k] / d;
+        } else {
+          wr[k] = INFINITY;
+          wi[k] = 0.0;
+        }
+      }
     double smax = 0.0;
-    for (int k = 0; k < n2; ++k) smax = fmax(smax, hypot(wr[k], wi[k]));
+    for (int k = 0; k < n2; ++k)
+      if (isfinite(wr[k])) smax = fmax(smax, hypot(wr[k], wi[k]));
     const double tiny = 1e-8 * smax;
     unsigned char* used = calloc((size_t)n2, 1);
     if (!used) goto oom;
     for (int k = 0; k < n2; ++k) {
+      if (!isfinite(wr[k])) continue;
       const double mag = hypot(wr[k], wi[k]);
-      if (wi[k] > tiny) { /* an oscillating pair: keep the root with Im s > 0 */
+      /* an oscillating pair: keep the root with Im s > 0. Its vector: columns k, k+1 of V as
+         dgeev stores them for the first of the pair (Im > 0 direct, Im < 0 after inversion) */
+      const int first = inverted ? (k + 1 < n2 && wi[k] < -tiny && wi[k + 1] > tiny)
+                                 : (wi[k] > tiny);
+      if (first) {
+        const int kk = inverted ? k + 1 : k;
+        const double mg = hypot(wr[kk], wi[kk]);
         /* |Re s| below 1e-10 |s| is the eigen-solver's rounding on an undamped gyroscopic
            system (measured: 1e-14 .. 1e-11), not damping */
-        const double zeta = fabs(wr[k]) <= 1e-10 * mag ? 0.0 : -wr[k] / mag;
-        roots[nroot++] = (Root){mag, zeta, k, 1};
+        const double zeta = fabs(wr[kk]) <= 1e-10 * mg ? 0.0 : -wr[kk] / mg;
+        roots[nroot++] = (Root){mg, zeta, k, inverted ? -1 : 1};
       } else if (fabs(wi[k]) <= tiny && !used[k]) {
         used[k] = 1;
         /* real: a divergent +a pairs with -a; zero roots come in pairs (one rigid motion) */
         int partner = -1;
         double best = 1e-6 * smax + 10.0 * tiny;
         for (int l = 0; l < n2; ++l)
-          if (!used[l] && fabs(wi[l]) <= tiny && fabs(wr[l] + wr[k]) < best) {
+          if (!used[l] && isfinite(wr[l]) && fabs(wi[l]) <= tiny && fabs(wr[l] + wr[k]) < best) {
             best = fabs(wr[l] + wr[k]);
             partner = l;
           }
         if (partner >= 0) used[partner] = 1;
         const int kk = partner >= 0 && wr[partner] > wr[k] ? partner : k;
-        const double s = wr[kk];
-        if (fabs(s) <= tiny)
+        const double sr = wr[kk];
+        if (fabs(sr) <= tiny)
           roots[nroot++] = (Root){0.0, 0.0, kk, 0};
-        else if (s > 0.0)
-          roots[nroot++] = (Root){-s, -1.0, kk, 0};
+        else if (sr > 0.0)
+          roots[nroot++] = (Root){-sr, -1.0, kk, 0};
         else
-          roots[nroot++] = (Root){-s, 1.0, kk, 0}; /* overdamped: decay rate, damping ratio 1 */
+          roots[nroot++] = (Root){-sr, 1.0, kk, 0}; /* overdamped: decay rate, damping ratio 1 */
+        (void)mag;
       }
     }
     free(used);
@@ -346,13 +395,14 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     /* displacement part of the eigenvector (first nr rows), back to q: N x */
     const double* xr = V + (size_t)r->col * nvec;
     const double* xi = r->complex_ ? V + (size_t)(r->col + 1) * nvec : NULL;
+    const double isign = r->complex_ < 0 ? -1.0 : 1.0; /* the conjugate (inverted form) */
     double* pr = md->shape_re + (size_t)k * nq;
     double* pi = md->shape_im + (size_t)k * nq;
     for (int i = 0; i < nq; ++i) {
       double a = 0.0, b = 0.0;
       for (int j = 0; j < nr; ++j) {
         a += N[(size_t)j * nq + i] * xr[j];
-        if (xi) b += N[(size_t)j * nq + i] * xi[j];
+        if (xi) b += isign * N[(size_t)j * nq + i] * xi[j];
       }
       pr[i] = a;
       pi[i] = b;

@@ -277,6 +277,49 @@ static int factor_jacobian(Newton* s, const double* x) {
   return fmb_lu_factor(n, s->A, s->piv) ? -1 : 0;
 }
 
+/* rad: the largest turn of a frame in one Newton iteration */
+#define MAX_TURN 0.5
+
+/* lambda that balances the forces at the start as well as the constraints can (least squares,
+   lambda = -(Phi_q Phi_q^T)^-1 Phi_q F_v(q, 0)): the stiffness a mechanism gets from its joints'
+   curvature (Phi_qq lambda, a pendulum's restoring moment) is there from the first iteration */
+static int initial_multipliers(Newton* s, double* x, fmbDiag* diag) {
+  const fmbModel* m = s->m;
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  double* Fx = malloc((size_t)(nq + nc) * sizeof(double));
+  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
+  double* G = calloc((size_t)nc * nc, sizeof(double));
+  double* r = calloc((size_t)nc, sizeof(double));
+  int* piv = calloc((size_t)nc, sizeof(int));
+  int rc = 0;
+  if (!Fx || !PhiQ || !G || !r || !piv) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    rc = FMB_EXIT_SOLVER;
+  } else if (!eval_F(s, x, Fx) && !fmb_constraints_all(m, s->w, s->t, x, s->y + nq, NULL, PhiQ, NULL, NULL)) {
+    for (int i = 0; i < nc; ++i) {
+      for (int k = 0; k < nc; ++k) {
+        double a = 0.0;
+        for (int c = 0; c < nq; ++c) a += PhiQ[(size_t)i * nq + c] * PhiQ[(size_t)k * nq + c];
+        G[(size_t)k * nc + i] = a;
+      }
+      double b = 0.0; /* F_v already holds Phi_q^T lambda for the current lambda */
+      for (int c = 0; c < nq; ++c) b += PhiQ[(size_t)i * nq + c] * Fx[c];
+      r[i] = -b;
+    }
+    if (fmb_lu_factor(nc, G, piv) == 0) {
+      fmb_lu_solve(nc, G, piv, r);
+      for (int i = 0; i < nc; ++i) x[nq + i] += r[i];
+    }
+  }
+  free(Fx);
+  free(PhiQ);
+  free(G);
+  free(r);
+  free(piv);
+  return rc;
+}
+
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt_in, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag) {
   fmbStaticOptions opt = {0.0, 0, 30, 12, 1e-10, 1};
@@ -316,6 +359,7 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
   res->speed = s.speed;
   res->center[0] = s.center[0];
   res->center[1] = s.center[1];
+  if ((rc = initial_multipliers(&s, x, diag))) goto done;
   if (eval_F(&s, x, F0)) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the starting point (t = %g)", opt.t);
     rc = FMB_EXIT_SOLVER;
@@ -333,11 +377,18 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
       for (int i = 0; i < n; ++i) G[i] -= (1.0 - st) * F0[i]; /* (S2) */
       if (factor_jacobian(&s, xt)) break;
       fmb_lu_solve(n, s.A, s.piv, G);
-      int finite = 1, small = 1;
+      /* a frame turns at most MAX_TURN per iteration: near a mechanism's dead point (a
+         pendulum at the horizontal has no stiffness in its angle) the full step would spin it
+         through many turns */
+      double turn = 0.0;
+      for (int b = 1; b < m->nbody; ++b)
+        if (has_frame(&m->body[b])) turn = fmax(turn, fabs(G[m->body[b].qadr + 2]));
+      const double scale = turn > MAX_TURN ? MAX_TURN / turn : 1.0;
+      int finite = 1, small = scale == 1.0;
       for (int i = 0; i < n; ++i) {
         if (!isfinite(G[i])) finite = 0;
         if (i < nq && fabs(G[i]) > opt.tol * (1.0 + fabs(xt[i]))) small = 0;
-        xt[i] -= G[i];
+        xt[i] -= scale * G[i];
       }
       res->iterations++;
       if (!finite) break;
