@@ -366,16 +366,22 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
     goto done;
   }
   res->residual_start = norm2(F0, n);
-  double done_s = 0.0, ds = 1.0;
-  int halvings = 0;
+  /* already balanced (a structure at rest without loads, free bodies): nothing to solve, and
+     nothing to factor where nothing holds a body */
+  double done_s = norm2(F0, n) == 0.0 ? 1.0 : 0.0, ds = 1.0;
+  int halvings = 0, singular = 0;
   while (done_s < 1.0) {
     const double st = ds >= 1.0 - done_s ? 1.0 : done_s + ds;
     memcpy(xt, x, (size_t)n * sizeof(double));
     int converged = 0, it;
+    singular = 0;
     for (it = 0; it < opt.max_iter; ++it) {
       if (eval_F(&s, xt, G)) break;
       for (int i = 0; i < n; ++i) G[i] -= (1.0 - st) * F0[i]; /* (S2) */
-      if (factor_jacobian(&s, xt)) break;
+      if (factor_jacobian(&s, xt)) {
+        singular = 1;
+        break;
+      }
       fmb_lu_solve(n, s.A, s.piv, G);
       /* a frame turns at most MAX_TURN per iteration: near a mechanism's dead point (a
          pendulum at the horizontal has no stiffness in its angle) the full step would spin it
@@ -405,7 +411,16 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
       if (ds < 1.0) ds *= 2.0; /* a step that worked: try a longer one */
     } else {
       ds *= 0.5;
-      if (++halvings > opt.max_halvings) {
+      if (++halvings > opt.max_halvings && singular) {
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                     "no equilibrium found: the equilibrium equations are singular (%d Newton iterations): some motion "
+                     "is held by nothing (a body without supports under a load, a mechanism at a dead point, a pendulum "
+                     "started exactly horizontal). Support the body, or start it away from the dead point",
+                     res->iterations);
+        rc = FMB_EXIT_SOLVER;
+        goto done;
+      }
+      if (halvings > opt.max_halvings) {
         fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                      "no equilibrium found: Newton failed even on a load step of %.3g of the load, at %.4g of it "
                      "(%d iterations in all). The structure may buckle or snap here, or the load is beyond what the "
