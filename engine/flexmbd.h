@@ -406,6 +406,7 @@ typedef struct fmbModes {
   int count;              /* modes held, sorted by |frequency| */
   int nq;                 /* length of a shape */
   int nreduced;           /* degrees of freedom after the constraints were eliminated */
+  int sparse;             /* 1 when the sparse (Arnoldi) path computed them */
   double speed;           /* the rigid rotation the state has (rad/s) */
   double* frequency;      /* rad/s, |s| of the eigenvalue s; negative -|s| for a divergent mode
                              (real s > 0, e.g. ZOAC spun above its first bending frequency) */
@@ -414,12 +415,16 @@ typedef struct fmbModes {
   double* shape_im;       /* scaled so the largest component is 1 (real) */
 } fmbModes;
 
+/* eigen-solvers: dense LAPACK on the constraint-reduced problem (all modes), or shift-invert
+   Arnoldi (ARPACK) with KLU on the saddle-point system (a few modes of a large system; falls
+   back to dense when the system has rigid motions); auto picks sparse from 48 coordinates */
+enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
 /* Linearize the DAE about the state (y, yp) at time t (from fmb_static: the rotating-frame
-   terms of a steady rotation are included), eliminate the constraints by a null-space basis and
-   solve the eigenproblem with LAPACK (dense). Returns 0 with *out (free with fmb_modes_free)
-   holding at most `count` modes (count <= 0: all), or an exit code with *diag. */
-FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, fmbModes** out,
-              fmbDiag* diag);
+   terms of a steady rotation are included), eliminate the constraints and solve the
+   eigenproblem (`method`). Returns 0 with *out (the caller frees it with fmb_modes_free)
+   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag. */
+FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
+              fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
 /* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1] */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);

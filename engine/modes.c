@@ -23,6 +23,13 @@
 
 #include "internal.h"
 
+#include <arpack/arpack.h>
+#include <klu.h>
+
+/* coordinates from which `auto` takes the sparse path for a few modes: bench/modes.sh measured
+   the crossover between 8 and 16 beam elements (27 and 51 coordinates) for 4 modes */
+#define FMB_SPARSE_MIN_COORDS 48
+
 /* LAPACK / BLAS (Debian's liblapack-dev, libblas-dev), Fortran calling convention */
 extern void dgesvd_(const char* jobu, const char* jobvt, const int* m, const int* n, double* a, const int* lda,
                     double* s, double* u, const int* ldu, double* vt, const int* ldvt, double* work,
@@ -89,6 +96,214 @@ static double state_speed(const fmbModel* m, const double* q, const double* v) {
   return d <= 1e-9 * s ? speed : 0.0;
 }
 
+/* the modes among eigenvalues s = wr + i wi of the first-order form (inverted: dgeev/ARPACK
+   computed 1/s, already mapped back; a pair's vector is stored for the conjugate root): one
+   root per oscillating pair (Im s > 0), per divergent +-a pair (frequency -a), per rigid motion
+   (two zero roots), per overdamped decay. Returns their number, -1 out of memory. */
+static int classify(const double* wr, const double* wi, int n2, int inverted, Root* roots) {
+  double smax = 0.0;
+  for (int k = 0; k < n2; ++k)
+    if (isfinite(wr[k])) smax = fmax(smax, hypot(wr[k], wi[k]));
+  const double tiny = 1e-8 * smax;
+  unsigned char* used = calloc((size_t)n2, 1);
+  if (!used) return -1;
+  int nroot = 0;
+  for (int k = 0; k < n2; ++k) {
+    if (!isfinite(wr[k])) continue;
+    /* an oscillating pair: keep the root with Im s > 0. Its vector: columns k, k+1 of V as
+       dgeev stores them for the first of the pair (Im > 0 direct, Im < 0 after inversion) */
+    const int first = inverted ? (k + 1 < n2 && wi[k] < -tiny && wi[k + 1] > tiny)
+                               : (wi[k] > tiny);
+    if (first) {
+      const int kk = inverted ? k + 1 : k;
+      const double mg = hypot(wr[kk], wi[kk]);
+      /* |Re s| below 1e-10 |s| is the eigen-solver's rounding on an undamped gyroscopic
+         system (measured: 1e-14 .. 1e-11), not damping */
+      const double zeta = fabs(wr[kk]) <= 1e-10 * mg ? 0.0 : -wr[kk] / mg;
+      roots[nroot++] = (Root){mg, zeta, k, inverted ? -1 : 1};
+    } else if (fabs(wi[k]) <= tiny && !used[k]) {
+      used[k] = 1;
+      /* real: a divergent +a pairs with -a; zero roots come in pairs (one rigid motion) */
+      int partner = -1;
+      double best = 1e-6 * smax + 10.0 * tiny;
+      for (int l = 0; l < n2; ++l)
+        if (!used[l] && isfinite(wr[l]) && fabs(wi[l]) <= tiny && fabs(wr[l] + wr[k]) < best) {
+          best = fabs(wr[l] + wr[k]);
+          partner = l;
+        }
+      if (partner >= 0) used[partner] = 1;
+      const int kk = partner >= 0 && wr[partner] > wr[k] ? partner : k;
+      const double sr = wr[kk];
+      if (fabs(sr) <= tiny)
+        roots[nroot++] = (Root){0.0, 0.0, kk, 0};
+      else if (sr > 0.0)
+        roots[nroot++] = (Root){-sr, -1.0, kk, 0};
+      else
+        roots[nroot++] = (Root){-sr, 1.0, kk, 0}; /* overdamped: decay rate, damping ratio 1 */
+    }
+  }
+  free(used);
+  return nroot;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * The sparse path: shift-invert (shift 0) Arnoldi on the first-order form without eliminating
+ * the constraints. The operator is the inverse of (M3) in saddle-point form,
+ *     [a; b] -> [a'; a],   [K  Phi_q^T; Phi_q  0] [a'; lambda] = [-(C a + M b); 0]           (M4)
+ * whose largest eigenvalues mu = 1/s are the slowest modes; the constraint directions give mu = 0.
+ * One KLU factorization of the saddle-point matrix, then one solve per Arnoldi step (ARPACK
+ * dnaupd/dneupd, Debian's libarpack2-dev). */
+
+typedef struct {
+  int n, nnz;
+  int *p, *i;
+  double* x;
+} Csc;
+
+static void csc_free(Csc* a) {
+  free(a->p);
+  free(a->i);
+  free(a->x);
+}
+
+/* the nonzeros of column-major blocks: rows [0, nr) of `top` (ld ldt) for columns [0, nt), the
+   saddle-point coupling `P` (nc x nt from the Jacobian J0's rows) below them, and P^T as
+   columns [nt, nt + nc); P = NULL gives a plain nt x nt matrix */
+static int csc_build(Csc* a, int nt, const double* top, int ldt, int nc, const double* J0, int ny, int prow) {
+  const int n = nt + nc;
+  long nnz = 0;
+  for (int j = 0; j < nt; ++j) {
+    for (int i = 0; i < nt; ++i) nnz += top[(size_t)j * ldt + i] != 0.0;
+    for (int r = 0; r < nc; ++r) nnz += 2 * (J0[(size_t)j * ny + prow + r] != 0.0);
+  }
+  a->n = n;
+  a->p = malloc((size_t)(n + 1) * sizeof(int));
+  a->i = malloc((size_t)(nnz + 1) * sizeof(int));
+  a->x = malloc((size_t)(nnz + 1) * sizeof(double));
+  if (!a->p || !a->i || !a->x) return -1;
+  int k = 0;
+  for (int j = 0; j < nt; ++j) {
+    a->p[j] = k;
+    for (int i = 0; i < nt; ++i)
+      if (top[(size_t)j * ldt + i] != 0.0) {
+        a->i[k] = i;
+        a->x[k++] = top[(size_t)j * ldt + i];
+      }
+    for (int r = 0; r < nc; ++r)
+      if (J0[(size_t)j * ny + prow + r] != 0.0) {
+        a->i[k] = nt + r;
+        a->x[k++] = J0[(size_t)j * ny + prow + r];
+      }
+  }
+  for (int r = 0; r < nc; ++r) {
+    a->p[nt + r] = k;
+    for (int j = 0; j < nt; ++j)
+      if (J0[(size_t)j * ny + prow + r] != 0.0) {
+        a->i[k] = j;
+        a->x[k++] = J0[(size_t)j * ny + prow + r];
+      }
+  }
+  a->p[n] = k;
+  a->nnz = k;
+  return 0;
+}
+
+/* y += A x (A square CSC) */
+static void csc_matvec_add(const Csc* a, const double* x, double* y) {
+  for (int j = 0; j < a->n; ++j) {
+    const double xj = x[j];
+    if (xj == 0.0) continue;
+    for (int k = a->p[j]; k < a->p[j + 1]; ++k) y[a->i[k]] += a->x[k] * xj;
+  }
+}
+
+/* 0 with the converged Ritz values mapped to s = 1/mu (*wr_out, *wi_out, *nconv) and vectors
+   (*V_out, 2 nq rows); 1 when the path does not apply (a singular saddle-point matrix: rigid
+   motions; no convergence); -1 out of memory */
+static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* K, const double* Cg, const double* M,
+                        int count, double** wr_out, double** wi_out, double** V_out, int* nconv) {
+  const int n2 = 2 * nq, ns = nq + nc;
+  int nev = 2 * count + 1; /* two Ritz values per oscillating mode, one more to keep pairs whole */
+  if (nev > n2 - 3) nev = n2 - 3;
+  int ncv = 2 * nev + 20;
+  if (ncv > n2) ncv = n2;
+  const int lworkl = 3 * ncv * ncv + 6 * ncv;
+  Csc S = {0, 0, NULL, NULL, NULL}, Cs = S, Ms = S;
+  klu_common common;
+  klu_symbolic* sym = NULL;
+  klu_numeric* num = NULL;
+  double *resid = calloc((size_t)n2, sizeof(double)), *V = calloc((size_t)n2 * ncv, sizeof(double));
+  double *workd = calloc((size_t)3 * n2, sizeof(double)), *workl = calloc((size_t)lworkl, sizeof(double));
+  double *rhs = calloc((size_t)ns, sizeof(double)), *dr = calloc((size_t)nev + 1, sizeof(double));
+  double *di = calloc((size_t)nev + 1, sizeof(double)), *Z = calloc((size_t)n2 * (nev + 1), sizeof(double));
+  double* workev = calloc((size_t)3 * ncv, sizeof(double));
+  int* select = calloc((size_t)ncv, sizeof(int));
+  int rc = -1;
+  if (!resid || !V || !workd || !workl || !rhs || !dr || !di || !Z || !workev || !select) goto done;
+  if (csc_build(&S, nq, K, nq, nc, J0, ny, 2 * nq) || csc_build(&Cs, nq, Cg, nq, 0, J0, ny, 0) ||
+      csc_build(&Ms, nq, M, nq, 0, J0, ny, 0))
+    goto done;
+  rc = 1;
+  klu_defaults(&common);
+  sym = klu_analyze(ns, S.p, S.i, &common);
+  num = sym ? klu_factor(S.p, S.i, S.x, sym, &common) : NULL;
+  if (!num || common.status != KLU_OK) goto done;
+  int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
+  iparam[0] = 1;    /* exact shifts */
+  iparam[2] = 3000; /* restarts */
+  iparam[6] = 1;    /* regular mode on the operator (M4) */
+  do {
+    dnaupd_c(&ido, "I", n2, "LM", nev, 0.0, resid, ncv, V, n2, iparam, ipntr, workd, workl, lworkl, &info);
+    if (ido != 1 && ido != -1) break;
+    const double* x = workd + ipntr[0] - 1;
+    double* yv = workd + ipntr[1] - 1;
+    memset(rhs, 0, (size_t)ns * sizeof(double));
+    csc_matvec_add(&Cs, x, rhs);
+    csc_matvec_add(&Ms, x + nq, rhs);
+    for (int i = 0; i < nq; ++i) rhs[i] = -rhs[i];
+    klu_solve(sym, num, ns, 1, rhs, &common);
+    memcpy(yv, rhs, (size_t)nq * sizeof(double));
+    memcpy(yv + nq, x, (size_t)nq * sizeof(double));
+  } while (1);
+  if (info < 0 || iparam[4] < 1) goto done;
+  dneupd_c(1, "A", select, dr, di, Z, n2, 0.0, 0.0, workev, "I", n2, "LM", nev, 0.0, resid, ncv, V, n2, iparam, ipntr,
+           workd, workl, lworkl, &info);
+  if (info != 0 || iparam[4] < 1) goto done;
+  *nconv = iparam[4] < nev + 1 ? iparam[4] : nev + 1;
+  for (int k = 0; k < *nconv; ++k) { /* s = 1/mu */
+    const double d = dr[k] * dr[k] + di[k] * di[k];
+    if (d > 0.0) {
+      dr[k] /= d;
+      di[k] = -di[k] / d;
+    } else {
+      dr[k] = INFINITY;
+      di[k] = 0.0;
+    }
+  }
+  *wr_out = dr;
+  *wi_out = di;
+  *V_out = Z;
+  dr = di = Z = NULL;
+  rc = 0;
+done:
+  if (num) klu_free_numeric(&num, &common);
+  if (sym) klu_free_symbolic(&sym, &common);
+  csc_free(&S);
+  csc_free(&Cs);
+  csc_free(&Ms);
+  free(resid);
+  free(V);
+  free(workd);
+  free(workl);
+  free(rhs);
+  free(dr);
+  free(di);
+  free(Z);
+  free(workev);
+  free(select);
+  return rc;
+}
+
 void fmb_modes_free(fmbModes* md) {
   if (!md) return;
   free(md->frequency);
@@ -98,8 +313,8 @@ void fmb_modes_free(fmbModes* md) {
   free(md);
 }
 
-int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, fmbModes** out,
-              fmbDiag* diag) {
+int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
+              fmbModes** out, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag);
@@ -110,7 +325,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   *out = NULL;
   const int nq = m->nq, nc = m->nc, ny = m->ny;
   const double speed = state_speed(m, y, y + nq);
-  int rc = 0, info = 0;
+  int rc = 0, info = 0, rank = 0, nr = nq, nvec = 0, nroot = 0, symmetric = 0, inverted = 0, sparse_used = 0;
   fmbWorkspace* w = fmb_workspace_new(m);
   double* J0 = calloc((size_t)ny * ny, sizeof(double));
   double* J1 = calloc((size_t)ny * ny, sizeof(double));
@@ -143,9 +358,26 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
       Cg[k] = C[k];
     }
   fmb_rotation_terms(m, speed, C, M, nq, K, Cg); /* (M1) */
+  /* a few modes of a large system: shift-invert Arnoldi (bench/modes.sh: the crossover) */
+  const int use_sparse = count > 0 && 4 * count < nq &&
+                         (method == FMB_EIGEN_SPARSE || (method == FMB_EIGEN_AUTO && nq >= FMB_SPARSE_MIN_COORDS));
 
   /* null space of Phi_q (nc x nq): the right singular vectors beyond its rank */
-  int rank = 0;
+  if (use_sparse) {
+    const int sp = sparse_modes(nq, nc, ny, J0, K, Cg, M, count, &wr, &wi, &V, &nvec);
+    if (sp < 0) goto oom;
+    if (sp == 0) {
+      roots = calloc((size_t)nvec + 1, sizeof(Root));
+      if (!roots) goto oom;
+      /* nvec: converged Ritz values; the vectors' rows are [dq; dq'] over all coordinates */
+      if ((nroot = classify(wr, wi, nvec, 1, roots)) < 0) goto oom;
+      nr = nq - nc;
+      nvec = 2 * nq;
+      sparse_used = 1;
+      goto have_roots;
+    }
+    /* singular (rigid motions) or no convergence: the dense path below */
+  }
   if (nc > 0) {
     double* P = calloc((size_t)nc * nq, sizeof(double));
     if (!P) goto oom;
@@ -172,7 +404,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     for (int i = 0; i < (nc < nq ? nc : nq); ++i)
       if (sv[i] > 1e-10 * sv[0]) rank++;
   }
-  const int nr = nq - rank;
+  nr = nq - rank;
   if (nr == 0) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints leave no motion: there are no modes");
     rc = FMB_EXIT_BAD_INPUT;
@@ -197,9 +429,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   double asym = 0.0;
   for (int j = 0; j < nr; ++j)
     for (int i = 0; i < j; ++i) asym = fmax(asym, fabs(Kr[(size_t)j * nr + i] - Kr[(size_t)i * nr + j]));
-  int nroot = 0, symmetric = 0, inverted = 0;
   /* the Ritz basis of the shapes: eigenvectors in columns of V, nvec rows */
-  int nvec = 0;
   if (cn <= 1e-9 * sqrt(kn * mn) && asym <= 1e-6 * kn) {
     /* symmetric-definite, symmetrized against difference noise. Solved inverted when Kr is
        positive definite, Mr x = (1/w^2) Kr x: the error of a dense eigen-solver is eps times the
@@ -331,50 +561,9 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
           wi[k] = 0.0;
         }
       }
-    double smax = 0.0;
-    for (int k = 0; k < n2; ++k)
-      if (isfinite(wr[k])) smax = fmax(smax, hypot(wr[k], wi[k]));
-    const double tiny = 1e-8 * smax;
-    unsigned char* used = calloc((size_t)n2, 1);
-    if (!used) goto oom;
-    for (int k = 0; k < n2; ++k) {
-      if (!isfinite(wr[k])) continue;
-      const double mag = hypot(wr[k], wi[k]);
-      /* an oscillating pair: keep the root with Im s > 0. Its vector: columns k, k+1 of V as
-         dgeev stores them for the first of the pair (Im > 0 direct, Im < 0 after inversion) */
-      const int first = inverted ? (k + 1 < n2 && wi[k] < -tiny && wi[k + 1] > tiny)
-                                 : (wi[k] > tiny);
-      if (first) {
-        const int kk = inverted ? k + 1 : k;
-        const double mg = hypot(wr[kk], wi[kk]);
-        /* |Re s| below 1e-10 |s| is the eigen-solver's rounding on an undamped gyroscopic
-           system (measured: 1e-14 .. 1e-11), not damping */
-        const double zeta = fabs(wr[kk]) <= 1e-10 * mg ? 0.0 : -wr[kk] / mg;
-        roots[nroot++] = (Root){mg, zeta, k, inverted ? -1 : 1};
-      } else if (fabs(wi[k]) <= tiny && !used[k]) {
-        used[k] = 1;
-        /* real: a divergent +a pairs with -a; zero roots come in pairs (one rigid motion) */
-        int partner = -1;
-        double best = 1e-6 * smax + 10.0 * tiny;
-        for (int l = 0; l < n2; ++l)
-          if (!used[l] && isfinite(wr[l]) && fabs(wi[l]) <= tiny && fabs(wr[l] + wr[k]) < best) {
-            best = fabs(wr[l] + wr[k]);
-            partner = l;
-          }
-        if (partner >= 0) used[partner] = 1;
-        const int kk = partner >= 0 && wr[partner] > wr[k] ? partner : k;
-        const double sr = wr[kk];
-        if (fabs(sr) <= tiny)
-          roots[nroot++] = (Root){0.0, 0.0, kk, 0};
-        else if (sr > 0.0)
-          roots[nroot++] = (Root){-sr, -1.0, kk, 0};
-        else
-          roots[nroot++] = (Root){-sr, 1.0, kk, 0}; /* overdamped: decay rate, damping ratio 1 */
-        (void)mag;
-      }
-    }
-    free(used);
+    if ((nroot = classify(wr, wi, n2, inverted, roots)) < 0) goto oom;
   }
+have_roots:
   qsort(roots, (size_t)nroot, sizeof(Root), cmp_root);
   if (count <= 0 || count > nroot) count = nroot;
   md = calloc(1, sizeof *md);
@@ -382,6 +571,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   md->count = count;
   md->nq = nq;
   md->nreduced = nr;
+  md->sparse = sparse_used;
   md->speed = speed;
   md->frequency = calloc((size_t)count + 1, sizeof(double));
   md->damping_ratio = calloc((size_t)count + 1, sizeof(double));
@@ -400,7 +590,11 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     double* pi = md->shape_im + (size_t)k * nq;
     for (int i = 0; i < nq; ++i) {
       double a = 0.0, b = 0.0;
-      for (int j = 0; j < nr; ++j) {
+      if (!N) { /* sparse path: the vectors are over the coordinates themselves */
+        a = xr[i];
+        b = xi ? isign * xi[i] : 0.0;
+      }
+      for (int j = 0; N && j < nr; ++j) {
         a += N[(size_t)j * nq + i] * xr[j];
         if (xi) b += isign * N[(size_t)j * nq + i] * xi[j];
       }

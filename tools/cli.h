@@ -40,4 +40,6 @@ int fmb_cmd_campbell(int argc, char** argv);
 /* shared by the analysis commands (cmd_static.c, cmd_modes.c) */
 int fmb_cli_parse_time(const char* cmd, const char* text, double* t);
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
+/* --eigen dense|sparse|auto -> FMB_EIGEN_*, or -1 after printing why */
+int fmb_cli_eigen_method(const char* cmd, const char* text);
 #endif

@@ -1,5 +1,6 @@
 /* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K]
- *                    [--at T] [-o campbell.csv] [--plot campbell.png] [--set PATH=VALUE]...`
+ *                    [--at T] [-o campbell.csv] [--plot campbell.png] [--eigen dense|sparse|auto]
+ *                    [--set PATH=VALUE]...`
  * For each hub speed (PATH: the scene key that sets it, e.g. joints.spin.speed): the steady state,
  * then its modes. CSV columns: speed, mode1 ... modeK (rad/s; negative = divergent), the modes
  * followed from speed to speed by shape (greatest modal assurance criterion, MAC), not by order.
@@ -60,6 +61,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
   memset(&s, 0, sizeof s);
   const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
   int count = 4;
+  int method = FMB_EIGEN_AUTO;
   fmbStaticOptions opt;
   memset(&opt, 0, sizeof opt);
   opt.quiet = 1;
@@ -80,6 +82,9 @@ int fmb_cmd_campbell(int argc, char** argv) {
       const char* v = fmb_cli_value("campbell", argc, argv, &i, "a time");
       if (!v || fmb_cli_parse_time("campbell", v, &opt.t)) return FMB_EXIT_BAD_INPUT;
       opt.has_t = 1;
+    } else if (strcmp(a, "--eigen") == 0) {
+      const char* v = fmb_cli_value("campbell", argc, argv, &i, "dense, sparse or auto");
+      if (!v || (method = fmb_cli_eigen_method("campbell", v)) < 0) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--count") == 0) {
       const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of modes");
       char* end;
@@ -133,7 +138,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
     fmbStaticResult res;
     fmbModes* cur = NULL;
     rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
-    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, &cur, &diag);
+    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, method, &cur, &diag);
     if (!rc && cur->count < count) {
       fprintf(stderr, "flexmbd campbell: the scene has only %d modes; --count %d asks for more\n", cur->count, count);
       rc = FMB_EXIT_BAD_INPUT;

@@ -1,5 +1,5 @@
 /* cmd_modes.c — `flexmbd modes SCENE [--at T | --static] [--count K] [-o modes.csv]
- *                 [--shapes shapes.csv] [--set PATH=VALUE]... [--quiet]`
+ *                 [--shapes shapes.csv] [--eigen dense|sparse|auto] [--set PATH=VALUE]... [--quiet]`
  * Frequencies, damping ratios and shapes of small motions about the static or steady state
  * (drives held at t0, or at T with --at). The CSV has one row per mode: mode, frequency (rad/s),
  * frequency_hz, damping_ratio; without -o it goes to stdout. A table goes to stderr, then
@@ -11,6 +11,14 @@
 #include <time.h>
 
 #include "cli.h"
+
+int fmb_cli_eigen_method(const char* cmd, const char* text) {
+  static const char* const names[] = {"auto", "dense", "sparse"}; /* FMB_EIGEN_* order */
+  for (int i = 0; i < 3; ++i)
+    if (strcmp(text, names[i]) == 0) return i;
+  fprintf(stderr, "flexmbd %s: --eigen expects dense, sparse or auto, got '%s'\n", cmd, text);
+  return -1;
+}
 
 int fmb_cli_modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
   static const char* const names[] = {"mode", "frequency", "frequency_hz", "damping_ratio"};
@@ -32,6 +40,7 @@ int fmb_cmd_modes(int argc, char** argv) {
   memset(&s, 0, sizeof s);
   const char *out = NULL, *shapes = NULL;
   int count = 10, quiet = 0, at_given = 0, static_given = 0;
+  int method = FMB_EIGEN_AUTO;
   fmbStaticOptions opt;
   memset(&opt, 0, sizeof opt);
   opt.quiet = 1;
@@ -50,6 +59,9 @@ int fmb_cmd_modes(int argc, char** argv) {
       opt.has_t = at_given = 1;
     } else if (strcmp(a, "--static") == 0) {
       static_given = 1;
+    } else if (strcmp(a, "--eigen") == 0) {
+      const char* v = fmb_cli_value("modes", argc, argv, &i, "dense, sparse or auto");
+      if (!v || (method = fmb_cli_eigen_method("modes", v)) < 0) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--count") == 0) {
       const char* v = fmb_cli_value("modes", argc, argv, &i, "a number of modes");
       char* end;
@@ -88,13 +100,14 @@ int fmb_cmd_modes(int argc, char** argv) {
   double* yp = calloc((size_t)ny, sizeof(double));
   fmbModes* md = NULL;
   int rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
-  if (!rc) rc = fmb_modes(m, res.t, y, yp, count, &md, &diag);
+  if (!rc) rc = fmb_modes(m, res.t, y, yp, count, method, &md, &diag);
   if (!rc) rc = fmb_cli_modes_csv(md, out, &diag);
   if (!rc && shapes) rc = fmb_write_mode_shapes(m, res.t, y, yp, md, shapes, &diag);
   if (rc) fmb_cli_print_diag(&diag);
   if (md && !quiet) {
-    fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints):\n",
-            res.speed != 0.0 ? "steady rotation" : "static equilibrium", res.t, md->nreduced);
+    fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints, %s eigen-solver):\n",
+            res.speed != 0.0 ? "steady rotation" : "static equilibrium", res.t, md->nreduced,
+            md->sparse ? "sparse shift-invert" : "dense");
     if (res.speed != 0.0) fprintf(stderr, "  speed %.8g rad/s about (%g, %g)\n", res.speed, res.center[0], res.center[1]);
     fprintf(stderr, "  %4s %16s %14s %14s\n", "mode", "frequency rad/s", "Hz", "damping ratio");
     for (int k = 0; k < md->count; ++k)

@@ -40,7 +40,7 @@ static inline int analyse(Analysis* a, const char* scene_rel, const char* const*
   o.t = t;
   o.quiet = 1;
   int rc = fmb_static(a->m, &o, a->y, a->yp, &a->st, &d);
-  if (!rc && count > 0) rc = fmb_modes(a->m, a->st.t, a->y, a->yp, count, &a->modes, &d);
+  if (!rc && count > 0) rc = fmb_modes(a->m, a->st.t, a->y, a->yp, count, FMB_EIGEN_AUTO, &a->modes, &d);
   if (rc) fprintf(stderr, "analysis of %s failed: %s\n", scene_rel, d.msg);
   return rc;
 }
