@@ -37,9 +37,19 @@ int fmb_cmd_new(int argc, char** argv);
 int fmb_cmd_static(int argc, char** argv);
 int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
-/* shared by the analysis commands (cmd_static.c, cmd_modes.c) */
-int fmb_cli_parse_time(const char* cmd, const char* text, double* t);
+/* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
+typedef struct fmbCliAnalysis {
+  fmbStaticOptions opt; /* --at T, --quiet */
+  int method;           /* --eigen dense|sparse|auto */
+  int count, count_max; /* --count K (1..count_max) */
+  int at_given, quiet;
+} fmbCliAnalysis;
+/* Takes --at T, --quiet/-q and, when count_max > 0, --eigen and --count K; same returns as
+   fmb_cli_take_scene_arg */
+int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fmbCliAnalysis* a);
+/* load the scene (with overrides[0..nover)) and solve its static or steady state: *m, *y, *yp
+   are the caller's to free (fmb_free, free) also on failure; returns 0 or an exit code */
+int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
+                         double** yp, fmbStaticResult* res, fmbDiag* diag);
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
-/* --eigen dense|sparse|auto -> FMB_EIGEN_*, or -1 after printing why */
-int fmb_cli_eigen_method(const char* cmd, const char* text);
 #endif

@@ -59,15 +59,16 @@ static void plot(const char* csv, const char* png, int count, const char* title)
 int fmb_cmd_campbell(int argc, char** argv) {
   fmbCliScene s;
   memset(&s, 0, sizeof s);
+  fmbCliAnalysis an;
+  memset(&an, 0, sizeof an);
+  an.count = 4;
+  an.count_max = MAX_TRACKED;
+  an.opt.quiet = 1;
   const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
-  int count = 4;
-  int method = FMB_EIGEN_AUTO;
-  fmbStaticOptions opt;
-  memset(&opt, 0, sizeof opt);
-  opt.quiet = 1;
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("campbell", argc, argv, &i, &s);
+    if (!r) r = fmb_cli_take_analysis_arg("campbell", argc, argv, &i, &an);
     if (r == 1) continue;
     if (r) return r;
     if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
@@ -78,27 +79,12 @@ int fmb_cmd_campbell(int argc, char** argv) {
       if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--speeds") == 0) {
       if (!(speeds_text = fmb_cli_value("campbell", argc, argv, &i, "A:B:N or S1,S2,..."))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--at") == 0) {
-      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a time");
-      if (!v || fmb_cli_parse_time("campbell", v, &opt.t)) return FMB_EXIT_BAD_INPUT;
-      opt.has_t = 1;
-    } else if (strcmp(a, "--eigen") == 0) {
-      const char* v = fmb_cli_value("campbell", argc, argv, &i, "dense, sparse or auto");
-      if (!v || (method = fmb_cli_eigen_method("campbell", v)) < 0) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--count") == 0) {
-      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of modes");
-      char* end;
-      if (!v) return FMB_EXIT_BAD_INPUT;
-      count = (int)strtol(v, &end, 10);
-      if (*end || count < 1 || count > MAX_TRACKED) {
-        fprintf(stderr, "flexmbd campbell: --count needs an integer from 1 to %d, got '%s'\n", MAX_TRACKED, v);
-        return FMB_EXIT_BAD_INPUT;
-      }
     } else {
       fprintf(stderr, "flexmbd campbell: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
     }
   }
+  const int count = an.count;
   if (!s.scene || !path || !speeds_text) {
     fprintf(stderr, "flexmbd campbell: needs SCENE, --speed PATH (e.g. joints.spin.speed) and --speeds A:B:N|S1,S2,...\n");
     return FMB_EXIT_BAD_INPUT;
@@ -127,18 +113,12 @@ int fmb_cmd_campbell(int argc, char** argv) {
   for (int i = 0; rc == 0 && i < nspeed; ++i) {
     snprintf(override, sizeof override, "%s=%.17g", path, speeds[i]);
     s.overrides[s.nover] = override;
-    fmbModel* m = fmb_load(s.scene, s.overrides, s.nover + 1, fmb_cli_registry(), &diag);
-    if (!m) {
-      rc = diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
-      break;
-    }
-    const int ny = fmb_state_size(m);
-    double* y = calloc((size_t)ny, sizeof(double));
-    double* yp = calloc((size_t)ny, sizeof(double));
+    fmbModel* m;
+    double *y, *yp;
     fmbStaticResult res;
     fmbModes* cur = NULL;
-    rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
-    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, method, &cur, &diag);
+    rc = fmb_cli_steady_state(&s, s.nover + 1, &an.opt, &m, &y, &yp, &res, &diag);
+    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, an.method, &cur, &diag);
     if (!rc && cur->count < count) {
       fprintf(stderr, "flexmbd campbell: the scene has only %d modes; --count %d asks for more\n", cur->count, count);
       rc = FMB_EXIT_BAD_INPUT;

@@ -12,15 +12,7 @@
 
 #include "cli.h"
 
-int fmb_cli_eigen_method(const char* cmd, const char* text) {
-  static const char* const names[] = {"auto", "dense", "sparse"}; /* FMB_EIGEN_* order */
-  for (int i = 0; i < 3; ++i)
-    if (strcmp(text, names[i]) == 0) return i;
-  fprintf(stderr, "flexmbd %s: --eigen expects dense, sparse or auto, got '%s'\n", cmd, text);
-  return -1;
-}
-
-int fmb_cli_modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
+static int modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
   static const char* const names[] = {"mode", "frequency", "frequency_hz", "damping_ratio"};
   double* rows = malloc((size_t)md->count * 4 * sizeof(double) + 1);
   if (!rows) return FMB_EXIT_SOLVER;
@@ -38,41 +30,25 @@ int fmb_cli_modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
 int fmb_cmd_modes(int argc, char** argv) {
   fmbCliScene s;
   memset(&s, 0, sizeof s);
+  fmbCliAnalysis an;
+  memset(&an, 0, sizeof an);
+  an.count = 10;
+  an.count_max = 1000000;
+  an.opt.quiet = 1;
   const char *out = NULL, *shapes = NULL;
-  int count = 10, quiet = 0, at_given = 0, static_given = 0;
-  int method = FMB_EIGEN_AUTO;
-  fmbStaticOptions opt;
-  memset(&opt, 0, sizeof opt);
-  opt.quiet = 1;
+  int static_given = 0;
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("modes", argc, argv, &i, &s);
+    if (!r) r = fmb_cli_take_analysis_arg("modes", argc, argv, &i, &an);
     if (r == 1) continue;
     if (r) return r;
     if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
       if (!(out = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--shapes") == 0) {
       if (!(shapes = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--at") == 0) {
-      const char* v = fmb_cli_value("modes", argc, argv, &i, "a time");
-      if (!v || fmb_cli_parse_time("modes", v, &opt.t)) return FMB_EXIT_BAD_INPUT;
-      opt.has_t = at_given = 1;
     } else if (strcmp(a, "--static") == 0) {
       static_given = 1;
-    } else if (strcmp(a, "--eigen") == 0) {
-      const char* v = fmb_cli_value("modes", argc, argv, &i, "dense, sparse or auto");
-      if (!v || (method = fmb_cli_eigen_method("modes", v)) < 0) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--count") == 0) {
-      const char* v = fmb_cli_value("modes", argc, argv, &i, "a number of modes");
-      char* end;
-      if (!v) return FMB_EXIT_BAD_INPUT;
-      count = (int)strtol(v, &end, 10);
-      if (*end || count < 1) {
-        fprintf(stderr, "flexmbd modes: --count needs a positive integer, got '%s'\n", v);
-        return FMB_EXIT_BAD_INPUT;
-      }
-    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-      quiet = 1;
     } else {
       fprintf(stderr, "flexmbd modes: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -82,29 +58,22 @@ int fmb_cmd_modes(int argc, char** argv) {
     fprintf(stderr, "flexmbd modes: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
   }
-  if (at_given && static_given) {
+  if (an.at_given && static_given) {
     fprintf(stderr, "flexmbd modes: --at T and --static are alternatives (--static: the state at the scene's t0)\n");
     return FMB_EXIT_BAD_INPUT;
   }
   fmbDiag diag;
   fmbStaticResult res;
-  memset(&res, 0, sizeof res);
-  const clock_t c0 = clock();
-  fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
-  if (!m) {
-    fmb_cli_print_diag(&diag);
-    return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
-  }
-  const int ny = fmb_state_size(m);
-  double* y = calloc((size_t)ny, sizeof(double));
-  double* yp = calloc((size_t)ny, sizeof(double));
+  fmbModel* m;
+  double *y, *yp;
   fmbModes* md = NULL;
-  int rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
-  if (!rc) rc = fmb_modes(m, res.t, y, yp, count, method, &md, &diag);
-  if (!rc) rc = fmb_cli_modes_csv(md, out, &diag);
+  const clock_t c0 = clock();
+  int rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
+  if (!rc) rc = fmb_modes(m, res.t, y, yp, an.count, an.method, &md, &diag);
+  if (!rc) rc = modes_csv(md, out, &diag);
   if (!rc && shapes) rc = fmb_write_mode_shapes(m, res.t, y, yp, md, shapes, &diag);
   if (rc) fmb_cli_print_diag(&diag);
-  if (md && !quiet) {
+  if (md && !an.quiet) {
     fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints, %s eigen-solver):\n",
             res.speed != 0.0 ? "steady rotation" : "static equilibrium", res.t, md->nreduced,
             md->sparse ? "sparse shift-invert" : "dense");

@@ -9,7 +9,7 @@
 
 #include "cli.h"
 
-int fmb_cli_parse_time(const char* cmd, const char* text, double* t) {
+static int parse_time(const char* cmd, const char* text, double* t) {
   char* end;
   *t = strtod(text, &end);
   if (end == text || *end != '\0') {
@@ -17,6 +17,53 @@ int fmb_cli_parse_time(const char* cmd, const char* text, double* t) {
     return FMB_EXIT_BAD_INPUT;
   }
   return 0;
+}
+
+int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fmbCliAnalysis* a) {
+  const char* arg = argv[*i];
+  if (strcmp(arg, "--at") == 0) {
+    const char* v = fmb_cli_value(cmd, argc, argv, i, "a time");
+    if (!v || parse_time(cmd, v, &a->opt.t)) return FMB_EXIT_BAD_INPUT;
+    a->opt.has_t = a->at_given = 1;
+  } else if (strcmp(arg, "--quiet") == 0 || strcmp(arg, "-q") == 0) {
+    a->quiet = 1;
+  } else if (a->count_max > 0 && strcmp(arg, "--eigen") == 0) {
+    static const char* const names[] = {"auto", "dense", "sparse"}; /* FMB_EIGEN_* order */
+    const char* v = fmb_cli_value(cmd, argc, argv, i, "dense, sparse or auto");
+    if (!v) return FMB_EXIT_BAD_INPUT;
+    a->method = -1;
+    for (int k = 0; k < 3; ++k)
+      if (strcmp(v, names[k]) == 0) a->method = k;
+    if (a->method < 0) {
+      fprintf(stderr, "flexmbd %s: --eigen expects dense, sparse or auto, got '%s'\n", cmd, v);
+      return FMB_EXIT_BAD_INPUT;
+    }
+  } else if (a->count_max > 0 && strcmp(arg, "--count") == 0) {
+    const char* v = fmb_cli_value(cmd, argc, argv, i, "a number of modes");
+    char* end;
+    if (!v) return FMB_EXIT_BAD_INPUT;
+    const long k = strtol(v, &end, 10);
+    if (*end || end == v || k < 1 || k > a->count_max) {
+      fprintf(stderr, "flexmbd %s: --count needs an integer from 1 to %d, got '%s'\n", cmd, a->count_max, v);
+      return FMB_EXIT_BAD_INPUT;
+    }
+    a->count = (int)k;
+  } else {
+    return 0;
+  }
+  return 1;
+}
+
+int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
+                         double** yp, fmbStaticResult* res, fmbDiag* diag) {
+  memset(res, 0, sizeof *res);
+  *y = *yp = NULL;
+  *m = fmb_load(s->scene, s->overrides, nover, fmb_cli_registry(), diag);
+  if (!*m) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
+  const int ny = fmb_state_size(*m);
+  *y = calloc((size_t)ny, sizeof(double));
+  *yp = calloc((size_t)ny, sizeof(double));
+  return *y && *yp ? fmb_static(*m, opt, *y, *yp, res, diag) : FMB_EXIT_SOLVER;
 }
 
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f) {
@@ -29,22 +76,17 @@ void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* 
 int fmb_cmd_static(int argc, char** argv) {
   fmbCliScene s;
   memset(&s, 0, sizeof s);
+  fmbCliAnalysis an;
+  memset(&an, 0, sizeof an);
   const char* out = NULL;
-  fmbStaticOptions opt;
-  memset(&opt, 0, sizeof opt);
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("static", argc, argv, &i, &s);
+    if (!r) r = fmb_cli_take_analysis_arg("static", argc, argv, &i, &an);
     if (r == 1) continue;
     if (r) return r;
     if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
       if (!(out = fmb_cli_value("static", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--at") == 0) {
-      const char* v = fmb_cli_value("static", argc, argv, &i, "a time");
-      if (!v || fmb_cli_parse_time("static", v, &opt.t)) return FMB_EXIT_BAD_INPUT;
-      opt.has_t = 1;
-    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-      opt.quiet = 1;
     } else {
       fprintf(stderr, "flexmbd static: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -54,20 +96,13 @@ int fmb_cmd_static(int argc, char** argv) {
     fprintf(stderr, "flexmbd static: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
   }
+  an.opt.quiet = an.quiet;
   fmbDiag diag;
   fmbStaticResult res;
-  memset(&res, 0, sizeof res);
+  fmbModel* m;
+  double *y, *yp;
   const clock_t c0 = clock();
-  fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
-  if (!m) {
-    fmb_cli_print_diag(&diag);
-    fmb_cli_print_static(&res, 0, 0.0, stderr);
-    return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
-  }
-  const int ny = fmb_state_size(m);
-  double* y = calloc((size_t)ny, sizeof(double));
-  double* yp = calloc((size_t)ny, sizeof(double));
-  int rc = y && yp ? fmb_static(m, &opt, y, yp, &res, &diag) : FMB_EXIT_SOLVER;
+  int rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
   if (!rc) rc = fmb_write_state_row(m, out, res.t, y, yp, &diag);
   if (rc) fmb_cli_print_diag(&diag);
   fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);

@@ -5,7 +5,10 @@
 #         VTK itself (skipped without it)
 # python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux.
 set -euo pipefail
-pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux)
+# liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
+# libarpack2-dev: its sparse shift-invert path (Arnoldi) for large systems
+pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
+      liblapack-dev libblas-dev libarpack2-dev)
 if [ "${1:-}" = "--ci" ]; then
   pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9)
 fi

@@ -52,6 +52,25 @@ static inline void analysis_free(Analysis* a) {
   fmb_free(a->m);
 }
 
+/* the dense and the sparse eigen-solver agree on the first `count` modes about a's state:
+   frequencies to 1e-9, shapes to MAC 1 - 1e-9 */
+static inline void ensure_solvers_agree(const Analysis* a, int count) {
+  fmbModes *dense = NULL, *sparse = NULL;
+  fmbDiag d;
+  ENSURE(fmb_modes(a->m, a->st.t, a->y, a->yp, count, FMB_EIGEN_DENSE, &dense, &d) == 0);
+  ENSURE(fmb_modes(a->m, a->st.t, a->y, a->yp, count, FMB_EIGEN_SPARSE, &sparse, &d) == 0);
+  if (dense && sparse) {
+    ENSURE(!dense->sparse && sparse->sparse);
+    for (int n = 0; n < count; ++n) {
+      ENSURE_REL(sparse->frequency[n], dense->frequency[n], 1e-9);
+      ENSURE_NEAR(fmb_modes_mac(sparse, n, dense, n), 1.0, 1e-9);
+      ENSURE(sparse->damping_ratio[n] == dense->damping_ratio[n]);
+    }
+  }
+  fmb_modes_free(dense);
+  fmb_modes_free(sparse);
+}
+
 /* one of the scene's outputs at the state (written through fmb_write_state_row, read back) */
 static inline double state_output(const Analysis* a, const char* column) {
   char out[1024];

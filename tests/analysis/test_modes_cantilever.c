@@ -47,19 +47,7 @@ int main(void) {
     const char* o[] = {pass ? "joints.load.force=[0, 0]" : "bodies.beam.elements=24"};
     Analysis a;
     ENSURE(analyse(&a, "tests/analysis/scenes/cantilever.yaml", o, 1, 0, 0.0, 0) == 0);
-    fmbModes *dense = NULL, *sparse = NULL;
-    fmbDiag d;
-    ENSURE(fmb_modes(a.m, a.st.t, a.y, a.yp, 5, FMB_EIGEN_DENSE, &dense, &d) == 0);
-    ENSURE(fmb_modes(a.m, a.st.t, a.y, a.yp, 5, FMB_EIGEN_SPARSE, &sparse, &d) == 0);
-    if (dense && sparse) {
-      ENSURE(!dense->sparse && sparse->sparse);
-      for (int n = 0; n < 5; ++n) {
-        ENSURE_REL(sparse->frequency[n], dense->frequency[n], 1e-9);
-        ENSURE_NEAR(fmb_modes_mac(sparse, n, dense, n), 1.0, 1e-9);
-      }
-    }
-    fmb_modes_free(dense);
-    fmb_modes_free(sparse);
+    ensure_solvers_agree(&a, 5);
     analysis_free(&a);
   }
   /* mesh convergence, complete model, against 64 elements */
