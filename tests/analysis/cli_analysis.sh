@@ -66,4 +66,8 @@ check "campbell without --speed: exit 2" test $? -eq 2
   -o "$out/partial.csv" >/dev/null 2>&1
 check "campbell failing at the 2nd speed: exit 2" test $? -eq 2
 check "... keeps the first row" test "$(wc -l < "$out/partial.csv")" -eq 2
+# initial: static — a misspelt value is bad input at its line and column
+"$flexmbd" run $cant --set initial=statc >/dev/null 2>"$out/initial.err"
+check "initial: statc: exit 2" test $? -eq 2
+check "... naming the choices" grep -q "expected one of scene, static for 'initial'" "$out/initial.err"
 exit $fail
