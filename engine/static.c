@@ -277,6 +277,49 @@ static int factor_jacobian(Newton* s, const double* x) {
   return fmb_lu_factor(n, s->A, s->piv) ? -1 : 0;
 }
 
+/* A steady rotation read at T = 20 s after a spin-up finds the drives 50 rad ahead of the bodies'
+   initial poses; Newton, limited to MAX_TURN per iteration, took 236 iterations to get there.
+   The whole system turned rigidly about the center by the angle that best satisfies the
+   constraints (least squares along the rigid rotation: drives are linear in it, the other joints
+   turn with it) starts Newton where the drives are. */
+static void turn_to_drives(Newton* s, double* x) {
+  const fmbModel* m = s->m;
+  const int nq = m->nq, nc = m->nc;
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* PhiQ = calloc((size_t)nc * nq + 1, sizeof(double));
+  double* zero = calloc((size_t)nq + 1, sizeof(double));
+  for (int pass = 0; phi && PhiQ && zero && pass < 3; ++pass) {
+    if (fmb_constraints_all(m, s->w, s->t, x, zero, phi, PhiQ, NULL, NULL)) break;
+    double num = 0.0, den = 0.0;
+    for (int r = 0; r < nc; ++r) {
+      double d = 0.0; /* Phi_q times the rigid-rotation direction */
+      for (int b = 1; b < m->nbody; ++b) {
+        const fmbBodyInst* bi = &m->body[b];
+        if (!has_frame(bi)) continue;
+        const double* row = PhiQ + (size_t)r * nq + bi->qadr;
+        d += -row[0] * (x[bi->qadr + 1] - s->center[1]) + row[1] * (x[bi->qadr] - s->center[0]) + row[2];
+      }
+      num += d * phi[r];
+      den += d * d;
+    }
+    if (!(den > 0.0)) break;
+    const double turn = -num / den;
+    if (fabs(turn) < 1e-14) break;
+    const double c = cos(turn), sn = sin(turn);
+    for (int b = 1; b < m->nbody; ++b) {
+      const fmbBodyInst* bi = &m->body[b];
+      if (!has_frame(bi)) continue;
+      const double rx = x[bi->qadr] - s->center[0], ry = x[bi->qadr + 1] - s->center[1];
+      x[bi->qadr] = s->center[0] + c * rx - sn * ry;
+      x[bi->qadr + 1] = s->center[1] + sn * rx + c * ry;
+      x[bi->qadr + 2] += turn;
+    }
+  }
+  free(phi);
+  free(PhiQ);
+  free(zero);
+}
+
 /* rad: the largest turn of a frame in one Newton iteration */
 #define MAX_TURN 0.5
 
@@ -359,6 +402,7 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
   res->speed = s.speed;
   res->center[0] = s.center[0];
   res->center[1] = s.center[1];
+  if (s.speed != 0.0) turn_to_drives(&s, x);
   if ((rc = initial_multipliers(&s, x, diag))) goto done;
   if (eval_F(&s, x, F0)) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the starting point (t = %g)", opt.t);
