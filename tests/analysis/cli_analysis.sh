@@ -66,6 +66,19 @@ check "campbell without --speed: exit 2" test $? -eq 2
   -o "$out/partial.csv" >/dev/null 2>&1
 check "campbell failing at the 2nd speed: exit 2" test $? -eq 2
 check "... keeps the first row" test "$(wc -l < "$out/partial.csv")" -eq 2
+# tracking by shape: ZOAC's first bending mode diverges ever faster (-sqrt(W^2 - w1^2)) and passes the
+# second (which softens and diverges from 25 rad/s); sorted by |frequency| they swap near 16 rad/s,
+# followed by MAC the columns stay with their shapes
+"$flexmbd" campbell tests/analysis/scenes/rotating.yaml --set bodies.beam.model=zoac --speed joints.spin.speed \
+  --speeds 10:30:11 --count 2 -o "$out/zoac.csv" --plot "$out/zoac.png" 2>/dev/null
+check "campbell ZOAC exits 0" test $? -eq 0
+check "mode1 at 30 rad/s is the first bending mode, -sqrt(W^2 - w1^2)" \
+  near "$(col "$out/zoac.csv" 11 mode1)" "$(awk 'BEGIN { printf "%.12g", -sqrt(900 - 3.90934219^2) }')" 1e-3
+check "mode2 at 30 rad/s is the second one" near "$(col "$out/zoac.csv" 11 mode2)" -17.3137 1e-4
+"$flexmbd" modes tests/analysis/scenes/rotating.yaml --set bodies.beam.model=zoac --set joints.spin.speed=30 --count 2 \
+  -o "$out/zoac30.csv" 2>/dev/null
+check "... where modes, sorted by |frequency|, lists the second first" near "$(col "$out/zoac30.csv" 1 frequency)" -17.3137 1e-4
+
 # initial: static — a misspelt value is bad input at its line and column
 "$flexmbd" run $cant --set initial=statc >/dev/null 2>"$out/initial.err"
 check "initial: statc: exit 2" test $? -eq 2
