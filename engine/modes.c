@@ -14,7 +14,10 @@
  * Without velocity terms (Cr = 0, as at rest) this is the symmetric-definite problem
  * Kr x = w^2 Mr x (LAPACK dsygv); otherwise the first-order form
  *     [0 I; -Mr^-1 Kr  -Mr^-1 Cr] [r; r'] = s [r; r']                                 (M3)
- * (dgesv, dgeev). A mode reports |s| as its frequency and -Re(s)/|s| as its damping ratio; a
+ * (dgesv, dgeev); both are solved inverted when Kr is regular (the low modes then carry the
+ * largest eigenvalues, which a dense solver gets to full precision). For a few modes of a large
+ * system the sparse path (M4, below) skips N: Arnoldi on one KLU factorization of the
+ * saddle-point matrix. A mode reports |s| as its frequency and -Re(s)/|s| as its damping ratio; a
  * real positive s (divergence: ZOAC spun above w1, where w^2 = w1^2 - W^2 < 0) is reported as
  * frequency -|s|, so a Campbell curve passes continuously through zero. Dense: O(n^3). */
 #include <math.h>
