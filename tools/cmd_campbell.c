@@ -39,7 +39,8 @@ static int parse_speeds(const char* text, double* out) {
   return *p ? -1 : n;
 }
 
-/* gnuplot: one curve per tracked mode; a failure here is a warning, the CSV stands */
+/* gnuplot: one curve per tracked mode; a failure here is a warning, the CSV stands. (Not through
+   `flexmbd plot`: its CSV reader takes run outputs, whose first column is t.) */
 static void plot(const char* csv, const char* png, int count, const char* title) {
   FILE* g = popen("gnuplot 2>/dev/null", "w");
   if (!g) {
