@@ -435,6 +435,11 @@ FMB_API int fmb_write_state_row(const fmbModel* m, const char* path, double t, c
    per mode, columns `mode` then the outputs (put beam.nodeK_v in `outputs` for nodal shapes) */
 FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const double* yp, const fmbModes* modes,
                           const char* path, fmbDiag* diag);
+/* mode k (0-based) as a ParaView animation in dir (created; DIR/SCENE.pvd and one .vtu per frame,
+   the run's VTK writer): `frames` states over one period, the largest coordinate moving by
+   `amplitude` (its units: m or rad) */
+FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
+                                     double amplitude, int frames, const char* dir, fmbDiag* diag);
 /* a table of named numeric columns (row-major values), through the one CSV writer */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);

@@ -769,3 +769,43 @@ done:
   free(names);
   return rc;
 }
+
+/* The animation of mode k through the run's VTK writer (engine/vtk.c): `frames` states over one
+   period, q = q* + amplitude Re(phi e^(i w tau)) = q* + amplitude (Re phi cos - Im phi sin), the
+   time value tau (s; frame numbers for a mode of frequency 0 or a divergent one, whose motion is
+   not periodic: there the shape is swept once, 0 -> amplitude -> -amplitude -> 0). */
+int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* md, int k,
+                             double amplitude, int frames, const char* dir, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_animation: NULL or mismatched arguments");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  const int nq = m->nq;
+  const double w = md->frequency[k];
+  const int periodic = w > 0.0;
+  fmbWorkspace* ws = fmb_workspace_new(m);
+  double* yy = malloc((size_t)m->ny * sizeof(double));
+  fmbVtk* v = ws && yy ? fmb_vtk_open(m, dir, diag) : NULL;
+  int rc = 0;
+  if (!v) {
+    if (!diag->code) fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    rc = diag->code;
+  }
+  const double *re = md->shape_re + (size_t)k * nq, *im = md->shape_im + (size_t)k * nq;
+  for (int j = 0; v && !rc && j < frames; ++j) {
+    const double phase = 2.0 * M_PI * j / frames;
+    const double c = cos(phase), sn = periodic ? sin(phase) : 0.0;
+    memcpy(yy, y, (size_t)m->ny * sizeof(double));
+    for (int i = 0; i < nq; ++i) yy[i] += amplitude * (re[i] * (periodic ? c : sin(phase)) - im[i] * sn);
+    if (fmb_vtk_step(v, m, ws, periodic ? t + phase / w : t + j, yy)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, dir, 0, 0, "writing the animation of mode %d failed (disk full?)", k + 1);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  fmb_vtk_close(v);
+  fmb_workspace_free(ws);
+  free(yy);
+  return rc;
+}

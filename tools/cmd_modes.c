@@ -1,13 +1,17 @@
 /* cmd_modes.c — `flexmbd modes SCENE [--at T | --static] [--count K] [-o modes.csv]
- *                 [--shapes shapes.csv] [--eigen dense|sparse|auto] [--set PATH=VALUE]... [--quiet]`
+ *                 [--shapes shapes.csv] [--animate DIR [--amplitude A]] [--eigen dense|sparse|auto]
+ *                 [--set PATH=VALUE]... [--quiet]`
  * Frequencies, damping ratios and shapes of small motions about the static or steady state
  * (drives held at t0, or at T with --at). The CSV has one row per mode: mode, frequency (rad/s),
- * frequency_hz, damping_ratio; without -o it goes to stdout. A table goes to stderr, then
+ * frequency_hz, damping_ratio; without -o it goes to stdout. --animate DIR: each mode as a
+ * ParaView animation DIR/modeK/SCENE.pvd (24 frames over a period, largest coordinate A = 0.1). A table goes to stderr, then
  * the static solution's stats line. */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "cli.h"
@@ -35,7 +39,8 @@ int fmb_cmd_modes(int argc, char** argv) {
   an.count = 10;
   an.count_max = 1000000;
   an.opt.quiet = 1;
-  const char *out = NULL, *shapes = NULL;
+  const char *out = NULL, *shapes = NULL, *animate = NULL;
+  double amplitude = 0.1;
   int static_given = 0;
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
@@ -47,6 +52,17 @@ int fmb_cmd_modes(int argc, char** argv) {
       if (!(out = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--shapes") == 0) {
       if (!(shapes = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--animate") == 0) {
+      if (!(animate = fmb_cli_value("modes", argc, argv, &i, "a directory"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--amplitude") == 0) {
+      const char* v = fmb_cli_value("modes", argc, argv, &i, "a number");
+      char* end;
+      if (!v) return FMB_EXIT_BAD_INPUT;
+      amplitude = strtod(v, &end);
+      if (*end || end == v || !(amplitude > 0.0)) {
+        fprintf(stderr, "flexmbd modes: --amplitude needs a positive number (m or rad), got '%s'\n", v);
+        return FMB_EXIT_BAD_INPUT;
+      }
     } else if (strcmp(a, "--static") == 0) {
       static_given = 1;
     } else {
@@ -72,6 +88,18 @@ int fmb_cmd_modes(int argc, char** argv) {
   if (!rc) rc = fmb_modes(m, res.t, y, yp, an.count, an.method, &md, &diag);
   if (!rc) rc = modes_csv(md, out, &diag);
   if (!rc && shapes) rc = fmb_write_mode_shapes(m, res.t, y, yp, md, shapes, &diag);
+  if (!rc && animate) {
+    /* one ParaView collection per mode: DIR/mode1, DIR/mode2, ... */
+    if (mkdir(animate, 0777) != 0 && errno != EEXIST) {
+      fprintf(stderr, "%s: error: cannot create the directory: %s\n", animate, strerror(errno));
+      rc = FMB_EXIT_BAD_INPUT;
+    }
+    char dir[1200];
+    for (int k = 0; !rc && k < md->count; ++k) {
+      snprintf(dir, sizeof dir, "%s/mode%d", animate, k + 1);
+      rc = fmb_write_mode_animation(m, res.t, y, md, k, amplitude, 24, dir, &diag);
+    }
+  }
   if (rc) fmb_cli_print_diag(&diag);
   if (md && !an.quiet) {
     fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints, %s eigen-solver):\n",

@@ -32,7 +32,7 @@ static const Command commands[] = {
     {"static", fmb_cmd_static,
      "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive"},
     {"modes", fmb_cmd_modes,
-     "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv]\n"
+     "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv] [--animate DIR]\n"
      "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state"},
     {"campbell", fmb_cmd_campbell,
      "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-o campbell.csv] [--plot campbell.png]\n"

@@ -46,6 +46,25 @@ check "... saying the drive accelerates" grep -q accelerating "$out/ramp.err"
 check "modes with a bad --set: exit 2" test $? -eq 2
 check "... quoting the override" grep -q "^--set: error: bodies.beam.elements=many" "$out/set.err"
 
+# mode animation through the VTK writer: 24 frames over one period; the tip swings +A, 0, -A at
+# frames 0, 6, 12 (time 0, T/4, T/2 with T = 2 pi / omega1) and shortens by w_c at both ends
+"$flexmbd" modes $cant --count 2 --animate "$out/anim" --amplitude 0.1 -o /dev/null 2>/dev/null
+check "modes --animate exits 0" test $? -eq 0
+check "a collection per mode, 24 frames" test "$(grep -c '<DataSet' "$out/anim/mode2/cantilever.pvd")" -eq 24
+check "mode 1 swings through +A, 0, -A over half a period" python3 - "$out/anim/mode1" <<'PY'
+import math, re, sys
+def frame(j):
+    s = open("%s/cantilever_%06d.vtu" % (sys.argv[1], j)).read()
+    t = float(re.search(r'Name="TimeValue"[^>]*>([^<]*)<', s).group(1))
+    d = [float(x) for x in re.search(r'Name="deformation"[^>]*>([^<]*)<', s).group(1).split()]
+    return t, max((d[i:i + 2] for i in range(0, len(d), 3)), key=lambda u: abs(u[1]))
+(t0, a), (t6, b), (t12, c) = frame(0), frame(6), frame(12)
+period = 2 * math.pi / 3.9093421
+ok = abs(a[1] - 0.1) < 1e-9 and abs(b[1]) < 1e-12 and abs(c[1] + 0.1) < 1e-9 and a[0] < 0 and abs(a[0] - c[0]) < 1e-12
+ok = ok and abs(t6 - period / 4) < 1e-6 and abs(t12 - period / 2) < 1e-6
+sys.exit(0 if ok else 1)
+PY
+
 # no equilibrium: a free body under gravity
 printf 'solver: {t_end: 1.0}\ngravity: [0, -9.81]\nbodies:\n  - {name: box, type: rigid, mass: 1.0, inertia: 0.1}\n' > "$out/free.yaml"
 "$flexmbd" static "$out/free.yaml" >/dev/null 2>"$out/free.err"
