@@ -13,6 +13,7 @@
 #ifndef FLEXMBD_H
 #define FLEXMBD_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -45,9 +46,10 @@ extern "C" {
 #define FMB_EXIT_OK 0
 #define FMB_EXIT_BAD_INPUT 2
 #define FMB_EXIT_SOLVER 3
+#define FMB_EXIT_INTERRUPTED 4 /* SIGINT/SIGTERM: stopped at the next step, rows so far kept */
 
 typedef struct fmbDiag {
-  int code;        /* 0 none, FMB_EXIT_BAD_INPUT or FMB_EXIT_SOLVER */
+  int code;        /* 0 none, FMB_EXIT_BAD_INPUT, FMB_EXIT_SOLVER or FMB_EXIT_INTERRUPTED */
   char file[512];  /* scene path, or "--set" for an override */
   int line, col;
   char msg[1024];
@@ -327,6 +329,7 @@ typedef struct fmbStats {
   double cpu_s;
   double ic_position_correction, ic_velocity_correction; /* norms of the initial projection */
   long rows_written;
+  int interrupted; /* the run stopped because *fmbRunOptions.stop was set */
 } fmbStats;
 
 typedef struct fmbRunOptions {
@@ -337,6 +340,9 @@ typedef struct fmbRunOptions {
   int progress;
   double progress_after_s;
   const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
+  /* may be NULL; when *stop becomes non-zero (e.g. set by a SIGINT handler) the run ends after
+     the step in progress, keeps its rows and returns FMB_EXIT_INTERRUPTED */
+  const volatile sig_atomic_t* stop;
 } fmbRunOptions;
 
 /* Load `path`, applying "PATH=VALUE" overrides (e.g. "solver.rtol=1e-8",

@@ -9,6 +9,7 @@
  * the error control acts on positions and velocities only. Output rows are written at the scene's
  * output step; on any failure every row so far is already on disk and the message says when,
  * why, and what to try. */
+#include <errno.h>
 #include <ida/ida.h>
 #include <math.h>
 #include <nvector/nvector_serial.h>
@@ -33,7 +34,10 @@ typedef struct {
   char ida_msg[512];
   long fresh_steps, fresh_conv_fails; /* IDA's counters at the last fresh Jacobian */
   long fresh, reused;
+  const volatile sig_atomic_t* stop; /* set by the program's SIGINT/SIGTERM handler */
 } RunCtx;
+
+static int stop_requested(const RunCtx* c) { return c->stop && *c->stop; }
 
 /* IDA asks for a new iteration matrix when cj has changed by more than 25 % or after a Newton
    convergence failure. Only the first needs nothing new from the bodies: their K, C, M do not
@@ -57,6 +61,8 @@ static int reuse_body_blocks(RunCtx* c) {
 
 static int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void* ud) {
   RunCtx* c = ud;
+  /* an interrupt ends the step in progress: IDA returns the last completed step */
+  if (stop_requested(c)) return -1;
   return fmb_system_residual(c->m, c->w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(F));
 }
 
@@ -87,12 +93,6 @@ static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N
   return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(c->ewt),
                              reuse, SUNSparseMatrix_Data(J), NULL);
 }
-
-/* A step this small (relative to the whole run) means IDA is closing in on a singularity it
-   cannot pass rather than resolving dynamics: the FOAC pendulum approached its mass matrix's
-   singular crossing with steps of 1e-14 s, 100,000 of them per output (47 s) before giving up.
-   With a floor, the first failure there ends the run and the usual diagnosis says why. */
-#define FMB_MIN_STEP_FRACTION 1e-12
 
 static void ida_error_handler(int code, const char* module, const char* function, char* msg, void* ud) {
   (void)code;
@@ -129,7 +129,7 @@ void fmb_print_stats(const fmbStats* s, FILE* f) {
   fprintf(f,
           "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
           "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
-          s->status_ok ? "ok" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
+          s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
           s->error_test_fails, s->conv_fails, s->jacobians_reused, s->cpu_s);
 }
 
@@ -232,6 +232,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   RunCtx ctx;
   memset(&ctx, 0, sizeof ctx);
   ctx.m = m;
+  ctx.stop = opt ? opt->stop : NULL;
   SUNContext sun = NULL;
   N_Vector y = NULL, yp = NULL, id = NULL, atol = NULL;
   SUNMatrix A = NULL;
@@ -270,7 +271,12 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  fmb_csv_header(csv, m);
+  if (stop_requested(&ctx)) goto done;
+  if (fmb_csv_header(csv, m)) {
+    row_failed(m, -1, t, diag);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
   if (row_failed(m, write_outputs(csv, vtk, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -306,7 +312,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       IDASetSuppressAlg(ida, SUNTRUE) != IDA_SUCCESS || IDASetMaxOrd(ida, m->solver.max_order) != IDA_SUCCESS ||
       IDASetMaxNumSteps(ida, m->solver.max_steps_per_output) != IDA_SUCCESS ||
       (m->solver.max_step > 0 && IDASetMaxStep(ida, m->solver.max_step) != IDA_SUCCESS) ||
-      IDASetMinStep(ida, FMB_MIN_STEP_FRACTION * (m->solver.t_end - m->solver.t0)) != IDA_SUCCESS) {
+      IDASetMinStep(ida, m->solver.min_step) != IDA_SUCCESS) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up IDA: %s", ctx.ida_msg);
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -330,6 +336,10 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     double tout = k == nout ? t_end : t0 + (double)k * dt;
     double tret = t;
     int flag = IDASolve(ida, tout, &tret, y, yp, IDA_NORMAL);
+    if (flag < 0 && stop_requested(&ctx)) {
+      t = tret;
+      break;
+    }
     if (flag < 0) {
       t = tret;
       bad = fmb_check_mass(m, ctx.w, tret, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 1e-5);
@@ -363,10 +373,17 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     }
     st->rows_written++;
     progress_update(&progress, m, t, ida);
+    if (stop_requested(&ctx)) break;
   }
   progress_end(&progress);
 
 done:
+  if (stop_requested(&ctx) && !rc) {
+    st->interrupted = 1;
+    rc = FMB_EXIT_INTERRUPTED;
+    fmb_diag_set(diag, rc, m->path, 0, 0, "interrupted at t = %.6g (SIGINT or SIGTERM): the %ld rows written so far are kept",
+                 t, st->rows_written);
+  }
   st->t_reached = t;
   st->status_ok = rc == 0;
   if (ida) {
@@ -389,8 +406,12 @@ done:
   if (ctx.ewt) N_VDestroy(ctx.ewt);
   if (sun) SUNContext_Free(&sun);
   fmb_workspace_free(ctx.w);
-  fmb_csv_close(csv);
   fmb_vtk_close(vtk);
+  if (fmb_csv_close(csv) && !rc) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not put the output in place: %s", strerror(errno));
+    rc = FMB_EXIT_SOLVER;
+    st->status_ok = 0;
+  }
   st->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
   return rc;
 }

@@ -48,6 +48,8 @@ typedef struct fmbOutput {
 
 typedef struct fmbSolverSettings {
   double t0, t_end, rtol, atol, output_step, max_step;
+  double min_step;     /* IDA's step floor: solver.min_step, default FMB_MIN_STEP_FRACTION (t_end - t0) */
+  int min_step_given;  /* 1 when the scene set solver.min_step (named in messages either way) */
   /* Newton systems: KLU on the Schur complement of the position rows (schur.c, default), KLU on
      the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
   enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
@@ -55,6 +57,12 @@ typedef struct fmbSolverSettings {
   int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
 } fmbSolverSettings;
+
+/* A step this small relative to the whole run means IDA is closing in on a singularity it
+   cannot pass rather than resolving dynamics: the FOAC pendulum approached its mass matrix's
+   singular crossing with steps of 1e-14 s, 100,000 of them per output (47 s) before giving up.
+   With a floor, the first failure there ends the run and the usual diagnosis says why. */
+#define FMB_MIN_STEP_FRACTION 1e-12
 
 /* one rectangle (or diagonal run) of the iteration matrix's fixed sparsity pattern */
 typedef struct fmbBlock {
@@ -227,10 +235,12 @@ int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, c
                    double* angle);
 void fmb_outputs_default(fmbModel* m);
 typedef struct fmbCsv fmbCsv;
+/* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
-void fmb_csv_header(fmbCsv* c, const fmbModel* m);
+int fmb_csv_header(fmbCsv* c, const fmbModel* m); /* 0 ok, -1 write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
-void fmb_csv_close(fmbCsv* c);
+/* puts a file with a header in place (rename), removes one without; -1 with errno on failure */
+int fmb_csv_close(fmbCsv* c);
 
 /* ---- vtk.c: the run as a ParaView collection (DIR/SCENE.pvd, one .vtu per output row) ---- */
 typedef struct fmbVtk fmbVtk;

@@ -9,6 +9,10 @@
 #include "internal.h"
 
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
+#define FMB_RTOL_MIN 1e-13 /* ~500 machine epsilons: below, IDA reports "too much accuracy requested" */
+#define FMB_RTOL_MAX 0.1
+#define FMB_ATOL_MIN 1e-16
+#define FMB_ATOL_MAX 1e-3 /* 1 mm, 1 mrad: looser hides errors as large as a small mechanism */
 
 static const char* const reserved_names[] = {"ground", "energy", "constraint", "t", NULL};
 
@@ -30,10 +34,11 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->atol = 1e-8;
   s->output_step = 0.0;
   s->max_step = 0.0;
+  s->min_step = 0.0;
   s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, max_order, error_control, linear_solver, max_steps)");
+  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps)");
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
@@ -45,6 +50,7 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_double(p, node, "atol", FMB_POSITIVE, &s->atol) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
       fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
+      fmb_get_double(p, node, "min_step", FMB_POSITIVE, &s->min_step) ||
       fmb_get_choice(p, node, "linear_solver", 0, solvers, &linear_solver) ||
       fmb_get_choice(p, node, "error_control", 0, controls, &s->positions_only) ||
       fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
@@ -53,8 +59,22 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->max_steps_per_output = max_steps;
   s->linear_solver = linear_solver;
-  if (s->rtol >= 0.1)
-    return fmb_parse_error(p, fmb_find_key(p, node, "rtol"), "expected rtol below 0.1 (a relative tolerance), got %g", s->rtol);
+  /* Tolerances outside these bounds give a wrong answer with exit 0 (atol = 1 lets a 1 m
+     pendulum's error test pass anything) or ask for more than double precision can hold (IDA
+     weighs errors by 1/(rtol |y| + atol); 1e-200 makes every step fail). */
+  if (s->rtol >= FMB_RTOL_MAX || s->rtol < FMB_RTOL_MIN)
+    return fmb_parse_error(p, fmb_find_key(p, node, "rtol"),
+                           "expected rtol from %g to below %g (a relative tolerance), got %g", FMB_RTOL_MIN, FMB_RTOL_MAX,
+                           s->rtol);
+  if (s->atol > FMB_ATOL_MAX || s->atol < FMB_ATOL_MIN)
+    return fmb_parse_error(p, fmb_find_key(p, node, "atol"),
+                           "expected atol from %g to %g (an absolute tolerance in SI units: metres, radians, m/s), got %g",
+                           FMB_ATOL_MIN, FMB_ATOL_MAX, s->atol);
+  s->min_step_given = s->min_step > 0.0;
+  if (!s->min_step_given) s->min_step = FMB_MIN_STEP_FRACTION * (s->t_end - s->t0);
+  if (s->min_step >= s->t_end - s->t0)
+    return fmb_parse_error(p, fmb_find_key(p, node, "min_step"), "min_step (%g) must be shorter than the run (t_end %g)",
+                           s->min_step, s->t_end);
   if (s->output_step == 0.0) s->output_step = s->t_end / 1000.0;
   if (s->output_step > s->t_end)
     return fmb_parse_error(p, fmb_find_key(p, node, "output_step"), "output_step (%g) is longer than t_end (%g)",

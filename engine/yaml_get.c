@@ -7,6 +7,7 @@
  * (libyaml marks are 0-based; we print 1-based) or, for nodes made by an override, its text. */
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -14,8 +15,13 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "internal.h"
+
+/* a scene is a few kilobytes; 64 MB is far beyond any mechanism the engine can integrate and
+   bounds what libyaml is asked to hold (its document takes ~20x the text) */
+#define FMB_SCENE_BYTES_MAX (64 * 1024 * 1024)
 
 void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...) {
   if (!d || d->code) return; /* the first error wins */
@@ -604,18 +610,33 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   p->nnodes_cap = 0;
   p->nlooked = 0;
   p->item = p->inherited[0] = p->inherited[1] = -1;
+  /* opened without blocking (a FIFO would wait for a writer) and checked on the open file: only
+     a regular file of bounded size is read (a FIFO, /dev/zero or a directory never ends) */
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
   struct stat st;
-  if (stat(path, &st) != 0) {
+  if (fd < 0 || fstat(fd, &st) != 0) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));
+    if (fd >= 0) close(fd);
     return -1;
   }
-  if (S_ISDIR(st.st_mode)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "is a directory, expected a YAML scene file");
+  const char* refuse = S_ISDIR(st.st_mode)    ? "is a directory, expected a YAML scene file"
+                       : !S_ISREG(st.st_mode) ? "is not a regular file (a device, FIFO or socket), expected a YAML scene file"
+                                              : NULL;
+  if (refuse) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s", refuse);
+    close(fd);
     return -1;
   }
-  FILE* f = fopen(path, "rb");
+  if (st.st_size > FMB_SCENE_BYTES_MAX) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene file is too large: %lld bytes, at most %d accepted",
+                 (long long)st.st_size, FMB_SCENE_BYTES_MAX);
+    close(fd);
+    return -1;
+  }
+  FILE* f = fdopen(fd, "rb");
   if (!f) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));
+    close(fd);
     return -1;
   }
   yaml_parser_t parser;

@@ -1,8 +1,12 @@
 /* cli.c — argument handling shared by the command files (tools/cli.h). */
 #include "cli.h"
 
+#include <errno.h>
+#include <fcntl.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 fmbRegistry* fmb_cli_registry(void) {
   static fmbRegistry* reg; /* the built-ins, then every --plugin in command-line order */
@@ -68,4 +72,34 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
   }
   s->overrides[s->nover++] = ov;
   return 1;
+}
+
+int fmb_cli_check_input(const char* path, const char* what) {
+  /* O_NONBLOCK: opening a FIFO must not wait for a writer; the type is checked on the open file */
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  struct stat st;
+  const char* why = NULL;
+  if (fd < 0)
+    why = strerror(errno);
+  else if (fstat(fd, &st) != 0)
+    why = strerror(errno);
+  else if (S_ISDIR(st.st_mode))
+    why = "it is a directory, expected a file";
+  else if (!S_ISREG(st.st_mode))
+    why = "it is not a regular file (a device, FIFO or socket would be read without end)";
+  if (fd >= 0) close(fd);
+  if (!why) return 0;
+  fprintf(stderr, "%s: error: cannot open the %s: %s\n", path, what, why);
+  return FMB_EXIT_BAD_INPUT;
+}
+
+int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n) {
+  struct stat so, si;
+  if (!out || strcmp(out, "-") == 0 || stat(out, &so) != 0 || !S_ISREG(so.st_mode)) return 0;
+  for (int i = 0; i < n; ++i)
+    if (inputs[i] && stat(inputs[i], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
+      fprintf(stderr, "%s: error: the output file is the input '%s': refusing to overwrite it\n", out, inputs[i]);
+      return FMB_EXIT_BAD_INPUT;
+    }
+  return 0;
 }
