@@ -56,7 +56,8 @@ typedef struct fmbDiag {
 } fmbDiag;
 
 /* ---------------------------------------------------------------------------------------------
- * Scene parsing API for plugins (the one YAML accessor layer, engine/yaml_get.c).
+ * Scene parsing API for plugins (the one YAML accessor layer, engine/yaml_get.c). A NULL parser,
+ * key or output pointer makes an accessor return -1 without touching anything.
  * A node is an index into the loaded document. Every accessor records the key as "known" for
  * the unknown-key check, applies the default already in *out when the key is absent and not
  * required, and on error records file:line:column plus what was expected, returning non-zero.
@@ -248,7 +249,8 @@ typedef struct fmbJointType {
   unsigned flags;
 } fmbJointType;
 
-/* what a joint may ask of the evaluation context */
+/* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
+   0, NULL or -1: a plugin bug, reported instead of crashing) */
 FMB_API double fmb_eval_time(const fmbJointEval* ev);
 FMB_API int fmb_eval_ncoord(const fmbJointEval* ev, int k);      /* coordinates of body k (0 for ground) */
 FMB_API const double* fmb_eval_q(const fmbJointEval* ev, int k);
@@ -345,12 +347,28 @@ typedef struct fmbRunOptions {
   const volatile sig_atomic_t* stop;
 } fmbRunOptions;
 
+/* Ownership and misuse (every function here checks its pointer arguments: a NULL required
+ * argument is an error, never a crash):
+ *   - fmb_load returns a model the caller owns and releases with fmb_free (NULL is fine). It
+ *     reads `path` and the override strings only during the call; the registry and the type
+ *     tables it points to must outlive the model (the model calls their ops). A plugin's `self`
+ *     belongs to the model once its parse returned 0 (and to nobody if it failed: the engine
+ *     calls destroy on whatever it set).
+ *   - fmb_run only reads the model (one model may be run several times); it writes *stats and
+ *     *diag, both optional (NULL = not wanted); opt may be NULL (stdout, progress lines on).
+ *   - fmbDiag and fmbStats are plain values owned by the caller; nothing in them needs freeing.
+ *   - Output files: fmb_run writes a regular file to a temporary file beside it and renames it
+ *     into place once the header is written, so a run that fails before that leaves an existing
+ *     file as it was; "-" and non-regular files are written through and never removed. */
+
 /* Load `path`, applying "PATH=VALUE" overrides (e.g. "solver.rtol=1e-8",
-   "bodies.beam.elements=32"). Returns NULL with *diag filled on error. */
+   "bodies.beam.elements=32"). Returns NULL with *diag filled (diag may be NULL) on error,
+   including a NULL path or registry, or NULL overrides with noverrides > 0. */
 FMB_API fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
                    fmbDiag* diag);
 /* Integrate from the scene's t0 to t_end, writing CSV rows as it goes. Returns 0 or an exit code
-   (FMB_EXIT_SOLVER) with *diag saying when and why it stopped. */
+   (FMB_EXIT_SOLVER, FMB_EXIT_INTERRUPTED; FMB_EXIT_BAD_INPUT for a NULL model or an output that
+   cannot be written) with *diag saying when and why it stopped. */
 FMB_API int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* stats, fmbDiag* diag);
 FMB_API void fmb_free(fmbModel* m);
 /* the solver settings a loaded scene runs with (its values after --set overrides) */
@@ -359,8 +377,9 @@ typedef struct fmbSolverInfo {
 } fmbSolverInfo;
 /* 0, or -1 when an argument is NULL */
 FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
-/* one line per body and joint: type and active terms */
+/* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
+/* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 
 /* ---------------------------------------------------------------------------------------------

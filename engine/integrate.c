@@ -101,31 +101,53 @@ static void ida_error_handler(int code, const char* module, const char* function
   snprintf(c->ida_msg, sizeof c->ida_msg, "%s: %s", function, msg);
 }
 
-static const char* failure_advice(int flag) {
+/* What to try after IDA gives up with `flag`. The advice names only causes this scene can have
+   (a dead point needs joints) and says when the state has left any physical scale, since
+   extreme values, not the mechanism's geometry, then explain a singular matrix. */
+static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, size_t len) {
+  const int joints = m->nc > 0;
+  if (ymax > 1e100 && (flag == IDA_CONV_FAIL || flag == IDA_LSETUP_FAIL || flag == IDA_LSOLVE_FAIL || flag == IDA_ERR_FAIL)) {
+    snprintf(buf, len,
+             "the solution reached a magnitude of %.3g: the state is blowing up or a parameter is far beyond a physical "
+             "scale (check masses, stiffnesses, forces and their units)",
+             ymax);
+    return;
+  }
+  const char* s = "the integrator stopped";
   switch (flag) {
     case IDA_TOO_MUCH_WORK:
-      return "too many steps between two outputs: the problem is very stiff or changing very fast here. "
-             "Try a larger solver.max_steps, a looser rtol, or check for unphysical parameters";
-    case IDA_TOO_MUCH_ACC: return "the tolerances are tighter than machine precision allows: loosen rtol/atol";
+      s = "too many steps between two outputs: the problem is very stiff or changing very fast here. "
+          "Try a larger solver.max_steps, a looser rtol, or check for unphysical parameters";
+      break;
+    case IDA_TOO_MUCH_ACC: s = "the tolerances are tighter than machine precision allows: loosen rtol/atol"; break;
     case IDA_ERR_FAIL:
-      return "the error test failed repeatedly down to the minimum step: the solution is blowing up or jumps "
-             "(an unstable model, e.g. a ZOAC beam spun above its first bending frequency, or a discontinuous input)";
+      s = "the error test failed repeatedly down to the minimum step: the solution is blowing up or jumps "
+          "(an unstable model or a discontinuous input)";
+      break;
     case IDA_CONV_FAIL:
-      return "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
-             "has become unstable. Try a smaller solver.max_step or a tighter rtol";
+      s = joints ? "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
+                   "has become unstable. Try a smaller solver.max_step or a tighter rtol"
+                 : "Newton's method failed repeatedly: the model has become unstable or too stiff for the step. Try a "
+                   "smaller solver.max_step or a tighter rtol";
+      break;
     case IDA_LSETUP_FAIL:
-      return "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
-             "(a dead point, where the joints no longer fix the motion) or a mass matrix that lost definiteness. "
-             "Check the mechanism's geometry; a drive that forces it through a dead point cannot be integrated";
-    case IDA_LSOLVE_FAIL: return "the linear solver failed: the Newton matrix is singular or ill-conditioned";
+      s = joints ? "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
+                   "(a dead point, where the joints no longer fix the motion) or a mass matrix that lost definiteness. "
+                   "Check the mechanism's geometry; a drive that forces it through a dead point cannot be integrated"
+                 : "the Newton matrix could not be factorized (it is singular): a mass matrix that lost definiteness";
+      break;
+    case IDA_LSOLVE_FAIL: s = "the linear solver failed: the Newton matrix is singular or ill-conditioned"; break;
     case IDA_REP_RES_ERR:
-      return "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
-    case IDA_RES_FAIL: return "a plugin could not evaluate its equations";
-    default: return "the integrator stopped";
+      s = "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
+      break;
+    case IDA_RES_FAIL: s = "a plugin could not evaluate its equations"; break;
+    default: break;
   }
+  snprintf(buf, len, "%s", s);
 }
 
 void fmb_print_stats(const fmbStats* s, FILE* f) {
+  if (!s || !f) return;
   fprintf(f,
           "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
           "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
@@ -213,6 +235,16 @@ static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* 
 }
 
 int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* diag) {
+  fmbStats local_stats;
+  fmbDiag local_diag;
+  if (!st) st = &local_stats;
+  if (!diag) diag = &local_diag;
+  if (!m) {
+    memset(st, 0, sizeof *st);
+    memset(diag, 0, sizeof *diag);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_run: no model (NULL)");
+    return FMB_EXIT_BAD_INPUT;
+  }
   clock_t c0 = clock();
   memset(st, 0, sizeof *st);
   memset(diag, 0, sizeof *diag);
@@ -346,11 +378,19 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       if (bad) {
         mass_failure(m, bad, tret, diag);
       } else {
-        double hcur = 0.0;
+        double hcur = 0.0, ymax = 0.0;
         IDAGetCurrentStep(ida, &hcur);
+        const double* yv = N_VGetArrayPointer(y);
+        for (int i = 0; i < ny; ++i) ymax = fmax(ymax, fabs(yv[i]));
+        char advice[600], floor_note[200] = "";
+        failure_advice(m, flag, ymax, advice, sizeof advice);
+        /* a stop at the step floor names the key that sets it and where its value came from */
+        if (fabs(hcur) <= 1.5 * m->solver.min_step)
+          snprintf(floor_note, sizeof floor_note, "; the step reached solver.min_step = %.3g (%s)", m->solver.min_step,
+                   m->solver.min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)");
         char* flag_name = IDAGetReturnFlagName(flag); /* allocated by SUNDIALS */
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s [IDA %s: %s]",
-                     tret, hcur, failure_advice(flag), flag_name ? flag_name : "?", ctx.ida_msg);
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s%s [IDA %s: %s]",
+                     tret, hcur, advice, floor_note, flag_name ? flag_name : "?", ctx.ida_msg);
         free(flag_name);
       }
       rc = FMB_EXIT_SOLVER;

@@ -140,6 +140,7 @@ struct fmbParser {
   fmbNode item;             /* the item being parsed, or -1 */
   fmbNode inherited[2];     /* its material and section entries, or -1 */
   fmbModel* model;          /* under construction */
+  long key_compares;        /* string comparisons of the duplicate-key check (tests count them) */
   const fmbRegistry* reg;
   fmbRegistry* own_reg;     /* the scene's plugins: a copy of the caller's registry, or NULL */
 };

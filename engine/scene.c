@@ -287,7 +287,25 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
 
 fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
                    fmbDiag* diag) {
+  fmbDiag local_diag;
+  if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
+  const char* misuse = !path                                                   ? "fmb_load: no scene path (NULL)"
+                       : (noverrides < 0 || (noverrides > 0 && !overrides))    ? "fmb_load: overrides NULL or a negative count"
+                       : !reg                                                  ? "fmb_load: no registry (NULL)"
+                       : (reg->nbodies < 0 || reg->njoints < 0 || (reg->nbodies > 0 && !reg->bodies) ||
+                          (reg->njoints > 0 && !reg->joints))                  ? "fmb_load: a registry list is NULL or has a negative length"
+                                                                               : NULL;
+  for (int i = 0; !misuse && i < noverrides; ++i)
+    if (!overrides[i]) misuse = "fmb_load: an override is NULL";
+  for (int i = 0; !misuse && i < reg->nbodies; ++i)
+    if (!reg->bodies[i] || !reg->bodies[i]->name) misuse = "fmb_load: a registered body type is NULL or has no name";
+  for (int i = 0; !misuse && i < reg->njoints; ++i)
+    if (!reg->joints[i] || !reg->joints[i]->name) misuse = "fmb_load: a registered joint type is NULL or has no name";
+  if (misuse) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "%s", misuse);
+    return NULL;
+  }
   fmbModel* m = calloc(1, sizeof *m);
   if (!m) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "out of memory");
@@ -333,6 +351,7 @@ int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
 }
 
 void fmb_describe(const fmbModel* m, FILE* f) {
+  if (!m || !f) return;
   fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
           m->path, m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);
   fprintf(f, "gravity: %s\n", m->env.has_gravity ? "on" : "off (no gravity terms evaluated)");

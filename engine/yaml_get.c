@@ -47,12 +47,43 @@ fmbNode fmbp_root(fmbParser* p) {
 
 static int node_count(fmbParser* p) { return (int)(p->doc.nodes.top - p->doc.nodes.start); }
 
+/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
+   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
+#define FMB_OVERRIDE_SHOWN 80
+static const char* shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]) {
+  size_t used = 0, i = 0;
+  const size_t len = strlen(text);
+  for (; text[i] && used < FMB_OVERRIDE_SHOWN - 20; ++i) {
+    const unsigned char ch = (unsigned char)text[i];
+    if (ch == '\n' || ch == '\t')
+      used += (size_t)snprintf(buf + used, 8, "\\%c", ch == '\n' ? 'n' : 't');
+    else if (ch < 0x20 || ch == 0x7f)
+      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
+    else
+      buf[used++] = (char)ch;
+  }
+  if (text[i] && len > FMB_OVERRIDE_SHOWN) {
+    snprintf(buf + used, FMB_OVERRIDE_SHOWN + 32 - used, "...(%zu characters)", len);
+    return buf;
+  }
+  for (; text[i] && used < FMB_OVERRIDE_SHOWN + 24; ++i) {
+    const unsigned char ch = (unsigned char)text[i];
+    if (ch < 0x20 || ch == 0x7f)
+      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
+    else
+      buf[used++] = (char)ch;
+  }
+  buf[used] = '\0';
+  return buf;
+}
+
 /* where `node` is: file:line:column, or the override that made it */
 static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
   yaml_node_t* nd = fmbp_node(p, node);
   int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
+  char shown[FMB_OVERRIDE_SHOWN + 32];
   if (ov >= 0)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", p->overrides[ov], msg);
+    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", shown_override(p->overrides[ov], shown), msg);
   else if (nd)
     fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s", msg);
   else
@@ -67,6 +98,7 @@ static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
 }
 
 int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
+  if (!p || !fmt) return -1;
   va_list ap;
   va_start(ap, fmt);
   verror_at(p, node, fmt, ap);
@@ -139,6 +171,7 @@ static fmbNode value_of(fmbParser* p, fmbNode map, const char* key) {
    (which are searched, and their key marked read, either way: a key the item overrides is not
    an unknown key of its material) */
 fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
+  if (!p || !key) return -1;
   remember_key(p, key);
   fmbNode v = value_of(p, map, key);
   for (int k = 0; k < 2 && map == p->item && p->item > 0; ++k) {
@@ -164,26 +197,55 @@ int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
   return 0;
 }
 
-/* every mapping in the document: no duplicate keys, keys are scalars */
+/* FNV-1a: the duplicate-key check's hash */
+static unsigned long hash_key(const char* s) {
+  unsigned long h = 2166136261u;
+  for (; *s; ++s) h = (h ^ (unsigned char)*s) * 16777619u;
+  return h;
+}
+
+/* every mapping in the document: no duplicate keys, keys are scalars. Linear in the number of
+   keys: each mapping's keys go into an open-addressing hash set (size a power of two at least
+   twice the keys), so a mapping of 100,000 keys costs ~100,000 string comparisons, not 5e9. */
 static int check_duplicates(fmbParser* p) {
   int n = node_count(p);
-  for (int id = 1; id <= n; ++id) {
+  size_t cap = 0;
+  yaml_node_pair_t** slot = NULL;
+  int rc = 0;
+  for (int id = 1; id <= n && !rc; ++id) {
     yaml_node_t* nd = fmbp_node(p, id);
     if (nd->type != YAML_MAPPING_NODE) continue;
+    const size_t npairs = (size_t)(nd->data.mapping.pairs.top - nd->data.mapping.pairs.start);
+    size_t want = 16;
+    while (want < 2 * npairs) want *= 2;
+    if (want > cap) {
+      free(slot);
+      cap = want;
+      slot = malloc(cap * sizeof *slot);
+      if (!slot) return fmb_parse_error(p, id, "out of memory checking for duplicate keys");
+    }
+    memset(slot, 0, want * sizeof *slot);
     for (yaml_node_pair_t* a = nd->data.mapping.pairs.start; a < nd->data.mapping.pairs.top; ++a) {
       const char* ka = fmbp_scalar(p, a->key);
-      if (!ka) return fmb_parse_error(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
-      for (yaml_node_pair_t* b = nd->data.mapping.pairs.start; b < a; ++b) {
-        const char* kb = fmbp_scalar(p, b->key);
-        if (kb && strcmp(ka, kb) == 0) {
-          yaml_node_t* first = fmbp_node(p, b->key);
-          return fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka,
-                               (int)first->start_mark.line + 1);
-        }
+      if (!ka) {
+        rc = fmb_parse_error(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
+        break;
       }
+      size_t h = hash_key(ka) & (want - 1);
+      for (; slot[h]; h = (h + 1) & (want - 1)) {
+        p->key_compares++;
+        if (strcmp(fmbp_scalar(p, slot[h]->key), ka) == 0) break;
+      }
+      if (slot[h]) {
+        yaml_node_t* first = fmbp_node(p, slot[h]->key);
+        rc = fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka, (int)first->start_mark.line + 1);
+        break;
+      }
+      slot[h] = a;
     }
   }
-  return 0;
+  free(slot);
+  return rc;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -230,6 +292,7 @@ static int absent(fmbParser* p, fmbNode map, const char* key, unsigned flags, co
 }
 
 int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a number");
   return number_at(p, n, key, flags, out);
@@ -293,6 +356,7 @@ int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
 }
 
 int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a whole number");
   const char* s = fmbp_scalar(p, n);
@@ -311,6 +375,7 @@ int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long
 }
 
 int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a list of two numbers [x, y]");
   if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != 2)
@@ -326,6 +391,7 @@ int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, dou
 
 int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out) {
+  if (!p || !key || !choices || !out) return -1;
   fmbNode n = fmb_find_key(p, map, key);
   char list[400] = "";
   size_t used = 0;
@@ -389,14 +455,17 @@ static int get_named(fmbParser* p, fmbNode map, const char* key, unsigned flags,
 }
 
 int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   return get_named(p, map, key, flags, 0, out);
 }
 
 int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   return get_named(p, map, key, flags, 1, out);
 }
 
 int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]) {
+  if (!p || !body || !local || (k != 0 && k != 1)) return -1;
   fmbModel* m = p->model;
   if (joint < 0 || joint >= m->njoint) return -1;
   const fmbJointInst* j = &m->joint[joint];
@@ -454,16 +523,18 @@ static void mark_override(fmbParser* p, int first_new, int ov) {
 }
 
 static int apply_override(fmbParser* p, int ov) {
-  const char* text = p->overrides[ov];
-  const char* eq = strchr(text, '=');
-  if (!eq || eq == text) {
+  const char* full = p->overrides[ov];
+  char shown[FMB_OVERRIDE_SHOWN + 32];
+  const char* text = shown_override(full, shown);
+  const char* eq = strchr(full, '=');
+  if (!eq || eq == full) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected PATH=VALUE, e.g. solver.rtol=1e-8", text);
     return -1;
   }
   char path[512];
-  size_t plen = (size_t)(eq - text);
+  size_t plen = (size_t)(eq - full);
   if (plen >= sizeof path) plen = sizeof path - 1;
-  memcpy(path, text, plen);
+  memcpy(path, full, plen);
   path[plen] = '\0';
   const char* value = eq + 1;
 
@@ -480,7 +551,22 @@ static int apply_override(fmbParser* p, int ov) {
     yaml_parser_delete(&parser);
     return -1;
   }
+  /* exactly one YAML value: "1e-8\n---\n2" would otherwise set 1e-8 and drop the rest */
+  yaml_document_t extra;
+  int more = 0;
+  if (!yaml_parser_load(&parser, &extra)) {
+    more = 1;
+  } else {
+    more = yaml_document_get_root_node(&extra) != NULL;
+    yaml_document_delete(&extra);
+  }
   yaml_parser_delete(&parser);
+  if (more) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected one YAML value after '=', found more after it",
+                 text);
+    yaml_document_delete(&vdoc);
+    return -1;
+  }
 
   if (path[0] == '.' || path[plen - 1] == '.' || strstr(path, "..")) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: empty name in the path (write names separated by single dots, e.g. solver.rtol)", text);
@@ -573,6 +659,10 @@ static int apply_override(fmbParser* p, int ov) {
    offset, so the position is counted from the file; a parser error may name where the construct
    it was reading began. */
 static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* parser, FILE* f) {
+  if (parser->error == YAML_MEMORY_ERROR) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene is too large to load: out of memory while parsing it");
+    return;
+  }
   const char* problem = parser->problem ? parser->problem : "unknown problem";
   if (parser->error == YAML_READER_ERROR) {
     int line = 1, col = 1, c;

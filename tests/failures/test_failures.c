@@ -28,6 +28,9 @@ static const Case cases[] = {
        mode grow exponentially once Omega passes omega1 = 3.9 rad/s; the beam's validity check stops
        it when a deflection exceeds the length */
     {"zoac_overspin", 0.01, 0.05, 2.0, "its deformation exceeds its length", "use model: foac or complete"},
+    /* the same four-bar with a step floor of 1e-6 s: stops at the floor, which the message names */
+    {"min_step_floor", 0.01, 1.585, 1.5874, "the error test failed repeatedly",
+     "the step reached solver.min_step = 1e-06 (as given)"},
     {"too_much_work", 2.0, 0.0, 2.0, "too many steps between two outputs", "Try a larger solver.max_steps"},
     {"foac_pendulum", 0.005, 0.02, 0.5, "the mass matrix is no longer positive definite", "use `model: complete`"},
     {"overflow_force", 1000.0, 0.0, 0.0, "the equations kept returning non-finite values",
