@@ -82,6 +82,9 @@ FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned f
 /* one of a NULL-terminated list of words; *out is the index */
 FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out);
+/* a point of body `body` in the body's reference frame, [x, y] (default: *out as given); a point
+   the body says is not on it (fmbBodyType.point_outside) is refused here, at the point */
+FMB_API int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]);
 /* a body by name ("ground" is always defined); *out is the body index */
 FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
 /* a joint defined earlier in the file, by name; *out is the joint index */
@@ -89,6 +92,10 @@ FMB_API int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned f
 /* body index and local point of attachment k (0 or 1) of an already parsed joint with
    constraint rows (a pivot, a weld; not a spring's ends) */
 FMB_API int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]);
+/* position and angle of material point `local` of body `body` in the pose the scene gives it
+   (before any assembly), e.g. for a joint whose default is the configuration as assembled.
+   Returns 0, or -1 (bad arguments, or the body cannot place the point). */
+FMB_API int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle);
 /* a plugin-level check failed at `node` (a value node or the item's mapping) */
 FMB_API int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
 #if defined(__GNUC__)

@@ -83,6 +83,7 @@ struct fmbModel {
   fmbSolverSettings solver;
   int noutput;
   fmbOutput* output;
+  int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */

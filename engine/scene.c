@@ -248,7 +248,11 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode outputs = fmb_find_key(p, root, "outputs");
   fmbNode plugins = fmb_find_key(p, root, "plugins");
   double g[2] = {0.0, 0.0};
-  if (fmb_get_vec2(p, root, "gravity", 0, g)) return -1;
+  /* initial: given (default) = the poses must satisfy the joints (to FMB_ASSEMBLY_TOL);
+     assemble = the initial projection may move the bodies onto the joints (ic.c) */
+  static const char* const initial_modes[] = {"given", "assemble", NULL};
+  if (fmb_get_vec2(p, root, "gravity", 0, g) || fmb_get_choice(p, root, "initial", 0, initial_modes, &m->assemble))
+    return -1;
   /* optional conveniences, not listed among the expected top-level keys (docs/scenes.md has them) */
   const int looked = p->nlooked;
   fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */

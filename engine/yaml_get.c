@@ -389,6 +389,17 @@ int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, dou
   return 0;
 }
 
+int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]) {
+  if (!p || !key || !out || !p->model || body < 0 || body >= p->model->nbody) return -1;
+  if (fmb_get_vec2(p, map, key, flags, out)) return -1;
+  const fmbBodyInst* b = &p->model->body[body];
+  char why[200] = "";
+  if (b->type && b->type->point_outside && b->type->point_outside(b->self, out, why, sizeof why))
+    return fmb_parse_error(p, fmb_find_key(p, map, key), "%s [%g, %g] is not on body '%s' (type %s): %s", key, out[0],
+                           out[1], b->name, b->type->name, why);
+  return 0;
+}
+
 int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out) {
   if (!p || !key || !choices || !out) return -1;
@@ -472,6 +483,25 @@ int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local
   /* only a constraining joint: a spring's ends (drawn through the same op) are no pivot to drive */
   if (!j->type->attachment || j->nrows == 0) return -1;
   return j->type->attachment(j->self, k, body, local);
+}
+
+int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle) {
+  if (!p || !p->model || !local || !pos || body < 0 || body >= p->model->nbody) return -1;
+  const fmbBodyInst* b = &p->model->body[body];
+  if (!b->type) { /* the world frame */
+    pos[0] = local[0];
+    pos[1] = local[1];
+    if (angle) *angle = 0.0;
+    return 0;
+  }
+  /* setup-time: the body's initial coordinates and its scratch, allocated for this one call */
+  const size_t n = (size_t)b->nq;
+  double* q = calloc(2 * n + b->nwork + 1, sizeof(double));
+  if (!q) return -1;
+  b->type->initial(b->self, q, q + n);
+  const int rc = b->type->marker(b->self, q, local, pos, angle, NULL, NULL, q + 2 * n);
+  free(q);
+  return rc ? -1 : 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
