@@ -15,6 +15,7 @@ typedef struct fmbBodyInst {
   const fmbBodyType* type; /* NULL for the world frame */
   void* self;
   int qadr, nq; /* slice of the coordinate vector */
+  fmbNode node; /* its item in the scene, for messages about it after parsing */
   size_t workadr, nwork;
 } fmbBodyInst;
 

@@ -5,6 +5,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include "internal.h"
 
@@ -192,7 +194,8 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
   for (int i = 0; i < n; ++i) {
     fmbBodyInst* b = &m->body[m->nbody];
     int t = 0;
-    if (parse_item(p, m, fmbp_seq_item(p, list, i), 0, names, b->name, &t, &b->self)) return -1;
+    b->node = fmbp_seq_item(p, list, i);
+    if (parse_item(p, m, b->node, 0, names, b->name, &t, &b->self)) return -1;
     b->type = p->reg->bodies[t];
     m->nbody++; /* owns self from here on, freed by fmb_free */
     b->qadr = m->nq;
@@ -235,6 +238,67 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
     j->nrows = j->type->nrows ? j->type->nrows(j->self) : 0;
     m->nc += j->nrows;
     if (j->ncol > m->max_joint_cols) m->max_joint_cols = j->ncol;
+  }
+  return 0;
+}
+
+/* What a run of this model will take, estimated from its sizes and fixed pattern at load:
+   - memory: the dense per-body blocks of the workspace (K, C, M, FD column: 4 nb^2 for the
+     largest body, up to 3 sum nb^2 for the block cache), the initial conditions' dense
+     augmented matrix (nq + nc)^2 and Phi_q copies, the mass check (nq^2), a dense Newton
+     matrix if asked for (ny^2), and the sparse pattern with KLU's copy and fill (~5 nnz);
+   - work per factorization of the Newton matrix: sum over columns of (column nnz)^2, the cost
+     of sparse LU without fill: nb^3 for a dense body block, linear for a banded one.
+   A model beyond either limit is refused at load with the estimate: the accepted beam of 4096
+   elements needed 19.5 GB, and one of 1024 elements could not do one step in 20 s. The memory
+   estimate is conservative (measured peak: 88 MB for 256 elements, estimated 182 MB). */
+/* measured: a 512-element beam (1.8e10) factorizes in ~1 s, so 5e10 is a few seconds; one of
+   1024 elements (1.5e11) could not do a step in 20 s */
+#define FMB_WORK_FLOPS_MAX 5e10
+static void estimate_resources(const fmbModel* m, double* bytes, double* flops) {
+  double nbmax = 0.0, sum_nb2 = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const double nb = m->body[b].nq;
+    nbmax = fmax(nbmax, nb);
+    sum_nb2 += nb * nb;
+  }
+  const double nq = m->nq, nc = m->nc, ny = m->ny, n = nq + nc;
+  double doubles = 4.0 * nbmax * nbmax + fmin(3.0 * sum_nb2, (double)(256 << 20) / 8.0) + n * n + 3.0 * nc * nq + nc * nc +
+                   20.0 * ny + (double)m->nwork;
+  if (m->check_definiteness) doubles += nq * nq + nc * nq;
+  if (m->solver.linear_solver == FMB_LS_DENSE) doubles += ny * ny;
+  *bytes = 8.0 * doubles + 5.0 * 16.0 * (double)m->nnz;
+  double w = 0.0;
+  for (int j = 0; j < m->ny; ++j) {
+    const double c = (double)(m->colptr[j + 1] - m->colptr[j]);
+    w += c * c;
+  }
+  if (m->solver.linear_solver == FMB_LS_DENSE) w = ny * ny * ny / 3.0;
+  *flops = w;
+}
+
+/* physical memory, or less if the address space is limited (ulimit -v) */
+static double memory_available(void) {
+  double bytes = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+  struct rlimit rl;
+  if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) bytes = fmin(bytes, (double)rl.rlim_cur);
+  return bytes > 0 ? bytes : 1e300;
+}
+
+static int check_resources(fmbParser* p, fmbModel* m) {
+  double bytes = 0.0, flops = 0.0;
+  estimate_resources(m, &bytes, &flops);
+  const double avail = memory_available();
+  if (bytes > 0.8 * avail || flops > FMB_WORK_FLOPS_MAX) {
+    /* named at the largest body: the one to make smaller */
+    int big = 1;
+    for (int b = 2; b < m->nbody; ++b)
+      if (m->body[b].nq > m->body[big].nq) big = b;
+    return fmb_parse_error(p, m->nbody > 1 ? m->body[big].node : fmbp_root(p),
+                           "the model is too large to run here (largest body '%s', %d coordinates): %d unknowns need an "
+                           "estimated %.3g GB of memory (this machine offers %.3g GB) and %.3g operations per Newton "
+                           "matrix factorization (limit %.3g, a few seconds each): use fewer elements or bodies",
+                           m->body[big].name, m->body[big].nq, m->ny, bytes / 1e9, avail / 1e9, flops, FMB_WORK_FLOPS_MAX);
   }
   return 0;
 }
@@ -286,7 +350,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
     fmb_outputs_default(m);
   }
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
-  return 0;
+  return check_resources(p, m);
 }
 
 fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
@@ -359,6 +423,9 @@ void fmb_describe(const fmbModel* m, FILE* f) {
   fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
           m->path, m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);
   fprintf(f, "gravity: %s\n", m->env.has_gravity ? "on" : "off (no gravity terms evaluated)");
+  double bytes = 0.0, flops = 0.0;
+  estimate_resources(m, &bytes, &flops);
+  fprintf(f, "resources: ~%.3g MB of memory, ~%.3g flops per Newton matrix factorization (estimates)\n", bytes / 1e6, flops);
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     fprintf(f, "body '%s' (%s, %d coordinates)%s", bi->name, bi->type->name, bi->nq, bi->type->describe ? ": " : "\n");
