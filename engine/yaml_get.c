@@ -719,6 +719,268 @@ static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* p
                  problem, parser->context ? " " : "", parser->context ? parser->context : "");
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* the composer: YAML events into the document tree (libyaml's own loader, rewritten for three
+   reasons). An alias is copied where it is used, each copied node carrying the alias's position,
+   so an error inside an aliased node is reported where it is used and each use is checked on its
+   own (unknown keys); a merge key `<<: *anchor` (or `<<: [*a, *b]`) adds the keys of the merged
+   mappings that the mapping does not give itself (YAML 1.1 merge); the copies are bounded by a
+   node budget (aliases of aliases grow exponentially) and the nesting by a depth limit (libyaml's
+   loader recurses once per level). */
+#define FMB_SCENE_NODES_MAX 2000000
+#define FMB_SCENE_DEPTH_MAX 200
+#define FMB_MERGE_KEYS_MAX 10000
+
+typedef struct {
+  char* name;
+  int id;
+} Anchor;
+
+typedef struct {
+  fmbParser* p;
+  Anchor* anchors;
+  int nanchors, capanchors;
+  int node[FMB_SCENE_DEPTH_MAX]; /* open sequences and mappings */
+  int key[FMB_SCENE_DEPTH_MAX];  /* a mapping's key waiting for its value (0 = none) */
+  int depth;
+  int root;
+} Composer;
+
+static void set_marks(yaml_document_t* doc, int id, yaml_mark_t start, yaml_mark_t end) {
+  yaml_node_t* nd = yaml_document_get_node(doc, id);
+  nd->start_mark = start;
+  nd->end_mark = end;
+}
+
+/* a copy of node `id` and everything below it, every node marked at `at` (the alias); 0 when the
+   budget of nodes is exhausted or memory is short */
+static int copy_here(yaml_document_t* doc, int id, yaml_mark_t at, long* budget) {
+  if (--*budget < 0) return 0;
+  yaml_node_t* s = yaml_document_get_node(doc, id);
+  int nid = 0;
+  if (s->type == YAML_SCALAR_NODE) {
+    nid = yaml_document_add_scalar(doc, NULL, s->data.scalar.value, (int)s->data.scalar.length, s->data.scalar.style);
+  } else if (s->type == YAML_SEQUENCE_NODE) {
+    const int n = (int)(s->data.sequence.items.top - s->data.sequence.items.start);
+    nid = yaml_document_add_sequence(doc, NULL, s->data.sequence.style);
+    for (int i = 0; i < n && nid; ++i) {
+      s = yaml_document_get_node(doc, id); /* adding nodes may move them */
+      const int c = copy_here(doc, s->data.sequence.items.start[i], at, budget);
+      if (!c || !yaml_document_append_sequence_item(doc, nid, c)) return 0;
+    }
+  } else if (s->type == YAML_MAPPING_NODE) {
+    const int n = (int)(s->data.mapping.pairs.top - s->data.mapping.pairs.start);
+    nid = yaml_document_add_mapping(doc, NULL, s->data.mapping.style);
+    for (int i = 0; i < n && nid; ++i) {
+      s = yaml_document_get_node(doc, id);
+      const yaml_node_pair_t pr = s->data.mapping.pairs.start[i];
+      const int k = copy_here(doc, pr.key, at, budget);
+      const int v = k ? copy_here(doc, pr.value, at, budget) : 0;
+      if (!v || !yaml_document_append_mapping_pair(doc, nid, k, v)) return 0;
+    }
+  }
+  if (nid) set_marks(doc, nid, at, at);
+  return nid;
+}
+
+static int is_merge_key(yaml_document_t* doc, int id) {
+  yaml_node_t* k = yaml_document_get_node(doc, id);
+  return k && k->type == YAML_SCALAR_NODE && k->data.scalar.style == YAML_PLAIN_SCALAR_STYLE &&
+         strcmp((const char*)k->data.scalar.value, "<<") == 0;
+}
+
+static int pairs_have_key(yaml_document_t* doc, const yaml_node_pair_t* pairs, int n, int key) {
+  yaml_node_t* k = yaml_document_get_node(doc, key);
+  if (!k || k->type != YAML_SCALAR_NODE) return 0;
+  for (int i = 0; i < n; ++i) {
+    yaml_node_t* o = yaml_document_get_node(doc, pairs[i].key);
+    if (o && o->type == YAML_SCALAR_NODE && strcmp((const char*)o->data.scalar.value, (const char*)k->data.scalar.value) == 0)
+      return 1;
+  }
+  return 0;
+}
+
+/* mapping `id` is complete: replace its merge keys by the merged mappings' pairs */
+static int merge_keys(Composer* c, int id) {
+  yaml_document_t* doc = &c->p->doc;
+  yaml_node_t* nd = yaml_document_get_node(doc, id);
+  const int n = (int)(nd->data.mapping.pairs.top - nd->data.mapping.pairs.start);
+  int nmerge = 0, total = 0;
+  for (int i = 0; i < n; ++i) {
+    const yaml_node_pair_t pr = nd->data.mapping.pairs.start[i];
+    if (!is_merge_key(doc, pr.key)) {
+      ++total;
+      continue;
+    }
+    ++nmerge;
+    yaml_node_t* v = yaml_document_get_node(doc, pr.value);
+    const int nsrc = v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
+    for (int k = 0; k < nsrc; ++k) {
+      yaml_node_t* src = v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
+      if (src->type != YAML_MAPPING_NODE)
+        return fmb_parse_error(c->p, v->type == YAML_SEQUENCE_NODE ? v->data.sequence.items.start[k] : pr.value,
+                               "the value of a merge key '<<' must be a mapping (e.g. *anchor) or a list of mappings, "
+                               "found %s",
+                               node_kind(src));
+      total += (int)(src->data.mapping.pairs.top - src->data.mapping.pairs.start);
+    }
+  }
+  if (!nmerge) return 0;
+  if (total > FMB_MERGE_KEYS_MAX) return fmb_parse_error(c->p, id, "merge keys add more than %d keys to one mapping", FMB_MERGE_KEYS_MAX);
+  yaml_node_pair_t* out = malloc(((size_t)total + 1) * sizeof *out);
+  if (!out) return fmb_parse_error(c->p, id, "out of memory merging keys");
+  int m = 0;
+  /* the mapping's own keys first: they win over merged ones */
+  for (int i = 0; i < n; ++i)
+    if (!is_merge_key(doc, nd->data.mapping.pairs.start[i].key)) out[m++] = nd->data.mapping.pairs.start[i];
+  const int own = m;
+  for (int i = 0; i < n; ++i) {
+    const yaml_node_pair_t pr = nd->data.mapping.pairs.start[i];
+    if (!is_merge_key(doc, pr.key)) continue;
+    yaml_node_t* v = yaml_document_get_node(doc, pr.value);
+    const int nsrc = v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
+    for (int k = 0; k < nsrc; ++k) {
+      yaml_node_t* src = v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
+      for (yaml_node_pair_t* sp = src->data.mapping.pairs.start; sp < src->data.mapping.pairs.top; ++sp)
+        if (!pairs_have_key(doc, out, own, sp->key) && !pairs_have_key(doc, out + own, m - own, sp->key)) out[m++] = *sp;
+    }
+  }
+  free(nd->data.mapping.pairs.start); /* libyaml allocates with malloc (yaml_malloc) */
+  nd->data.mapping.pairs.start = out;
+  nd->data.mapping.pairs.top = out + m;
+  nd->data.mapping.pairs.end = out + total + 1;
+  return 0;
+}
+
+/* a finished node goes to its parent: the root, a list item, a key or a value */
+static int attach(Composer* c, int id) {
+  if (c->depth == 0) {
+    c->root = id;
+    return 0;
+  }
+  const int parent = c->node[c->depth - 1];
+  yaml_document_t* doc = &c->p->doc;
+  if (yaml_document_get_node(doc, parent)->type == YAML_SEQUENCE_NODE)
+    return yaml_document_append_sequence_item(doc, parent, id) ? 0 : -1;
+  if (!c->key[c->depth - 1]) {
+    c->key[c->depth - 1] = id;
+    return 0;
+  }
+  const int key = c->key[c->depth - 1];
+  c->key[c->depth - 1] = 0;
+  return yaml_document_append_mapping_pair(doc, parent, key, id) ? 0 : -1;
+}
+
+static int remember_anchor(Composer* c, const yaml_char_t* name, int id) {
+  if (!name) return 0;
+  if (c->nanchors == c->capanchors) {
+    const int cap = c->capanchors ? 2 * c->capanchors : 16;
+    Anchor* a = realloc(c->anchors, (size_t)cap * sizeof *a);
+    if (!a) return -1;
+    c->anchors = a;
+    c->capanchors = cap;
+  }
+  c->anchors[c->nanchors].name = strdup((const char*)name);
+  if (!c->anchors[c->nanchors].name) return -1;
+  c->anchors[c->nanchors++].id = id;
+  return 0;
+}
+
+/* one event; 1 at the end of the stream, -1 on error (diag set) */
+static int compose_event(Composer* c, const yaml_event_t* ev, int* ndocs) {
+  fmbParser* p = c->p;
+  yaml_document_t* doc = &p->doc;
+  const char* path = p->path;
+  int id = 0;
+  if (node_count(p) > FMB_SCENE_NODES_MAX) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                 "the scene is too large: more than %d YAML nodes (counting every use of an alias)", FMB_SCENE_NODES_MAX);
+    return -1;
+  }
+  switch (ev->type) {
+    case YAML_STREAM_END_EVENT: return 1;
+    case YAML_DOCUMENT_START_EVENT:
+      if (++*ndocs > 1) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "a scene file holds one YAML document; found a second one");
+        return -1;
+      }
+      return 0;
+    case YAML_SCALAR_EVENT:
+      id = yaml_document_add_scalar(doc, NULL, ev->data.scalar.value, (int)ev->data.scalar.length, ev->data.scalar.style);
+      if (!id || remember_anchor(c, ev->data.scalar.anchor, id)) break;
+      set_marks(doc, id, ev->start_mark, ev->end_mark);
+      return attach(c, id);
+    case YAML_ALIAS_EVENT: {
+      int target = 0;
+      for (int i = c->nanchors - 1; i >= 0 && !target; --i)
+        if (strcmp(c->anchors[i].name, (const char*)ev->data.alias.anchor) == 0) target = c->anchors[i].id;
+      if (!target) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "YAML syntax error: found undefined alias");
+        return -1;
+      }
+      long budget = FMB_SCENE_NODES_MAX - node_count(p);
+      id = copy_here(doc, target, ev->start_mark, &budget);
+      if (!id && budget < 0) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "the scene is too large: more than %d YAML nodes (counting every use of an alias)", FMB_SCENE_NODES_MAX);
+        return -1;
+      }
+      if (!id) break;
+      return attach(c, id);
+    }
+    case YAML_SEQUENCE_START_EVENT:
+    case YAML_MAPPING_START_EVENT: {
+      const int seq = ev->type == YAML_SEQUENCE_START_EVENT;
+      if (c->depth == FMB_SCENE_DEPTH_MAX) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "the scene nests lists and mappings more than %d deep", FMB_SCENE_DEPTH_MAX);
+        return -1;
+      }
+      id = seq ? yaml_document_add_sequence(doc, NULL, ev->data.sequence_start.style)
+               : yaml_document_add_mapping(doc, NULL, ev->data.mapping_start.style);
+      if (!id || remember_anchor(c, seq ? ev->data.sequence_start.anchor : ev->data.mapping_start.anchor, id)) break;
+      set_marks(doc, id, ev->start_mark, ev->end_mark);
+      if (attach(c, id)) break;
+      c->node[c->depth] = id;
+      c->key[c->depth++] = 0;
+      return 0;
+    }
+    case YAML_SEQUENCE_END_EVENT: --c->depth; return 0;
+    case YAML_MAPPING_END_EVENT: --c->depth; return merge_keys(c, c->node[c->depth]) ? -1 : 0;
+    default: return 0;
+  }
+  fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene is too large to load: out of memory");
+  return -1;
+}
+
+/* the file's one document into p->doc; 0 or -1 with diag set */
+static int compose(fmbParser* p, yaml_parser_t* parser, FILE* f) {
+  Composer c;
+  memset(&c, 0, sizeof c);
+  c.p = p;
+  if (!yaml_document_initialize(&p->doc, NULL, NULL, NULL, 1, 1)) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "out of memory");
+    return -1;
+  }
+  p->have_doc = 1;
+  int ndocs = 0, rc = 0;
+  while (rc == 0) {
+    yaml_event_t ev;
+    if (!yaml_parser_parse(parser, &ev)) {
+      syntax_error(p->diag, p->path, parser, f);
+      rc = -1;
+      break;
+    }
+    rc = compose_event(&c, &ev, &ndocs);
+    yaml_event_delete(&ev);
+  }
+  for (int i = 0; i < c.nanchors; ++i) free(c.anchors[i].name);
+  free(c.anchors);
+  return rc < 0 ? -1 : 0;
+}
+
 int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag) {
   memset(&p->doc, 0, sizeof p->doc);
   p->path = path;
@@ -762,35 +1024,10 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   yaml_parser_t parser;
   yaml_parser_initialize(&parser);
   yaml_parser_set_input_file(&parser, f);
-  int ok = yaml_parser_load(&parser, &p->doc);
-  if (!ok) {
-    syntax_error(diag, path, &parser, f);
-    yaml_parser_delete(&parser);
-    fclose(f);
-    return -1;
-  }
-  p->have_doc = 1;
-  /* a second document in the same file is a mistake worth reporting */
-  yaml_document_t extra;
-  if (yaml_parser_load(&parser, &extra)) {
-    int more = yaml_document_get_root_node(&extra) != NULL;
-    yaml_mark_t mk = extra.start_mark;
-    yaml_document_delete(&extra);
-    if (more) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1,
-                   "a scene file holds one YAML document; found a second one");
-      yaml_parser_delete(&parser);
-      fclose(f);
-      return -1;
-    }
-  } else {
-    syntax_error(diag, path, &parser, f);
-    yaml_parser_delete(&parser);
-    fclose(f);
-    return -1;
-  }
+  const int rc = compose(p, &parser, f);
   yaml_parser_delete(&parser);
   fclose(f);
+  if (rc) return -1;
 
   if (!yaml_document_get_root_node(&p->doc)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1,
