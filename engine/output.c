@@ -252,15 +252,7 @@ static int write_line(fmbCsv* c, const char* buf, size_t len) {
 
 static fmbCsv* csv_fail(fmbCsv* c, fmbDiag* diag, const char* path, const char* what) {
   fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", what);
-  if (c) {
-    if (c->temp) {
-      close(c->fd);
-      unlink(c->temp);
-    }
-    free(c->temp);
-    free(c->target);
-    free(c);
-  }
+  fmb_csv_close(c); /* no header written: removes the temporary file, if any */
   return NULL;
 }
 
