@@ -223,13 +223,6 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   return 0;
 }
 
-static int beam_point_outside(const void* self, const double local[2], char* why, size_t len) {
-  const Beam* b = self;
-  if (local[0] >= 0.0 && local[0] <= b->L * (1.0 + 1e-12)) return 0;
-  snprintf(why, len, "x = %g is beyond the beam's ends (0 to its length %g)", local[0], b->L);
-  return 1;
-}
-
 static void beam_destroy(void* self) { free(self); }
 
 static int beam_ncoord(const void* self) { return 3 + ((const Beam*)self)->n; }
@@ -819,7 +812,6 @@ const fmbBodyType fmb_body_beam = {
     .name = "beam",
     .abi = FMB_ABI_VERSION,
     .parse = beam_parse,
-    .point_outside = beam_point_outside,
     .destroy = beam_destroy,
     .ncoord = beam_ncoord,
     .initial = beam_initial,

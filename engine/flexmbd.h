@@ -83,7 +83,8 @@ FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned f
 FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out);
 /* a point of body `body` in the body's reference frame, [x, y] (default: *out as given); a point
-   the body says is not on it (fmbBodyType.point_outside) is refused here, at the point */
+   the body cannot place (its `marker` fails in the pose the scene gives, e.g. beyond a beam's
+   length) is refused here, at the point, instead of failing the run later with a false cause */
 FMB_API int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]);
 /* a body by name ("ground" is always defined); *out is the body index */
 FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);

@@ -393,10 +393,12 @@ int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, in
   if (!p || !key || !out || !p->model || body < 0 || body >= p->model->nbody) return -1;
   if (fmb_get_vec2(p, map, key, flags, out)) return -1;
   const fmbBodyInst* b = &p->model->body[body];
-  char why[200] = "";
-  if (b->type && b->type->point_outside && b->type->point_outside(b->self, out, why, sizeof why))
-    return fmb_parse_error(p, fmb_find_key(p, map, key), "%s [%g, %g] is not on body '%s' (type %s): %s", key, out[0],
-                           out[1], b->name, b->type->name, why);
+  double pos[2], angle;
+  if (b->type && fmb_initial_marker(p, body, out, pos, &angle))
+    return fmb_parse_error(p, fmb_find_key(p, map, key),
+                           "%s [%g, %g] is not on body '%s' (type %s): the body cannot place it (e.g. beyond a beam's "
+                           "length)",
+                           key, out[0], out[1], b->name, b->type->name);
   return 0;
 }
 
