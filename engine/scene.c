@@ -358,18 +358,13 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
   fmbDiag local_diag;
   if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
-  const char* misuse = !path                                                   ? "fmb_load: no scene path (NULL)"
-                       : (noverrides < 0 || (noverrides > 0 && !overrides))    ? "fmb_load: overrides NULL or a negative count"
-                       : !reg                                                  ? "fmb_load: no registry (NULL)"
-                       : (reg->nbodies < 0 || reg->njoints < 0 || (reg->nbodies > 0 && !reg->bodies) ||
-                          (reg->njoints > 0 && !reg->joints))                  ? "fmb_load: a registry list is NULL or has a negative length"
-                                                                               : NULL;
+  /* the registry itself is whole: every type entered it through fmb_registry_add's checks */
+  const char* misuse = !path                                                ? "fmb_load: no scene path (NULL)"
+                       : (noverrides < 0 || (noverrides > 0 && !overrides)) ? "fmb_load: overrides NULL or a negative count"
+                       : !reg                                               ? "fmb_load: no registry (NULL)"
+                                                                            : NULL;
   for (int i = 0; !misuse && i < noverrides; ++i)
     if (!overrides[i]) misuse = "fmb_load: an override is NULL";
-  for (int i = 0; !misuse && i < reg->nbodies; ++i)
-    if (!reg->bodies[i] || !reg->bodies[i]->name) misuse = "fmb_load: a registered body type is NULL or has no name";
-  for (int i = 0; !misuse && i < reg->njoints; ++i)
-    if (!reg->joints[i] || !reg->joints[i]->name) misuse = "fmb_load: a registered joint type is NULL or has no name";
   if (misuse) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "%s", misuse);
     return NULL;

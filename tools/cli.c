@@ -51,6 +51,7 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
       fmb_cli_print_diag(&d);
       return FMB_EXIT_BAD_INPUT;
     }
+    if (s->nplugins < (int)(sizeof s->plugins / sizeof s->plugins[0])) s->plugins[s->nplugins++] = so;
     return 1;
   }
   if (strcmp(a, "--set") == 0) {

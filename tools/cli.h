@@ -12,6 +12,8 @@ typedef struct fmbCliScene {
   const char* scene;
   const char* overrides[FMB_CLI_MAX_OVERRIDES];
   int nover;
+  const char* plugins[16]; /* the --plugin files (the first 16): inputs an output may not replace */
+  int nplugins;
 } fmbCliScene;
 
 /* Takes argv[*i] if it is `--set PATH=VALUE`, `--set=PATH=VALUE`, `--plugin x.so` (loaded into

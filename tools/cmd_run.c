@@ -69,9 +69,11 @@ int fmb_cmd_run(int argc, char** argv) {
   memset(&stats, 0, sizeof stats);
   /* every input is checked (the scene by fmb_load), and the output compared with them, before
      anything is run or written */
-  const char* inputs[] = {s.scene, reference};
+  const char* inputs[2 + sizeof s.plugins / sizeof s.plugins[0]] = {s.scene, reference};
+  int ninputs = 2;
+  for (int k = 0; k < s.nplugins; ++k) inputs[ninputs++] = s.plugins[k];
   int bad = reference ? fmb_cli_check_input(reference, "reference") : 0;
-  if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, reference ? 2 : 1);
+  if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
   if (bad) {
     fmb_print_stats(&stats, stderr);
     return bad;
