@@ -197,9 +197,9 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
      52 % off): refused, with the minimum */
   if (!err && b->ng < default_points(b->model))
     err = fmb_parse_error(p, fmb_find_key(p, item, "quadrature_points"),
-                          "quadrature_points %d under-integrates the %s beam: its integrands reach degree %d in x, "
-                          "which needs at least %d Gauss points per element (the default)",
-                          b->ng, model_names[b->model], b->model == BEAM_COMPLETE ? 10 : 6, default_points(b->model));
+                          "expected at least %d for 'quadrature_points' (the default), got %d: fewer Gauss points "
+                          "under-integrate the %s beam, whose integrands reach degree %d in x",
+                          default_points(b->model), b->ng, model_names[b->model], b->model == BEAM_COMPLETE ? 10 : 6);
   if (err) {
     free(b);
     return err;
@@ -792,8 +792,8 @@ static const fmbParam beam_params[] = {
     {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial frame angular velocity"},
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .fallback = "0",
      .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
-    {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 1,
-     .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element"},
+    {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 4,
+     .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
     {.key = NULL},
 };
 
