@@ -78,7 +78,7 @@ static void load_and_run_misuse(const char* scene, const char* csv) {
   fmbModel* m = fmb_load(scene, NULL, 0, reg, NULL);
   ENSURE(m != NULL);
   if (m) {
-    fmbRunOptions opt = {csv, 1, NULL};
+    fmbRunOptions opt = {.csv_path = csv, .quiet = 1};
     ENSURE(fmb_run(m, &opt, NULL, NULL) == 0);
     /* a directory as the output: an error, not a crash, and the model still runs after it */
     opt.csv_path = "/";
