@@ -321,6 +321,7 @@ static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
 
 /* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */
 int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  if (!p || !key || !out) return -1;
   static const double two_pi = 6.283185307179586;
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "an angle");

@@ -115,6 +115,12 @@ static void parser_misuse(const char* scene) {
   ENSURE(fmb_get_int(NULL, root, "k", 0, 0, 1, &i) == -1);
   ENSURE(fmb_get_int(&p, root, "k", 0, 0, 1, NULL) == -1);
   ENSURE(fmb_get_vec2(NULL, root, "gravity", 0, v) == -1);
+  ENSURE(fmb_get_angle(NULL, root, "angle", FMB_REQUIRED, &x) == -1);
+  ENSURE(fmb_get_angle(&p, root, "angle", 0, NULL) == -1);
+  ENSURE(fmb_get_point(NULL, root, "point", 0, 0, v) == -1);
+  ENSURE(fmb_get_point(&p, root, "point", 0, 0, NULL) == -1);
+  ENSURE(fmb_initial_marker(NULL, 0, v, v, NULL) == -1);
+  ENSURE(fmb_initial_marker(&p, 0, NULL, v, NULL) == -1);
   ENSURE(fmb_get_vec2(&p, root, "gravity", 0, NULL) == -1);
   ENSURE(fmb_get_choice(NULL, root, "k", 0, words, &i) == -1);
   ENSURE(fmb_get_choice(&p, root, "k", 0, NULL, &i) == -1);
