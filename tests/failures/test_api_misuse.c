@@ -1,6 +1,7 @@
 /* test_api_misuse.c — the library answers misuse with an error, never a crash (issue 12):
  *   1. every public function of engine/flexmbd.h called with NULL pointers and bad values;
- *   2. the duplicate-key check is linear: a mapping of 100,000 keys costs fewer than 2 string
+ *   2. (and messages: a long override is shortened, control characters escaped)
+ *   3. the duplicate-key check is linear: a mapping of 100,000 keys costs fewer than 2 string
  *      comparisons per key (counted, not timed: the old pairwise check made n^2/2 = 5e9), and
  *      a duplicate at its end is still found, at the right line.
  *
@@ -96,6 +97,23 @@ static void load_and_run_misuse(const char* scene, const char* csv) {
   fmb_print_stats(&st, NULL);
   fmb_free(NULL);
   fmb_free(m);
+}
+
+/* a long override is shortened in the message, which still ends with the reason; control
+   characters are escaped so the message stays on one line */
+static void long_override(const char* scene) {
+  char ov[400] = "solver.rtol=[";
+  for (int i = 0; i < 150; ++i) strcat(ov, "1,");
+  strcat(ov, "1]");
+  const char* list[] = {ov};
+  fmbDiag d;
+  ENSURE(fmb_load(scene, list, 1, fmb_builtin_registry(), &d) == NULL);
+  printf("long override: %s: %s\n", d.file, d.msg);
+  ENSURE(strlen(d.msg) < 200);
+  ENSURE(strstr(d.msg, "...(315 characters): expected a number for 'rtol', found a list") != NULL);
+  const char* two[] = {"solver.rtol=1e-8\n---\n2"};
+  ENSURE(fmb_load(scene, two, 1, fmb_builtin_registry(), &d) == NULL);
+  ENSURE(strchr(d.msg, '\n') == NULL && strstr(d.msg, "solver.rtol=1e-8\\n---\\n2: expected one YAML value") != NULL);
 }
 
 static void parser_misuse(const char* scene) {
@@ -218,6 +236,7 @@ int main(int argc, char** argv) {
   write_file(scene, scene_text);
   load_and_run_misuse(scene, csv);
   parser_misuse(scene);
+  long_override(scene);
   many_keys(argv[1]);
   return fmbt_finish("api_misuse");
 }
