@@ -732,7 +732,7 @@ static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* p
    loader recurses once per level). */
 #define FMB_SCENE_NODES_MAX 2000000
 #define FMB_SCENE_DEPTH_MAX 200
-#define FMB_MERGE_KEYS_MAX 10000
+#define FMB_MERGE_KEYS_MAX 1000 /* the merge is quadratic in the keys; scenes have tens */
 
 typedef struct {
   char* name;
