@@ -728,9 +728,11 @@ static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* p
    so an error inside an aliased node is reported where it is used and each use is checked on its
    own (unknown keys); a merge key `<<: *anchor` (or `<<: [*a, *b]`) adds the keys of the merged
    mappings that the mapping does not give itself (YAML 1.1 merge); the copies are bounded by a
-   node budget (aliases of aliases grow exponentially) and the nesting by a depth limit (libyaml's
+   node budget (aliases of aliases grow exponentially: 100,000 copied nodes in all, 2,000,000 in the
+   document) and the nesting by a depth limit (libyaml's
    loader recurses once per level). */
 #define FMB_SCENE_NODES_MAX 2000000
+#define FMB_ALIAS_NODES_MAX 100000 /* nodes copied for aliases, all uses together */
 #define FMB_SCENE_DEPTH_MAX 200
 #define FMB_MERGE_KEYS_MAX 1000 /* the merge is quadratic in the keys; scenes have tens */
 
@@ -747,6 +749,7 @@ typedef struct {
   int key[FMB_SCENE_DEPTH_MAX];  /* a mapping's key waiting for its value (0 = none) */
   int depth;
   int root;
+  long alias_budget; /* nodes aliases may still copy */
 } Composer;
 
 static void set_marks(yaml_document_t* doc, int id, yaml_mark_t start, yaml_mark_t end) {
@@ -923,11 +926,10 @@ static int compose_event(Composer* c, const yaml_event_t* ev, int* ndocs) {
                      "YAML syntax error: found undefined alias");
         return -1;
       }
-      long budget = FMB_SCENE_NODES_MAX - node_count(p);
-      id = copy_here(doc, target, ev->start_mark, &budget);
-      if (!id && budget < 0) {
+      id = copy_here(doc, target, ev->start_mark, &c->alias_budget);
+      if (!id && c->alias_budget < 0) {
         fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
-                     "the scene is too large: more than %d YAML nodes (counting every use of an alias)", FMB_SCENE_NODES_MAX);
+                     "the scene is too large: its aliases expand to more than %d YAML nodes", FMB_ALIAS_NODES_MAX);
         return -1;
       }
       if (!id) break;
@@ -963,6 +965,7 @@ static int compose(fmbParser* p, yaml_parser_t* parser, FILE* f) {
   Composer c;
   memset(&c, 0, sizeof c);
   c.p = p;
+  c.alias_budget = FMB_ALIAS_NODES_MAX;
   if (!yaml_document_initialize(&p->doc, NULL, NULL, NULL, 1, 1)) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "out of memory");
     return -1;
