@@ -21,6 +21,10 @@ static int rigid_parse(fmbParser* p, fmbNode item, void** self) {
       fmb_get_vec2(p, item, "position", 0, r->pos) || fmb_get_angle(p, item, "angle", FMB_POSE, &r->angle) ||
       fmb_get_vec2(p, item, "velocity", 0, r->vel) || fmb_get_double(p, item, "angular_velocity", 0, &r->omega))
     return -1;
+  /* subnormal values pass "positive" but their inverses overflow */
+  if (!isnormal(r->mass)) return fmb_parse_error(p, fmb_find_key(p, item, "mass"), "mass %g is too small to compute with", r->mass);
+  if (!isnormal(r->inertia))
+    return fmb_parse_error(p, fmb_find_key(p, item, "inertia"), "inertia %g is too small to compute with", r->inertia);
   return 0;
 }
 

@@ -514,6 +514,7 @@ static void check_energy(Report* r, const char* base, const char* type, const Li
 /* ---- the driver ------------------------------------------------------------------------------ */
 
 int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, FILE* report) {
+  if (!reg || !type_name || !work_dir || !report) return -1;
   const fmbBodyType* bt = NULL;
   const fmbJointType* jt = NULL;
   for (int i = 0; i < reg->nbodies && !bt; ++i)

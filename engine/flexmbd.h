@@ -13,6 +13,7 @@
 #ifndef FLEXMBD_H
 #define FLEXMBD_H
 
+#include <signal.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -45,16 +46,18 @@ extern "C" {
 #define FMB_EXIT_OK 0
 #define FMB_EXIT_BAD_INPUT 2
 #define FMB_EXIT_SOLVER 3
+#define FMB_EXIT_INTERRUPTED 4 /* SIGINT/SIGTERM: stopped at the next step, rows so far kept */
 
 typedef struct fmbDiag {
-  int code;        /* 0 none, FMB_EXIT_BAD_INPUT or FMB_EXIT_SOLVER */
+  int code;        /* 0 none, FMB_EXIT_BAD_INPUT, FMB_EXIT_SOLVER or FMB_EXIT_INTERRUPTED */
   char file[512];  /* scene path, or "--set" for an override */
   int line, col;
   char msg[1024];
 } fmbDiag;
 
 /* ---------------------------------------------------------------------------------------------
- * Scene parsing API for plugins (the one YAML accessor layer, engine/yaml_get.c).
+ * Scene parsing API for plugins (the one YAML accessor layer, engine/yaml_get.c). A NULL parser,
+ * key or output pointer makes an accessor return -1 without touching anything.
  * A node is an index into the loaded document. Every accessor records the key as "known" for
  * the unknown-key check, applies the default already in *out when the key is absent and not
  * required, and on error records file:line:column plus what was expected, returning non-zero.
@@ -79,6 +82,10 @@ FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned f
 /* one of a NULL-terminated list of words; *out is the index */
 FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out);
+/* a point of body `body` in the body's reference frame, [x, y] (default: *out as given); a point
+   the body cannot place (its `marker` fails in the pose the scene gives, e.g. beyond a beam's
+   length) is refused here, at the point, instead of failing the run later with a false cause */
+FMB_API int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]);
 /* a body by name ("ground" is always defined); *out is the body index */
 FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
 /* a joint defined earlier in the file, by name; *out is the joint index */
@@ -86,6 +93,10 @@ FMB_API int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned f
 /* body index and local point of attachment k (0 or 1) of an already parsed joint with
    constraint rows (a pivot, a weld; not a spring's ends) */
 FMB_API int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]);
+/* position and angle of material point `local` of body `body` in the pose the scene gives it
+   (before any assembly), e.g. for a joint whose default is the configuration as assembled.
+   Returns 0, or -1 (bad arguments, or the body cannot place the point). */
+FMB_API int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle);
 /* a plugin-level check failed at `node` (a value node or the item's mapping) */
 FMB_API int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
 #if defined(__GNUC__)
@@ -246,7 +257,8 @@ typedef struct fmbJointType {
   unsigned flags;
 } fmbJointType;
 
-/* what a joint may ask of the evaluation context */
+/* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
+   0, NULL or -1: a plugin bug, reported instead of crashing) */
 FMB_API double fmb_eval_time(const fmbJointEval* ev);
 FMB_API int fmb_eval_ncoord(const fmbJointEval* ev, int k);      /* coordinates of body k (0 for ground) */
 FMB_API const double* fmb_eval_q(const fmbJointEval* ev, int k);
@@ -327,6 +339,7 @@ typedef struct fmbStats {
   double cpu_s;
   double ic_position_correction, ic_velocity_correction; /* norms of the initial projection */
   long rows_written;
+  int interrupted; /* the run stopped because *fmbRunOptions.stop was set */
 } fmbStats;
 
 typedef struct fmbRunOptions {
@@ -337,14 +350,33 @@ typedef struct fmbRunOptions {
   int progress;
   double progress_after_s;
   const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
+  /* may be NULL; when *stop becomes non-zero (e.g. set by a SIGINT handler) the run ends after
+     the step in progress, keeps its rows and returns FMB_EXIT_INTERRUPTED */
+  const volatile sig_atomic_t* stop;
 } fmbRunOptions;
 
+/* Ownership and misuse (every function here checks its pointer arguments: a NULL required
+ * argument is an error, never a crash):
+ *   - fmb_load returns a model the caller owns and releases with fmb_free (NULL is fine). It
+ *     reads `path` and the override strings only during the call; the registry and the type
+ *     tables it points to must outlive the model (the model calls their ops). A plugin's `self`
+ *     belongs to the model once its parse returned 0 (and to nobody if it failed: the engine
+ *     calls destroy on whatever it set).
+ *   - fmb_run only reads the model (one model may be run several times); it writes *stats and
+ *     *diag, both optional (NULL = not wanted); opt may be NULL (stdout, progress lines on).
+ *   - fmbDiag and fmbStats are plain values owned by the caller; nothing in them needs freeing.
+ *   - Output files: fmb_run writes a regular file to a temporary file beside it and renames it
+ *     into place once the header is written, so a run that fails before that leaves an existing
+ *     file as it was; "-" and non-regular files are written through and never removed. */
+
 /* Load `path`, applying "PATH=VALUE" overrides (e.g. "solver.rtol=1e-8",
-   "bodies.beam.elements=32"). Returns NULL with *diag filled on error. */
+   "bodies.beam.elements=32"). Returns NULL with *diag filled (diag may be NULL) on error,
+   including a NULL path or registry, or NULL overrides with noverrides > 0. */
 FMB_API fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
                    fmbDiag* diag);
 /* Integrate from the scene's t0 to t_end, writing CSV rows as it goes. Returns 0 or an exit code
-   (FMB_EXIT_SOLVER) with *diag saying when and why it stopped. */
+   (FMB_EXIT_SOLVER, FMB_EXIT_INTERRUPTED; FMB_EXIT_BAD_INPUT for a NULL model or an output that
+   cannot be written) with *diag saying when and why it stopped. */
 FMB_API int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* stats, fmbDiag* diag);
 FMB_API void fmb_free(fmbModel* m);
 /* the solver settings a loaded scene runs with (its values after --set overrides) */
@@ -353,8 +385,9 @@ typedef struct fmbSolverInfo {
 } fmbSolverInfo;
 /* 0, or -1 when an argument is NULL */
 FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
-/* one line per body and joint: type and active terms */
+/* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
+/* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 
 /* ---------------------------------------------------------------------------------------------

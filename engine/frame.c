@@ -8,6 +8,7 @@
 
 void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* angle, double* dpos_dframe,
                      double* dangle_dframe) {
+  if (!frame || !local || !pos) return;
   const double c = cos(frame[2]), s = sin(frame[2]);
   pos[0] = frame[0] + c * local[0] - s * local[1];
   pos[1] = frame[1] + s * local[0] + c * local[1];

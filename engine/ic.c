@@ -1,18 +1,32 @@
 /* ic.c — consistent initial conditions for the GGL system.
  *
  * 1. positions: Gauss–Newton projection onto Phi(q, t0) = 0, the minimum-norm correction
- *    dq = -Phi_q^T (Phi_q Phi_q^T)^-1 Phi;
+ *    dq = -Phi_q^T (Phi_q Phi_q^T)^-1 Phi, until max |Phi_i| <= FMB_IC_PHI_TOL: absolute, in
+ *    the constraint's own units (m, rad), whatever the coordinates' magnitude (a test relative
+ *    to |q| let a pose 1e13 m out "converge" with a 1 m rod violated by 0.9 m). A body moved by
+ *    more than FMB_ASSEMBLY_TOL is an error unless the scene says `initial: assemble`: the
+ *    projection would otherwise change the mechanism silently;
  * 2. velocities: the minimum-norm correction onto Phi_q v + Phi_t = 0;
  * 3. accelerations and multipliers from the augmented system
  *        [M  Phi_q^T] [a     ]   [Q    ]
  *        [Phi_q   0 ] [lambda] = [gamma],   gamma = -(Phi_q v)_q v - Phi_tt,
  *    so IDA starts from F(t0, y0, y0') = 0. mu = 0. The sizes of the corrections are reported.
  * Setup-time code: it may allocate. */
+#include <float.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "internal.h"
+
+#define FMB_IC_PHI_TOL 1e-10   /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
+#define FMB_ASSEMBLY_TOL 1e-6  /* m or rad: a larger initial correction changes the mechanism */
+
+static double max_abs(const double* x, int n) {
+  double s = 0.0;
+  for (int i = 0; i < n; ++i) s = fmax(s, fabs(x[i]));
+  return s;
+}
 
 static double norm2(const double* x, int n) {
   double s = 0.0;
@@ -72,12 +86,12 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   memcpy(v0, v, (size_t)nq * sizeof(double));
 
   if (nc > 0) {
-    double scale = 1.0 + norm2(q, nq), res = 0.0;
+    double res = 0.0;
     int it, converged = 0;
     for (it = 0; it < 50; ++it) {
       if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt)) break;
-      res = norm2(phi, nc);
-      if (res <= 1e-13 * scale) {
+      res = max_abs(phi, nc);
+      if (res <= FMB_IC_PHI_TOL) {
         converged = 1;
         break;
       }
@@ -91,10 +105,16 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
       }
     }
     if (!converged) {
+      /* far from the origin double precision cannot resolve FMB_IC_PHI_TOL: say so */
+      const double qmax = max_abs(q, nq);
+      char far[160] = "";
+      if (qmax * 1e-15 > 0.1 * FMB_IC_PHI_TOL)
+        snprintf(far, sizeof far, "; coordinates reach %.3g, too far out for double precision to hold joints to %g",
+                 qmax, FMB_IC_PHI_TOL);
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps, "
-                   "or redundant constraints): check the joints' points, the bodies' initial poses, and that no joint repeats another",
-                   t0, res, it);
+                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g, tolerance %g, after %d projection steps, "
+                   "or redundant constraints): check the joints' points, the bodies' initial poses, and that no joint repeats another%s",
+                   t0, res, FMB_IC_PHI_TOL, it, far);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
@@ -119,6 +139,37 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   for (int i = 0; i < nq; ++i) {
     q0[i] = q[i] - q0[i];
     v0[i] = v[i] - v0[i];
+  }
+  /* coordinates so large that a double cannot resolve the joint tolerance: the run would hold
+     its joints only to that resolution (a bob projected from 1e13 m got an angle of -3e12 rad,
+     resolved to 5e-4 rad) */
+  const double qmax = max_abs(q, nq);
+  if (qmax * DBL_EPSILON > FMB_IC_PHI_TOL) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the initial coordinates reach %.3g (m or rad)%s: at that magnitude a double resolves only %.2g, coarser "
+                 "than the joints' tolerance %g. Place the mechanism near the origin",
+                 qmax, m->assemble ? " after assembly" : "", qmax * DBL_EPSILON, FMB_IC_PHI_TOL);
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  /* the body the projection moved most: beyond FMB_ASSEMBLY_TOL only if the scene asks */
+  int worst = 0;
+  double moved = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const double d = max_abs(q0 + m->body[b].qadr, m->body[b].nq);
+    if (d > moved) {
+      moved = d;
+      worst = b;
+    }
+  }
+  if (moved > FMB_ASSEMBLY_TOL && !m->assemble) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the joints are not satisfied by the poses given: they move body '%s' by %.3g (the largest change of "
+                 "one of its coordinates, m or rad; tolerance %g). Give poses that satisfy the joints, or write "
+                 "`initial: assemble` at the top level to let flexmbd move the bodies onto them",
+                 m->body[worst].name, moved, FMB_ASSEMBLY_TOL);
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
   }
   st->ic_position_correction = norm2(q0, nq);
   st->ic_velocity_correction = norm2(v0, nq);

@@ -9,6 +9,7 @@
  * the error control acts on positions and velocities only. Output rows are written at the scene's
  * output step; on any failure every row so far is already on disk and the message says when,
  * why, and what to try. */
+#include <errno.h>
 #include <ida/ida.h>
 #include <math.h>
 #include <nvector/nvector_serial.h>
@@ -33,7 +34,10 @@ typedef struct {
   char ida_msg[512];
   long fresh_steps, fresh_conv_fails; /* IDA's counters at the last fresh Jacobian */
   long fresh, reused;
+  const volatile sig_atomic_t* stop; /* set by the program's SIGINT/SIGTERM handler */
 } RunCtx;
+
+static int stop_requested(const RunCtx* c) { return c->stop && *c->stop; }
 
 /* IDA asks for a new iteration matrix when cj has changed by more than 25 % or after a Newton
    convergence failure. Only the first needs nothing new from the bodies: their K, C, M do not
@@ -57,6 +61,8 @@ static int reuse_body_blocks(RunCtx* c) {
 
 static int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void* ud) {
   RunCtx* c = ud;
+  /* an interrupt ends the step in progress: IDA returns the last completed step */
+  if (stop_requested(c)) return -1;
   return fmb_system_residual(c->m, c->w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(F));
 }
 
@@ -88,12 +94,6 @@ static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N
                              reuse, SUNSparseMatrix_Data(J), NULL);
 }
 
-/* A step this small (relative to the whole run) means IDA is closing in on a singularity it
-   cannot pass rather than resolving dynamics: the FOAC pendulum approached its mass matrix's
-   singular crossing with steps of 1e-14 s, 100,000 of them per output (47 s) before giving up.
-   With a floor, the first failure there ends the run and the usual diagnosis says why. */
-#define FMB_MIN_STEP_FRACTION 1e-12
-
 static void ida_error_handler(int code, const char* module, const char* function, char* msg, void* ud) {
   (void)code;
   (void)module;
@@ -101,35 +101,57 @@ static void ida_error_handler(int code, const char* module, const char* function
   snprintf(c->ida_msg, sizeof c->ida_msg, "%s: %s", function, msg);
 }
 
-static const char* failure_advice(int flag) {
+/* What to try after IDA gives up with `flag`. The advice names only causes this scene can have
+   (a dead point needs joints) and says when the state has left any physical scale, since
+   extreme values, not the mechanism's geometry, then explain a singular matrix. */
+static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, size_t len) {
+  const int joints = m->nc > 0;
+  if (ymax > 1e100 && (flag == IDA_CONV_FAIL || flag == IDA_LSETUP_FAIL || flag == IDA_LSOLVE_FAIL || flag == IDA_ERR_FAIL)) {
+    snprintf(buf, len,
+             "the solution reached a magnitude of %.3g: the state is blowing up or a parameter is far beyond a physical "
+             "scale (check masses, stiffnesses, forces and their units)",
+             ymax);
+    return;
+  }
+  const char* s = "the integrator stopped";
   switch (flag) {
     case IDA_TOO_MUCH_WORK:
-      return "too many steps between two outputs: the problem is very stiff or changing very fast here. "
-             "Try a larger solver.max_steps, a looser rtol, or check for unphysical parameters";
-    case IDA_TOO_MUCH_ACC: return "the tolerances are tighter than machine precision allows: loosen rtol/atol";
+      s = "too many steps between two outputs: the problem is very stiff or changing very fast here. "
+          "Try a larger solver.max_steps, a looser rtol, or check for unphysical parameters";
+      break;
+    case IDA_TOO_MUCH_ACC: s = "the tolerances are tighter than machine precision allows: loosen rtol/atol"; break;
     case IDA_ERR_FAIL:
-      return "the error test failed repeatedly down to the minimum step: the solution is blowing up or jumps "
-             "(an unstable model, e.g. a ZOAC beam spun above its first bending frequency, or a discontinuous input)";
+      s = "the error test failed repeatedly down to the minimum step: the solution is blowing up or jumps "
+          "(an unstable model or a discontinuous input)";
+      break;
     case IDA_CONV_FAIL:
-      return "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
-             "has become unstable. Try a smaller solver.max_step or a tighter rtol";
+      s = joints ? "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
+                   "has become unstable. Try a smaller solver.max_step or a tighter rtol"
+                 : "Newton's method failed repeatedly: the model has become unstable or too stiff for the step. Try a "
+                   "smaller solver.max_step or a tighter rtol";
+      break;
     case IDA_LSETUP_FAIL:
-      return "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
-             "(a dead point, where the joints no longer fix the motion) or a mass matrix that lost definiteness. "
-             "Check the mechanism's geometry; a drive that forces it through a dead point cannot be integrated";
-    case IDA_LSOLVE_FAIL: return "the linear solver failed: the Newton matrix is singular or ill-conditioned";
+      s = joints ? "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
+                   "(a dead point, where the joints no longer fix the motion) or a mass matrix that lost definiteness. "
+                   "Check the mechanism's geometry; a drive that forces it through a dead point cannot be integrated"
+                 : "the Newton matrix could not be factorized (it is singular): a mass matrix that lost definiteness";
+      break;
+    case IDA_LSOLVE_FAIL: s = "the linear solver failed: the Newton matrix is singular or ill-conditioned"; break;
     case IDA_REP_RES_ERR:
-      return "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
-    case IDA_RES_FAIL: return "a plugin could not evaluate its equations";
-    default: return "the integrator stopped";
+      s = "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
+      break;
+    case IDA_RES_FAIL: s = "a plugin could not evaluate its equations"; break;
+    default: break;
   }
+  snprintf(buf, len, "%s", s);
 }
 
 void fmb_print_stats(const fmbStats* s, FILE* f) {
+  if (!s || !f) return;
   fprintf(f,
           "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
           "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
-          s->status_ok ? "ok" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
+          s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
           s->error_test_fails, s->conv_fails, s->jacobians_reused, s->cpu_s);
 }
 
@@ -213,6 +235,16 @@ static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* 
 }
 
 int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* diag) {
+  fmbStats local_stats;
+  fmbDiag local_diag;
+  if (!st) st = &local_stats;
+  if (!diag) diag = &local_diag;
+  if (!m) {
+    memset(st, 0, sizeof *st);
+    memset(diag, 0, sizeof *diag);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_run: no model (NULL)");
+    return FMB_EXIT_BAD_INPUT;
+  }
   clock_t c0 = clock();
   memset(st, 0, sizeof *st);
   memset(diag, 0, sizeof *diag);
@@ -232,6 +264,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   RunCtx ctx;
   memset(&ctx, 0, sizeof ctx);
   ctx.m = m;
+  ctx.stop = opt ? opt->stop : NULL;
   SUNContext sun = NULL;
   N_Vector y = NULL, yp = NULL, id = NULL, atol = NULL;
   SUNMatrix A = NULL;
@@ -270,7 +303,12 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  fmb_csv_header(csv, m);
+  if (stop_requested(&ctx)) goto done;
+  if (fmb_csv_header(csv, m)) {
+    row_failed(m, -1, t, diag);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
   if (row_failed(m, write_outputs(csv, vtk, m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp)), t, diag)) {
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -306,7 +344,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       IDASetSuppressAlg(ida, SUNTRUE) != IDA_SUCCESS || IDASetMaxOrd(ida, m->solver.max_order) != IDA_SUCCESS ||
       IDASetMaxNumSteps(ida, m->solver.max_steps_per_output) != IDA_SUCCESS ||
       (m->solver.max_step > 0 && IDASetMaxStep(ida, m->solver.max_step) != IDA_SUCCESS) ||
-      IDASetMinStep(ida, FMB_MIN_STEP_FRACTION * (m->solver.t_end - m->solver.t0)) != IDA_SUCCESS) {
+      IDASetMinStep(ida, m->solver.min_step) != IDA_SUCCESS) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up IDA: %s", ctx.ida_msg);
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -330,17 +368,29 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     double tout = k == nout ? t_end : t0 + (double)k * dt;
     double tret = t;
     int flag = IDASolve(ida, tout, &tret, y, yp, IDA_NORMAL);
+    if (flag < 0 && stop_requested(&ctx)) {
+      t = tret;
+      break;
+    }
     if (flag < 0) {
       t = tret;
       bad = fmb_check_mass(m, ctx.w, tret, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 1e-5);
       if (bad) {
         mass_failure(m, bad, tret, diag);
       } else {
-        double hcur = 0.0;
+        double hcur = 0.0, ymax = 0.0;
         IDAGetCurrentStep(ida, &hcur);
+        const double* yv = N_VGetArrayPointer(y);
+        for (int i = 0; i < ny; ++i) ymax = fmax(ymax, fabs(yv[i]));
+        char advice[600], floor_note[200] = "";
+        failure_advice(m, flag, ymax, advice, sizeof advice);
+        /* a stop at the step floor names the key that sets it and where its value came from */
+        if (fabs(hcur) <= 1.5 * m->solver.min_step)
+          snprintf(floor_note, sizeof floor_note, "; the step reached solver.min_step = %.3g (%s)", m->solver.min_step,
+                   m->solver.min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)");
         char* flag_name = IDAGetReturnFlagName(flag); /* allocated by SUNDIALS */
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s [IDA %s: %s]",
-                     tret, hcur, failure_advice(flag), flag_name ? flag_name : "?", ctx.ida_msg);
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s%s [IDA %s: %s]",
+                     tret, hcur, advice, floor_note, flag_name ? flag_name : "?", ctx.ida_msg);
         free(flag_name);
       }
       rc = FMB_EXIT_SOLVER;
@@ -363,10 +413,17 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     }
     st->rows_written++;
     progress_update(&progress, m, t, ida);
+    if (stop_requested(&ctx)) break;
   }
   progress_end(&progress);
 
 done:
+  if (stop_requested(&ctx) && !rc) {
+    st->interrupted = 1;
+    rc = FMB_EXIT_INTERRUPTED;
+    fmb_diag_set(diag, rc, m->path, 0, 0, "interrupted at t = %.6g (SIGINT or SIGTERM): the %ld rows written so far are kept",
+                 t, st->rows_written);
+  }
   st->t_reached = t;
   st->status_ok = rc == 0;
   if (ida) {
@@ -389,8 +446,12 @@ done:
   if (ctx.ewt) N_VDestroy(ctx.ewt);
   if (sun) SUNContext_Free(&sun);
   fmb_workspace_free(ctx.w);
-  fmb_csv_close(csv);
   fmb_vtk_close(vtk);
+  if (fmb_csv_close(csv) && !rc) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not put the output in place: %s", strerror(errno));
+    rc = FMB_EXIT_SOLVER;
+    st->status_ok = 0;
+  }
   st->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
   return rc;
 }

@@ -15,6 +15,7 @@ typedef struct fmbBodyInst {
   const fmbBodyType* type; /* NULL for the world frame */
   void* self;
   int qadr, nq; /* slice of the coordinate vector */
+  fmbNode node; /* its item in the scene, for messages about it after parsing */
   size_t workadr, nwork;
 } fmbBodyInst;
 
@@ -48,6 +49,8 @@ typedef struct fmbOutput {
 
 typedef struct fmbSolverSettings {
   double t0, t_end, rtol, atol, output_step, max_step;
+  double min_step;     /* IDA's step floor: solver.min_step, default FMB_MIN_STEP_FRACTION (t_end - t0) */
+  int min_step_given;  /* 1 when the scene set solver.min_step (named in messages either way) */
   /* Newton systems: KLU on the Schur complement of the position rows (schur.c, default), KLU on
      the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
   enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
@@ -55,6 +58,12 @@ typedef struct fmbSolverSettings {
   int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
 } fmbSolverSettings;
+
+/* A step this small relative to the whole run means IDA is closing in on a singularity it
+   cannot pass rather than resolving dynamics: the FOAC pendulum approached its mass matrix's
+   singular crossing with steps of 1e-14 s, 100,000 of them per output (47 s) before giving up.
+   With a floor, the first failure there ends the run and the usual diagnosis says why. */
+#define FMB_MIN_STEP_FRACTION 1e-12
 
 /* one rectangle (or diagonal run) of the iteration matrix's fixed sparsity pattern */
 typedef struct fmbBlock {
@@ -75,6 +84,7 @@ struct fmbModel {
   fmbSolverSettings solver;
   int noutput;
   fmbOutput* output;
+  int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
@@ -133,6 +143,7 @@ struct fmbParser {
   fmbNode item;             /* the item being parsed, or -1 */
   fmbNode inherited[2];     /* its material and section entries, or -1 */
   fmbModel* model;          /* under construction */
+  long key_compares;        /* string comparisons of the duplicate-key check (tests count them) */
   const fmbRegistry* reg;
   fmbRegistry* own_reg;     /* the scene's plugins: a copy of the caller's registry, or NULL */
 };
@@ -239,12 +250,14 @@ int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, c
                    double* angle);
 void fmb_outputs_default(fmbModel* m);
 typedef struct fmbCsv fmbCsv;
+/* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
-void fmb_csv_header(fmbCsv* c, const fmbModel* m);
+int fmb_csv_header(fmbCsv* c, const fmbModel* m); /* 0 ok, -1 write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
-void fmb_csv_close(fmbCsv* c);
+/* puts a file with a header in place (rename), removes one without; -1 with errno on failure */
+int fmb_csv_close(fmbCsv* c);
 /* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */
-void fmb_csv_header_names(fmbCsv* c, int n, const char* const* names);
+int fmb_csv_header_names(fmbCsv* c, int n, const char* const* names);
 int fmb_csv_values(fmbCsv* c, const double* values);
 /* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row);

@@ -1,12 +1,15 @@
 /* output.c — named outputs and the one CSV writer.
  * Columns are resolved once at load ("BODY.quantity", "JOINT.quantity", "energy.*",
  * "constraint.*"); a row computes only what its columns need (no energy pass unless an energy
- * column is asked for). Rows are flushed as they are written, so a run that stops keeps them. */
+ * column is asked for). Rows go to disk as they are written, so a run that stops keeps them. */
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "internal.h"
 
@@ -200,58 +203,146 @@ void fmb_outputs_default(fmbModel* m) {
 
 /* ------------------------------------------------------------------------------------------ */
 
+/* The writer never deletes, replaces or truncates a file this run did not create:
+ *  - a regular (or not yet existing) target is written to a temporary file beside it
+ *    (".NAME.XXXXXX", same directory, so same file system) that fmb_csv_close renames onto the
+ *    target once the run has written its header: a run that stops on bad input before that
+ *    leaves the target as it was; one that stops later replaces it with the rows it has;
+ *  - "-" (stdout) and non-regular targets (/dev/null, a FIFO, a terminal) are written straight
+ *    through and never removed;
+ *  - a symbolic link is followed: the file it names is the target, the link stays.
+ * Whole rows only: a row is formatted in memory and written with one write loop; if that fails
+ * (disk full) the temporary file is cut back to the last complete row. Signals only set a flag
+ * (tools/cmd_run.c), so a row is never left half written by SIGINT or SIGTERM. */
 struct fmbCsv {
-  FILE* f;
-  int owns;
+  int fd;
+  int through;       /* stdout or a non-regular target: written in place, never removed */
+  char* target;      /* the file the rows are for (symbolic links resolved) */
+  char* temp;        /* the temporary file beside it, NULL when written through */
+  off_t complete;    /* bytes of whole lines in the temporary file */
+  int wrote_header;
   double* row;
-  int nrow;      /* 0 until the header is written */
-  char* path;    /* owned file: removed on close if no header was ever written */
+  int nrow;
+  char* line;        /* one formatted row */
+  size_t cap;
 };
+
+static int write_all(int fd, const char* buf, size_t len) {
+  while (len > 0) {
+    ssize_t k = write(fd, buf, len);
+    if (k < 0 && errno == EINTR) continue;
+    if (k <= 0) return -1;
+    buf += k;
+    len -= (size_t)k;
+  }
+  return 0;
+}
+
+/* write one whole line, or (temporary file) nothing: a short write is cut back */
+static int write_line(fmbCsv* c, const char* buf, size_t len) {
+  if (write_all(c->fd, buf, len) == 0) {
+    c->complete += (off_t)len;
+    return 0;
+  }
+  const int err = errno;
+  if (c->temp && ftruncate(c->fd, c->complete) == 0) lseek(c->fd, c->complete, SEEK_SET);
+  errno = err;
+  return -1;
+}
+
+static fmbCsv* csv_fail(fmbCsv* c, fmbDiag* diag, const char* path, const char* what) {
+  fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", what);
+  fmb_csv_close(c); /* no header written: removes the temporary file, if any */
+  return NULL;
+}
 
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
   fmbCsv* c = calloc(1, sizeof *c);
-  if (!c) return NULL;
+  if (!c) return csv_fail(NULL, diag, path, "out of memory");
+  c->fd = -1;
   if (!path || strcmp(path, "-") == 0) {
-    c->f = stdout;
-  } else {
-    c->f = fopen(path, "w");
-    c->owns = 1;
-    c->path = c->f ? strdup(path) : NULL;
-    if (!c->f || !c->path) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", strerror(errno));
-      if (c->f) fclose(c->f);
-      free(c);
-      return NULL;
-    }
+    fflush(stdout);
+    c->fd = STDOUT_FILENO;
+    c->through = 1;
+    return c;
   }
+  struct stat st, lst;
+  const int exists = stat(path, &st) == 0;
+  if (!exists && lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode))
+    return csv_fail(c, diag, path, "it is a symbolic link to a file that does not exist");
+  if (exists && S_ISDIR(st.st_mode)) return csv_fail(c, diag, path, strerror(EISDIR));
+  if (exists && !S_ISREG(st.st_mode)) {
+    /* a device or FIFO: write through, no truncation, never removed */
+    c->fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
+    if (c->fd < 0) return csv_fail(c, diag, path, strerror(errno));
+    c->through = 1;
+    return c;
+  }
+  if (exists && access(path, W_OK) != 0) return csv_fail(c, diag, path, strerror(errno));
+  c->target = exists ? realpath(path, NULL) : strdup(path);
+  if (!c->target) return csv_fail(c, diag, path, strerror(errno));
+  const char* slash = strrchr(c->target, '/');
+  const size_t dirlen = slash ? (size_t)(slash - c->target) + 1 : 0;
+  const char* base = slash ? slash + 1 : c->target;
+  const size_t n = dirlen + strlen(base) + 16;
+  c->temp = malloc(n);
+  if (!c->temp) return csv_fail(c, diag, path, "out of memory");
+  snprintf(c->temp, n, "%.*s.%s.XXXXXX", (int)dirlen, c->target, base);
+  c->fd = mkstemp(c->temp);
+  if (c->fd < 0) {
+    const int err = errno;
+    free(c->temp);
+    c->temp = NULL;
+    return csv_fail(c, diag, path, strerror(err));
+  }
+  /* the permissions a plain fopen(path, "w") would give: the old file's, or 0666 less umask */
+  mode_t mode = exists ? (st.st_mode & 07777) : 0666;
+  if (!exists) {
+    const mode_t mask = umask(0);
+    umask(mask);
+    mode &= ~mask;
+  }
+  if (fchmod(c->fd, mode) != 0) return csv_fail(c, diag, path, strerror(errno));
   return c;
 }
 
-void fmb_csv_header(fmbCsv* c, const fmbModel* m) {
-  for (int i = 0; i < m->noutput; ++i) fprintf(c->f, "%s%s", i ? "," : "", m->output[i].name);
-  fprintf(c->f, "\n");
-  fflush(c->f);
+/* a header of named columns; rows of as many values follow (the scene's outputs, or tables
+   that are not: modes, Campbell). 0 ok, -1 a write failed or no memory */
+int fmb_csv_header_names(fmbCsv* c, int n, const char* const* names) {
+  size_t need = 2;
+  for (int i = 0; i < n; ++i) need += strlen(names[i]) + 1;
+  /* a row: at most 24 characters per %.12g value plus its comma */
+  if (need < (size_t)n * 26 + 2) need = (size_t)n * 26 + 2;
+  free(c->line);
   free(c->row);
-  c->row = calloc((size_t)m->noutput, sizeof(double));
-  c->nrow = m->noutput;
-}
-
-/* a header of arbitrary named columns (tables that are not the scene's outputs: modes, Campbell) */
-void fmb_csv_header_names(fmbCsv* c, int n, const char* const* names) {
-  for (int i = 0; i < n; ++i) fprintf(c->f, "%s%s", i ? "," : "", names[i]);
-  fprintf(c->f, "\n");
-  fflush(c->f);
-  free(c->row);
-  c->row = calloc((size_t)n, sizeof(double));
+  c->line = malloc(need);
+  c->row = calloc((size_t)(n > 0 ? n : 1), sizeof(double));
+  c->cap = need;
+  if (!c->line || !c->row) return -1;
+  size_t used = 0;
+  for (int i = 0; i < n; ++i) used += (size_t)snprintf(c->line + used, need - used, "%s%s", i ? "," : "", names[i]);
+  c->line[used++] = '\n';
   c->nrow = n;
+  c->wrote_header = 1;
+  return write_line(c, c->line, used);
 }
 
-/* one row of as many values as the header has columns; 0 ok, -1 a write failed */
+int fmb_csv_header(fmbCsv* c, const fmbModel* m) {
+  const char** names = malloc((size_t)(m->noutput > 0 ? m->noutput : 1) * sizeof *names);
+  if (!names) return -1;
+  for (int i = 0; i < m->noutput; ++i) names[i] = m->output[i].name;
+  const int rc = fmb_csv_header_names(c, m->noutput, names);
+  free(names);
+  return rc;
+}
+
+/* one whole row of as many values as the header has columns; 0 ok, -1 a write failed */
 int fmb_csv_values(fmbCsv* c, const double* values) {
-  for (int i = 0; i < c->nrow; ++i) fprintf(c->f, "%s%.12g", i ? "," : "", values[i]);
-  fprintf(c->f, "\n");
-  if (fflush(c->f) != 0 || ferror(c->f)) return -1;
-  return 0;
+  size_t used = 0;
+  for (int i = 0; i < c->nrow; ++i)
+    used += (size_t)snprintf(c->line + used, c->cap - used, "%s%.12g", i ? "," : "", values[i]);
+  c->line[used++] = '\n';
+  return write_line(c, c->line, used) ? -1 : 0;
 }
 
 /* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
@@ -304,12 +395,27 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
   return fmb_csv_values(c, c->row);
 }
 
-void fmb_csv_close(fmbCsv* c) {
-  if (!c) return;
-  if (c->owns && c->f) fclose(c->f);
-  /* a run that stopped before its first row (bad initial conditions) leaves no empty file */
-  if (c->owns && c->path && c->nrow == 0) remove(c->path);
-  free(c->path);
+/* A temporary file becomes the target if the header was written (the run got as far as its
+   first row: keep what it has), else it is removed and the target is left as it was. Returns 0,
+   or -1 with errno when the rows could not be put in place. */
+int fmb_csv_close(fmbCsv* c) {
+  if (!c) return 0;
+  int rc = 0;
+  if (c->temp) {
+    const int keep = c->wrote_header;
+    if (keep && fsync(c->fd) != 0 && errno != EINVAL) rc = -1;
+    if (close(c->fd) != 0) rc = -1;
+    if (keep && rc == 0 && rename(c->temp, c->target) != 0) rc = -1;
+    const int err = errno;
+    if (!keep || rc) unlink(c->temp);
+    errno = err;
+  } else if (c->fd > STDERR_FILENO) {
+    if (close(c->fd) != 0) rc = -1;
+  }
+  free(c->temp);
+  free(c->target);
+  free(c->line);
   free(c->row);
   free(c);
+  return rc;
 }

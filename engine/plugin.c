@@ -15,7 +15,13 @@
 #include "internal.h"
 
 int fmb_registry_load(fmbRegistry* reg, const char* path, fmbDiag* diag) {
+  fmbDiag local_diag;
+  if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
+  if (!reg) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_registry_load: the registry is NULL");
+    return -1;
+  }
   if (!path || !path[0]) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "empty plugin path: expected a shared object file (x.so)");
     return -1;

@@ -41,7 +41,7 @@ static void build_rule(int n) {
 }
 
 int fmb_gauss_legendre01(int n, double* x, double* w) {
-  if (n < 1 || n > FMB_GAUSS_MAX) return -1;
+  if (n < 1 || n > FMB_GAUSS_MAX || !x || !w) return -1;
   if (n == 1) {
     x[0] = 0.5;
     w[0] = 1.0;

@@ -33,19 +33,20 @@ void fmb_registry_free(fmbRegistry* reg) {
   free(reg);
 }
 
-int fmb_registry_nbodies(const fmbRegistry* reg) { return reg->nbodies; }
-int fmb_registry_njoints(const fmbRegistry* reg) { return reg->njoints; }
+/* a NULL registry has no types (issue 12: no public function crashes on NULL) */
+int fmb_registry_nbodies(const fmbRegistry* reg) { return reg ? reg->nbodies : 0; }
+int fmb_registry_njoints(const fmbRegistry* reg) { return reg ? reg->njoints : 0; }
 const fmbBodyType* fmb_registry_body(const fmbRegistry* reg, int i) {
-  return i >= 0 && i < reg->nbodies ? reg->bodies[i] : NULL;
+  return reg && i >= 0 && i < reg->nbodies ? reg->bodies[i] : NULL;
 }
 const fmbJointType* fmb_registry_joint(const fmbRegistry* reg, int i) {
-  return i >= 0 && i < reg->njoints ? reg->joints[i] : NULL;
+  return reg && i >= 0 && i < reg->njoints ? reg->joints[i] : NULL;
 }
 const char* fmb_registry_body_origin(const fmbRegistry* reg, int i) {
-  return i >= 0 && i < reg->nbodies ? reg->body_origin[i] : NULL;
+  return reg && i >= 0 && i < reg->nbodies ? reg->body_origin[i] : NULL;
 }
 const char* fmb_registry_joint_origin(const fmbRegistry* reg, int i) {
-  return i >= 0 && i < reg->njoints ? reg->joint_origin[i] : NULL;
+  return reg && i >= 0 && i < reg->njoints ? reg->joint_origin[i] : NULL;
 }
 
 /* room for one more entry in the four parallel arrays of one kind (names has a NULL sentinel) */
@@ -155,7 +156,13 @@ static int check_abi(const char* origin, const char* what, const char* name, int
 }
 
 int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* origin, fmbDiag* diag) {
+  fmbDiag local_diag;
+  if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
+  if (!reg || !plugin) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin ? origin : "", 0, 0, "fmb_registry_add: %s is NULL", reg ? "the plugin" : "the registry");
+    return -1;
+  }
   if (!origin) origin = "?";
   /* the descriptor's abi is read before anything else of it (the field never moves) */
   if (check_abi(origin, "plugin", NULL, plugin->abi, diag)) return -1;

@@ -5,10 +5,16 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
+#include <unistd.h>
 
 #include "internal.h"
 
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
+#define FMB_RTOL_MIN 1e-13 /* ~500 machine epsilons: below, IDA reports "too much accuracy requested" */
+#define FMB_RTOL_MAX 0.1
+#define FMB_ATOL_MIN 1e-16
+#define FMB_ATOL_MAX 1e-3 /* 1 mm, 1 mrad: looser hides errors as large as a small mechanism */
 
 static const char* const reserved_names[] = {"ground", "energy", "constraint", "t", NULL};
 
@@ -30,10 +36,11 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->atol = 1e-8;
   s->output_step = 0.0;
   s->max_step = 0.0;
+  s->min_step = 0.0;
   s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, max_order, error_control, linear_solver, max_steps)");
+  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps)");
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
@@ -45,6 +52,7 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_double(p, node, "atol", FMB_POSITIVE, &s->atol) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
       fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
+      fmb_get_double(p, node, "min_step", FMB_POSITIVE, &s->min_step) ||
       fmb_get_choice(p, node, "linear_solver", 0, solvers, &linear_solver) ||
       fmb_get_choice(p, node, "error_control", 0, controls, &s->positions_only) ||
       fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
@@ -53,8 +61,22 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->max_steps_per_output = max_steps;
   s->linear_solver = linear_solver;
-  if (s->rtol >= 0.1)
-    return fmb_parse_error(p, fmb_find_key(p, node, "rtol"), "expected rtol below 0.1 (a relative tolerance), got %g", s->rtol);
+  /* Tolerances outside these bounds give a wrong answer with exit 0 (atol = 1 lets a 1 m
+     pendulum's error test pass anything) or ask for more than double precision can hold (IDA
+     weighs errors by 1/(rtol |y| + atol); 1e-200 makes every step fail). */
+  if (s->rtol >= FMB_RTOL_MAX || s->rtol < FMB_RTOL_MIN)
+    return fmb_parse_error(p, fmb_find_key(p, node, "rtol"),
+                           "expected rtol from %g to below %g (a relative tolerance), got %g", FMB_RTOL_MIN, FMB_RTOL_MAX,
+                           s->rtol);
+  if (s->atol > FMB_ATOL_MAX || s->atol < FMB_ATOL_MIN)
+    return fmb_parse_error(p, fmb_find_key(p, node, "atol"),
+                           "expected atol from %g to %g (an absolute tolerance in SI units: metres, radians, m/s), got %g",
+                           FMB_ATOL_MIN, FMB_ATOL_MAX, s->atol);
+  s->min_step_given = s->min_step > 0.0;
+  if (!s->min_step_given) s->min_step = FMB_MIN_STEP_FRACTION * (s->t_end - s->t0);
+  if (s->min_step >= s->t_end - s->t0)
+    return fmb_parse_error(p, fmb_find_key(p, node, "min_step"), "min_step (%g) must be shorter than the run (t_end %g)",
+                           s->min_step, s->t_end);
   if (s->output_step == 0.0) s->output_step = s->t_end / 1000.0;
   if (s->output_step > s->t_end)
     return fmb_parse_error(p, fmb_find_key(p, node, "output_step"), "output_step (%g) is longer than t_end (%g)",
@@ -172,7 +194,8 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
   for (int i = 0; i < n; ++i) {
     fmbBodyInst* b = &m->body[m->nbody];
     int t = 0;
-    if (parse_item(p, m, fmbp_seq_item(p, list, i), 0, names, b->name, &t, &b->self)) return -1;
+    b->node = fmbp_seq_item(p, list, i);
+    if (parse_item(p, m, b->node, 0, names, b->name, &t, &b->self)) return -1;
     b->type = p->reg->bodies[t];
     m->nbody++; /* owns self from here on, freed by fmb_free */
     b->qadr = m->nq;
@@ -219,6 +242,67 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
   return 0;
 }
 
+/* What a run of this model will take, estimated from its sizes and fixed pattern at load:
+   - memory: the dense per-body blocks of the workspace (K, C, M, FD column: 4 nb^2 for the
+     largest body, up to 3 sum nb^2 for the block cache), the initial conditions' dense
+     augmented matrix (nq + nc)^2 and Phi_q copies, the mass check (nq^2), a dense Newton
+     matrix if asked for (ny^2), and the sparse pattern with KLU's copy and fill (~5 nnz);
+   - work per factorization of the Newton matrix: sum over columns of (column nnz)^2, the cost
+     of sparse LU without fill: nb^3 for a dense body block, linear for a banded one.
+   A model beyond either limit is refused at load with the estimate: the accepted beam of 4096
+   elements needed 19.5 GB, and one of 1024 elements could not do one step in 20 s. The memory
+   estimate is conservative (measured peak: 88 MB for 256 elements, estimated 182 MB). */
+/* measured: a 512-element beam (1.8e10) factorizes in ~1 s, so 5e10 is a few seconds; one of
+   1024 elements (1.5e11) could not do a step in 20 s */
+#define FMB_WORK_FLOPS_MAX 5e10
+static void estimate_resources(const fmbModel* m, double* bytes, double* flops) {
+  double nbmax = 0.0, sum_nb2 = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const double nb = m->body[b].nq;
+    nbmax = fmax(nbmax, nb);
+    sum_nb2 += nb * nb;
+  }
+  const double nq = m->nq, nc = m->nc, ny = m->ny, n = nq + nc;
+  double doubles = 4.0 * nbmax * nbmax + fmin(3.0 * sum_nb2, (double)(256 << 20) / 8.0) + n * n + 3.0 * nc * nq + nc * nc +
+                   20.0 * ny + (double)m->nwork;
+  if (m->check_definiteness) doubles += nq * nq + nc * nq;
+  if (m->solver.linear_solver == FMB_LS_DENSE) doubles += ny * ny;
+  *bytes = 8.0 * doubles + 5.0 * 16.0 * (double)m->nnz;
+  double w = 0.0;
+  for (int j = 0; j < m->ny; ++j) {
+    const double c = (double)(m->colptr[j + 1] - m->colptr[j]);
+    w += c * c;
+  }
+  if (m->solver.linear_solver == FMB_LS_DENSE) w = ny * ny * ny / 3.0;
+  *flops = w;
+}
+
+/* physical memory, or less if the address space is limited (ulimit -v) */
+static double memory_available(void) {
+  double bytes = (double)sysconf(_SC_PHYS_PAGES) * (double)sysconf(_SC_PAGESIZE);
+  struct rlimit rl;
+  if (getrlimit(RLIMIT_AS, &rl) == 0 && rl.rlim_cur != RLIM_INFINITY) bytes = fmin(bytes, (double)rl.rlim_cur);
+  return bytes > 0 ? bytes : 1e300;
+}
+
+static int check_resources(fmbParser* p, fmbModel* m) {
+  double bytes = 0.0, flops = 0.0;
+  estimate_resources(m, &bytes, &flops);
+  const double avail = memory_available();
+  if (bytes > 0.8 * avail || flops > FMB_WORK_FLOPS_MAX) {
+    /* named at the largest body: the one to make smaller */
+    int big = 1;
+    for (int b = 2; b < m->nbody; ++b)
+      if (m->body[b].nq > m->body[big].nq) big = b;
+    return fmb_parse_error(p, m->nbody > 1 ? m->body[big].node : fmbp_root(p),
+                           "the model is too large to run here (largest body '%s', %d coordinates): %d unknowns need an "
+                           "estimated %.3g GB of memory (this machine offers %.3g GB) and %.3g operations per Newton "
+                           "matrix factorization (limit %.3g, a few seconds each): use fewer elements or bodies",
+                           m->body[big].name, m->body[big].nq, m->ny, bytes / 1e9, avail / 1e9, flops, FMB_WORK_FLOPS_MAX);
+  }
+  return 0;
+}
+
 static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode root = fmbp_root(p);
   fmbp_begin_item(p);
@@ -228,14 +312,19 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode outputs = fmb_find_key(p, root, "outputs");
   fmbNode plugins = fmb_find_key(p, root, "plugins");
   double g[2] = {0.0, 0.0};
-  if (fmb_get_vec2(p, root, "gravity", 0, g)) return -1;
+  /* initial: given (default) = the poses must satisfy the joints (to FMB_ASSEMBLY_TOL);
+     assemble = the initial projection may move the bodies onto the joints (ic.c);
+     static = runs start from the static or steady state (engine/static.c) */
+  static const char* const initial_modes[] = {"given", "assemble", "static", NULL};
+  int initial = 0;
+  if (fmb_get_vec2(p, root, "gravity", 0, g) || fmb_get_choice(p, root, "initial", 0, initial_modes, &initial))
+    return -1;
+  m->assemble = initial == 1;
+  m->initial_static = initial == 2;
   /* optional conveniences, not listed among the expected top-level keys (docs/scenes.md has them) */
   const int looked = p->nlooked;
   fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */
   fmbNode library[2] = {fmb_find_key(p, root, library_keys[0]), fmb_find_key(p, root, library_keys[1])};
-  /* `initial: static`: runs start from the static or steady state (engine/static.c) */
-  static const char* const initial_choices[] = {"scene", "static", NULL};
-  if (fmb_get_choice(p, root, "initial", 0, initial_choices, &m->initial_static)) return -1;
   p->nlooked = looked;
   if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
   if (vtk >= 0) {
@@ -265,12 +354,25 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
     fmb_outputs_default(m);
   }
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
-  return 0;
+  return check_resources(p, m);
 }
 
 fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
                    fmbDiag* diag) {
+  fmbDiag local_diag;
+  if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
+  /* the registry itself is whole: every type entered it through fmb_registry_add's checks */
+  const char* misuse = !path                                                ? "fmb_load: no scene path (NULL)"
+                       : (noverrides < 0 || (noverrides > 0 && !overrides)) ? "fmb_load: overrides NULL or a negative count"
+                       : !reg                                               ? "fmb_load: no registry (NULL)"
+                                                                            : NULL;
+  for (int i = 0; !misuse && i < noverrides; ++i)
+    if (!overrides[i]) misuse = "fmb_load: an override is NULL";
+  if (misuse) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "%s", misuse);
+    return NULL;
+  }
   fmbModel* m = calloc(1, sizeof *m);
   if (!m) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "out of memory");
@@ -316,9 +418,13 @@ int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
 }
 
 void fmb_describe(const fmbModel* m, FILE* f) {
+  if (!m || !f) return;
   fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
           m->path, m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);
   fprintf(f, "gravity: %s\n", m->env.has_gravity ? "on" : "off (no gravity terms evaluated)");
+  double bytes = 0.0, flops = 0.0;
+  estimate_resources(m, &bytes, &flops);
+  fprintf(f, "resources: ~%.3g MB of memory, ~%.3g flops per Newton matrix factorization (estimates)\n", bytes / 1e6, flops);
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     fprintf(f, "body '%s' (%s, %d coordinates)%s", bi->name, bi->type->name, bi->nq, bi->type->describe ? ": " : "\n");

@@ -125,29 +125,34 @@ double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
 /* ---------------------------------------------------------------------------------------------
  * joints' view of the bodies */
 
-double fmb_eval_time(const fmbJointEval* ev) { return ev->t; }
+/* Plugins call these from their callbacks; a NULL context or a body index other than 0 or 1 is a
+   plugin bug, answered with a neutral value (NaN, 0, NULL, -1) instead of a crash. */
+static int eval_body(const fmbJointEval* ev, int k) { return (ev && (k == 0 || k == 1)) ? ev->j->body[k] : -1; }
+
+double fmb_eval_time(const fmbJointEval* ev) { return ev ? ev->t : NAN; }
 
 int fmb_eval_ncoord(const fmbJointEval* ev, int k) {
-  int b = ev->j->body[k];
+  int b = eval_body(ev, k);
   return b >= 0 ? ev->m->body[b].nq : 0;
 }
 
 const double* fmb_eval_q(const fmbJointEval* ev, int k) {
-  int b = ev->j->body[k];
+  int b = eval_body(ev, k);
   return b >= 0 ? ev->q + ev->m->body[b].qadr : NULL;
 }
 
 const double* fmb_eval_v(const fmbJointEval* ev, int k) {
-  int b = ev->j->body[k];
+  int b = eval_body(ev, k);
   return b >= 0 ? ev->v + ev->m->body[b].qadr : NULL;
 }
 
-double* fmb_eval_scratch(const fmbJointEval* ev) { return ev->js; }
+double* fmb_eval_scratch(const fmbJointEval* ev) { return ev ? ev->js : NULL; }
 
-int fmb_eval_col0(const fmbJointEval* ev, int k) { return k == 0 ? 0 : fmb_eval_ncoord(ev, 0); }
+int fmb_eval_col0(const fmbJointEval* ev, int k) { return k == 1 ? fmb_eval_ncoord(ev, 0) : 0; }
 
 int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle, double* dpos_dq,
                int ld, double* dangle_dq) {
+  if (!ev || !local || !pos || (k != 0 && k != 1) || (dpos_dq && ld < 0)) return -1;
   int b = ev->j->body[k];
   const fmbBodyInst* bi = b >= 0 ? &ev->m->body[b] : NULL;
   if (!bi || !bi->type) { /* the world frame */

@@ -7,6 +7,7 @@
  * (libyaml marks are 0-based; we print 1-based) or, for nodes made by an override, its text. */
 #include <ctype.h>
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
@@ -14,8 +15,13 @@
 #include <string.h>
 #include <strings.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "internal.h"
+
+/* a scene is a few kilobytes; 64 MB is far beyond any mechanism the engine can integrate and
+   bounds what libyaml is asked to hold (its document takes ~20x the text) */
+#define FMB_SCENE_BYTES_MAX (64 * 1024 * 1024)
 
 void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...) {
   if (!d || d->code) return; /* the first error wins */
@@ -41,12 +47,43 @@ fmbNode fmbp_root(fmbParser* p) {
 
 static int node_count(fmbParser* p) { return (int)(p->doc.nodes.top - p->doc.nodes.start); }
 
+/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
+   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
+#define FMB_OVERRIDE_SHOWN 80
+static const char* shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]) {
+  size_t used = 0, i = 0;
+  const size_t len = strlen(text);
+  for (; text[i] && used < FMB_OVERRIDE_SHOWN - 20; ++i) {
+    const unsigned char ch = (unsigned char)text[i];
+    if (ch == '\n' || ch == '\t')
+      used += (size_t)snprintf(buf + used, 8, "\\%c", ch == '\n' ? 'n' : 't');
+    else if (ch < 0x20 || ch == 0x7f)
+      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
+    else
+      buf[used++] = (char)ch;
+  }
+  if (text[i] && len > FMB_OVERRIDE_SHOWN) {
+    snprintf(buf + used, FMB_OVERRIDE_SHOWN + 32 - used, "...(%zu characters)", len);
+    return buf;
+  }
+  for (; text[i] && used < FMB_OVERRIDE_SHOWN + 24; ++i) {
+    const unsigned char ch = (unsigned char)text[i];
+    if (ch < 0x20 || ch == 0x7f)
+      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
+    else
+      buf[used++] = (char)ch;
+  }
+  buf[used] = '\0';
+  return buf;
+}
+
 /* where `node` is: file:line:column, or the override that made it */
 static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
   yaml_node_t* nd = fmbp_node(p, node);
   int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
+  char shown[FMB_OVERRIDE_SHOWN + 32];
   if (ov >= 0)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", p->overrides[ov], msg);
+    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", shown_override(p->overrides[ov], shown), msg);
   else if (nd)
     fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s", msg);
   else
@@ -61,6 +98,7 @@ static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
 }
 
 int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
+  if (!p || !fmt) return -1;
   va_list ap;
   va_start(ap, fmt);
   verror_at(p, node, fmt, ap);
@@ -133,6 +171,7 @@ static fmbNode value_of(fmbParser* p, fmbNode map, const char* key) {
    (which are searched, and their key marked read, either way: a key the item overrides is not
    an unknown key of its material) */
 fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
+  if (!p || !key) return -1;
   remember_key(p, key);
   fmbNode v = value_of(p, map, key);
   for (int k = 0; k < 2 && map == p->item && p->item > 0; ++k) {
@@ -158,26 +197,55 @@ int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
   return 0;
 }
 
-/* every mapping in the document: no duplicate keys, keys are scalars */
+/* FNV-1a: the duplicate-key check's hash */
+static unsigned long hash_key(const char* s) {
+  unsigned long h = 2166136261u;
+  for (; *s; ++s) h = (h ^ (unsigned char)*s) * 16777619u;
+  return h;
+}
+
+/* every mapping in the document: no duplicate keys, keys are scalars. Linear in the number of
+   keys: each mapping's keys go into an open-addressing hash set (size a power of two at least
+   twice the keys), so a mapping of 100,000 keys costs ~100,000 string comparisons, not 5e9. */
 static int check_duplicates(fmbParser* p) {
   int n = node_count(p);
-  for (int id = 1; id <= n; ++id) {
+  size_t cap = 0;
+  yaml_node_pair_t** slot = NULL;
+  int rc = 0;
+  for (int id = 1; id <= n && !rc; ++id) {
     yaml_node_t* nd = fmbp_node(p, id);
     if (nd->type != YAML_MAPPING_NODE) continue;
+    const size_t npairs = (size_t)(nd->data.mapping.pairs.top - nd->data.mapping.pairs.start);
+    size_t want = 16;
+    while (want < 2 * npairs) want *= 2;
+    if (want > cap) {
+      free(slot);
+      cap = want;
+      slot = malloc(cap * sizeof *slot);
+      if (!slot) return fmb_parse_error(p, id, "out of memory checking for duplicate keys");
+    }
+    memset(slot, 0, want * sizeof *slot);
     for (yaml_node_pair_t* a = nd->data.mapping.pairs.start; a < nd->data.mapping.pairs.top; ++a) {
       const char* ka = fmbp_scalar(p, a->key);
-      if (!ka) return fmb_parse_error(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
-      for (yaml_node_pair_t* b = nd->data.mapping.pairs.start; b < a; ++b) {
-        const char* kb = fmbp_scalar(p, b->key);
-        if (kb && strcmp(ka, kb) == 0) {
-          yaml_node_t* first = fmbp_node(p, b->key);
-          return fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka,
-                               (int)first->start_mark.line + 1);
-        }
+      if (!ka) {
+        rc = fmb_parse_error(p, a->key, "a key must be a plain word, found %s", node_kind(fmbp_node(p, a->key)));
+        break;
       }
+      size_t h = hash_key(ka) & (want - 1);
+      for (; slot[h]; h = (h + 1) & (want - 1)) {
+        p->key_compares++;
+        if (strcmp(fmbp_scalar(p, slot[h]->key), ka) == 0) break;
+      }
+      if (slot[h]) {
+        yaml_node_t* first = fmbp_node(p, slot[h]->key);
+        rc = fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka, (int)first->start_mark.line + 1);
+        break;
+      }
+      slot[h] = a;
     }
   }
-  return 0;
+  free(slot);
+  return rc;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -224,6 +292,7 @@ static int absent(fmbParser* p, fmbNode map, const char* key, unsigned flags, co
 }
 
 int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a number");
   return number_at(p, n, key, flags, out);
@@ -252,6 +321,7 @@ static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
 
 /* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */
 int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  if (!p || !key || !out) return -1;
   static const double two_pi = 6.283185307179586;
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "an angle");
@@ -287,6 +357,7 @@ int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
 }
 
 int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a whole number");
   const char* s = fmbp_scalar(p, n);
@@ -305,6 +376,7 @@ int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long
 }
 
 int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a list of two numbers [x, y]");
   if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != 2)
@@ -318,8 +390,22 @@ int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, dou
   return 0;
 }
 
+int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]) {
+  if (!p || !key || !out || !p->model || body < 0 || body >= p->model->nbody) return -1;
+  if (fmb_get_vec2(p, map, key, flags, out)) return -1;
+  const fmbBodyInst* b = &p->model->body[body];
+  double pos[2], angle;
+  if (b->type && fmb_initial_marker(p, body, out, pos, &angle))
+    return fmb_parse_error(p, fmb_find_key(p, map, key),
+                           "%s [%g, %g] is not on body '%s' (type %s): the body cannot place it (e.g. beyond a beam's "
+                           "length)",
+                           key, out[0], out[1], b->name, b->type->name);
+  return 0;
+}
+
 int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out) {
+  if (!p || !key || !choices || !out) return -1;
   fmbNode n = fmb_find_key(p, map, key);
   char list[400] = "";
   size_t used = 0;
@@ -383,20 +469,42 @@ static int get_named(fmbParser* p, fmbNode map, const char* key, unsigned flags,
 }
 
 int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   return get_named(p, map, key, flags, 0, out);
 }
 
 int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   return get_named(p, map, key, flags, 1, out);
 }
 
 int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]) {
+  if (!p || !body || !local || (k != 0 && k != 1)) return -1;
   fmbModel* m = p->model;
   if (joint < 0 || joint >= m->njoint) return -1;
   const fmbJointInst* j = &m->joint[joint];
   /* only a constraining joint: a spring's ends (drawn through the same op) are no pivot to drive */
   if (!j->type->attachment || j->nrows == 0) return -1;
   return j->type->attachment(j->self, k, body, local);
+}
+
+int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle) {
+  if (!p || !p->model || !local || !pos || body < 0 || body >= p->model->nbody) return -1;
+  const fmbBodyInst* b = &p->model->body[body];
+  if (!b->type) { /* the world frame */
+    pos[0] = local[0];
+    pos[1] = local[1];
+    if (angle) *angle = 0.0;
+    return 0;
+  }
+  /* setup-time: the body's initial coordinates and its scratch, allocated for this one call */
+  const size_t n = (size_t)b->nq;
+  double* q = calloc(2 * n + b->nwork + 1, sizeof(double));
+  if (!q) return -1;
+  b->type->initial(b->self, q, q + n);
+  const int rc = b->type->marker(b->self, q, local, pos, angle, NULL, NULL, q + 2 * n);
+  free(q);
+  return rc ? -1 : 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -448,16 +556,18 @@ static void mark_override(fmbParser* p, int first_new, int ov) {
 }
 
 static int apply_override(fmbParser* p, int ov) {
-  const char* text = p->overrides[ov];
-  const char* eq = strchr(text, '=');
-  if (!eq || eq == text) {
+  const char* full = p->overrides[ov];
+  char shown[FMB_OVERRIDE_SHOWN + 32];
+  const char* text = shown_override(full, shown);
+  const char* eq = strchr(full, '=');
+  if (!eq || eq == full) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected PATH=VALUE, e.g. solver.rtol=1e-8", text);
     return -1;
   }
   char path[512];
-  size_t plen = (size_t)(eq - text);
+  size_t plen = (size_t)(eq - full);
   if (plen >= sizeof path) plen = sizeof path - 1;
-  memcpy(path, text, plen);
+  memcpy(path, full, plen);
   path[plen] = '\0';
   const char* value = eq + 1;
 
@@ -474,7 +584,22 @@ static int apply_override(fmbParser* p, int ov) {
     yaml_parser_delete(&parser);
     return -1;
   }
+  /* exactly one YAML value: "1e-8\n---\n2" would otherwise set 1e-8 and drop the rest */
+  yaml_document_t extra;
+  int more = 0;
+  if (!yaml_parser_load(&parser, &extra)) {
+    more = 1;
+  } else {
+    more = yaml_document_get_root_node(&extra) != NULL;
+    yaml_document_delete(&extra);
+  }
   yaml_parser_delete(&parser);
+  if (more) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected one YAML value after '=', found more after it",
+                 text);
+    yaml_document_delete(&vdoc);
+    return -1;
+  }
 
   if (path[0] == '.' || path[plen - 1] == '.' || strstr(path, "..")) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: empty name in the path (write names separated by single dots, e.g. solver.rtol)", text);
@@ -567,6 +692,10 @@ static int apply_override(fmbParser* p, int ov) {
    offset, so the position is counted from the file; a parser error may name where the construct
    it was reading began. */
 static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* parser, FILE* f) {
+  if (parser->error == YAML_MEMORY_ERROR) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene is too large to load: out of memory while parsing it");
+    return;
+  }
   const char* problem = parser->problem ? parser->problem : "unknown problem";
   if (parser->error == YAML_READER_ERROR) {
     int line = 1, col = 1, c;
@@ -593,6 +722,271 @@ static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* p
                  problem, parser->context ? " " : "", parser->context ? parser->context : "");
 }
 
+/* ------------------------------------------------------------------------------------------ */
+/* the composer: YAML events into the document tree (libyaml's own loader, rewritten for three
+   reasons). An alias is copied where it is used, each copied node carrying the alias's position,
+   so an error inside an aliased node is reported where it is used and each use is checked on its
+   own (unknown keys); a merge key `<<: *anchor` (or `<<: [*a, *b]`) adds the keys of the merged
+   mappings that the mapping does not give itself (YAML 1.1 merge); the copies are bounded by a
+   node budget (aliases of aliases grow exponentially: 100,000 copied nodes in all, 2,000,000 in the
+   document) and the nesting by a depth limit (libyaml's
+   loader recurses once per level). */
+#define FMB_SCENE_NODES_MAX 2000000
+#define FMB_ALIAS_NODES_MAX 100000 /* nodes copied for aliases, all uses together */
+#define FMB_SCENE_DEPTH_MAX 200
+#define FMB_MERGE_KEYS_MAX 1000 /* the merge is quadratic in the keys; scenes have tens */
+
+typedef struct {
+  char* name;
+  int id;
+} Anchor;
+
+typedef struct {
+  fmbParser* p;
+  Anchor* anchors;
+  int nanchors, capanchors;
+  int node[FMB_SCENE_DEPTH_MAX]; /* open sequences and mappings */
+  int key[FMB_SCENE_DEPTH_MAX];  /* a mapping's key waiting for its value (0 = none) */
+  int depth;
+  int root;
+  long alias_budget; /* nodes aliases may still copy */
+} Composer;
+
+static void set_marks(yaml_document_t* doc, int id, yaml_mark_t start, yaml_mark_t end) {
+  yaml_node_t* nd = yaml_document_get_node(doc, id);
+  nd->start_mark = start;
+  nd->end_mark = end;
+}
+
+/* a copy of node `id` and everything below it, every node marked at `at` (the alias); 0 when the
+   budget of nodes is exhausted or memory is short */
+static int copy_here(yaml_document_t* doc, int id, yaml_mark_t at, long* budget) {
+  if (--*budget < 0) return 0;
+  yaml_node_t* s = yaml_document_get_node(doc, id);
+  int nid = 0;
+  if (s->type == YAML_SCALAR_NODE) {
+    nid = yaml_document_add_scalar(doc, NULL, s->data.scalar.value, (int)s->data.scalar.length, s->data.scalar.style);
+  } else if (s->type == YAML_SEQUENCE_NODE) {
+    const int n = (int)(s->data.sequence.items.top - s->data.sequence.items.start);
+    nid = yaml_document_add_sequence(doc, NULL, s->data.sequence.style);
+    for (int i = 0; i < n && nid; ++i) {
+      s = yaml_document_get_node(doc, id); /* adding nodes may move them */
+      const int c = copy_here(doc, s->data.sequence.items.start[i], at, budget);
+      if (!c || !yaml_document_append_sequence_item(doc, nid, c)) return 0;
+    }
+  } else if (s->type == YAML_MAPPING_NODE) {
+    const int n = (int)(s->data.mapping.pairs.top - s->data.mapping.pairs.start);
+    nid = yaml_document_add_mapping(doc, NULL, s->data.mapping.style);
+    for (int i = 0; i < n && nid; ++i) {
+      s = yaml_document_get_node(doc, id);
+      const yaml_node_pair_t pr = s->data.mapping.pairs.start[i];
+      const int k = copy_here(doc, pr.key, at, budget);
+      const int v = k ? copy_here(doc, pr.value, at, budget) : 0;
+      if (!v || !yaml_document_append_mapping_pair(doc, nid, k, v)) return 0;
+    }
+  }
+  if (nid) set_marks(doc, nid, at, at);
+  return nid;
+}
+
+static int is_merge_key(yaml_document_t* doc, int id) {
+  yaml_node_t* k = yaml_document_get_node(doc, id);
+  return k && k->type == YAML_SCALAR_NODE && k->data.scalar.style == YAML_PLAIN_SCALAR_STYLE &&
+         strcmp((const char*)k->data.scalar.value, "<<") == 0;
+}
+
+static int pairs_have_key(yaml_document_t* doc, const yaml_node_pair_t* pairs, int n, int key) {
+  yaml_node_t* k = yaml_document_get_node(doc, key);
+  if (!k || k->type != YAML_SCALAR_NODE) return 0;
+  for (int i = 0; i < n; ++i) {
+    yaml_node_t* o = yaml_document_get_node(doc, pairs[i].key);
+    if (o && o->type == YAML_SCALAR_NODE && strcmp((const char*)o->data.scalar.value, (const char*)k->data.scalar.value) == 0)
+      return 1;
+  }
+  return 0;
+}
+
+/* mapping `id` is complete: replace its merge keys by the merged mappings' pairs */
+static int merge_keys(Composer* c, int id) {
+  yaml_document_t* doc = &c->p->doc;
+  yaml_node_t* nd = yaml_document_get_node(doc, id);
+  const int n = (int)(nd->data.mapping.pairs.top - nd->data.mapping.pairs.start);
+  int nmerge = 0, total = 0;
+  for (int i = 0; i < n; ++i) {
+    const yaml_node_pair_t pr = nd->data.mapping.pairs.start[i];
+    if (!is_merge_key(doc, pr.key)) {
+      ++total;
+      continue;
+    }
+    ++nmerge;
+    yaml_node_t* v = yaml_document_get_node(doc, pr.value);
+    const int nsrc = v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
+    for (int k = 0; k < nsrc; ++k) {
+      yaml_node_t* src = v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
+      if (src->type != YAML_MAPPING_NODE)
+        return fmb_parse_error(c->p, v->type == YAML_SEQUENCE_NODE ? v->data.sequence.items.start[k] : pr.value,
+                               "the value of a merge key '<<' must be a mapping (e.g. *anchor) or a list of mappings, "
+                               "found %s",
+                               node_kind(src));
+      total += (int)(src->data.mapping.pairs.top - src->data.mapping.pairs.start);
+    }
+  }
+  if (!nmerge) return 0;
+  if (total > FMB_MERGE_KEYS_MAX) return fmb_parse_error(c->p, id, "merge keys add more than %d keys to one mapping", FMB_MERGE_KEYS_MAX);
+  yaml_node_pair_t* out = malloc(((size_t)total + 1) * sizeof *out);
+  if (!out) return fmb_parse_error(c->p, id, "out of memory merging keys");
+  int m = 0;
+  /* the mapping's own keys first: they win over merged ones */
+  for (int i = 0; i < n; ++i)
+    if (!is_merge_key(doc, nd->data.mapping.pairs.start[i].key)) out[m++] = nd->data.mapping.pairs.start[i];
+  const int own = m;
+  for (int i = 0; i < n; ++i) {
+    const yaml_node_pair_t pr = nd->data.mapping.pairs.start[i];
+    if (!is_merge_key(doc, pr.key)) continue;
+    yaml_node_t* v = yaml_document_get_node(doc, pr.value);
+    const int nsrc = v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
+    for (int k = 0; k < nsrc; ++k) {
+      yaml_node_t* src = v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
+      for (yaml_node_pair_t* sp = src->data.mapping.pairs.start; sp < src->data.mapping.pairs.top; ++sp)
+        if (!pairs_have_key(doc, out, own, sp->key) && !pairs_have_key(doc, out + own, m - own, sp->key)) out[m++] = *sp;
+    }
+  }
+  free(nd->data.mapping.pairs.start); /* libyaml allocates with malloc (yaml_malloc) */
+  nd->data.mapping.pairs.start = out;
+  nd->data.mapping.pairs.top = out + m;
+  nd->data.mapping.pairs.end = out + total + 1;
+  return 0;
+}
+
+/* a finished node goes to its parent: the root, a list item, a key or a value */
+static int attach(Composer* c, int id) {
+  if (c->depth == 0) {
+    c->root = id;
+    return 0;
+  }
+  const int parent = c->node[c->depth - 1];
+  yaml_document_t* doc = &c->p->doc;
+  if (yaml_document_get_node(doc, parent)->type == YAML_SEQUENCE_NODE)
+    return yaml_document_append_sequence_item(doc, parent, id) ? 0 : -1;
+  if (!c->key[c->depth - 1]) {
+    c->key[c->depth - 1] = id;
+    return 0;
+  }
+  const int key = c->key[c->depth - 1];
+  c->key[c->depth - 1] = 0;
+  return yaml_document_append_mapping_pair(doc, parent, key, id) ? 0 : -1;
+}
+
+static int remember_anchor(Composer* c, const yaml_char_t* name, int id) {
+  if (!name) return 0;
+  if (c->nanchors == c->capanchors) {
+    const int cap = c->capanchors ? 2 * c->capanchors : 16;
+    Anchor* a = realloc(c->anchors, (size_t)cap * sizeof *a);
+    if (!a) return -1;
+    c->anchors = a;
+    c->capanchors = cap;
+  }
+  c->anchors[c->nanchors].name = strdup((const char*)name);
+  if (!c->anchors[c->nanchors].name) return -1;
+  c->anchors[c->nanchors++].id = id;
+  return 0;
+}
+
+/* one event; 1 at the end of the stream, -1 on error (diag set) */
+static int compose_event(Composer* c, const yaml_event_t* ev, int* ndocs) {
+  fmbParser* p = c->p;
+  yaml_document_t* doc = &p->doc;
+  const char* path = p->path;
+  int id = 0;
+  if (node_count(p) > FMB_SCENE_NODES_MAX) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                 "the scene is too large: more than %d YAML nodes (counting every use of an alias)", FMB_SCENE_NODES_MAX);
+    return -1;
+  }
+  switch (ev->type) {
+    case YAML_STREAM_END_EVENT: return 1;
+    case YAML_DOCUMENT_START_EVENT:
+      if (++*ndocs > 1) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "a scene file holds one YAML document; found a second one");
+        return -1;
+      }
+      return 0;
+    case YAML_SCALAR_EVENT:
+      id = yaml_document_add_scalar(doc, NULL, ev->data.scalar.value, (int)ev->data.scalar.length, ev->data.scalar.style);
+      if (!id || remember_anchor(c, ev->data.scalar.anchor, id)) break;
+      set_marks(doc, id, ev->start_mark, ev->end_mark);
+      return attach(c, id);
+    case YAML_ALIAS_EVENT: {
+      int target = 0;
+      for (int i = c->nanchors - 1; i >= 0 && !target; --i)
+        if (strcmp(c->anchors[i].name, (const char*)ev->data.alias.anchor) == 0) target = c->anchors[i].id;
+      if (!target) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "YAML syntax error: found undefined alias");
+        return -1;
+      }
+      id = copy_here(doc, target, ev->start_mark, &c->alias_budget);
+      if (!id && c->alias_budget < 0) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "the scene is too large: its aliases expand to more than %d YAML nodes", FMB_ALIAS_NODES_MAX);
+        return -1;
+      }
+      if (!id) break;
+      return attach(c, id);
+    }
+    case YAML_SEQUENCE_START_EVENT:
+    case YAML_MAPPING_START_EVENT: {
+      const int seq = ev->type == YAML_SEQUENCE_START_EVENT;
+      if (c->depth == FMB_SCENE_DEPTH_MAX) {
+        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
+                     "the scene nests lists and mappings more than %d deep", FMB_SCENE_DEPTH_MAX);
+        return -1;
+      }
+      id = seq ? yaml_document_add_sequence(doc, NULL, ev->data.sequence_start.style)
+               : yaml_document_add_mapping(doc, NULL, ev->data.mapping_start.style);
+      if (!id || remember_anchor(c, seq ? ev->data.sequence_start.anchor : ev->data.mapping_start.anchor, id)) break;
+      set_marks(doc, id, ev->start_mark, ev->end_mark);
+      if (attach(c, id)) break;
+      c->node[c->depth] = id;
+      c->key[c->depth++] = 0;
+      return 0;
+    }
+    case YAML_SEQUENCE_END_EVENT: --c->depth; return 0;
+    case YAML_MAPPING_END_EVENT: --c->depth; return merge_keys(c, c->node[c->depth]) ? -1 : 0;
+    default: return 0;
+  }
+  fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene is too large to load: out of memory");
+  return -1;
+}
+
+/* the file's one document into p->doc; 0 or -1 with diag set */
+static int compose(fmbParser* p, yaml_parser_t* parser, FILE* f) {
+  Composer c;
+  memset(&c, 0, sizeof c);
+  c.p = p;
+  c.alias_budget = FMB_ALIAS_NODES_MAX;
+  if (!yaml_document_initialize(&p->doc, NULL, NULL, NULL, 1, 1)) {
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "out of memory");
+    return -1;
+  }
+  p->have_doc = 1;
+  int ndocs = 0, rc = 0;
+  while (rc == 0) {
+    yaml_event_t ev;
+    if (!yaml_parser_parse(parser, &ev)) {
+      syntax_error(p->diag, p->path, parser, f);
+      rc = -1;
+      break;
+    }
+    rc = compose_event(&c, &ev, &ndocs);
+    yaml_event_delete(&ev);
+  }
+  for (int i = 0; i < c.nanchors; ++i) free(c.anchors[i].name);
+  free(c.anchors);
+  return rc < 0 ? -1 : 0;
+}
+
 int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag) {
   memset(&p->doc, 0, sizeof p->doc);
   p->path = path;
@@ -604,52 +998,42 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   p->nnodes_cap = 0;
   p->nlooked = 0;
   p->item = p->inherited[0] = p->inherited[1] = -1;
+  /* opened without blocking (a FIFO would wait for a writer) and checked on the open file: only
+     a regular file of bounded size is read (a FIFO, /dev/zero or a directory never ends) */
+  int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
   struct stat st;
-  if (stat(path, &st) != 0) {
+  if (fd < 0 || fstat(fd, &st) != 0) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));
+    if (fd >= 0) close(fd);
     return -1;
   }
-  if (S_ISDIR(st.st_mode)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "is a directory, expected a YAML scene file");
+  const char* refuse = S_ISDIR(st.st_mode)    ? "is a directory, expected a YAML scene file"
+                       : !S_ISREG(st.st_mode) ? "is not a regular file (a device, FIFO or socket), expected a YAML scene file"
+                                              : NULL;
+  if (refuse) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s", refuse);
+    close(fd);
     return -1;
   }
-  FILE* f = fopen(path, "rb");
+  if (st.st_size > FMB_SCENE_BYTES_MAX) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene file is too large: %lld bytes, at most %d accepted",
+                 (long long)st.st_size, FMB_SCENE_BYTES_MAX);
+    close(fd);
+    return -1;
+  }
+  FILE* f = fdopen(fd, "rb");
   if (!f) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot open scene file: %s", strerror(errno));
+    close(fd);
     return -1;
   }
   yaml_parser_t parser;
   yaml_parser_initialize(&parser);
   yaml_parser_set_input_file(&parser, f);
-  int ok = yaml_parser_load(&parser, &p->doc);
-  if (!ok) {
-    syntax_error(diag, path, &parser, f);
-    yaml_parser_delete(&parser);
-    fclose(f);
-    return -1;
-  }
-  p->have_doc = 1;
-  /* a second document in the same file is a mistake worth reporting */
-  yaml_document_t extra;
-  if (yaml_parser_load(&parser, &extra)) {
-    int more = yaml_document_get_root_node(&extra) != NULL;
-    yaml_mark_t mk = extra.start_mark;
-    yaml_document_delete(&extra);
-    if (more) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1,
-                   "a scene file holds one YAML document; found a second one");
-      yaml_parser_delete(&parser);
-      fclose(f);
-      return -1;
-    }
-  } else {
-    syntax_error(diag, path, &parser, f);
-    yaml_parser_delete(&parser);
-    fclose(f);
-    return -1;
-  }
+  const int rc = compose(p, &parser, f);
   yaml_parser_delete(&parser);
   fclose(f);
+  if (rc) return -1;
 
   if (!yaml_document_get_root_node(&p->doc)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1,

@@ -117,11 +117,23 @@ static int drive_lookup(const void* self, const char* q) {
     if (strcmp(q, drive_outputs[i]) == 0) return i;
   return -1;
 }
-/* the prescribed angle and speed */
+/* angle: the joint's relative angle (angle2 - angle1) as the bodies are, which on the
+   constraint manifold is angle0 + f(t) (it once gave f(t) alone, off by angle0); speed: the
+   prescribed relative speed f'(t) */
 static int drive_output(const void* self, int id, const fmbJointEval* ev, double* value) {
+  const Drive* d = self;
+  if (id == 0) {
+    double pos[2], ang[2];
+    for (int k = 0; k < 2; ++k) {
+      const int rc = fmb_marker(ev, k, d->point[k], pos, &ang[k], NULL, 0, NULL);
+      if (rc) return rc;
+    }
+    *value = ang[1] - ang[0];
+    return 0;
+  }
   double f[3];
-  drive_profile(self, fmb_eval_time(ev), f);
-  *value = f[id];
+  drive_profile(d, fmb_eval_time(ev), f);
+  *value = f[1];
   return 0;
 }
 

@@ -1,6 +1,8 @@
-/* fixed.c — a weld: point1 and point2 coincide and the relative angle stays `angle` (default 0):
+/* fixed.c — a weld: point1 and point2 coincide and the relative angle stays `angle`:
  * Phi = [p1 - p2; (angle2 - angle1) - angle] (3 rows). A beam on a hub is a fixed joint between
- * the hub and the beam's root. */
+ * the hub and the beam's root. `angle` defaults to the relative angle of the two points in the
+ * poses the scene gives (the weld holds the mechanism as drawn): a default of 0 silently turned
+ * bodies drawn at an angle. */
 #include <stdio.h>
 #include <stdlib.h>
 
@@ -15,7 +17,13 @@ static int fixed_parse(fmbParser* p, fmbNode item, void** self) {
   Fixed* f = calloc(1, sizeof *f);
   if (!f) return fmb_parse_error(p, item, "out of memory");
   *self = f;
-  return fmbj_parse_two_points(p, item, &f->tp) || fmb_get_angle(p, item, "angle", FMB_POSE, &f->angle) ? -1 : 0;
+  if (fmbj_parse_two_points(p, item, &f->tp)) return -1;
+  double pos[2], ang[2];
+  for (int k = 0; k < 2; ++k)
+    if (fmb_initial_marker(p, f->tp.body[k], f->tp.point[k], pos, &ang[k]))
+      return fmb_parse_error(p, item, "fixed joint: cannot place point%d on its body", k + 1);
+  f->angle = ang[1] - ang[0]; /* as assembled */
+  return fmb_get_angle(p, item, "angle", FMB_POSE, &f->angle) ? -1 : 0;
 }
 
 static void fixed_destroy(void* self) { free(self); }

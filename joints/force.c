@@ -14,7 +14,7 @@ static int load_parse(fmbParser* p, fmbNode item, void** self) {
   Load* l = calloc(1, sizeof *l);
   if (!l) return fmb_parse_error(p, item, "out of memory");
   *self = l;
-  if (fmb_get_body(p, item, "body", FMB_REQUIRED, &l->body) || fmb_get_vec2(p, item, "point", 0, l->point) ||
+  if (fmb_get_body(p, item, "body", FMB_REQUIRED, &l->body) || fmb_get_point(p, item, "point", 0, l->body, l->point) ||
       fmb_get_vec2(p, item, "force", 0, l->force) || fmb_get_double(p, item, "torque", 0, &l->torque))
     return -1;
   if (l->body == 0) return fmb_parse_error(p, fmb_find_key(p, item, "body"), "a load on the ground does nothing: name a moving body");

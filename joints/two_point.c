@@ -7,7 +7,8 @@ int fmbj_parse_two_points(fmbParser* p, fmbNode item, fmbTwoPoint* tp) {
   memset(tp, 0, sizeof *tp);
   return (fmb_get_body(p, item, "body1", FMB_REQUIRED, &tp->body[0]) ||
           fmb_get_body(p, item, "body2", FMB_REQUIRED, &tp->body[1]) ||
-          fmb_get_vec2(p, item, "point1", 0, tp->point[0]) || fmb_get_vec2(p, item, "point2", 0, tp->point[1]))
+          fmb_get_point(p, item, "point1", 0, tp->body[0], tp->point[0]) ||
+          fmb_get_point(p, item, "point2", 0, tp->body[1], tp->point[1]))
              ? -1
              : 0;
 }

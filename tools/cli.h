@@ -12,6 +12,8 @@ typedef struct fmbCliScene {
   const char* scene;
   const char* overrides[FMB_CLI_MAX_OVERRIDES];
   int nover;
+  const char* plugins[16]; /* the --plugin files (the first 16): inputs an output may not replace */
+  int nplugins;
 } fmbCliScene;
 
 /* Takes argv[*i] if it is `--set PATH=VALUE`, `--set=PATH=VALUE`, `--plugin x.so` (loaded into
@@ -22,6 +24,12 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
 /* file:line:col: error: msg (or the shorter forms when no location is known) */
 void fmb_cli_print_diag(const fmbDiag* d);
+/* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
+   else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
+int fmb_cli_check_input(const char* path, const char* what);
+/* FMB_EXIT_BAD_INPUT after saying so when `out` is the same file (device and inode, whatever
+   the names) as one of the n inputs, else 0; "-" and a file that does not exist are never inputs */
+int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n);
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
 

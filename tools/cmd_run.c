@@ -1,11 +1,30 @@
 /* cmd_run.c — `flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet] [--progress]
  *                [--vtk DIR] [--reference REF.csv [--columns a,b]]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
+#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "cli.h"
+
+/* SIGINT/SIGTERM end the run after the step in progress (fmbRunOptions.stop): the rows so far
+   stay, the stats line says status=interrupted and the exit code is FMB_EXIT_INTERRUPTED. The
+   handler is one-shot (SA_RESETHAND): a second signal ends the program at once. */
+static volatile sig_atomic_t stop_requested;
+static void on_stop_signal(int sig) {
+  (void)sig;
+  stop_requested = 1;
+}
+static void catch_stop_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_stop_signal;
+  sa.sa_flags = SA_RESETHAND | SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+}
 
 int fmb_cmd_run(int argc, char** argv) {
   fmbCliScene s;
@@ -48,6 +67,18 @@ int fmb_cmd_run(int argc, char** argv) {
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);
+  /* every input is checked (the scene by fmb_load), and the output compared with them, before
+     anything is run or written */
+  const char* inputs[2 + sizeof s.plugins / sizeof s.plugins[0]] = {s.scene, reference};
+  int ninputs = 2;
+  for (int k = 0; k < s.nplugins; ++k) inputs[ninputs++] = s.plugins[k];
+  int bad = reference ? fmb_cli_check_input(reference, "reference") : 0;
+  if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
+  if (bad) {
+    fmb_print_stats(&stats, stderr);
+    return bad;
+  }
+  catch_stop_signals();
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
@@ -60,7 +91,8 @@ int fmb_cmd_run(int argc, char** argv) {
                        .quiet = quiet,
                        .progress = !quiet && (progress || isatty(STDERR_FILENO)),
                        .progress_after_s = progress ? 0.0 : 2.0,
-                       .vtk_dir = vtk};
+                       .vtk_dir = vtk,
+                       .stop = &stop_requested};
   int rc = fmb_run(m, &opt, &stats, &diag);
   if (rc) fmb_cli_print_diag(&diag);
   if (reference) {

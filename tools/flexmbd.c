@@ -1,6 +1,6 @@
 /* flexmbd.c — the command line: a table of commands, one file each (tools/cmd_NAME.c).
  * Exit codes: 0 ok, 1 a comparison beyond tolerance (compare, regress), 2 bad input, 3 solver
- * failure. The last stderr line of `run` is the stats line. */
+ * failure, 4 interrupted by SIGINT/SIGTERM (run). The last stderr line of `run` is the stats line. */
 #include <stdio.h>
 #include <string.h>
 
@@ -43,7 +43,7 @@ static const Command commands[] = {
 static void usage(FILE* f) {
   for (int i = 0; i < NCOMMANDS; ++i) fprintf(f, "%s flexmbd %s\n", i ? "      " : "usage:", commands[i].usage);
   fprintf(f, "PATH addresses any scene value, bodies and joints by name: solver.rtol=1e-8, bodies.beam.elements=32\n"
-             "exit codes: 0 ok, 1 beyond tolerance (compare, regress), 2 bad input, 3 solver failure\n");
+             "exit codes: 0 ok, 1 beyond tolerance (compare, regress), 2 bad input, 3 solver failure, 4 interrupted\n");
 }
 
 int main(int argc, char** argv) {

@@ -101,5 +101,5 @@ check "... where modes, sorted by |frequency|, lists the second first" near "$(c
 # initial: static — a misspelt value is bad input at its line and column
 "$flexmbd" run $cant --set initial=statc >/dev/null 2>"$out/initial.err"
 check "initial: statc: exit 2" test $? -eq 2
-check "... naming the choices" grep -q "expected one of scene, static for 'initial'" "$out/initial.err"
+check "... naming the choices" grep -q "expected one of given, assemble, static for 'initial'" "$out/initial.err"
 exit $fail

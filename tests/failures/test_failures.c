@@ -19,20 +19,28 @@ typedef struct {
   double t_lo, t_hi;  /* the run must stop in [t_lo, t_hi] */
   const char* cause;  /* in the message */
   const char* advice; /* in the message: what to try (NULL: the engine gives none) */
+  const char* wrong;  /* must not be in the message: a cause this scene cannot have (NULL: none) */
 } Case;
 
 static const Case cases[] = {
     /* the toggle of the non-Grashof four-bar is at crank angle acos(-1/64) = 1.58642 rad */
-    {"singular_fourbar", 0.01, 1.5855, 1.5874, "Newton's method failed repeatedly", "singular configuration"},
+    {"singular_fourbar", 0.01, 1.5855, 1.5874, "Newton's method failed repeatedly", "singular configuration", NULL},
     /* spun to 100 rad/s in 0.5 s: ZOAC's softening (omega^2 = omega1^2 - Omega^2) makes the bending
        mode grow exponentially once Omega passes omega1 = 3.9 rad/s; the beam's validity check stops
        it when a deflection exceeds the length */
-    {"zoac_overspin", 0.01, 0.05, 2.0, "its deformation exceeds its length", "use model: foac or complete"},
-    {"too_much_work", 2.0, 0.0, 2.0, "too many steps between two outputs", "Try a larger solver.max_steps"},
-    {"foac_pendulum", 0.005, 0.02, 0.5, "the mass matrix is no longer positive definite", "use `model: complete`"},
+    {"zoac_overspin", 0.01, 0.05, 2.0, "its deformation exceeds its length", "use model: foac or complete", NULL},
+    /* the same four-bar with a step floor of 1e-6 s: stops at the floor, which the message names */
+    {"min_step_floor", 0.01, 1.585, 1.5874, "the error test failed repeatedly",
+     "the step reached solver.min_step = 1e-06 (as given)", NULL},
+    {"too_much_work", 2.0, 0.0, 2.0, "too many steps between two outputs", "Try a larger solver.max_steps", NULL},
+    {"foac_pendulum", 0.005, 0.02, 0.5, "the mass matrix is no longer positive definite", "use `model: complete`", NULL},
+    /* a free body: no joints, so no dead point or singular configuration may be named */
     {"overflow_force", 1000.0, 0.0, 0.0, "the equations kept returning non-finite values",
-     "Check parameters and initial values"},
-    {"infinite_energy", 0.001, 0.0, 0.0, "an output is not finite", "check the initial values and parameters"},
+     "Check parameters and initial values", "singular configuration"},
+    {"infinite_energy", 0.001, 0.0, 0.0, "an output is not finite", "check the initial values and parameters", NULL},
+    /* a coupler of 1e200 kg: the parameters' scale is to blame, not the mechanism's geometry */
+    {"huge_mass", 0.01, 0.0, 0.0, "a parameter is far beyond a physical scale", "check masses, stiffnesses, forces",
+     "singular configuration"},
 };
 
 static int failures = 0;
@@ -159,6 +167,7 @@ int main(int argc, char** argv) {
     }
     CHECK(strstr(msg, c->cause) != NULL, "the message lacks the cause '%s'", c->cause);
     if (c->advice) CHECK(strstr(msg, c->advice) != NULL, "the message lacks the advice '%s'", c->advice);
+    if (c->wrong) CHECK(strstr(msg, c->wrong) == NULL, "the message names '%s', which this scene cannot have", c->wrong);
   }
   double t_last = -1.0;
   long rows = check_csv(csv, c, t_reached, &t_last);

@@ -33,12 +33,13 @@ edit() {
   mv "$1.orig" "$1"
   echo "$r"
 }
-# a 1e-3 relative change of a modulus, a length, a mass: FAIL, and the column is named
+# a 1e-3 relative change of a modulus, a length, a mass: FAIL, and the column is named (the
+# longer rod needs `initial: assemble`: the bob as drawn is 1 mm off it)
 for change in "paper/spinup_w4.yaml|s/youngs_modulus: 68.95e9/youngs_modulus: 69.01895e9/" \
               "paper/spinup_w4.yaml|s/length: 1.8 /length: 1.8018 /" \
               "paper/spinup_w4.yaml|s/density: 2767.0/density: 2769.767/" \
               "fourbar.yaml|s/mass: 3.5,/mass: 3.5035,/" \
-              "pendulum.yaml|s/point2: \[0.0, 1.0\]/point2: [0.0, 1.001]/"; do
+              "pendulum.yaml|s/point2: \[0.0, 1.0\]/point2: [0.0, 1.001]/;s/^gravity:/initial: assemble\ngravity:/"; do
   f=${change%%|*}
   [ "$(edit "$S/$f" "${change#*|}")" = 1 ] || fail "$f with '${change#*|}' is not a failure"
   grep -q "^FAIL: .*$f: beyond tolerance: [a-z_0-9]*\.[a-z_]* (max error" "$D/out.txt" ||

@@ -1,0 +1,242 @@
+/* test_api_misuse.c — the library answers misuse with an error, never a crash (issue 12):
+ *   1. every public function of engine/flexmbd.h called with NULL pointers and bad values;
+ *   2. (and messages: a long override is shortened, control characters escaped)
+ *   3. the duplicate-key check is linear: a mapping of 100,000 keys costs fewer than 2 string
+ *      comparisons per key (counted, not timed: the old pairwise check made n^2/2 = 5e9), and
+ *      a duplicate at its end is still found, at the right line.
+ *
+ *   test_api_misuse OUT_DIR */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "builtin.h"
+#include "check.h"
+#include "internal.h"
+
+static const char* scene_text =
+    "solver: {t_end: 0.01, output_step: 0.005}\n"
+    "gravity: [0, -9.81]\n"
+    "bodies:\n"
+    "  - {name: bob, type: rigid, mass: 1, inertia: 0.1, position: [1, 0]}\n"
+    "joints:\n"
+    "  - {name: pin, type: revolute, body1: ground, body2: bob, point1: [0, 0], point2: [-1, 0]}\n";
+
+static void write_file(const char* path, const char* text) {
+  FILE* f = fopen(path, "w");
+  if (!f) {
+    perror(path);
+    exit(1);
+  }
+  fputs(text, f);
+  fclose(f);
+}
+
+static void load_and_run_misuse(const char* scene, const char* csv) {
+  const fmbRegistry* reg = fmb_builtin_registry();
+  fmbDiag d;
+  const char* ov[1] = {NULL};
+
+  /* fmb_load: each required argument missing, a broken registry, diag optional */
+  ENSURE(fmb_load(NULL, NULL, 0, reg, &d) == NULL && d.code == FMB_EXIT_BAD_INPUT && strstr(d.msg, "no scene path"));
+  ENSURE(fmb_load(scene, NULL, 0, NULL, &d) == NULL && d.code == FMB_EXIT_BAD_INPUT && strstr(d.msg, "no registry"));
+  ENSURE(fmb_load(scene, NULL, 1, reg, &d) == NULL && d.code == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_load(scene, ov, 1, reg, &d) == NULL && d.code == FMB_EXIT_BAD_INPUT && strstr(d.msg, "override is NULL"));
+  ENSURE(fmb_load(scene, ov, -1, reg, &d) == NULL && d.code == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_load(NULL, NULL, 0, NULL, NULL) == NULL);
+  /* an empty registry (no types): a located error for the unknown type, not a crash */
+  fmbRegistry* empty = fmb_registry_new();
+  ENSURE(empty != NULL);
+  if (empty) {
+    ENSURE(fmb_load(scene, NULL, 0, empty, &d) == NULL && d.code == FMB_EXIT_BAD_INPUT && d.line > 0);
+    fmb_registry_free(empty);
+  }
+  /* the registry's own functions, the plugin loader, conformance, frame kinematics */
+  ENSURE(fmb_registry_nbodies(NULL) == 0 && fmb_registry_njoints(NULL) == 0);
+  ENSURE(fmb_registry_body(NULL, 0) == NULL && fmb_registry_joint(NULL, 0) == NULL);
+  ENSURE(fmb_registry_body_origin(NULL, 0) == NULL && fmb_registry_joint_origin(NULL, 0) == NULL);
+  ENSURE(fmb_registry_body(reg, -1) == NULL && fmb_registry_joint(reg, 1 << 30) == NULL);
+  ENSURE(fmb_registry_add(NULL, fmb_builtin_plugin(), "built-in", &d) != 0 && d.code == FMB_EXIT_BAD_INPUT);
+  fmbRegistry* r2 = fmb_registry_new();
+  ENSURE(r2 && fmb_registry_add(r2, NULL, NULL, NULL) != 0);
+  ENSURE(fmb_registry_load(NULL, "x.so", &d) != 0 && d.code == FMB_EXIT_BAD_INPUT);
+  ENSURE(r2 && fmb_registry_load(r2, NULL, NULL) != 0);
+  ENSURE(fmb_conform(NULL, "rigid", "/tmp", stdout) == -1 && fmb_conform(r2, NULL, "/tmp", stdout) == -1);
+  fmb_registry_free(r2);
+  fmb_registry_free(NULL);
+  double pos[2] = {7, 7};
+  fmb_frame_point(NULL, NULL, NULL, NULL, NULL, NULL);
+  fmb_frame_point((const double[3]){1, 2, 0}, (const double[2]){0.5, 0}, pos, NULL, NULL, NULL);
+  ENSURE(pos[0] == 1.5 && pos[1] == 2.0);
+  ENSURE(fmb_model_solver(NULL, NULL) == -1);
+
+  /* fmb_run: no model; stats and diag optional */
+  fmbStats st;
+  ENSURE(fmb_run(NULL, NULL, NULL, NULL) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_run(NULL, NULL, &st, &d) == FMB_EXIT_BAD_INPUT && d.code == FMB_EXIT_BAD_INPUT && !st.status_ok);
+  fmbModel* m = fmb_load(scene, NULL, 0, reg, NULL);
+  ENSURE(m != NULL);
+  if (m) {
+    fmbRunOptions opt = {.csv_path = csv, .quiet = 1};
+    ENSURE(fmb_run(m, &opt, NULL, NULL) == 0);
+    /* a directory as the output: an error, not a crash, and the model still runs after it */
+    opt.csv_path = "/";
+    ENSURE(fmb_run(m, &opt, &st, &d) == FMB_EXIT_BAD_INPUT && d.code == FMB_EXIT_BAD_INPUT);
+    opt.csv_path = csv;
+    ENSURE(fmb_run(m, &opt, &st, &d) == 0 && st.status_ok && st.rows_written == 3);
+    /* a stop flag already set: interrupted before the first row, nothing written */
+    volatile sig_atomic_t stop = 1;
+    opt.stop = &stop;
+    ENSURE(fmb_run(m, &opt, &st, &d) == FMB_EXIT_INTERRUPTED && st.interrupted && st.rows_written == 0);
+    fmb_describe(m, NULL);
+  }
+  fmb_describe(NULL, stdout);
+  fmb_print_stats(NULL, stdout);
+  fmb_print_stats(&st, NULL);
+  fmb_free(NULL);
+  fmb_free(m);
+}
+
+/* a long override is shortened in the message, which still ends with the reason; control
+   characters are escaped so the message stays on one line */
+static void long_override(const char* scene) {
+  char ov[400] = "solver.rtol=[";
+  for (int i = 0; i < 150; ++i) strcat(ov, "1,");
+  strcat(ov, "1]");
+  const char* list[] = {ov};
+  fmbDiag d;
+  ENSURE(fmb_load(scene, list, 1, fmb_builtin_registry(), &d) == NULL);
+  printf("long override: %s: %s\n", d.file, d.msg);
+  ENSURE(strlen(d.msg) < 200);
+  ENSURE(strstr(d.msg, "...(315 characters): expected a number for 'rtol', found a list") != NULL);
+  const char* two[] = {"solver.rtol=1e-8\n---\n2"};
+  ENSURE(fmb_load(scene, two, 1, fmb_builtin_registry(), &d) == NULL);
+  ENSURE(strchr(d.msg, '\n') == NULL && strstr(d.msg, "solver.rtol=1e-8\\n---\\n2: expected one YAML value") != NULL);
+}
+
+static void parser_misuse(const char* scene) {
+  fmbParser p;
+  memset(&p, 0, sizeof p);
+  fmbDiag d;
+  memset(&d, 0, sizeof d);
+  ENSURE(fmbp_open(&p, scene, NULL, 0, &d) == 0);
+  fmbNode root = fmbp_root(&p);
+  double x = 0, v[2];
+  int i = 0, body = 0;
+  const char* const words[] = {"a", NULL};
+  /* no parser, no key, no output */
+  ENSURE(fmb_get_double(NULL, root, "gravity", 0, &x) == -1);
+  ENSURE(fmb_get_double(&p, root, NULL, 0, &x) == -1);
+  ENSURE(fmb_get_double(&p, root, "gravity", 0, NULL) == -1);
+  ENSURE(fmb_get_int(NULL, root, "k", 0, 0, 1, &i) == -1);
+  ENSURE(fmb_get_int(&p, root, "k", 0, 0, 1, NULL) == -1);
+  ENSURE(fmb_get_vec2(NULL, root, "gravity", 0, v) == -1);
+  ENSURE(fmb_get_angle(NULL, root, "angle", FMB_REQUIRED, &x) == -1);
+  ENSURE(fmb_get_angle(&p, root, "angle", 0, NULL) == -1);
+  ENSURE(fmb_get_point(NULL, root, "point", 0, 0, v) == -1);
+  ENSURE(fmb_get_point(&p, root, "point", 0, 0, NULL) == -1);
+  ENSURE(fmb_initial_marker(NULL, 0, v, v, NULL) == -1);
+  ENSURE(fmb_initial_marker(&p, 0, NULL, v, NULL) == -1);
+  ENSURE(fmb_get_vec2(&p, root, "gravity", 0, NULL) == -1);
+  ENSURE(fmb_get_choice(NULL, root, "k", 0, words, &i) == -1);
+  ENSURE(fmb_get_choice(&p, root, "k", 0, NULL, &i) == -1);
+  ENSURE(fmb_get_choice(&p, root, "k", 0, words, NULL) == -1);
+  ENSURE(fmb_get_body(NULL, root, "body1", 0, &i) == -1);
+  ENSURE(fmb_get_body(&p, root, "body1", 0, NULL) == -1);
+  ENSURE(fmb_get_joint(NULL, root, "joint", 0, &i) == -1);
+  ENSURE(fmb_get_joint(&p, root, "joint", 0, NULL) == -1);
+  ENSURE(fmb_joint_attachment(NULL, 0, 0, &body, v) == -1);
+  ENSURE(fmb_joint_attachment(&p, 0, 0, NULL, v) == -1);
+  ENSURE(fmb_joint_attachment(&p, 0, 2, &body, v) == -1);
+  ENSURE(fmb_find_key(NULL, root, "solver") == -1);
+  ENSURE(fmb_find_key(&p, root, NULL) == -1);
+  ENSURE(fmb_parse_error(NULL, root, "x") == -1);
+  ENSURE(fmb_parse_error(&p, root, NULL) == -1);
+  /* and a valid call still works (the parser was not damaged) */
+  ENSURE(fmb_get_vec2(&p, root, "gravity", 0, v) == 0 && v[1] == -9.81);
+  ENSURE(d.code == 0);
+  fmbp_close(&p);
+
+  /* the evaluation context a joint sees */
+  ENSURE(isnan(fmb_eval_time(NULL)));
+  ENSURE(fmb_eval_ncoord(NULL, 0) == 0);
+  ENSURE(fmb_eval_q(NULL, 0) == NULL && fmb_eval_v(NULL, 1) == NULL);
+  ENSURE(fmb_eval_scratch(NULL) == NULL);
+  ENSURE(fmb_eval_col0(NULL, 1) == 0);
+  double pos[2], ang;
+  ENSURE(fmb_marker(NULL, 0, v, pos, &ang, NULL, 0, NULL) == -1);
+
+  /* the quadrature: bad n, NULL arrays; a good rule integrates x^5 exactly (1/6) */
+  double xg[FMB_GAUSS_MAX], wg[FMB_GAUSS_MAX];
+  ENSURE(fmb_gauss_legendre01(0, xg, wg) == -1);
+  ENSURE(fmb_gauss_legendre01(FMB_GAUSS_MAX + 1, xg, wg) == -1);
+  ENSURE(fmb_gauss_legendre01(3, NULL, wg) == -1);
+  ENSURE(fmb_gauss_legendre01(3, xg, NULL) == -1);
+  ENSURE(fmb_gauss_legendre01(3, xg, wg) == 0);
+  double s = 0;
+  for (int k = 0; k < 3; ++k) s += wg[k] * pow(xg[k], 5);
+  ENSURE_NEAR(s, 1.0 / 6.0, 1e-15);
+}
+
+/* a top-level mapping `many:` of n keys k0 .. k(n-1), plus optionally k0 again at the end */
+static void write_many_keys(const char* path, int n, int duplicate_last) {
+  FILE* f = fopen(path, "w");
+  if (!f) {
+    perror(path);
+    exit(1);
+  }
+  fputs(scene_text, f);
+  fputs("many:\n", f);
+  for (int k = 0; k < n; ++k) fprintf(f, "  k%d: %d\n", k, k);
+  if (duplicate_last) fputs("  k0: 0\n", f);
+  fclose(f);
+}
+
+static void many_keys(const char* dir) {
+  const int n = 100000;
+  char path[1024];
+  snprintf(path, sizeof path, "%s/many_keys.yaml", dir);
+  write_many_keys(path, n, 0);
+  fmbParser p;
+  memset(&p, 0, sizeof p);
+  fmbDiag d;
+  memset(&d, 0, sizeof d);
+  ENSURE(fmbp_open(&p, path, NULL, 0, &d) == 0);
+  printf("100000 distinct keys: %ld string comparisons\n", p.key_compares);
+  ENSURE(p.key_compares < 2L * n);
+  fmbp_close(&p);
+  /* the whole load: refused for the unknown key, after a linear check */
+  fmbModel* m = fmb_load(path, NULL, 0, fmb_builtin_registry(), &d);
+  ENSURE(m == NULL && d.code == FMB_EXIT_BAD_INPUT && strstr(d.msg, "unknown key 'many'"));
+
+  write_many_keys(path, n, 1);
+  memset(&p, 0, sizeof p);
+  memset(&d, 0, sizeof d);
+  ENSURE(fmbp_open(&p, path, NULL, 0, &d) != 0);
+  printf("duplicate after 100000 keys: %ld string comparisons; %s:%d:%d: %s\n", p.key_compares, d.file, d.line, d.col,
+         d.msg);
+  ENSURE(p.key_compares < 2L * n);
+  /* the scene's 6 lines, "many:", then k0 .. k99999: the duplicate is on line 6 + 1 + n + 1 */
+  ENSURE(d.line == 6 + 1 + n + 1 && d.col == 3);
+  ENSURE(strstr(d.msg, "duplicate key 'k0' (first given at line 8)") != NULL);
+  fmbp_close(&p);
+}
+
+int main(int argc, char** argv) {
+  if (argc != 2) {
+    fprintf(stderr, "usage: %s OUT_DIR\n", argv[0]);
+    return 2;
+  }
+  mkdir(argv[1], 0755);
+  char scene[1024], csv[1024];
+  snprintf(scene, sizeof scene, "%s/pendulum.yaml", argv[1]);
+  snprintf(csv, sizeof csv, "%s/pendulum.csv", argv[1]);
+  write_file(scene, scene_text);
+  load_and_run_misuse(scene, csv);
+  parser_misuse(scene);
+  long_override(scene);
+  many_keys(argv[1]);
+  return fmbt_finish("api_misuse");
+}
