@@ -775,6 +775,9 @@ static int beam_velocity_error_test(const void* self) {
   return 0;
 }
 
+/* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
+static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
+
 static const fmbParam beam_params[] = {
     {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "undeformed length"},
     {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = MAX_ELEMENTS,
@@ -784,8 +787,9 @@ static const fmbParam beam_params[] = {
     {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",
      .doc = "second moment of area of the cross-section"},
     {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa", .doc = "Young's modulus"},
-    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "complete", .choices = model_names,
-     .doc = "coupling deformation kept in full, to first order, or left out (docs/beam.md)"},
+    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "complete", .choices = all_models,
+     .doc = "coupling deformation kept in full, to first order, or left out (docs/beam.md); exact: the "
+            "geometrically exact beam (docs/models.md)"},
     {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial root of the floating frame"},
     {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"},
     {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial root velocity"},
@@ -806,6 +810,16 @@ static int beam_centreline(const void* self, int n, double* local) {
     local[2 * i + 1] = 0.0;
   }
   return n;
+}
+
+/* `model: exact` (the geometrically exact beam) is its own implementation behind the same type
+   name: bodies/beam_exact.c. The other three models are this file's. */
+extern const fmbBodyType fmb_body_beam_exact;
+static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
+  extern const fmbBodyType fmb_body_beam;
+  int model = BEAM_COMPLETE;
+  if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model)) return NULL;
+  return model == 3 ? &fmb_body_beam_exact : &fmb_body_beam;
 }
 
 const fmbBodyType fmb_body_beam = {
@@ -834,4 +848,5 @@ const fmbBodyType fmb_body_beam = {
     .example_damped = "damping: 0.05\n",
 
     .centreline = beam_centreline,
+    .variant = beam_variant,
 };

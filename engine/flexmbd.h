@@ -218,6 +218,10 @@ typedef struct fmbBodyType {
      draws with by default (a beam: its nodes). The engine asks `marker` where they are now.
      NULL = a body without a centreline (drawn from its frame and joint points). */
   int (*centreline)(const void* self, int n, double* local);
+  /* a type whose items choose between implementations behind one `type:` name (beam: `model:
+     exact` is bodies/beam_exact.c) returns the ops table for this item, or NULL after recording
+     a parse error; the engine then parses and runs the item with that table. NULL op = this one. */
+  const struct fmbBodyType* (*variant)(fmbParser* p, fmbNode item);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -280,6 +284,9 @@ FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 /* n-point Gauss-Legendre rule on [0, 1] (1 <= n <= FMB_GAUSS_MAX); exact to degree 2n-1.
    Returns 0, or -1 for an unsupported n. */
 FMB_API int fmb_gauss_legendre01(int n, double* x, double* w);
+/* n-point Gauss-Lobatto rule on [0, 1] (2 <= n <= FMB_GAUSS_MAX): both ends and n - 2 interior
+   points, exact to degree 2n-3. Returns 0, or -1 for an unsupported n. */
+FMB_API int fmb_gauss_lobatto01(int n, double* x, double* w);
 
 /* Rigid-frame kinematics (engine/frame.c): the global position and angle of the point `local` of
    a planar frame at frame = [x, y, theta] (p = r + A(theta) local, angle = theta), dp/dframe

@@ -54,3 +54,29 @@ int fmb_gauss_legendre01(int n, double* x, double* w) {
   }
   return 0;
 }
+
+/* Gauss-Lobatto rules on [0, 1]: the two ends and the roots of P'_{n-1}, exact to degree 2n-3;
+   weights 2 / (n (n-1) P_{n-1}(x_i)^2) on [-1, 1]. Used where an integrand must be sampled at
+   the element ends (reduced integration against membrane locking). Newton on P'_{n-1} uses the
+   Legendre equation (1 - x^2) P'' = 2x P' - k(k+1) P. */
+int fmb_gauss_lobatto01(int n, double* x, double* w) {
+  if (n < 2 || n > FMB_GAUSS_MAX) return -1;
+  const int k = n - 1;
+  for (int i = 0; i < n; ++i) {
+    double t = -cos(M_PI * i / k); /* Chebyshev-Lobatto guess, ascending */
+    if (i > 0 && i < k)
+      for (int it = 0; it < 100; ++it) {
+        double p, dp;
+        legendre(k, t, &p, &dp);
+        double d2p = (2.0 * t * dp - k * (k + 1.0) * p) / (1.0 - t * t);
+        double dt = dp / d2p;
+        t -= dt;
+        if (fabs(dt) < 1e-16) break;
+      }
+    double p = (i == 0) ? (k % 2 ? -1.0 : 1.0) : (i == k ? 1.0 : 0.0), dp;
+    if (i > 0 && i < k) legendre(k, t, &p, &dp);
+    x[i] = 0.5 * (t + 1.0);
+    w[i] = 0.5 * 2.0 / (n * (double)k * p * p);
+  }
+  return 0;
+}

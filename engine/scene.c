@@ -151,7 +151,7 @@ static int check_library_keys(fmbParser* p, fmbNode lib, const char* what) {
    by its plugin with no key left unread. On success *self belongs to the caller; on error
    nothing is left allocated. */
 static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints, const char* const* names,
-                      char name[FMB_NAME_MAX], int* t, void** self) {
+                      char name[FMB_NAME_MAX], int* t, const fmbBodyType** body_type, void** self) {
   const char* kind = joints ? "joint" : "body";
   *self = NULL;
   if (!fmbp_is_map(p, item)) return fmb_parse_error(p, item, "expected a mapping for a %s (with name and type)", kind);
@@ -161,13 +161,20 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
     return fmb_parse_error(p, fmb_find_key(p, item, "name"),
                          "duplicate or reserved name '%s': every body and joint needs its own name", name);
   if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
-  const char* type_name = joints ? p->reg->joints[*t]->name : p->reg->bodies[*t]->name;
-  int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : p->reg->bodies[*t]->parse;
-  void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : p->reg->bodies[*t]->destroy;
-  char what[FMB_NAME_MAX + 40];
-  snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
   if (resolve_references(p, item)) return -1;
   p->item = item;
+  /* a type with implementations behind one name picks this item's (fmbBodyType.variant) */
+  const fmbBodyType* bt = joints ? NULL : p->reg->bodies[*t];
+  if (bt && bt->variant && !(bt = bt->variant(p, item))) {
+    p->item = p->inherited[0] = p->inherited[1] = -1;
+    return -1;
+  }
+  if (body_type) *body_type = bt;
+  const char* type_name = joints ? p->reg->joints[*t]->name : bt->name;
+  int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : bt->parse;
+  void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : bt->destroy;
+  char what[FMB_NAME_MAX + 40];
+  snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
   const int failed = parse(p, item, self) || fmbp_check_unknown(p, item, what);
   p->item = p->inherited[0] = p->inherited[1] = -1;
   if (failed) {
@@ -195,8 +202,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     fmbBodyInst* b = &m->body[m->nbody];
     int t = 0;
     b->node = fmbp_seq_item(p, list, i);
-    if (parse_item(p, m, b->node, 0, names, b->name, &t, &b->self)) return -1;
-    b->type = p->reg->bodies[t];
+    if (parse_item(p, m, b->node, 0, names, b->name, &t, &b->type, &b->self)) return -1;
     m->nbody++; /* owns self from here on, freed by fmb_free */
     b->qadr = m->nq;
     b->nq = b->type->ncoord(b->self);
@@ -225,7 +231,7 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
     fmbNode item = fmbp_seq_item(p, list, i);
     fmbJointInst* j = &m->joint[m->njoint];
     int t = 0;
-    if (parse_item(p, m, item, 1, names, j->name, &t, &j->self)) return -1;
+    if (parse_item(p, m, item, 1, names, j->name, &t, NULL, &j->self)) return -1;
     j->type = p->reg->joints[t];
     m->njoint++;
     j->type->bodies(j->self, j->body);

@@ -13,7 +13,7 @@ extern const fmbJointType fmb_joint_revolute, fmb_joint_fixed, fmb_joint_drive, 
 static const fmbBodyType* const builtin_bodies[] = {
     &fmb_body_ground,
     &fmb_body_rigid,
-    &fmb_body_beam,
+    &fmb_body_beam, /* and, behind it, model: exact (fmb_body_beam_exact) */
     NULL,
 };
 
