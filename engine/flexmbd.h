@@ -392,6 +392,10 @@ typedef struct fmbSolverInfo {
 } fmbSolverInfo;
 /* 0, or -1 when an argument is NULL */
 FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
+/* the scene's bodies (the fixed ground excluded): their count, and body i's name and `type:`
+   (0 <= i < count; 0, or -1 when out of range). Lets a program address them with --set. */
+FMB_API int fmb_model_nbody(const fmbModel* m);
+FMB_API int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type);
 /* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */

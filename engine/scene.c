@@ -423,6 +423,15 @@ int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
   return 0;
 }
 
+int fmb_model_nbody(const fmbModel* m) { return m ? m->nbody - 1 : 0; }
+
+int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type) {
+  if (!m || i < 0 || i >= m->nbody - 1) return -1;
+  if (name) *name = m->body[i + 1].name;
+  if (type) *type = m->body[i + 1].type->name;
+  return 0;
+}
+
 void fmb_describe(const fmbModel* m, FILE* f) {
   if (!m || !f) return;
   fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",

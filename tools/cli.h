@@ -33,6 +33,9 @@ int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, i
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
 
+/* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c) */
+int fmb_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet);
+
 /* the commands */
 int fmb_cmd_run(int argc, char** argv);
 int fmb_cmd_check(int argc, char** argv);

@@ -1,5 +1,6 @@
 /* cmd_run.c — `flexmbd run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--quiet] [--progress]
- *                [--vtk DIR] [--reference REF.csv [--columns a,b]]`
+ *                [--vtk DIR] [--reference REF.csv [--columns a,b]]
+ *                [--models zoac,foac,complete,exact]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
 #include <signal.h>
 #include <stdio.h>
@@ -34,6 +35,7 @@ int fmb_cmd_run(int argc, char** argv) {
   const char* columns = NULL;
   int quiet = 0, progress = 0;
   const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
+  const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("run", argc, argv, &i, &s);
@@ -45,6 +47,8 @@ int fmb_cmd_run(int argc, char** argv) {
       if (!(reference = fmb_cli_value("run", argc, argv, &i, "a CSV file"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--columns") == 0) {
       if (!(columns = fmb_cli_value("run", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--models") == 0) {
+      if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = 1;
     } else if (strcmp(a, "--progress") == 0) {
@@ -64,6 +68,11 @@ int fmb_cmd_run(int argc, char** argv) {
     fprintf(stderr, "flexmbd run: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
   }
+  if (models && reference) {
+    fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (models) return fmb_run_models(&s, models, out, quiet);
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);

@@ -15,7 +15,8 @@ typedef struct {
 static const Command commands[] = {
     {"run", fmb_cmd_run,
      "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR]\n"
-     "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost"},
+     "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
+     "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each"},
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run"},
     {"compare", fmb_cmd_compare,
      "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance"},
