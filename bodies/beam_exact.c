@@ -588,6 +588,12 @@ static int exact_velocity_error_test(const void* self) {
   return 0;
 }
 
+/* its tangent stiffness turns with the centreline (fmbBodyType.reuse_blocks) */
+static int exact_reuse_blocks(const void* self) {
+  (void)self;
+  return 0;
+}
+
 static const char* exact_invalid_state(const void* self, const double* q, const double* v) {
   (void)v;
   const BeamExact* b = self;
@@ -618,4 +624,5 @@ const fmbBodyType fmb_body_beam_exact = {
     .max_bdf_order = exact_max_bdf_order,
     .velocity_error_test = exact_velocity_error_test,
     .invalid_state = exact_invalid_state,
+    .reuse_blocks = exact_reuse_blocks,
 };

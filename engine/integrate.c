@@ -48,7 +48,7 @@ static int reuse_body_blocks(RunCtx* c) {
   long nst = 0, ncf = 0;
   IDAGetNumSteps(c->ida, &nst);
   IDAGetNumNonlinSolvConvFails(c->ida, &ncf);
-  const int reuse = c->fresh > 0 && ncf == c->fresh_conv_fails && nst - c->fresh_steps < 50;
+  const int reuse = !c->m->fresh_body_blocks && c->fresh > 0 && ncf == c->fresh_conv_fails && nst - c->fresh_steps < 50;
   if (reuse) {
     c->reused++;
   } else {

@@ -89,6 +89,7 @@ struct fmbModel {
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
   int initial_static; /* scene `initial: static`: runs start from the static or steady state */
+  int fresh_body_blocks;       /* a body's reuse_blocks said 0 */
   /* sparsity pattern of the iteration matrix, CSC, fixed at load */
   int nblock;
   fmbBlock* block;

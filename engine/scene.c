@@ -212,6 +212,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     m->nwork += b->nwork;
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
     if (b->type->velocity_error_test && !b->type->velocity_error_test(b->self)) m->bodies_prefer_positions = 1;
+    if (b->type->reuse_blocks && !b->type->reuse_blocks(b->self)) m->fresh_body_blocks = 1;
     if (b->type->max_bdf_order) {
       const int k = b->type->max_bdf_order(b->self);
       if (k >= 1 && k < m->bdf_order_cap) m->bdf_order_cap = k;

@@ -38,7 +38,7 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     return FMB_EXIT_BAD_INPUT;
   }
   for (char* tok = strtok(words, ","); tok; tok = strtok(NULL, ",")) {
-    if (nmodel == MAX_MODELS || strspn(tok, "abcdefghijklmnopqrstuvwxyz") != strlen(tok)) {
+    if (nmodel == MAX_MODELS || strlen(tok) > 63 || strspn(tok, "abcdefghijklmnopqrstuvwxyz") != strlen(tok)) {
       fprintf(stderr, "flexmbd run: --models expects up to %d model names separated by commas (zoac,foac,complete,exact), "
                       "got '%s'\n", MAX_MODELS, list);
       return FMB_EXIT_BAD_INPUT;
@@ -85,7 +85,7 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     const char* ov[FMB_CLI_MAX_OVERRIDES];
     memcpy(ov, s->overrides, sizeof(ov[0]) * (size_t)s->nover);
     for (int b = 0; b < nbeam; ++b) {
-      snprintf(set[b], sizeof set[b], "bodies.%s.model=%s", beam[b], model[k]);
+      snprintf(set[b], sizeof set[b], "bodies.%.127s.model=%.63s", beam[b], model[k]);
       ov[s->nover + b] = set[b];
     }
     char part[1024];
