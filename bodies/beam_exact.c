@@ -126,20 +126,23 @@ static void interp(const double w[4], const double X[8], double out[2]) {
 }
 
 /* ---------------------------------------------------------------------------------------------
- * Elastic energy of one element, its gradient f = dU/dX and (optionally) Hessian K (8 x 8, column-
- * major). Pure function of the nodal vectors: a rigid motion of X leaves eps, kappa and so U
- * unchanged.
+ * Elastic energy of one element, its gradient f = dU/dD and (optionally) Hessian K (8 x 8, column-
+ * major), from the nodal displacements D = X - X_ref (X_ref: the straight element, rho = (s, 0),
+ * rho' = (1, 0)). The Hermite interpolation reproduces the reference exactly, so rho' = (1, 0) +
+ * sum d1_k D_k and rho'' = sum d2_k D_k: the strain comes from displacements, without the round-
+ * off of positions near s ~ L. U depends on X only through eps and kappa: a rigid motion of X
+ * leaves it unchanged.
  * ------------------------------------------------------------------------------------------- */
-static double element_elastic(const BeamExact* b, const double X[8], double f[8], double* K) {
+static double element_elastic(const BeamExact* b, const double D[8], double f[8], double* K) {
   double U = 0.0;
   memset(f, 0, 8 * sizeof(double));
   if (K) memset(K, 0, 64 * sizeof(double));
   /* axial: dU = EA eps t . d(rho'), t = rho'/|rho'|; d2 eps/d rho'^2 = (I - t t^T)/|rho'| */
   for (int g = 0; g < b->axial.np; ++g) {
     const Shape* sh = &b->axial.sh[g];
-    double a[2];
-    interp(sh->d1, X, a);
-    const double dx = a[0] - 1.0, dy = a[1];
+    double dr[2];
+    interp(sh->d1, D, dr);
+    const double dx = dr[0], dy = dr[1], a[2] = {1.0 + dx, dy};
     const double len = sqrt(a[0] * a[0] + a[1] * a[1]);
     const double eps = (2.0 * dx + dx * dx + dy * dy) / (1.0 + len);
     const double wq = b->axial.w[g] * b->le * b->EA;
@@ -158,8 +161,9 @@ static double element_elastic(const BeamExact* b, const double X[8], double f[8]
   for (int g = 0; g < b->bending.np; ++g) {
     const Shape* sh = &b->bending.sh[g];
     double a[2], bb[2];
-    interp(sh->d1, X, a);
-    interp(sh->d2, X, bb);
+    interp(sh->d1, D, a);
+    a[0] += 1.0;
+    interp(sh->d2, D, bb);
     const double gg = a[0] * a[0] + a[1] * a[1];
     const double c = a[0] * bb[1] - a[1] * bb[0];
     const double kap = c / gg;
@@ -303,7 +307,8 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
   frame_terms(env, q, a, &c, &s, G0);
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   for (int e = 0; e < b->ne; ++e) {
-    double X[8], Xd[8], Xdd[8], f[8];
+    double X[8], D[8], Xd[8], Xdd[8], f[8];
+    element_values(b, q, e, 0, D);
     element_values(b, q, e, 1, X);
     element_values(b, v, e, 0, Xd);
     element_values(b, a, e, 0, Xdd);
@@ -313,7 +318,7 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
       const double w = b->mu * b->mass.w[g] * b->le;
       for (int k = 0; k < pf.ncol; ++k) R[pf.col[k]] += w * (pf.J[k][0] * pf.F[0] + pf.J[k][1] * pf.F[1]);
     }
-    element_elastic(b, X, f, NULL);
+    element_elastic(b, D, f, NULL);
     for (int l = 0; l < 8; ++l) {
       const int i = edof(e, l);
       if (i >= 0) R[i] += f[l];
@@ -342,7 +347,8 @@ static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, 
   if (C) memset(C, 0, sizeof(double) * nc * nc);
   if (M) memset(M, 0, sizeof(double) * nc * nc);
   for (int e = 0; e < b->ne; ++e) {
-    double X[8], Xd[8], Xdd[8], f[8], Ke[64];
+    double X[8], D[8], Xd[8], Xdd[8], f[8], Ke[64];
+    element_values(b, q, e, 0, D);
     element_values(b, q, e, 1, X);
     element_values(b, v, e, 0, Xd);
     element_values(b, a, e, 0, Xdd);
@@ -384,7 +390,7 @@ static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, 
       }
     }
     if (K) {
-      element_elastic(b, X, f, Ke);
+      element_elastic(b, D, f, Ke);
       for (int l2 = 0; l2 < 8; ++l2) {
         const int j = edof(e, l2);
         if (j < 0) continue;
@@ -480,7 +486,8 @@ static void exact_integrals(const BeamExact* b, const fmbEnv* env, const double*
   const double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
   double T = 0.0, Ue = 0.0, pth = 0.0, mrho[2] = {0.0, 0.0};
   for (int e = 0; e < b->ne; ++e) {
-    double X[8], Xd[8], f[8];
+    double X[8], D[8], Xd[8], f[8];
+    element_values(b, q, e, 0, D);
     element_values(b, q, e, 1, X);
     element_values(b, v, e, 0, Xd);
     for (int g = 0; g < b->mass.np; ++g) {
@@ -494,7 +501,7 @@ static void exact_integrals(const BeamExact* b, const fmbEnv* env, const double*
       mrho[0] += w * rho[0];
       mrho[1] += w * rho[1];
     }
-    Ue += element_elastic(b, X, f, NULL);
+    Ue += element_elastic(b, D, f, NULL);
   }
   double Ug = 0.0;
   if (env && env->has_gravity) {
