@@ -299,6 +299,15 @@ static void frame_terms(const fmbEnv* env, const double* q, const double* a, dou
   G0[1] = -*s * d[0] + *c * d[1];
 }
 
+/* element e's nodal displacements D, positions X, rates Xd and accelerations Xdd */
+static void element_state(const BeamExact* b, const double* q, const double* v, const double* a, int e, double D[8],
+                          double X[8], double Xd[8], double Xdd[8]) {
+  element_values(b, q, e, 0, D);
+  element_values(b, q, e, 1, X);
+  element_values(b, v, e, 0, Xd);
+  element_values(b, a, e, 0, Xdd);
+}
+
 static int exact_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
                           double* R, double* work) {
   (void)work;
@@ -308,10 +317,7 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   for (int e = 0; e < b->ne; ++e) {
     double X[8], D[8], Xd[8], Xdd[8], f[8];
-    element_values(b, q, e, 0, D);
-    element_values(b, q, e, 1, X);
-    element_values(b, v, e, 0, Xd);
-    element_values(b, a, e, 0, Xdd);
+    element_state(b, q, v, a, e, D, X, Xd, Xdd);
     for (int g = 0; g < b->mass.np; ++g) {
       PointFrame pf;
       point_frame(&b->mass.sh[g], e, X, Xd, Xdd, c, s, G0, v[2], a[2], &pf);
@@ -348,10 +354,7 @@ static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, 
   if (M) memset(M, 0, sizeof(double) * nc * nc);
   for (int e = 0; e < b->ne; ++e) {
     double X[8], D[8], Xd[8], Xdd[8], f[8], Ke[64];
-    element_values(b, q, e, 0, D);
-    element_values(b, q, e, 1, X);
-    element_values(b, v, e, 0, Xd);
-    element_values(b, a, e, 0, Xdd);
+    element_state(b, q, v, a, e, D, X, Xd, Xdd);
     for (int g = 0; g < b->mass.np; ++g) {
       PointFrame pf;
       point_frame(&b->mass.sh[g], e, X, Xd, Xdd, c, s, G0, om, al, &pf);
