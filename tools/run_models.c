@@ -59,7 +59,7 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
-  static char set[MAX_BEAMS][400];
+  static char set[MAX_MODELS][MAX_BEAMS][224];
   char beam[MAX_BEAMS][128];
   int nbeam = 0;
   for (int i = 0; i < fmb_model_nbody(m); ++i) {
@@ -78,16 +78,27 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     return FMB_EXIT_BAD_INPUT;
   }
 
+  /* every model must load before any runs (a misspelt model is bad input, not a late failure) */
+  const char* ov[MAX_MODELS][FMB_CLI_MAX_OVERRIDES];
+  for (int k = 0; k < nmodel; ++k) {
+    memcpy(ov[k], s->overrides, sizeof(ov[k][0]) * (size_t)s->nover);
+    for (int b = 0; b < nbeam; ++b) {
+      snprintf(set[k][b], sizeof set[k][b], "bodies.%.127s.model=%.63s", beam[b], model[k]);
+      ov[k][s->nover + b] = set[k][b];
+    }
+    fmbModel* mk = fmb_load(s->scene, ov[k], s->nover + nbeam, fmb_cli_registry(), &diag);
+    if (!mk) {
+      fmb_cli_print_diag(&diag);
+      fmb_print_stats(&stats, stderr);
+      return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
+    }
+    fmb_free(mk);
+  }
+
   fmbTable table[MAX_MODELS];
   memset(table, 0, sizeof table);
   int rc = 0, loaded = 0;
   for (int k = 0; k < nmodel; ++k) {
-    const char* ov[FMB_CLI_MAX_OVERRIDES];
-    memcpy(ov, s->overrides, sizeof(ov[0]) * (size_t)s->nover);
-    for (int b = 0; b < nbeam; ++b) {
-      snprintf(set[b], sizeof set[b], "bodies.%.127s.model=%.63s", beam[b], model[k]);
-      ov[s->nover + b] = set[b];
-    }
     char part[1024];
     if (snprintf(part, sizeof part, "%s.%s.part", out, model[k]) >= (int)sizeof part) {
       fprintf(stderr, "flexmbd run: output path too long\n");
@@ -95,7 +106,7 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
       break;
     }
     memset(&stats, 0, sizeof stats);
-    fmbModel* mk = fmb_load(s->scene, ov, s->nover + nbeam, fmb_cli_registry(), &diag);
+    fmbModel* mk = fmb_load(s->scene, ov[k], s->nover + nbeam, fmb_cli_registry(), &diag);
     if (!mk) {
       fmb_cli_print_diag(&diag);
       print_model_stats(model[k], &stats);

@@ -1,0 +1,40 @@
+#!/bin/sh
+# test_models_cli.sh FLEXMBD SOURCE_DIR OUT_DIR — `flexmbd run SCENE --models ...` (tools/run_models.c):
+# each model's columns NAME@MODEL equal that model's own run, a stats line per model, exit 3 with
+# nan cells after a model stops (ZOAC above its critical speed), exit 2 for bad use.
+set -u
+F=$1
+SRC=$2
+OUT=$3
+mkdir -p "$OUT"
+cd "$SRC" || exit 1
+fail=0
+check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
+
+"$F" run scenes/paper/spinup_w1.yaml --models complete,exact -o "$OUT/m.csv" --set solver.t_end=2 --quiet 2>"$OUT/m.err"
+rc=$?
+check "two models run: exit 0" "[ $rc -eq 0 ]"
+check "header has beam.tip_v@complete and beam.tip_v@exact" \
+  "head -1 '$OUT/m.csv' | grep -q 'beam.tip_v@complete' && head -1 '$OUT/m.csv' | grep -q 'beam.tip_v@exact'"
+check "one stats line per model, the last stderr line a stats line" \
+  "[ \$(grep -c '^stats: model=' '$OUT/m.err') -eq 2 ] && tail -1 '$OUT/m.err' | grep -q '^stats: model=exact status=ok'"
+"$F" run scenes/paper/spinup_w1.yaml -o "$OUT/e.csv" --set solver.t_end=2 --set bodies.beam.model=exact --quiet 2>/dev/null
+col=$(head -1 "$OUT/m.csv" | tr , '\n' | grep -n '^beam.tip_v@exact$' | cut -d: -f1)
+check "beam.tip_v@exact equals the exact model's own run" \
+  "[ \"\$(cut -d, -f$col '$OUT/m.csv' | tail -n +2)\" = \"\$(cut -d, -f2 '$OUT/e.csv' | tail -n +2)\" ]"
+
+"$F" run scenes/paper/spinup_w4.yaml --models zoac,complete -o "$OUT/z.csv" --quiet 2>"$OUT/z.err"
+rc=$?
+check "ZOAC diverging at omega0 = 4: exit 3, its message, the other model complete" \
+  "[ $rc -eq 3 ] && grep -q 'model zoac: .*diverging' '$OUT/z.err' && grep -q '^stats: model=complete status=ok' '$OUT/z.err'"
+check "ZOAC's cells after it stopped are nan, complete's are numbers" \
+  "tail -1 '$OUT/z.csv' | cut -d, -f2 | grep -q nan && ! tail -1 '$OUT/z.csv' | cut -d, -f12- | grep -q nan"
+
+"$F" run scenes/paper/spinup_w1.yaml --models complete 2>"$OUT/b1.err"; rc=$?
+check "--models without -o: exit 2" "[ $rc -eq 2 ] && grep -q 'needs the CSV in a file' '$OUT/b1.err'"
+"$F" run scenes/pendulum.yaml --models complete,exact -o "$OUT/b2.csv" 2>"$OUT/b2.err"; rc=$?
+check "--models on a scene without a beam: exit 2" "[ $rc -eq 2 ] && grep -q 'no body of type beam' '$OUT/b2.err'"
+"$F" run scenes/paper/spinup_w1.yaml --models complete,cubic -o "$OUT/b3.csv" 2>"$OUT/b3.err"; rc=$?
+check "--models with an unknown model: exit 2 naming the choices" \
+  "[ $rc -eq 2 ] && grep -q \"expected one of zoac, foac, complete, exact for 'model', got 'cubic'\" '$OUT/b3.err'"
+exit $fail
