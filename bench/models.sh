@@ -2,7 +2,7 @@
 # bench/models.sh — the four beam models on the paper's cases against a converged exact solution
 # (docs/models.md).
 #
-#   bash bench/models.sh [--reps N]
+#   bash bench/models.sh [--reps N] [--plots-from WORKDIR]
 #
 # Per case (spin-up at omega0 = 1, 4, 15 rad/s over 20 s; the pendulum over 2 s):
 #   reference  exact model, 64 elements (pendulum: 32), rtol 1e-10, atol 1e-12, positions only;
@@ -12,16 +12,20 @@
 # Error = max |beam.tip_v - reference| over the run (flexmbd compare), CPU = median cpu_s of REPS
 # runs. Results: bench/results/models_runs.csv and one work-precision plot per case,
 # bench/results/models_CASE.png (gnuplot); the CPU target at omega0 = 15 in models_target.txt.
+# --plots-from WORKDIR: no sweep; redraw the plots from models_runs.csv and measure the target
+# against the references a previous run left in WORKDIR (it is kept when the sweep stops).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 F=${FLEXMBD:-$ROOT/build/flexmbd}
 RES=${RESULTS:-$ROOT/bench/results}
-WORK=$(mktemp -d /tmp/flexmbd-models.XXXXXX)
+WORK=""
 REPS=3
+PLOTS_ONLY=0
 while [ $# -gt 0 ]; do
   case $1 in
     --reps) REPS=$2; shift ;;
+    --plots-from) WORK=$2; PLOTS_ONLY=1; shift ;;
     -h|--help) sed -n 2,16p "$0"; exit 0 ;;
     *) echo "models.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
@@ -29,7 +33,7 @@ while [ $# -gt 0 ]; do
 done
 mkdir -p "$RES"
 OUT=$RES/models_runs.csv
-echo "case,group,model,elements,rtol,status,steps,cpu_s,err_tip_v" > "$OUT"
+[ -n "$WORK" ] || WORK=$(mktemp -d /tmp/flexmbd-models.XXXXXX)
 
 # run CASE GROUP MODEL ELEMENTS RTOL [extra --set ...]: median CPU over REPS, error vs reference
 run() {
@@ -54,7 +58,9 @@ run() {
 }
 
 POS="--set solver.error_control=positions"
+[ $PLOTS_ONLY = 1 ] || echo "case,group,model,elements,rtol,status,steps,cpu_s,err_tip_v" > "$OUT"
 for case in spinup_w1 spinup_w4 spinup_w15 pendulum; do
+  [ $PLOTS_ONLY = 0 ] || break
   T_END=""
   ref_ne=64
   if [ $case = pendulum ]; then T_END="--set solver.t_end=2"; ref_ne=32; fi
@@ -74,7 +80,7 @@ done
 # one work-precision plot per case: error against CPU, a line per model (exact: one per mesh)
 for case in spinup_w1 spinup_w4 spinup_w15 pendulum; do
   gnuplot <<EOF
-set terminal pngcairo size 800,560
+set terminal pngcairo size 800,560 noenhanced
 set output "$RES/models_$case.png"
 set datafile separator ","
 set logscale xy
@@ -94,6 +100,10 @@ median_cpu() {
   for _ in 1 2 3 4 5; do "$F" run "$1" -o "$WORK/target.csv" --quiet 2>&1 | tail -1 | sed -n 's/.*cpu_s=\([0-9.e+-]*\).*/\1/p'; done |
     sort -g | sed -n 3p
 }
+if [ ! -f "$WORK/spinup_w15_ref.csv" ]; then
+  echo "no reference in $WORK: target not measured" >&2
+  exit 0
+fi
 cpu_exact=$(median_cpu scenes/exact/spinup_w15_exact.yaml)
 err_exact=$("$F" compare "$WORK/target.csv" "$WORK/spinup_w15_ref.csv" --columns beam.tip_v 2>&1 | sed -n 's/.*max_abs=\([^ ]*\).*/\1/p')
 cpu_complete=$(median_cpu scenes/paper/spinup_w15.yaml)
