@@ -777,6 +777,7 @@ static int beam_velocity_error_test(const void* self) {
 
 /* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
 static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
+static const char* const exact_integrations[] = {"reduced", "full", NULL};
 
 static const fmbParam beam_params[] = {
     {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "undeformed length"},
@@ -798,6 +799,8 @@ static const fmbParam beam_params[] = {
      .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
     {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 4,
      .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
+    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
+     .doc = "model: exact only: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full)"},
     {.key = NULL},
 };
 

@@ -201,9 +201,10 @@ static double element_elastic(const BeamExact* b, const double D[8], double f[8]
 /* ---------------------------------------------------------------------------------------------
  * Parse.
  * ------------------------------------------------------------------------------------------- */
+static const char* const exact_models[] = {"zoac", "foac", "complete", "exact", NULL}; /* as beam.c's */
+static const char* const exact_integrations[] = {"reduced", "full", NULL};
+
 static int exact_parse(fmbParser* p, fmbNode item, void** self) {
-  static const char* const models[] = {"zoac", "foac", "complete", "exact", NULL};
-  static const char* const integrations[] = {"reduced", "full", NULL};
   BeamExact* b = calloc(1, sizeof *b);
   if (!b) return fmb_parse_error(p, item, "out of memory");
   int model = 3, err = 0;
@@ -213,18 +214,18 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
   err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->Izz);
   err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
-  err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, models, &model); /* "exact": beam.c chose this table */
-  err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, integrations, &b->integration);
+  err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, exact_models, &model); /* "exact": beam.c chose this table */
+  err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, exact_integrations, &b->integration);
   err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
-  err |= fmb_get_double(p, item, "angle", FMB_OPTIONAL, &b->angle0);
+  err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
   err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
   err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
   if (!err && fmb_find_key(p, item, "damping") >= 0)
-    err = fmb_parse_error(p, fmb_find_key(p, item, "damping"), "damping is not available with model: exact "
+    err = fmb_parse_error(p, fmb_find_key(p, item, "damping"), "'damping' is not available with model: exact "
                                                                "(the exact beam is undamped); remove the key");
   if (!err && fmb_find_key(p, item, "quadrature_points") >= 0)
     err = fmb_parse_error(p, fmb_find_key(p, item, "quadrature_points"),
-                          "model: exact sets its points with `integration: reduced | full`, not quadrature_points");
+                          "model: exact sets its points with `integration: reduced | full`, not 'quadrature_points'");
   if (err) {
     free(b);
     return err;
@@ -616,6 +617,31 @@ static const char* exact_invalid_state(const void* self, const double* q, const 
   return NULL;
 }
 
+/* what `flexmbd conform` needs to check this table on its own (tests/exact/test_exact_conform.c:
+   beam.c's table, which the registry holds, declares the keys of type beam for users) */
+static const fmbParam exact_params[] = {
+    {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "undeformed length"},
+    {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = EXACT_MAX_ELEMENTS,
+     .doc = "finite elements along the length"},
+    {.key = "density", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg/m^3", .doc = "mass density"},
+    {.key = "area", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^2", .doc = "cross-section area"},
+    {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",
+     .doc = "second moment of area"},
+    {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa", .doc = "Young's modulus"},
+    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = exact_models, .doc = "exact here"},
+    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
+     .doc = "reduced: axial at 3 Lobatto, bending at 2 Gauss points; full: 5 and 3 Gauss points"},
+    {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial root of the frame"},
+    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"},
+    {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial root velocity"},
+    {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial angular velocity"},
+    /* keys of type beam that this model refuses, with the reason (so they are looked up) */
+    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
+    {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .lo = 1, .hi = FMB_GAUSS_MAX,
+     .doc = "refused: see integration"},
+    {.key = NULL},
+};
+
 const fmbBodyType fmb_body_beam_exact = {
     .name = "beam",
     .abi = FMB_ABI_VERSION,
@@ -635,4 +661,7 @@ const fmbBodyType fmb_body_beam_exact = {
     .velocity_error_test = exact_velocity_error_test,
     .invalid_state = exact_invalid_state,
     .reuse_blocks = exact_reuse_blocks,
+    .params = exact_params,
+    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
+               "model: exact\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",
 };
