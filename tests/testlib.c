@@ -117,3 +117,36 @@ void fmbt_csv_free(fmbtCsv* c) {
   free(c->data);
   memset(c, 0, sizeof *c);
 }
+
+double fmbt_crossing_frequency(const fmbtCsv* c, const char* col, double t0, int* ncross) {
+  const double* t = fmbt_col(c, "t");
+  const double* x = fmbt_col(c, col);
+  *ncross = 0;
+  if (!t || !x) return NAN;
+  double first = NAN, last = NAN;
+  for (int i = 1; i < c->nrow; ++i) {
+    if (t[i - 1] < t0 || (x[i - 1] < 0.0) == (x[i] < 0.0)) continue;
+    const double tc = t[i - 1] - x[i - 1] * (t[i] - t[i - 1]) / (x[i] - x[i - 1]);
+    if (*ncross == 0) first = tc;
+    last = tc;
+    ++*ncross;
+  }
+  return *ncross >= 2 ? M_PI * (*ncross - 1) / (last - first) : NAN;
+}
+
+double fmbt_energy_balance(const fmbtCsv* c, const char* body) {
+  char omega[96], momentum[96];
+  snprintf(omega, sizeof omega, "%s.omega", body);
+  snprintf(momentum, sizeof momentum, "%s.ang_momentum", body);
+  const double* e = fmbt_col(c, "energy.total");
+  const double* om = fmbt_col(c, omega);
+  const double* lz = fmbt_col(c, momentum);
+  if (!e || !om || !lz) return INFINITY;
+  double w = 0.0, worst = 0.0, emax = 0.0;
+  for (int i = 1; i < c->nrow; ++i) {
+    w += 0.5 * (om[i] + om[i - 1]) * (lz[i] - lz[i - 1]);
+    worst = fmax(worst, fabs(e[i] - e[0] - w));
+    emax = fmax(emax, fabs(e[i]));
+  }
+  return worst / emax;
+}

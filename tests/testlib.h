@@ -29,6 +29,15 @@ int fmbt_csv_read(const char* path, fmbtCsv* c);
 /* the column called name, or NULL (and a failure recorded) */
 const double* fmbt_col(const fmbtCsv* c, const char* name);
 void fmbt_csv_free(fmbtCsv* c);
+/* angular frequency from the zero crossings of column col for t >= t0 (linear interpolation
+   between rows); *ncross = the crossings used; NaN with fewer than two */
+double fmbt_crossing_frequency(const fmbtCsv* c, const char* col, double t0, int* ncross);
+/* a driven beam's energy balance: with its root pinned at the origin and no gravity the only
+   torque about the pin is the drive's, so dp_theta/dt = tau and the drive's work is
+   W = int tau omega dt = int omega dp_theta (p_theta = BODY.ang_momentum = dT/dtheta').
+   max |E(t) - E(0) - W(t)| / max |E| over the rows (trapezoidal rule), from the columns
+   energy.total, BODY.omega and BODY.ang_momentum */
+double fmbt_energy_balance(const fmbtCsv* c, const char* body);
 const char* fmbt_out_path(const char* name, char* buf, size_t len);
 
 #endif

@@ -34,43 +34,6 @@ static double max_diff(const fmbtCsv* a, const fmbtCsv* b, const char* col) {
   return m;
 }
 
-/* angular frequency from the zero crossings of col for t >= t0 (linear interpolation) */
-static double crossing_frequency(const fmbtCsv* c, const char* col, double t0, int* ncross) {
-  const double* t = fmbt_col(c, "t");
-  const double* x = fmbt_col(c, col);
-  *ncross = 0;
-  if (!t || !x) return NAN;
-  double first = NAN, last = NAN;
-  for (int i = 1; i < c->nrow; ++i) {
-    if (t[i - 1] < t0) continue;
-    if ((x[i - 1] < 0.0) != (x[i] < 0.0)) {
-      double tc = t[i - 1] + (0.0 - x[i - 1]) * (t[i] - t[i - 1]) / (x[i] - x[i - 1]);
-      if (*ncross == 0) first = tc;
-      last = tc;
-      ++*ncross;
-    }
-  }
-  return *ncross >= 2 ? M_PI * (*ncross - 1) / (last - first) : NAN;
-}
-
-/* energy balance against the drive's work: with the root pinned at the origin and no gravity,
-   the only torque about the pin is the drive's, so dp_theta/dt = tau and the drive's work is
-   W = int tau omega dt = int omega dp_theta (p_theta = beam.ang_momentum = dT/dtheta').
-   Returns max |E(t) - E(0) - W(t)| / max E (trapezoidal rule on the output samples). */
-static double energy_balance(const fmbtCsv* c) {
-  const double* e = fmbt_col(c, "energy.total");
-  const double* om = fmbt_col(c, "beam.omega");
-  const double* lz = fmbt_col(c, "beam.ang_momentum");
-  if (!e || !om || !lz) return INFINITY;
-  double w = 0.0, worst = 0.0, emax = 0.0;
-  for (int i = 1; i < c->nrow; ++i) {
-    w += 0.5 * (om[i] + om[i - 1]) * (lz[i] - lz[i - 1]);
-    worst = fmax(worst, fabs(e[i] - e[0] - w));
-    emax = fmax(emax, fabs(e[i]));
-  }
-  return worst / emax;
-}
-
 static int run(const char* scene, const char* model, int elements, double t_end, fmbtCsv* c, fmbStats* st) {
   char set_model[64], set_el[64], set_t[64], out[96];
   snprintf(set_model, sizeof set_model, "bodies.beam.model=%s", model);
@@ -129,7 +92,7 @@ int main(void) {
   fmbtCsv* cb[4] = {&c4[0], &c4[1], &c15[0], &c15[1]};
   const char* bn[4] = {"omega0 = 4, complete", "omega0 = 4, foac", "omega0 = 15, complete", "omega0 = 15, foac"};
   for (int k = 0; k < 4; ++k) {
-    double r = energy_balance(cb[k]);
+    double r = fmbt_energy_balance(cb[k], "beam");
     printf("%s: max |E - E0 - int omega dp_theta| / max E = %.2e\n", bn[k], r);
     ENSURE(r < 1e-6);
   }
@@ -140,7 +103,7 @@ int main(void) {
   for (int w = 0; w < 2; ++w)
     for (int k = 0; k < 2; ++k) {
       int n;
-      double om = crossing_frequency(cs[w][k], "beam.tip_v", 15.5, &n);
+      double om = fmbt_crossing_frequency(cs[w][k], "beam.tip_v", 15.5, &n);
       printf("omega0 = %s, %-8s: free vibration after spin-up %.5f rad/s over %d crossings (continuum %.5f, %+.3f %%)\n",
              w ? "15" : "4", models[k], om, n, ref[w], 100.0 * (om / ref[w] - 1.0));
       ENSURE(n >= 6);

@@ -26,21 +26,6 @@ static double max_abs_diff(const fmbtCsv* a, const fmbtCsv* b, const char* col) 
   return m;
 }
 
-/* max |E - E0 - int omega dp_theta| / max |E| (trapezoidal rule on the output samples) */
-static double energy_balance(const fmbtCsv* c) {
-  const double* e = fmbt_col(c, "energy.total");
-  const double* om = fmbt_col(c, "beam.omega");
-  const double* lz = fmbt_col(c, "beam.ang_momentum");
-  if (!e || !om || !lz) return INFINITY;
-  double w = 0.0, worst = 0.0, emax = 0.0;
-  for (int i = 1; i < c->nrow; ++i) {
-    w += 0.5 * (om[i] + om[i - 1]) * (lz[i] - lz[i - 1]);
-    worst = fmax(worst, fabs(e[i] - e[0] - w));
-    emax = fmax(emax, fabs(e[i]));
-  }
-  return worst / emax;
-}
-
 static void pendulum(void) {
   const char* tol[2][2] = {{"solver.rtol=1e-5", "solver.atol=1e-7"}, {"solver.rtol=1e-8", "solver.atol=1e-10"}};
   double d[2] = {0.0, 0.0};
@@ -83,7 +68,7 @@ static void spinup_w1(void) {
   double peak = 0.0;
   for (int i = 0; tv && i < c[1].nrow; ++i) peak = fmax(peak, fabs(tv[i]));
   const double d = max_abs_diff(&c[0], &c[1], "beam.tip_v");
-  const double eb = energy_balance(&c[1]);
+  const double eb = fmbt_energy_balance(&c[1], "beam");
   printf("spin-up omega0 = 1: |exact - complete| tip_v <= %.3e m (peak %.4f m); exact energy balance %.2e\n", d, peak,
          eb);
   ENSURE(peak > 0.01);
@@ -93,23 +78,6 @@ static void spinup_w1(void) {
   fmbt_csv_free(&c[1]);
 }
 
-/* angular frequency from the zero crossings of col for t >= t0 (linear interpolation) */
-static double crossing_frequency(const fmbtCsv* c, const char* col, double t0, int* ncross) {
-  const double* t = fmbt_col(c, "t");
-  const double* x = fmbt_col(c, col);
-  *ncross = 0;
-  if (!t || !x) return NAN;
-  double first = NAN, last = NAN;
-  for (int i = 1; i < c->nrow; ++i) {
-    if (t[i - 1] < t0 || (x[i - 1] < 0.0) == (x[i] < 0.0)) continue;
-    const double tc = t[i - 1] - x[i - 1] * (t[i] - t[i - 1]) / (x[i] - x[i - 1]);
-    if (*ncross == 0) first = tc;
-    last = tc;
-    ++*ncross;
-  }
-  return *ncross >= 2 ? M_PI * (*ncross - 1) / (last - first) : NAN;
-}
-
 static void spinup_w15_vibration(void) {
   fmbtCsv c;
   fmbStats st;
@@ -117,7 +85,7 @@ static void spinup_w15_vibration(void) {
                       "solver.atol=1e-10", "solver.error_control=positions"};
   ENSURE(fmbt_run_read("scenes/paper/spinup_w15.yaml", ov, 6, "exact_w15_30s.csv", &c, &st) == 0);
   int n;
-  const double w = crossing_frequency(&c, "beam.tip_v", 15.5, &n);
+  const double w = fmbt_crossing_frequency(&c, "beam.tip_v", 15.5, &n);
   printf("spin-up omega0 = 15, exact, 20 elements: free vibration after the ramp %.5f rad/s over %d crossings "
          "(rotating cantilever 6.33515, %+.3f %%), %.2f s CPU\n", w, n, 100.0 * (w / 6.33515 - 1.0), st.cpu_s);
   ENSURE(n >= 6);
