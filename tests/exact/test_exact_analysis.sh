@@ -5,15 +5,7 @@
 # against 4.26118, and `initial: static` starting a beam spinning at 15 rad/s in its stretched
 # steady state (tip stretch rho Omega^2 L^3/(3E) = 1.75531e-5 m held, no axial ringing) where the
 # scene's unstretched start rings its axial mode with the stretch's amplitude.
-set -u
-F=$1
-SRC=$2
-OUT=$3
-mkdir -p "$OUT"
-cd "$SRC" || exit 1
-fail=0
-check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
-near() { awk -v a="$1" -v b="$2" -v t="$3" 'BEGIN { d = a - b; if (d < 0) d = -d; exit !(d <= t) }'; }
+. "$(dirname "$0")/cli_lib.sh"
 
 "$F" static tests/exact/scenes/elastica_exact.yaml -o "$OUT/el.csv" 2>"$OUT/el.err"
 v=$(tail -1 "$OUT/el.csv" | cut -d, -f3)

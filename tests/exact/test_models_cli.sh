@@ -2,14 +2,7 @@
 # test_models_cli.sh FLEXMBD SOURCE_DIR OUT_DIR — `flexmbd run SCENE --models ...` (tools/run_models.c):
 # each model's columns NAME@MODEL equal that model's own run, a stats line per model, exit 3 with
 # nan cells after a model stops (ZOAC above its critical speed), exit 2 for bad use.
-set -u
-F=$1
-SRC=$2
-OUT=$3
-mkdir -p "$OUT"
-cd "$SRC" || exit 1
-fail=0
-check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
+. "$(dirname "$0")/cli_lib.sh"
 
 "$F" run scenes/paper/spinup_w1.yaml --models complete,exact -o "$OUT/m.csv" --set solver.t_end=2 --quiet 2>"$OUT/m.err"
 rc=$?
