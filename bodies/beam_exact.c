@@ -231,6 +231,18 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
     return err;
   }
   exact_setup(b);
+  /* as for the other models (beam.c): parameters that are each valid can still combine into an
+     element whose mass or stiffness is not a usable double (length 1e-300: EI/le^3 overflows) */
+  const double me = b->mu * b->le, k_axial = b->EA / b->le, k_bend = 12.0 * b->EI / (b->le * b->le * b->le);
+  if (!isnormal(me) || !isnormal(k_axial) || !isnormal(k_bend) || !isfinite(fmax(k_axial, k_bend) / me)) {
+    fmb_parse_error(p, item,
+                    "degenerate beam: length %g in %d elements with density %g, area %g, second moment %g and Young's "
+                    "modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: not all are "
+                    "usable (finite, non-zero) floating-point numbers",
+                    b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
+    free(b);
+    return -1;
+  }
   *self = b;
   return 0;
 }
