@@ -14,6 +14,11 @@
  * with three force vectors (per model, see point_forces). J_C's p-columns are -e1 h^T with the
  * dense h(x) = H(x) p; its products are accumulated with prefix sums (scalars h^T(.)) and tail
  * sums (the vector sum over points of c h), so a residual costs O(ne * points).
+ *
+ * Those sums couple every element to all others, so the Jacobian of `residual` is dense. The
+ * banded assembly (`assembly: banded`, the default from 32 elements) carries them as auxiliary
+ * unknowns z with one recursion per element (beam_residual_aux, beam_pattern): the engine then
+ * differentiates and factorizes a banded system, O(ne) per step in time and memory.
  */
 #include <math.h>
 #include <stdio.h>
@@ -29,6 +34,7 @@ typedef struct Beam {
   /* parameters */
   double L, rho, A, Izz, Emod, beta;
   int ne, ng, model;
+  int banded; /* the coupling's long-range sums carried as auxiliary unknowns (beam_residual_aux) */
   double pos0[2], angle0, vel0[2], omega0;
   /* derived */
   double le, r;   /* element length, cross-section point offset sqrt(I/A) */
@@ -144,6 +150,11 @@ static void int_weights(double le, double xi, double pw[5]) {
  * Parse.
  * ------------------------------------------------------------------------------------------- */
 static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
+static const char* const assembly_names[] = {"auto", "dense", "banded", NULL};
+enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
+/* `assembly: auto` is banded from this many elements on: below it the dense blocks are small
+   and the fewer unknowns win (docs/performance.md, "Scaling") */
+enum { BANDED_FROM_ELEMENTS = 32 };
 
 static void beam_setup(Beam* b) {
   b->le = b->L / b->ne;
@@ -189,7 +200,10 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
   err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
   err |= fmb_get_double(p, item, "damping", FMB_OPTIONAL | FMB_NONNEGATIVE, &b->beta);
+  int assembly = ASSEMBLY_AUTO;
+  err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, assembly_names, &assembly);
   if (!err) {
+    b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
     b->ng = default_points(b->model);
     err |= fmb_get_int(p, item, "quadrature_points", FMB_OPTIONAL, 1, FMB_GAUSS_MAX, &b->ng);
   }
@@ -227,7 +241,8 @@ static void beam_destroy(void* self) { free(self); }
 
 static int beam_ncoord(const void* self) { return 3 + ((const Beam*)self)->n; }
 
-static size_t beam_nwork(const void* self) { return (size_t)9 * (size_t)((const Beam*)self)->ne; }
+/* residual_serial's F and csum (5 ne), and one residual for beam_aux_initial (3 + 3 ne) */
+static size_t beam_nwork(const void* self) { return (size_t)9 * (size_t)((const Beam*)self)->ne + 3; }
 
 static void beam_initial(const void* self, double* q0, double* v0) {
   const Beam* b = self;
@@ -272,143 +287,138 @@ static inline void point_forces(int model, double m, const double aRD[2], const 
   }
 }
 
-static int beam_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                         double* R, double* work) {
-  const Beam* b = self;
-  const int ne = b->ne, ng = b->ng, model = b->model;
-  const int coupled = model != BEAM_ZOAC;
-  const double le = b->le;
-  const double* p = q + 3;
-  const double* pd = v + 3;
-  const double* pdd = a + 3;
-  double* Rp = R + 3;
+/* The frame's motion as every point sees it: acceleration a0 and gravity f in the body frame,
+   angular velocity om (om2 = om^2) and acceleration al */
+typedef struct {
+  double a0[2], f[2], om, om2, al;
+} FrameMotion;
+
+static void frame_motion(const fmbEnv* env, const double* q, const double* v, const double* a, FrameMotion* fm) {
   double c = cos(q[2]), s = sin(q[2]);
-  double om = v[2], om2 = v[2] * v[2], al = a[2];
-  /* frame acceleration and gravity in the body frame */
-  double a0[2] = {c * a[0] + s * a[1], -s * a[0] + c * a[1]};
-  double f[2] = {0.0, 0.0};
+  fm->a0[0] = c * a[0] + s * a[1];
+  fm->a0[1] = -s * a[0] + c * a[1];
+  fm->f[0] = fm->f[1] = 0.0;
   if (env && env->has_gravity) {
-    f[0] = c * env->gravity[0] + s * env->gravity[1];
-    f[1] = -s * env->gravity[0] + c * env->gravity[1];
+    fm->f[0] = c * env->gravity[0] + s * env->gravity[1];
+    fm->f[1] = -s * env->gravity[0] + c * env->gravity[1];
   }
-  /* work: per element full integrals F[4] of N2j' w2', partial sums pv[4], point sum csum */
-  double* Fe = work;
-  double* pv = work + 4 * ne;
-  double* csum = work + 8 * ne;
+  fm->om = v[2];
+  fm->om2 = v[2] * v[2];
+  fm->al = a[2];
+}
 
-  memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
-  double Fr[2] = {0.0, 0.0}, Rth = 0.0;
-  /* prefix integrals over inboard elements: int w2'^2, w2' w2d', w2' w2dd' + w2d'^2 */
-  double Ipp = 0.0, Ipv = 0.0, Iha = 0.0;
+/* What one element contributes to the residual, given the coupling integrals over the elements
+   inboard of it (prefix: int w2'^2, int w2' w2d', int (w2' w2dd' + w2d'^2) from the root to its
+   left node). Everything here is local to the element; the only long-range couplings of the
+   beam are the prefix (inboard -> outboard) and the tail (outboard -> inboard: the sum of the
+   coupling forces F_C[0] of every point outboard, which multiplies F) and the frame sums. */
+typedef struct {
+  double rp_a[2], rp_t[4]; /* its p rows, without the outboard part -F tail */
+  double F[4];             /* int over the element of N2j' w2' (what the outboard tail multiplies) */
+  double csum;             /* sum of its points' F_C[0]: what it adds to the tail of inboard elements */
+  double dprefix[3];       /* its whole-element coupling integrals: what it adds to the prefix */
+  double frame[3];         /* body-frame force sums F_R (x, y) and the theta row */
+} ElementTerms;
+
+static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
+                          const double* pdd, const double prefix[3], ElementTerms* out) {
+  const int ng = b->ng, model = b->model;
+  const int coupled = model != BEAM_ZOAC;
+  const double le = b->le, om = fm->om, om2 = fm->om2, al = fm->al;
+  const double *a0 = fm->a0, *f = fm->f;
+  const double Ipp = prefix[0], Ipv = prefix[1], Iha = prefix[2];
   const double mhalf = 0.5 * b->rho * b->A * le;
-
-  for (int e = 0; e < ne; ++e) {
-    double ua[2], d[4], uda[2], dd[4], udda[2], ddd[4];
-    gather(p, e, ua, d);
-    gather(pd, e, uda, dd);
-    gather(pdd, e, udda, ddd);
-    double xe = e * le;
-    double rp_a[2] = {0.0, 0.0}, rp_t[4] = {0.0, 0.0, 0.0, 0.0};
-    /* slope polynomials of p, pd, pdd and the quartic products the coupling needs:
-       w2'^2, w2' w2d', and w2' w2dd' + w2d'^2 (what h^T pdd + pd^T H pd integrates) */
-    double cp[3], pp[5], pv5[5], ha[5], fc_moment[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+  double ua[2], d[4], uda[2], dd[4], udda[2], ddd[4];
+  gather(p, e, ua, d);
+  gather(pd, e, uda, dd);
+  gather(pdd, e, udda, ddd);
+  double xe = e * le;
+  memset(out, 0, sizeof *out);
+  /* slope polynomials of p, pd, pdd and the quartic products the coupling needs:
+     w2'^2, w2' w2d', and w2' w2dd' + w2d'^2 (what h^T pdd + pd^T H pd integrates) */
+  double cp[3], pp[5], pv5[5], ha[5], fc_moment[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+  if (coupled) {
+    double cv[3], ca[3], vv[5];
+    slope_products(b, d, dd, cp, cv, pp, pv5);
+    slope_poly(b, ddd, ca);
+    poly_mul(cp, ca, ha);
+    poly_mul(cv, cv, vv);
+    for (int k = 0; k < 5; ++k) ha[k] += vv[k];
+  }
+  for (int g = 0; g < ng; ++g) {
+    double xi = b->xg[g], x = xe + xi * le;
+    const double* ns = b->ns_out[g];
+    const double* nd = b->nd_out[g];
+    double n1[2] = {1.0 - xi, xi};
+    double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
+    double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
+    double w1dd = n1[0] * udda[0] + n1[1] * udda[1], w2dd = dot4(ns, ddd), w2sdd = dot4(nd, ddd);
+    double wc = 0.0, wcd = 0.0, hacc = 0.0;
     if (coupled) {
-      csum[e] = 0.0;
-      double cv[3], ca[3], vv[5];
-      slope_products(b, d, dd, cp, cv, pp, pv5);
-      slope_poly(b, ddd, ca);
-      poly_mul(cp, ca, ha);
-      poly_mul(cv, cv, vv);
-      for (int k = 0; k < 5; ++k) ha[k] += vv[k];
+      /* inboard integrals + this element's part over [0, xi], in closed form */
+      const double* pw = b->pw_out[g];
+      wc = -0.5 * (Ipp + dot5(pp, pw)); /* w_c = -1/2 p^T H p */
+      wcd = -(Ipv + dot5(pv5, pw));     /* dw_c/dt = -p^T H pd */
+      hacc = Iha + dot5(ha, pw);        /* h^T pdd + pd^T H pd */
     }
-    for (int g = 0; g < ng; ++g) {
-      double xi = b->xg[g], x = xe + xi * le;
-      const double* ns = b->ns_out[g];
-      const double* nd = b->nd_out[g];
-      double n1[2] = {1.0 - xi, xi};
-      double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
-      double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
-      double w1dd = n1[0] * udda[0] + n1[1] * udda[1], w2dd = dot4(ns, ddd), w2sdd = dot4(nd, ddd);
-      double wc = 0.0, wcd = 0.0, hacc = 0.0;
-      if (coupled) {
-        /* inboard integrals + this element's part over [0, xi], in closed form */
-        const double* pw = b->pw_out[g];
-        wc = -0.5 * (Ipp + dot5(pp, pw)); /* w_c = -1/2 p^T H p */
-        wcd = -(Ipv + dot5(pv5, pw));     /* dw_c/dt = -p^T H pd */
-        hacc = Iha + dot5(ha, pw);        /* h^T pdd + pd^T H pd */
-      }
-      /* The cross-section's two points y = -r, +r (weights m each): every force below is affine
-         in y, F = F0 + y F1, so the sums over the pair are exact in closed form,
-         sum (A + yB)(C + yD) = 2 (AC + r^2 BD); with M2 = 2m folded into F0 and F1, one pass
-         gives what the two points gave. The accelerations split the same way:
-           a_RD = a_RD0 + y a_RD1,  a_R = a_R0 + y a_R1,  a_C and f do not depend on y. */
-      {
-        const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
-        const double aRD0[2] = {a0[0] - w2 * al - (x + w1) * om2 - 2.0 * w2d * om + w1dd,
-                                a0[1] + (x + w1) * al - w2 * om2 + 2.0 * w1d * om + w2dd};
-        const double aRD1[2] = {-al + w2s * om2 - w2sdd, -w2s * al - om2 - 2.0 * w2sd * om};
-        const double aR0[2] = {a0[0] - x * om2, a0[1] + x * al};
-        const double aR1[2] = {-al, -om2};
-        const double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
-        const double zero[2] = {0.0, 0.0};
-        double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
-        point_forces(model, M2, aRD0, aR0, aC, f, FR0, FD0, FC0);
-        point_forces(model, M2, aRD1, aR1, zero, zero, FR1, FD1, FC1);
-        Fr[0] += FR0[0];
-        Fr[1] += FR0[1];
-        /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
-        Rth += x * FR0[1] - r2 * FR1[0] + w1 * FD0[1] - r2 * w2s * FD1[1] - w2 * FD0[0] + wc * FC0[1];
-        /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
-        rp_a[0] += n1[0] * FD0[0];
-        rp_a[1] += n1[1] * FD0[0];
-        for (int j = 0; j < 4; ++j) rp_t[j] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0];
-        if (coupled) {
-          /* p rows: -h F_C[0]; h's own element part through the F_C-weighted moments of the
-             partial-integral weights (pv below), the inboard part by tail sums */
-          csum[e] += FC0[0];
-          for (int k = 0; k < 5; ++k) fc_moment[k] += FC0[0] * b->pw_out[g][k];
-        }
-      }
-    }
-    for (int j = 0; j < 2; ++j) {
-      int i = adof(e, j);
-      if (i >= 0) Rp[i] += rp_a[j];
-    }
-    for (int j = 0; j < 4; ++j) {
-      int i = tdof(e, j);
-      if (i >= 0) Rp[i] += rp_t[j];
-    }
+    /* The cross-section's two points y = -r, +r (weights m each): every force below is affine
+       in y, F = F0 + y F1, so the sums over the pair are exact in closed form,
+       sum (A + yB)(C + yD) = 2 (AC + r^2 BD); with M2 = 2m folded into F0 and F1, one pass
+       gives what the two points gave. The accelerations split the same way:
+         a_RD = a_RD0 + y a_RD1,  a_R = a_R0 + y a_R1,  a_C and f do not depend on y. */
+    const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
+    const double aRD0[2] = {a0[0] - w2 * al - (x + w1) * om2 - 2.0 * w2d * om + w1dd,
+                            a0[1] + (x + w1) * al - w2 * om2 + 2.0 * w1d * om + w2dd};
+    const double aRD1[2] = {-al + w2s * om2 - w2sdd, -w2s * al - om2 - 2.0 * w2sd * om};
+    const double aR0[2] = {a0[0] - x * om2, a0[1] + x * al};
+    const double aR1[2] = {-al, -om2};
+    const double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
+    const double zero[2] = {0.0, 0.0};
+    double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
+    point_forces(model, M2, aRD0, aR0, aC, f, FR0, FD0, FC0);
+    point_forces(model, M2, aRD1, aR1, zero, zero, FR1, FD1, FC1);
+    out->frame[0] += FR0[0];
+    out->frame[1] += FR0[1];
+    /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
+    out->frame[2] += x * FR0[1] - r2 * FR1[0] + w1 * FD0[1] - r2 * w2s * FD1[1] - w2 * FD0[0] + wc * FC0[1];
+    /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
+    out->rp_a[0] += n1[0] * FD0[0];
+    out->rp_a[1] += n1[1] * FD0[0];
+    for (int j = 0; j < 4; ++j) out->rp_t[j] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0];
     if (coupled) {
-      /* full-element integrals: prefix scalars and F_e = int N2' w2' */
-      double* F = Fe + 4 * e;
-      double Gm[4][3]; /* sum over points of F_C[0] G(xi_g) */
-      h_weights(b, fc_moment, Gm);
-      for (int j = 0; j < 4; ++j) {
-        F[j] = dot3(b->G_full[j], cp);
-        pv[4 * e + j] = dot3(Gm[j], cp);
-      }
-      Ipp += dot5(pp, b->pw_full);
-      Ipv += dot5(pv5, b->pw_full);
-      Iha += dot5(ha, b->pw_full);
+      /* p rows: -h F_C[0]; h's own element part through the F_C-weighted moments of the
+         partial-integral weights, the inboard part by the tail */
+      out->csum += FC0[0];
+      for (int k = 0; k < 5; ++k) fc_moment[k] += FC0[0] * b->pw_out[g][k];
     }
   }
   if (coupled) {
-    /* tail sums: sum over points of c h = for each element e, F_e (sum of c outboard of e)
-       + the partial parts of e's own points */
-    double tail = 0.0;
-    for (int e = ne - 1; e >= 0; --e) {
-      for (int j = 0; j < 4; ++j) {
-        int i = tdof(e, j);
-        if (i >= 0) Rp[i] -= Fe[4 * e + j] * tail + pv[4 * e + j];
-      }
-      tail += csum[e];
+    double Gm[4][3]; /* sum over points of F_C[0] G(xi_g) */
+    h_weights(b, fc_moment, Gm);
+    for (int j = 0; j < 4; ++j) {
+      out->F[j] = dot3(b->G_full[j], cp);
+      out->rp_t[j] -= dot3(Gm[j], cp);
     }
+    out->dprefix[0] = dot5(pp, b->pw_full);
+    out->dprefix[1] = dot5(pv5, b->pw_full);
+    out->dprefix[2] = dot5(ha, b->pw_full);
   }
-  R[0] = c * Fr[0] - s * Fr[1];
-  R[1] = s * Fr[0] + c * Fr[1];
-  R[2] = Rth;
-  /* elastic and damping forces: K (p + beta pd), element by element */
-  for (int e = 0; e < ne; ++e) {
+}
+
+static void add_element_rows(int e, const ElementTerms* t, double* Rp) {
+  for (int j = 0; j < 2; ++j) {
+    int i = adof(e, j);
+    if (i >= 0) Rp[i] += t->rp_a[j];
+  }
+  for (int j = 0; j < 4; ++j) {
+    int i = tdof(e, j);
+    if (i >= 0) Rp[i] += t->rp_t[j];
+  }
+}
+
+/* elastic and damping forces: K (p + beta pd), element by element */
+static void add_elastic(const Beam* b, const double* p, const double* pd, double* Rp) {
+  for (int e = 0; e < b->ne; ++e) {
     double ua[2], d[4], uda[2], dd[4];
     gather(p, e, ua, d);
     gather(pd, e, uda, dd);
@@ -425,9 +435,186 @@ static int beam_residual(const void* self, const fmbEnv* env, const double* q, c
       if (i >= 0) Rp[i] += dot4(b->kb[j], d);
     }
   }
-  for (int i = 0; i < 3 + b->n; ++i)
-    if (!isfinite(R[i])) return 1;
-  return 0;
+}
+
+/* frame rows from the body-frame force sums: R_xy = A(theta) F_R, R_theta */
+static void frame_rows(const double* q, const double sums[3], double* R) {
+  double c = cos(q[2]), s = sin(q[2]);
+  R[0] = c * sums[0] - s * sums[1];
+  R[1] = s * sums[0] + c * sums[1];
+  R[2] = sums[2];
+}
+
+static int all_finite(const double* x, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!isfinite(x[i])) return 0;
+  return 1;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * The auxiliary unknowns of the banded assembly (beam_residual_aux). Per element e, at its
+ * left node: the prefix P_e (3: the coupling integrals from the root), the tail T_e (1: sum of
+ * F_C[0] over the points outboard of e) and the frame sums S_e (3: over elements e..ne-1).
+ * ZOAC has no coupling: S_e only.
+ * ------------------------------------------------------------------------------------------- */
+static int aux_per_element(const Beam* b) { return b->model == BEAM_ZOAC ? 3 : 7; }
+static int zP(const Beam* b, int e) { return aux_per_element(b) * e; }
+static int zT(const Beam* b, int e) { return aux_per_element(b) * e + 3; }
+static int zS(const Beam* b, int e) { return aux_per_element(b) * e + (b->model == BEAM_ZOAC ? 0 : 4); }
+
+/* The residual with the long-range sums accumulated serially (O(ne)): inboard to outboard for
+   the prefix, then outboard to inboard for the tail. When z != NULL it also records the
+   auxiliary unknowns these sums are (the consistent z of the banded assembly). */
+static int residual_serial(const Beam* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                           double* R, double* work, double* z) {
+  const int ne = b->ne, coupled = b->model != BEAM_ZOAC;
+  double* Rp = R + 3;
+  FrameMotion fm;
+  frame_motion(env, q, v, a, &fm);
+  double* Fe = work;        /* per element F[4] */
+  double* csum = work + 4 * ne;
+  memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
+  double prefix[3] = {0.0, 0.0, 0.0}, sums[3] = {0.0, 0.0, 0.0};
+  for (int e = 0; e < ne; ++e) {
+    ElementTerms t;
+    if (z && coupled) memcpy(z + zP(b, e), prefix, sizeof prefix);
+    element_terms(b, &fm, e, q + 3, v + 3, a + 3, prefix, &t);
+    add_element_rows(e, &t, Rp);
+    memcpy(Fe + 4 * e, t.F, sizeof t.F);
+    csum[e] = t.csum;
+    for (int k = 0; k < 3; ++k) {
+      prefix[k] += t.dprefix[k];
+      sums[k] += t.frame[k];
+    }
+    if (z) memcpy(z + zS(b, e), t.frame, sizeof t.frame);
+  }
+  /* tail: the coupling forces of every point outboard of e act on e's dofs through F_e */
+  double tail = 0.0;
+  for (int e = ne - 1; e >= 0; --e) {
+    if (coupled) {
+      for (int j = 0; j < 4; ++j) {
+        int i = tdof(e, j);
+        if (i >= 0) Rp[i] -= Fe[4 * e + j] * tail;
+      }
+      if (z) z[zT(b, e)] = tail;
+      tail += csum[e];
+    }
+    if (z && e < ne - 1)
+      for (int k = 0; k < 3; ++k) z[zS(b, e) + k] += z[zS(b, e + 1) + k];
+  }
+  frame_rows(q, sums, R);
+  add_elastic(b, q + 3, v + 3, Rp);
+  return all_finite(R, 3 + b->n) ? 0 : 1;
+}
+
+static int beam_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                         double* R, double* work) {
+  return residual_serial(self, env, q, v, a, R, work, NULL);
+}
+
+/* The same residual with the prefix, tail and frame sums as unknowns z and one recursion per
+   element among them (Rz = 0): every equation then touches one element, its neighbours' sums
+   and the frame, so the Jacobian is banded (plus the frame's rows and columns) and its cost,
+   its factorization and memory grow linearly with ne. On Rz = 0, R is residual_serial's. */
+static int beam_residual_aux(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                             const double* z, double* R, double* Rz, double* work) {
+  (void)work;
+  const Beam* b = self;
+  const int ne = b->ne, coupled = b->model != BEAM_ZOAC;
+  double* Rp = R + 3;
+  FrameMotion fm;
+  frame_motion(env, q, v, a, &fm);
+  memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
+  /* the recursions: P_e = P_(e-1) + dP(e-1), P_0 = 0; T_e = T_(e+1) + csum(e+1), T_last = 0;
+     S_e = S_(e+1) + s(e), S_ne = 0; the element terms are subtracted below */
+  for (int e = 0; e < ne; ++e) {
+    for (int k = 0; k < 3; ++k)
+      Rz[zS(b, e) + k] = z[zS(b, e) + k] - (e + 1 < ne ? z[zS(b, e + 1) + k] : 0.0);
+    if (!coupled) continue;
+    for (int k = 0; k < 3; ++k) Rz[zP(b, e) + k] = z[zP(b, e) + k] - (e > 0 ? z[zP(b, e - 1) + k] : 0.0);
+    Rz[zT(b, e)] = z[zT(b, e)] - (e + 1 < ne ? z[zT(b, e + 1)] : 0.0);
+  }
+  const double zero[3] = {0.0, 0.0, 0.0};
+  for (int e = 0; e < ne; ++e) {
+    ElementTerms t;
+    element_terms(b, &fm, e, q + 3, v + 3, a + 3, coupled ? z + zP(b, e) : zero, &t);
+    add_element_rows(e, &t, Rp);
+    for (int k = 0; k < 3; ++k) Rz[zS(b, e) + k] -= t.frame[k];
+    if (!coupled) continue;
+    for (int j = 0; j < 4; ++j) {
+      int i = tdof(e, j);
+      if (i >= 0) Rp[i] -= t.F[j] * z[zT(b, e)];
+    }
+    if (e + 1 < ne)
+      for (int k = 0; k < 3; ++k) Rz[zP(b, e + 1) + k] -= t.dprefix[k];
+    if (e > 0) Rz[zT(b, e - 1)] -= t.csum;
+  }
+  frame_rows(q, z + zS(b, 0), R);
+  add_elastic(b, q + 3, v + 3, Rp);
+  return all_finite(R, 3 + b->n) && all_finite(Rz, aux_per_element(b) * ne) ? 0 : 1;
+}
+
+static int beam_naux(const void* self) {
+  const Beam* b = self;
+  return b->banded ? aux_per_element(b) * b->ne : 0;
+}
+
+static int beam_aux_initial(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                            double* z, double* work) {
+  const Beam* b = self;
+  double* R = work + 5 * (size_t)b->ne; /* beam_nwork leaves room for one residual */
+  return residual_serial(b, env, q, v, a, R, work, z);
+}
+
+/* The banded assembly's pattern over [coordinates | aux]: element e's equations (its dof rows
+   and the recursions it feeds: P_(e+1), T_(e-1), S_e) read the frame, its dofs, and the sums
+   at its own and its neighbours' nodes; the frame rows read the frame and S_0. */
+static long beam_pattern(const void* self, int* rows, int* cols) {
+  const Beam* b = self;
+  if (!b->banded) return -1;
+  const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
+  long n = 0;
+#define PAIR(r, c)         \
+  do {                     \
+    if (rows) {            \
+      rows[n] = (r);       \
+      cols[n] = (c);       \
+    }                      \
+    ++n;                   \
+  } while (0)
+  int rr[16], cc[32];
+  for (int e = 0; e < ne; ++e) {
+    int nr = 0, nc = 0;
+    for (int k = 0; k < 3; ++k) cc[nc++] = k;
+    for (int j = 0; j < 2; ++j)
+      if (adof(e, j) >= 0) rr[nr++] = cc[nc++] = 3 + adof(e, j);
+    for (int j = 0; j < 4; ++j)
+      if (tdof(e, j) >= 0) rr[nr++] = cc[nc++] = 3 + tdof(e, j);
+    for (int k = 0; k < 3; ++k) {
+      rr[nr++] = cc[nc++] = nq + zS(b, e) + k;
+      if (e + 1 < ne) cc[nc++] = nq + zS(b, e + 1) + k;
+      if (!coupled) continue;
+      cc[nc++] = nq + zP(b, e) + k;
+      if (e + 1 < ne) rr[nr++] = cc[nc++] = nq + zP(b, e + 1) + k;
+    }
+    if (coupled) {
+      cc[nc++] = nq + zT(b, e);
+      if (e > 0) rr[nr++] = cc[nc++] = nq + zT(b, e - 1);
+    }
+    for (int i = 0; i < nr; ++i)
+      for (int j = 0; j < nc; ++j) PAIR(rr[i], cc[j]);
+  }
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) {
+      PAIR(i, k);
+      PAIR(i, nq + zS(b, 0) + k);
+    }
+  if (coupled) {
+    for (int k = 0; k < 3; ++k) PAIR(nq + zP(b, 0) + k, nq + zP(b, 0) + k);
+    PAIR(nq + zT(b, ne - 1), nq + zT(b, ne - 1));
+  }
+#undef PAIR
+  return n;
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -730,8 +917,9 @@ static void beam_describe(const void* self, FILE* f) {
   static const char* const terms[] = {"w_c dropped (no coupling deformation)",
                                       "w_c to first order (rigid x coupling products only)",
                                       "w_c and all its high-order terms kept"};
-  fprintf(f, "%s model, %d elements, %d Gauss points/element, %s%s", model_names[b->model], b->ne, b->ng,
-          terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "");
+  fprintf(f, "%s model, %d elements, %d Gauss points/element, %s%s, %s assembly", model_names[b->model], b->ne, b->ng,
+          terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "",
+          b->banded ? "banded (coupling sums as auxiliary unknowns)" : "dense");
   fputc('\n', f);
 }
 
@@ -801,6 +989,8 @@ static const fmbParam beam_params[] = {
      .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
     {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
      .doc = "model: exact only: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full)"},
+    {.key = "assembly", .kind = FMB_PARAM_CHOICE, .fallback = "auto", .choices = assembly_names,
+     .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
     {.key = NULL},
 };
 
@@ -852,4 +1042,8 @@ const fmbBodyType fmb_body_beam = {
 
     .centreline = beam_centreline,
     .variant = beam_variant,
+    .naux = beam_naux,
+    .residual_aux = beam_residual_aux,
+    .aux_initial = beam_aux_initial,
+    .pattern = beam_pattern,
 };

@@ -24,7 +24,8 @@ extern "C" {
 /* The plugin ABI: the layout of fmbPlugin, fmbBodyType, fmbJointType, fmbParam and the signatures
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
-   the optional centreline op (added to 2 before any release of it). */
+   the optional centreline op and the optional naux, residual_aux, aux_initial and pattern ops
+   (added to 2 before any release of it). */
 #define FMB_ABI_VERSION 2
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
@@ -229,6 +230,23 @@ typedef struct fmbBodyType {
      cost Newton failures (spin-up at 15 rad/s, 20 elements: 454 against 123, 1.7x the CPU).
      NULL = 1 (reuse allowed). */
   int (*reuse_blocks)(const void* self);
+  /* Auxiliary algebraic unknowns, for a body whose equations couple far-apart coordinates
+     through sums (the beam's coupling deformation accumulates every inboard slope): carrying
+     the sums as `naux` unknowns z with one equation each keeps every equation local, so the
+     Jacobian is sparse. With naux > 0 the engine integrates R(q, v, a, z) = 0 (ncoord rows, R
+     as `residual` returns it once Rz = 0) and Rz(q, v, a, z) = 0 (naux rows) from residual_aux;
+     aux_initial gives the z that satisfies Rz = 0. `residual` (z eliminated) stays required:
+     initial conditions and checks use it. NULL naux or 0 = none. */
+  int (*naux)(const void* self);
+  int (*residual_aux)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                      const double* z, double* R, double* Rz, double* work);
+  int (*aux_initial)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                     double* z, double* work);
+  /* The nonzeros of d[R; Rz]/d[x; z], x = q, v or a (their union), as (row, column) pairs over
+     the ncoord + naux rows and columns (duplicates allowed): with rows/cols NULL it returns the
+     count, else fills them. -1 (or a NULL op) = one dense block. The engine then differentiates
+     the body over that pattern, grouping columns that share no row (engine/fd.c). */
+  long (*pattern)(const void* self, int* rows, int* cols);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

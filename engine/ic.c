@@ -238,6 +238,16 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
       rc = FMB_EXIT_SOLVER;
       break;
     }
+  /* the bodies' auxiliary unknowns, consistent with (q, v, a) */
+  for (int b = 1; b < m->nbody && !rc; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bi->nz > 0 && bi->type->aux_initial(bi->self, &m->env, q + bi->qadr, v + bi->qadr, yp + nq + bi->qadr,
+                                            y + m->zoff + bi->zadr, fmb_workspace_plugin(w) + bi->workadr)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the auxiliary unknowns of body '%s' are not finite at t = %g",
+                   bi->name, t0);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
 done:
   free(PhiQ);
   free(PhiQ2);

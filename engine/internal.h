@@ -17,6 +17,14 @@ typedef struct fmbBodyInst {
   int qadr, nq; /* slice of the coordinate vector */
   fmbNode node; /* its item in the scene, for messages about it after parsing */
   size_t workadr, nwork;
+  int zadr, nz;  /* auxiliary algebraic unknowns (fmbBodyType.naux): slice of z, at m->zoff in y */
+  /* sparse body block (fmbBodyType.pattern), CSC over nq + nz rows and columns; pnnz < 0: dense.
+     Columns are grouped in colours that share no row, for differencing (fd.c). */
+  long pnnz;
+  long* pcolptr;
+  int* prowind;
+  int ncolor;
+  int *color_ptr, *color_col; /* columns of colour k: color_col[color_ptr[k] .. color_ptr[k+1]) */
 } fmbBodyInst;
 
 typedef struct fmbJointInst {
@@ -26,6 +34,10 @@ typedef struct fmbJointInst {
   int body[2];   /* body indices, -1 = none */
   int ncol;      /* nq(body0) + nq(body1) */
   int rowadr, nrows;
+  /* the columns (of the ncol) its constraint or force can depend on, found by evaluating it at
+     random states at load (pattern.c): a joint at a beam's root touches the frame only */
+  int nsup;
+  int* sup;
 } fmbJointInst;
 
 typedef enum {
@@ -65,11 +77,6 @@ typedef struct fmbSolverSettings {
    With a floor, the first failure there ends the run and the usual diagnosis says why. */
 #define FMB_MIN_STEP_FRACTION 1e-12
 
-/* one rectangle (or diagonal run) of the iteration matrix's fixed sparsity pattern */
-typedef struct fmbBlock {
-  int r0, nr, c0, nc, diag;
-} fmbBlock;
-
 struct fmbModel {
   char path[512];
   int nbody, njoint;
@@ -77,7 +84,9 @@ struct fmbModel {
   fmbJointInst* joint;
   int nq;   /* coordinates */
   int nc;   /* constraint rows */
-  int ny;   /* unknowns of the DAE: 2 nq + 2 nc */
+  int nz;   /* auxiliary algebraic unknowns of the bodies (fmbBodyType.naux) */
+  int zoff; /* their offset in y: y = [q | v | lambda | mu | z] */
+  int ny;   /* unknowns of the DAE: 2 nq + 2 nc + nz */
   size_t nwork; /* total plugin scratch doubles */
   int max_joint_cols;
   fmbEnv env;
@@ -91,8 +100,6 @@ struct fmbModel {
   int initial_static; /* scene `initial: static`: runs start from the static or steady state */
   int fresh_body_blocks;       /* a body's reuse_blocks said 0 */
   /* sparsity pattern of the iteration matrix, CSC, fixed at load */
-  int nblock;
-  fmbBlock* block;
   long nnz;
   long* colptr; /* ny + 1 */
   long* rowind; /* nnz */
@@ -195,6 +202,8 @@ int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const doub
                         double* phi, double* phi_q_dense, double* phi_t, double* phi_tt);
 void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, fmbEnergy* e);
 int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols);
+/* the joint's columns its equations can depend on (indices into fmb_joint_cols' list, increasing) */
+int fmb_joint_support(const fmbModel* m, fmbWorkspace* w, int j, int* sup);
 void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* pos,
                           double* vel);
 double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y);
@@ -207,6 +216,7 @@ int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q
 
 /* ---- pattern.c ---- */
 int fmb_pattern_build(fmbModel* m);
+void fmb_pattern_free(fmbModel* m);
 void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals,
                        int ld, double scale);
 void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v);
@@ -275,5 +285,15 @@ double fmb_fd_increment(double y, double ewt);
 int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
                          const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
                          double* M, double* work, double* scratch);
+/* the same over a body's sparse pattern (b->pcolptr/prowind), one residual pair per colour:
+   K = d[R; Rz]/dq (and d/dz in the z columns), C = d/dv, M = d/da, each in pattern order
+   (pnnz). z: the body's auxiliary unknowns (NULL when nz = 0). scratch: fmb_fd_sparse_scratch. */
+size_t fmb_fd_sparse_scratch(const fmbBodyInst* b);
+int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                       const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
+                       double* work, double* scratch);
+/* a body's rows [R; Rz] at (q, v, a, z): residual_aux when it has auxiliary unknowns */
+int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                  const double* z, double* R, double* work);
 
 #endif

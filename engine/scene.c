@@ -210,6 +210,9 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     b->workadr = m->nwork;
     b->nwork = b->type->nwork ? b->type->nwork(b->self) : 0;
     m->nwork += b->nwork;
+    b->zadr = m->nz;
+    b->nz = (b->type->naux && b->type->residual_aux && b->type->aux_initial) ? b->type->naux(b->self) : 0;
+    m->nz += b->nz;
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
     if (b->type->velocity_error_test && !b->type->velocity_error_test(b->self)) m->bodies_prefer_positions = 1;
     if (b->type->reuse_blocks && !b->type->reuse_blocks(b->self)) m->fresh_body_blocks = 1;
@@ -352,7 +355,8 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   if (m->nc > m->nq)
     return fmb_parse_error(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
                          m->nc, m->nq);
-  m->ny = 2 * m->nq + 2 * m->nc;
+  m->zoff = 2 * m->nq + 2 * m->nc;
+  m->ny = m->zoff + m->nz;
   if (m->solver.max_order == 0) m->solver.max_order = m->bdf_order_cap;
   if (m->solver.positions_only < 0) m->solver.positions_only = m->bodies_prefer_positions;
   if (outputs >= 0) {
@@ -408,12 +412,10 @@ void fmb_free(fmbModel* m) {
     if (m->body[b].type && m->body[b].self) m->body[b].type->destroy(m->body[b].self);
   for (int j = 0; j < m->njoint; ++j)
     if (m->joint[j].self) m->joint[j].type->destroy(m->joint[j].self);
+  fmb_pattern_free(m);
   free(m->body);
   free(m->joint);
   free(m->output);
-  free(m->block);
-  free(m->colptr);
-  free(m->rowind);
   free(m);
 }
 

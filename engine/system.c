@@ -46,6 +46,11 @@ static size_t max_body_nq(const fmbModel* m) {
   return (size_t)mx;
 }
 
+/* doubles of one of a body's K, C, M blocks: its pattern's nonzeros, or nq^2 when dense */
+static size_t block_size(const fmbBodyInst* b) {
+  return b->pnnz >= 0 ? (size_t)b->pnnz : (size_t)b->nq * (size_t)b->nq;
+}
+
 fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   fmbWorkspace* w = calloc(1, sizeof *w);
   if (!w) return NULL;
@@ -55,6 +60,12 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   size_t mc = (size_t)(m->max_joint_cols > 0 ? m->max_joint_cols : 1);
   size_t nb = max_body_nq(m);
   size_t nq = (size_t)m->nq;
+  /* fmb_check_mass takes a dense mass matrix of the body in w->M */
+  size_t nblk = m->check_definiteness ? nb * nb : 1, nfd = 7 * nb;
+  for (int b = 1; b < m->nbody; ++b) {
+    if (block_size(&m->body[b]) > nblk) nblk = block_size(&m->body[b]);
+    if (m->body[b].pnnz >= 0 && fmb_fd_sparse_scratch(&m->body[b]) > nfd) nfd = fmb_fd_sparse_scratch(&m->body[b]);
+  }
   w->max_rows = mr;
   w->max_nq = (int)nb;
   w->plugin = calloc(m->nwork + 1, sizeof(double));
@@ -68,11 +79,11 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->jQ = calloc(mc, sizeof(double));
   w->jQ2 = calloc(mc * (mc + 1), sizeof(double));
   w->cols = calloc(mc, sizeof(int));
-  w->K = calloc(nb * nb, sizeof(double));
-  w->C = calloc(nb * nb, sizeof(double));
-  w->M = calloc(nb * nb, sizeof(double));
-  w->fdcol = calloc(nb * nb, sizeof(double));
-  w->fd = calloc(7 * nb, sizeof(double));
+  w->K = calloc(nblk, sizeof(double));
+  w->C = calloc(nblk, sizeof(double));
+  w->M = calloc(nblk, sizeof(double));
+  w->fdcol = calloc(nblk, sizeof(double));
+  w->fd = calloc(nfd, sizeof(double));
   w->mk = calloc(3 * nb, sizeof(double));
   w->js = calloc(2 * mc, sizeof(double));
   w->qpert = calloc(nq, sizeof(double));
@@ -85,7 +96,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
     return NULL;
   }
   size_t ncache = 0;
-  for (int b = 1; b < m->nbody; ++b) ncache += 3 * (size_t)m->body[b].nq * (size_t)m->body[b].nq;
+  for (int b = 1; b < m->nbody; ++b) ncache += 3 * block_size(&m->body[b]);
   if (ncache * sizeof(double) <= FMB_BLOCK_CACHE_BYTES) {
     w->cache = malloc((ncache + 1) * sizeof(double));
     w->cache_adr = calloc((size_t)m->nbody + 1, sizeof(size_t));
@@ -96,7 +107,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
     size_t adr = 0;
     for (int b = 1; b < m->nbody; ++b) {
       w->cache_adr[b] = adr;
-      adr += 3 * (size_t)m->body[b].nq * (size_t)m->body[b].nq;
+      adr += 3 * block_size(&m->body[b]);
     }
   }
   if (m->check_definiteness) {
@@ -204,8 +215,63 @@ static int joint_force(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
   return ji->type->force(ji->self, &ev, Q);
 }
 
+/* The columns (of the joint's ncol) its equations can depend on: those where its Phi_q or its
+   force Q is nonzero at either of two random states near the initial one (for a body with a
+   sparse pattern; a dense body's columns are all kept). A structural nonzero
+   vanishes at a random state with probability zero, so what vanishes at both is zero for the
+   smooth functions joints are; a joint that cannot be evaluated there keeps every column. A pin
+   at a beam's root then touches the frame's 3 columns instead of all 3 + 3 ne. Setup-time. */
+int fmb_joint_support(const fmbModel* m, fmbWorkspace* w, int j, int* sup) {
+  const fmbJointInst* ji = &m->joint[j];
+  const int ncol = fmb_joint_cols(m, ji, w->cols), nq = m->nq;
+  unsigned char* hit = calloc((size_t)ncol + 1, 1);
+  double* q = calloc(4 * (size_t)nq, sizeof(double));
+  int all = !hit || !q;
+  if (!all) {
+    double *v = q + nq, *q0 = v + nq, *v0 = q0 + nq;
+    for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, q0 + m->body[b].qadr, v0 + m->body[b].qadr);
+    unsigned long long seed = 0x9E3779B97F4A7C15ull + (unsigned long long)j;
+    for (int probe = 0; probe < 2 && !all; ++probe) {
+      for (int i = 0; i < 2 * nq; ++i) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        const double u = (double)(seed >> 11) / 9007199254740992.0 - 0.5;
+        const double x0 = i < nq ? q0[i] : v0[i - nq];
+        (i < nq ? q : v)[i % nq] = x0 + 0.01 * (1.0 + fabs(x0)) * u;
+      }
+      if (ji->type->force) {
+        if (joint_force(m, w, j, m->solver.t0, q, v, w->jQ)) all = 1;
+        for (int c = 0; c < ncol && !all; ++c) hit[c] |= w->jQ[c] != 0.0;
+      }
+      if (ji->nrows > 0 && !all) {
+        if (joint_eval(m, w, j, m->solver.t0, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) all = 1;
+        for (int k = 0; k < ji->nrows * ncol && !all; ++k) hit[k % ncol] |= w->phi_q[k] != 0.0;
+      }
+    }
+  }
+  /* only a body that declared a sparse pattern (a large one) is narrowed: a dense body's columns
+     stay whole, as its block is (the same pattern, hence the same KLU pivoting, as before) */
+  for (int k = 0, c0 = 0; k < 2 && !all; ++k) {
+    if (ji->body[k] < 0) continue;
+    const fmbBodyInst* bk = &m->body[ji->body[k]];
+    if (bk->pnnz < 0) memset(hit + c0, 1, (size_t)bk->nq);
+    c0 += bk->nq;
+  }
+  int n = 0;
+  for (int c = 0; c < ncol; ++c)
+    if (all || hit[c]) sup[n++] = c;
+  free(hit);
+  free(q);
+  return n;
+}
+
 /* ---------------------------------------------------------------------------------------------
  * residual */
+
+int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                  const double* z, double* R, double* work) {
+  if (b->nz > 0) return b->type->residual_aux(b->self, env, q, v, a, z, R, R + b->nq, work);
+  return b->type->residual(b->self, env, q, v, a, R, work);
+}
 
 static int all_finite(const double* x, int n) {
   for (int i = 0; i < n; ++i)
@@ -222,8 +288,11 @@ int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const doub
   for (int i = 0; i < nq; ++i) Fq[i] = qp[i] - v[i];
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    int rc = bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr, Fv + bi->qadr,
-                                w->plugin + bi->workadr);
+    int rc = bi->nz > 0 ? bi->type->residual_aux(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr,
+                                                 y + m->zoff + bi->zadr, Fv + bi->qadr, F + m->zoff + bi->zadr,
+                                                 w->plugin + bi->workadr)
+                        : bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr,
+                                             Fv + bi->qadr, w->plugin + bi->workadr);
     if (rc) return rc;
   }
   for (int j = 0; j < m->njoint; ++j) {
@@ -307,7 +376,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     const int n = bi->nq, a0 = bi->qadr;
-    const size_t nn = (size_t)n * (size_t)n;
+    const size_t nn = block_size(bi);
     double *K = w->K, *C = w->C, *M = w->M;
     if (w->cache) {
       K = w->cache + w->cache_adr[b];
@@ -315,11 +384,28 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
       M = C + nn;
     }
     if (!reuse) {
-      int rc = fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, K, C, M);
+      int rc = bi->pnnz >= 0 ? fmb_fd_body_sparse(bi, &m->env, q + a0, v + a0, vp + a0, y + m->zoff + bi->zadr,
+                                                  ewt + a0, ewt + nq + a0, K, C, M, w->plugin + bi->workadr, w->fd)
+                             : fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, K, C, M);
       if (rc) {
         w->cache_valid = 0;
         return rc;
       }
+    }
+    if (bi->pnnz >= 0) {
+      /* the declared pattern: rows R then Rz, columns q/v/a then z */
+      for (int c = 0; c < n + bi->nz; ++c)
+        for (long k = bi->pcolptr[c]; k < bi->pcolptr[c + 1]; ++k) {
+          const int r = bi->prowind[k];
+          const int row = r < n ? Fv + a0 + r : m->zoff + bi->zadr + (r - n);
+          if (c < n) {
+            sink_add(&s, row, Yq + a0 + c, K[k]);
+            sink_add(&s, row, Yv + a0 + c, C[k] + cj * M[k]);
+          } else {
+            sink_add(&s, row, m->zoff + bi->zadr + (c - n), K[k]);
+          }
+        }
+      continue;
     }
     /* dR/dq under q, dR/dv + cj dR/da under v */
     for (size_t k = 0; k < nn; ++k) w->fdcol[k] = C[k] + cj * M[k];
@@ -342,8 +428,8 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
       for (int pass = 0; pass < 2; ++pass) {
         double* x = pass == 0 ? w->qpert : w->vpert;
         const double* ew = ewt + (pass == 0 ? 0 : nq);
-        for (int c = 0; c < ncol; ++c) {
-          const int gc = cols[c];
+        for (int si = 0; si < ji->nsup; ++si) {
+          const int gc = cols[ji->sup[si]];
           const double x0 = x[gc];
           double h = fmb_fd_increment(x0, ew[gc]);
           x[gc] = x0 + h;
@@ -351,7 +437,10 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
           rc = joint_force(m, w, j, t, w->qpert, w->vpert, w->jQ2);
           x[gc] = x0;
           if (rc) return rc;
-          for (int r = 0; r < ncol; ++r) sink_add(&s, Fv + cols[r], (pass == 0 ? Yq : Yv) + gc, -(w->jQ2[r] - w->jQ[r]) / h);
+          for (int sr = 0; sr < ji->nsup; ++sr) {
+            const int r = ji->sup[sr];
+            sink_add(&s, Fv + cols[r], (pass == 0 ? Yq : Yv) + gc, -(w->jQ2[r] - w->jQ[r]) / h);
+          }
         }
       }
     }
@@ -368,8 +457,8 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
         sink_add(&s, Fq + cols[c], Ym + ji->rowadr + r, -d);
       }
     /* d(Phi_q v)/dq, d(Phi_q^T lambda)/dq and d(Phi_q^T mu)/dq by forward differences of Phi_q */
-    for (int c = 0; c < ncol; ++c) {
-      const int gc = cols[c];
+    for (int si = 0; si < ji->nsup; ++si) {
+      const int gc = cols[ji->sup[si]];
       const double x0 = w->qpert[gc];
       double h = fmb_fd_increment(x0, ewt[gc]);
       w->qpert[gc] = x0 + h;
@@ -380,7 +469,8 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
       for (int r = 0; r < nr; ++r) {
         double dpv = 0.0;
         const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
-        for (int k = 0; k < ncol; ++k) {
+        for (int sk = 0; sk < ji->nsup; ++sk) {
+          const int k = ji->sup[sk];
           const double dphiq = (w->phi_q2[(size_t)r * ncol + k] - w->phi_q[(size_t)r * ncol + k]) / h;
           if (dphiq == 0.0) continue;
           dpv += dphiq * v[cols[k]];
