@@ -195,6 +195,11 @@ static int schur_free(SUNLinearSolver S) {
   return SUNLS_SUCCESS;
 }
 
+static int cmp_sslong(const void* a, const void* b) {
+  SuiteSparse_long x = *(const SuiteSparse_long*)a, y = *(const SuiteSparse_long*)b;
+  return (x > y) - (x < y);
+}
+
 /* S's pattern: the kept rows of J's column, and for each eliminated row i in it, the kept rows
    of J's column i. Returns 0, or -1 when out of memory. */
 static int schur_pattern(Schur* s) {
@@ -202,8 +207,10 @@ static int schur_pattern(Schur* s) {
   const int nq = s->nq, nr = s->nr;
   s->colptr = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1));
   int* mark = malloc(sizeof(int) * (size_t)nr);
-  if (!s->colptr || !mark) {
+  SuiteSparse_long* list = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1)); /* rows of one column */
+  if (!s->colptr || !mark || !list) {
     free(mark);
+    free(list);
     return -1;
   }
   for (int pass = 0; pass < 2; ++pass) {
@@ -212,19 +219,25 @@ static int schur_pattern(Schur* s) {
     for (int c = 0; c < nr; ++c) {
       const int jc = nq + c;
       s->colptr[c] = nnz;
+      long nl = 0; /* the column's rows, collected and sorted: O(nnz log) rather than O(nr) per column */
       for (long k = m->colptr[jc]; k < m->colptr[jc + 1]; ++k) {
         const long i = m->rowind[k];
         if (i >= nq) {
+          if (mark[i - nq] != c) list[nl++] = i - nq;
           mark[i - nq] = c;
         } else {
-          for (long kk = s->first_kept[i]; kk < m->colptr[i + 1]; ++kk) mark[m->rowind[kk] - nq] = c;
+          for (long kk = s->first_kept[i]; kk < m->colptr[i + 1]; ++kk) {
+            const long r = m->rowind[kk] - nq;
+            if (mark[r] != c) list[nl++] = r;
+            mark[r] = c;
+          }
         }
       }
-      for (int r = 0; r < nr; ++r)
-        if (mark[r] == c) {
-          if (pass) s->rowind[nnz] = r;
-          ++nnz;
-        }
+      qsort(list, (size_t)nl, sizeof *list, cmp_sslong);
+      for (long k = 0; k < nl; ++k) {
+        if (pass) s->rowind[nnz] = list[k];
+        ++nnz;
+      }
     }
     s->colptr[nr] = nnz;
     if (!pass) {
@@ -232,11 +245,13 @@ static int schur_pattern(Schur* s) {
       s->data = calloc((size_t)nnz + 1, sizeof(double));
       if (!s->rowind || !s->data) {
         free(mark);
+        free(list);
         return -1;
       }
     }
   }
   free(mark);
+  free(list);
   return 0;
 }
 
