@@ -16,7 +16,7 @@
  * sums (the vector sum over points of c h), so a residual costs O(ne * points).
  *
  * Those sums couple every element to all others, so the Jacobian of `residual` is dense. The
- * banded assembly (`assembly: banded`, the default from 32 elements) carries them as auxiliary
+ * banded assembly (`assembly: banded`, the default from 64 elements) carries them as auxiliary
  * unknowns z with one recursion per element (beam_residual_aux, beam_pattern): the engine then
  * differentiates and factorizes a banded system, O(ne) per step in time and memory.
  */
@@ -154,7 +154,7 @@ static const char* const assembly_names[] = {"auto", "dense", "banded", NULL};
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on: below it the dense blocks are small
    and the fewer unknowns win (docs/performance.md, "Scaling") */
-enum { BANDED_FROM_ELEMENTS = 32 };
+enum { BANDED_FROM_ELEMENTS = 64 };
 
 static void beam_setup(Beam* b) {
   b->le = b->L / b->ne;

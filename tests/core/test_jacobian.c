@@ -3,7 +3,9 @@
  * perturbed state with nonzero velocities, accelerations and multipliers. Checks both the
  * analytic blocks (rigid, joints) and the engine's FD blocks (beam), that the CSC pattern holds
  * every nonzero (the dense and sparse assemblies must agree), and that reassembling cached body
- * blocks for a new cj equals a fresh evaluation. */
+ * blocks for a new cj equals a fresh evaluation. The beam also in its banded assembly (auxiliary
+ * unknowns, its declared pattern differenced by column colours): a missing pattern entry shows
+ * as a dense/sparse difference, a wrong difference as a Jacobian error. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -114,5 +116,10 @@ int main(void) {
   check_scene("tests/core/scenes/conformance_rigid.yaml", NULL, 0);
   static const char* const models[][1] = {{"bodies.beam.model=complete"}, {"bodies.beam.model=foac"}, {"bodies.beam.model=zoac"}};
   for (int k = 0; k < 3; ++k) check_scene("tests/core/scenes/conformance_beam.yaml", models[k], 1);
+  /* the banded assembly: auxiliary unknowns, a declared pattern differenced by colours */
+  static const char* const banded[][2] = {{"bodies.beam.model=complete", "bodies.beam.assembly=banded"},
+                                          {"bodies.beam.model=foac", "bodies.beam.assembly=banded"},
+                                          {"bodies.beam.model=zoac", "bodies.beam.assembly=banded"}};
+  for (int k = 0; k < 3; ++k) check_scene("tests/core/scenes/conformance_beam.yaml", banded[k], 2);
   return fmbt_finish("test_jacobian");
 }
