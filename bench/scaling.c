@@ -9,13 +9,24 @@
  *   - the whole DAE residual (fmb_system_residual),
  *   - one iteration matrix J = dF/dy + cj dF/dy' into the sparse pattern (fmb_system_jacobian:
  *     the beam's analytic `jacobian` op if it has one, otherwise engine/fd.c's differences),
+ *   - one factorization of the Newton matrix and one solve with it (the default solver: KLU on
+ *     the Schur complement, engine/schur.c), what a Jacobian update and a Newton iteration add,
  * each as the median of 5 blocks of repeated calls (a block lasts >= 0.05 s), in CPU time.
- * Prints one CSV line per N: n,ncoord,nnz,residual_us,system_residual_us,jacobian_us,jac_per_res. */
+ *
+ *   scaling SCENE.yaml [-s PATH=VALUE]... [N...]     (-s: an override for every run, e.g.
+ *                                                      -s bodies.beam.assembly=banded)
+ * Prints one CSV line per N:
+ *   n,ncoord,ny,nnz,residual_us,system_residual_us,jacobian_us,jac_per_res,lsetup_us,lsolve_us */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+
+#include <sundials/sundials_context.h>
+#include <sundials/sundials_linearsolver.h>
+#include <nvector/nvector_serial.h>
+#include <sunmatrix/sunmatrix_sparse.h>
 
 #include "builtin.h"
 #include "internal.h"
@@ -36,7 +47,10 @@ typedef struct {
   fmbWorkspace* w;
   const fmbBodyInst* b;
   double *y, *yp, *F, *R, *ewt, *csc;
-  int what; /* 0 body residual, 1 system residual, 2 jacobian */
+  SUNMatrix A;
+  SUNLinearSolver LS;
+  N_Vector x, rhs;
+  int what; /* 0 body residual, 1 system residual, 2 jacobian, 3 factorization, 4 solve */
 } Ctx;
 
 static volatile double sink;
@@ -56,9 +70,15 @@ static int once(Ctx* c) {
       sink += c->F[0];
       return rc;
     }
-    default: {
+    case 2: {
       int rc = fmb_system_jacobian(m, c->w, 1.0, 1e3, c->y, c->yp, c->ewt, 0, c->csc, NULL); /* fresh blocks */
       sink += c->csc[0];
+      return rc;
+    }
+    case 3: return SUNLinSolSetup(c->LS, c->A);
+    default: {
+      int rc = SUNLinSolSolve(c->LS, c->A, c->x, c->rhs, 0.0);
+      sink += NV_Ith_S(c->x, 0);
       return rc;
     }
   }
@@ -90,20 +110,29 @@ int main(int argc, char** argv) {
     fprintf(stderr, "usage: scaling SCENE.yaml [N...]\n");
     return 2;
   }
-  int ns[32], nn = 0;
-  for (int i = 2; i < argc && nn < 32; ++i) ns[nn++] = atoi(argv[i]);
+  int ns[32], nn = 0, nset = 0;
+  const char* sets[16];
+  for (int i = 2; i < argc && nn < 32; ++i) {
+    if (strcmp(argv[i], "-s") == 0 && i + 1 < argc && nset < 15)
+      sets[nset++] = argv[++i];
+    else
+      ns[nn++] = atoi(argv[i]);
+  }
   if (nn == 0) {
     const int def[] = {8, 16, 32, 64, 128, 256};
     for (int i = 0; i < 6; ++i) ns[nn++] = def[i];
   }
-  printf("n,ncoord,nnz,residual_us,system_residual_us,jacobian_us,jac_per_res\n");
+  printf("n,ncoord,ny,nnz,residual_us,system_residual_us,jacobian_us,jac_per_res,lsetup_us,lsolve_us\n");
+  SUNContext sun = NULL;
+  if (SUNContext_Create(NULL, &sun)) return 3;
   srand(12345);
   for (int i = 0; i < nn; ++i) {
     char set[64];
     snprintf(set, sizeof set, "bodies.beam.elements=%d", ns[i]);
-    const char* ov[] = {set};
+    const char* ov[17] = {set};
+    for (int k = 0; k < nset; ++k) ov[1 + k] = sets[k];
     fmbDiag diag;
-    fmbModel* m = fmb_load(argv[1], ov, 1, fmb_builtin_registry(), &diag);
+    fmbModel* m = fmb_load(argv[1], ov, 1 + nset, fmb_builtin_registry(), &diag);
     if (!m) {
       fprintf(stderr, "scaling: %s: %s\n", argv[1], diag.msg);
       return 2;
@@ -148,15 +177,30 @@ int main(int argc, char** argv) {
         a[3 + 3 * (k - 1) + j] = 1e-2 * ((double)rand() / RAND_MAX - 0.5);
       }
     }
+    /* the auxiliary unknowns of a banded beam, consistent with that state */
+    if (beam->nz > 0 &&
+        beam->type->aux_initial(beam->self, &m->env, q, v, a, c.y + m->zoff + beam->zadr, fmb_workspace_plugin(c.w) + beam->workadr))
+      return 3;
     for (size_t k = 0; k < ny; ++k) c.ewt[k] = 1.0 / (1e-6 * fabs(c.y[k]) + 1e-8);
-    double tr, ts, tj;
-    c.what = 0;
-    tr = time_per_call(&c);
-    c.what = 1;
-    ts = time_per_call(&c);
-    c.what = 2;
-    tj = time_per_call(&c);
-    printf("%d,%d,%ld,%.3f,%.3f,%.3f,%.1f\n", ne, beam->nq, m->nnz, tr, ts, tj, tj / tr);
+    /* the Newton matrix at that state, for the factorization and solve timings */
+    c.A = SUNSparseMatrix((sunindextype)ny, (sunindextype)ny, m->nnz, CSC_MAT, sun);
+    c.LS = fmb_schur_klu_new(m, sun);
+    c.x = N_VNew_Serial((sunindextype)ny, sun);
+    c.rhs = N_VNew_Serial((sunindextype)ny, sun);
+    if (!c.A || !c.LS || !c.x || !c.rhs) return 3;
+    fmb_sparse_pattern_into(m, c.A);
+    if (fmb_system_jacobian(m, c.w, 1.0, 1e3, c.y, c.yp, c.ewt, 0, SUNSparseMatrix_Data(c.A), NULL) ||
+        SUNLinSolInitialize(c.LS) || SUNLinSolSetup(c.LS, c.A))
+      return 3;
+    for (size_t k = 0; k < ny; ++k) NV_Ith_S(c.rhs, k) = (double)rand() / RAND_MAX - 0.5;
+    double t[5];
+    for (c.what = 0; c.what < 5; ++c.what) t[c.what] = time_per_call(&c);
+    printf("%d,%d,%zu,%ld,%.3f,%.3f,%.3f,%.1f,%.3f,%.3f\n", ne, beam->nq, ny, m->nnz, t[0], t[1], t[2], t[2] / t[0], t[3],
+           t[4]);
+    SUNLinSolFree(c.LS);
+    SUNMatDestroy(c.A);
+    N_VDestroy(c.x);
+    N_VDestroy(c.rhs);
     fflush(stdout);
     free(c.y);
     free(c.yp);
@@ -167,5 +211,6 @@ int main(int argc, char** argv) {
     fmb_workspace_free(c.w);
     fmb_free(m);
   }
+  SUNContext_Free(&sun);
   return sink == 12345.678 ? 1 : 0;
 }
