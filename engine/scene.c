@@ -266,15 +266,19 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
    1024 elements (1.5e11) could not do a step in 20 s */
 #define FMB_WORK_FLOPS_MAX 5e10
 static void estimate_resources(const fmbModel* m, double* bytes, double* flops) {
-  double nbmax = 0.0, sum_nb2 = 0.0;
+  /* a body with a declared sparse pattern (a banded beam) keeps its blocks in pattern order, and
+     its initial conditions are a sparse solve (ic.c): no dense block or augmented matrix */
+  double blkmax = 0.0, sum_blk = 0.0;
+  int sparse = 0;
   for (int b = 1; b < m->nbody; ++b) {
-    const double nb = m->body[b].nq;
-    nbmax = fmax(nbmax, nb);
-    sum_nb2 += nb * nb;
+    const double nb = m->body[b].nq, blk = m->body[b].pnnz >= 0 ? (double)m->body[b].pnnz : nb * nb;
+    blkmax = fmax(blkmax, blk);
+    sum_blk += blk;
+    sparse |= m->body[b].pnnz >= 0;
   }
   const double nq = m->nq, nc = m->nc, ny = m->ny, n = nq + nc;
-  double doubles = 4.0 * nbmax * nbmax + fmin(3.0 * sum_nb2, (double)(256 << 20) / 8.0) + n * n + 3.0 * nc * nq + nc * nc +
-                   20.0 * ny + (double)m->nwork;
+  double doubles = 4.0 * blkmax + fmin(3.0 * sum_blk, (double)(256 << 20) / 8.0) + (sparse ? 0.0 : n * n) +
+                   3.0 * nc * nq + nc * nc + 20.0 * ny + (double)m->nwork;
   if (m->check_definiteness) doubles += nq * nq + nc * nq;
   if (m->solver.linear_solver == FMB_LS_DENSE) doubles += ny * ny;
   *bytes = 8.0 * doubles + 5.0 * 16.0 * (double)m->nnz;
