@@ -25,6 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beam_section.h"
 #include "flexmbd.h"
 
 enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
@@ -225,11 +226,7 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   const double me = b->rho * b->A * b->le, k_bend = b->kb[0][0], k_axial = b->ka;
   const double w2 = fmax(k_bend, k_axial) / me; /* an element's highest frequency squared */
   if (!isnormal(me) || !isnormal(k_bend) || !isnormal(k_axial) || !isfinite(w2) || !isfinite(b->kb[1][1])) {
-    fmb_parse_error(p, item,
-                    "degenerate beam: length %g in %d elements with density %g, area %g, second moment %g and Young's "
-                    "modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: not all are "
-                    "usable (finite, non-zero) floating-point numbers",
-                    b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
+    fmb_beam_refuse_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
     free(b);
     return -1;
   }
@@ -640,13 +637,7 @@ static void coupling_at(const Beam* b, const double* p, const double* pd, int e,
   if (wcd) *wcd = -Ipv;
 }
 
-static void locate(const Beam* b, double x, int* e, double* xi) {
-  int k = (int)floor(x / b->le);
-  if (k < 0) k = 0;
-  if (k > b->ne - 1) k = b->ne - 1;
-  *e = k;
-  *xi = x / b->le - k;
-}
+static void locate(const Beam* b, double x, int* e, double* xi) { fmb_beam_locate(b->le, b->ne, x, e, xi); }
 
 static int beam_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
                        double* dpos_dq, double* dangle_dq, double* work) {
@@ -968,21 +959,11 @@ static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NU
 static const char* const exact_integrations[] = {"reduced", "full", NULL};
 
 static const fmbParam beam_params[] = {
-    {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "undeformed length"},
-    {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = MAX_ELEMENTS,
-     .doc = "finite elements along the length"},
-    {.key = "density", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg/m^3", .doc = "mass density"},
-    {.key = "area", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^2", .doc = "cross-section area"},
-    {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",
-     .doc = "second moment of area of the cross-section"},
-    {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa", .doc = "Young's modulus"},
+    FMB_BEAM_SECTION_PARAMS(MAX_ELEMENTS),
     {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "complete", .choices = all_models,
      .doc = "coupling deformation kept in full, to first order, or left out (docs/beam.md); exact: the "
             "geometrically exact beam (docs/models.md)"},
-    {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial root of the floating frame"},
-    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"},
-    {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial root velocity"},
-    {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial frame angular velocity"},
+    FMB_BEAM_FRAME_PARAMS,
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .fallback = "0",
      .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
     {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 4,

@@ -30,6 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "beam_section.h"
 #include "flexmbd.h"
 
 enum { EXACT_MAX_ELEMENTS = 4096 };
@@ -235,11 +236,7 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
      element whose mass or stiffness is not a usable double (length 1e-300: EI/le^3 overflows) */
   const double me = b->mu * b->le, k_axial = b->EA / b->le, k_bend = 12.0 * b->EI / (b->le * b->le * b->le);
   if (!isnormal(me) || !isnormal(k_axial) || !isnormal(k_bend) || !isfinite(fmax(k_axial, k_bend) / me)) {
-    fmb_parse_error(p, item,
-                    "degenerate beam: length %g in %d elements with density %g, area %g, second moment %g and Young's "
-                    "modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: not all are "
-                    "usable (finite, non-zero) floating-point numbers",
-                    b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
+    fmb_beam_refuse_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
     free(b);
     return -1;
   }
@@ -424,13 +421,7 @@ static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, 
  * Where a point of the reference configuration is: local (x, y) = arc length x along the
  * centreline, offset y along the deformed normal n = I~rho'/|rho'|.
  * ------------------------------------------------------------------------------------------- */
-static void locate(const BeamExact* b, double x, int* e, double* xi) {
-  int k = (int)floor(x / b->le);
-  if (k < 0) k = 0;
-  if (k > b->ne - 1) k = b->ne - 1;
-  *e = k;
-  *xi = x / b->le - k;
-}
+static void locate(const BeamExact* b, double x, int* e, double* xi) { fmb_beam_locate(b->le, b->ne, x, e, xi); }
 
 static int exact_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
                         double* dpos_dq, double* dangle_dq, double* work) {
@@ -632,21 +623,11 @@ static const char* exact_invalid_state(const void* self, const double* q, const 
 /* what `flexmbd conform` needs to check this table on its own (tests/exact/test_exact_conform.c:
    beam.c's table, which the registry holds, declares the keys of type beam for users) */
 static const fmbParam exact_params[] = {
-    {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "undeformed length"},
-    {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = EXACT_MAX_ELEMENTS,
-     .doc = "finite elements along the length"},
-    {.key = "density", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg/m^3", .doc = "mass density"},
-    {.key = "area", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^2", .doc = "cross-section area"},
-    {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",
-     .doc = "second moment of area"},
-    {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa", .doc = "Young's modulus"},
+    FMB_BEAM_SECTION_PARAMS(EXACT_MAX_ELEMENTS),
     {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = exact_models, .doc = "exact here"},
     {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
      .doc = "reduced: axial at 3 Lobatto, bending at 2 Gauss points; full: 5 and 3 Gauss points"},
-    {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial root of the frame"},
-    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"},
-    {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial root velocity"},
-    {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial angular velocity"},
+    FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
     {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .lo = 1, .hi = FMB_GAUSS_MAX,

@@ -1,0 +1,52 @@
+/* beam_section.h — what the two files of `type: beam` share: beam.c (ZOAC, FOAC, complete) and
+ * beam_exact.c (exact). The section's keys as declared to users and `conform`, the refusal of a
+ * section that gives unusable element numbers, and where a point of the reference line lies. */
+#ifndef FLEXMBD_BEAM_SECTION_H
+#define FLEXMBD_BEAM_SECTION_H
+#include <math.h>
+
+#include "flexmbd.h"
+
+/* the keys every beam model reads the same way, then the frame's initial state */
+#define FMB_BEAM_SECTION_PARAMS(max_elements)                                                                      \
+  {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m",                    \
+   .doc = "undeformed length"},                                                                                     \
+      {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = (max_elements), \
+       .doc = "finite elements along the length"},                                                                  \
+      {.key = "density", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg/m^3",          \
+       .doc = "mass density"},                                                                                      \
+      {.key = "area", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^2",                \
+       .doc = "cross-section area"},                                                                                \
+      {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",       \
+       .doc = "second moment of area of the cross-section"},                                                        \
+      {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa",       \
+       .doc = "Young's modulus"}
+#define FMB_BEAM_FRAME_PARAMS                                                                                       \
+  {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]",                                    \
+   .doc = "initial root of the floating frame"},                                                                    \
+      {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"}, \
+      {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]",                              \
+       .doc = "initial root velocity"},                                                                             \
+      {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0",                       \
+       .doc = "initial frame angular velocity"}
+
+/* the parse error for a section whose element mass or stiffness is not a usable double (length
+   1e-300: EI/le^3 overflows) */
+static inline void fmb_beam_refuse_degenerate(fmbParser* p, fmbNode item, double L, int ne, double rho, double A,
+                                             double Izz, double E, double me, double k_bend, double k_axial) {
+  fmb_parse_error(p, item,
+                         "degenerate beam: length %g in %d elements with density %g, area %g, second moment %g and "
+                         "Young's modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: "
+                         "not all are usable (finite, non-zero) floating-point numbers",
+                         L, ne, rho, A, Izz, E, me, k_bend, k_axial);
+}
+
+/* element e (0-based, clamped to the mesh) and local coordinate xi in [0, 1] of arc length x */
+static inline void fmb_beam_locate(double le, int ne, double x, int* e, double* xi) {
+  int k = (int)floor(x / le);
+  if (k < 0) k = 0;
+  if (k > ne - 1) k = ne - 1;
+  *e = k;
+  *xi = x / le - k;
+}
+#endif
