@@ -13,7 +13,7 @@ QUICK=0; [ "${1:-}" = --quick ] && QUICK=1
 mkdir -p "$RES"
 EXE=$B/bench_scaling
 cc -std=c11 -O3 -DNDEBUG -D_DEFAULT_SOURCE -Wall -Wextra -Wpedantic -Wshadow -Iengine -Itools bench/scaling.c -o "$EXE" \
-  "$B/libflexmbd.a" -lsundials_ida -lsundials_nvecserial -lsundials_sunlinsolklu \
+  "$B/libflexmbd.a" -lsundials_idas -lsundials_nvecserial -lsundials_sunlinsolklu \
   -lsundials_sunmatrixsparse -lsundials_sunlinsoldense -lsundials_sunmatrixdense -lklu -lyaml -lm
 NS="8 16 32 64 128 256"; [ $QUICK = 1 ] && NS="8 16 32 64"
 "$EXE" scenes/paper/spinup_w15.yaml $NS | tee "$RES/scaling.csv"

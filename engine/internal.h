@@ -33,8 +33,10 @@ typedef enum {
   FMB_OUT_FRAME,       /* body frame quantity: index into frame_names */
   FMB_OUT_BODY,        /* body plugin output */
   FMB_OUT_JOINT,       /* joint plugin output */
-  FMB_OUT_JOINT_POWER, /* power of a joint's constraint forces, lambda^T Phi_t */
-  FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total */
+  FMB_OUT_JOINT_POWER, /* power a joint feeds in: constraint forces lambda^T Phi_t + its forces Q . v */
+  FMB_OUT_JOINT_WORK,  /* that power integrated from t0 (an IDA quadrature) */
+  FMB_OUT_JOINT_REACTION, /* 0 x, 1 y: force on body2 at its point; 2 torque about that point */
+  FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total 5 balance */
   FMB_OUT_CONSTRAINT,  /* 0 position 1 velocity */
   FMB_OUT_SHAPE        /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
 } fmbOutKind;
@@ -86,6 +88,7 @@ struct fmbModel {
   fmbOutput* output;
   int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
+  int need_work; /* a work or energy.balance column: integrate every joint's power */
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
   int initial_static; /* scene `initial: static`: runs start from the static or steady state */
@@ -198,6 +201,13 @@ int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols);
 void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* pos,
                           double* vel);
 double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y);
+/* force (global x, y) and torque (about the joint's point) that joint j's constraint forces exert
+   on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
+int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y, double out[3]);
+/* work done by each joint since t0 (njoint entries, filled by the integrator before each row) and
+   the force elements' potential energy at t0 (energy.balance) */
+double* fmb_workspace_work(fmbWorkspace* w);
+double* fmb_workspace_spring_energy0(fmbWorkspace* w);
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
 /* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1.

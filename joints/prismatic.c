@@ -1,5 +1,5 @@
 /* prismatic.c — a slider: point2 on body2 moves along a line through point1 on body1, the line's
- * direction `axis` fixed in body1's frame at point1, and the relative angle stays `angle`.
+ * direction `axis` fixed in body1's frame at point1, and the relative angle stays `angle` (default: as drawn).
  * With the axis e = R(angle1) a/|a| and its normal n = R(angle1) Ĩ a/|a| (angle1: the marker angle
  * of point1, which on a beam includes the local slope) and d = p2 - p1:
  *   Phi_0 = n . d                         = 0   (stay on the line)
