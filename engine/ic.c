@@ -45,6 +45,97 @@ static int gram_factor(int nc, int nq, const double* PhiQ, double* G, int* piv) 
   return fmb_lu_factor(nc, G, piv);
 }
 
+/* Accelerations and multipliers consistent with (q, v) at t, from the augmented system
+ *     [M      Phi_q^T] [a     ]   [Q    ]
+ *     [Phi_q  0      ] [lambda] = [gamma],   gamma = -(Phi_q v)_q v - Phi_tt
+ * (the index-1 form of the equations of motion). The initial conditions start IDA from it, and
+ * the reaction outputs use it: IDA's multipliers are algebraic unknowns outside its error test,
+ * so between steps their interpolated values can be off by per cent where the positions are
+ * exact to the tolerance. Scratch is allocated once per model (dense: nq + nc squared). */
+fmbAugmented* fmb_augmented_new(const fmbModel* m) {
+  fmbAugmented* g = calloc(1, sizeof *g);
+  if (!g) return NULL;
+  const size_t nq = (size_t)m->nq, nc = (size_t)m->nc, n = nq + nc;
+  size_t mb = 1;
+  for (int b = 1; b < m->nbody; ++b)
+    if ((size_t)m->body[b].nq > mb) mb = (size_t)m->body[b].nq;
+  g->A = calloc(n * n, sizeof(double));
+  g->rhs = calloc(n + 1, sizeof(double));
+  g->piv = calloc(n + 1, sizeof(int));
+  g->PhiQ = calloc((nc ? nc : 1) * nq, sizeof(double));
+  g->PhiQ2 = calloc((nc ? nc : 1) * nq, sizeof(double));
+  g->phi = calloc(nc + 1, sizeof(double));
+  g->phit = calloc(nc + 1, sizeof(double));
+  g->phitt = calloc(nc + 1, sizeof(double));
+  g->qs = calloc(nq, sizeof(double));
+  g->Mb = calloc(mb * mb, sizeof(double));
+  if (!g->A || !g->rhs || !g->piv || !g->PhiQ || !g->PhiQ2 || !g->phi || !g->phit || !g->phitt || !g->qs || !g->Mb) {
+    fmb_augmented_free(g);
+    return NULL;
+  }
+  return g;
+}
+
+void fmb_augmented_free(fmbAugmented* g) {
+  if (!g) return;
+  double* bufs[] = {g->A, g->rhs, g->PhiQ, g->PhiQ2, g->phi, g->phit, g->phitt, g->qs, g->Mb};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(g->piv);
+  free(g);
+}
+
+int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
+                        double* a, double* lambda) {
+  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  double *A = g->A, *rhs = g->rhs;
+  memset(A, 0, (size_t)n * n * sizeof(double));
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, g->Mb)) {
+      g->failed_body = b;
+      return FMB_AUG_MASS_FAILED;
+    }
+    for (int c = 0; c < bi->nq; ++c)
+      for (int r = 0; r < bi->nq; ++r) A[(size_t)(bi->qadr + c) * n + bi->qadr + r] = g->Mb[(size_t)c * bi->nq + r];
+  }
+  if (fmb_generalized_forces(m, w, t, q, v, rhs)) return FMB_AUG_FORCES_FAILED;
+  if (nc > 0) {
+    fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt);
+    /* (Phi_q v)_q v by a central difference along v */
+    double vn = norm2(v, nq);
+    double h = vn > 0 ? 1e-5 * (1.0 + norm2(q, nq)) / vn : 0.0;
+    double* dpv = g->phit; /* reuse: holds (Phi_q v)_q v below */
+    memset(dpv, 0, (size_t)nc * sizeof(double));
+    if (h > 0) {
+      for (int i = 0; i < nq; ++i) g->qs[i] = q[i] + h * v[i];
+      fmb_constraints_all(m, w, t, g->qs, v, NULL, g->PhiQ2, NULL, NULL);
+      for (int r = 0; r < nc; ++r)
+        for (int c = 0; c < nq; ++c) dpv[r] += g->PhiQ2[(size_t)r * nq + c] * v[c];
+      for (int i = 0; i < nq; ++i) g->qs[i] = q[i] - h * v[i];
+      fmb_constraints_all(m, w, t, g->qs, v, NULL, g->PhiQ2, NULL, NULL);
+      for (int r = 0; r < nc; ++r) {
+        double s = 0.0;
+        for (int c = 0; c < nq; ++c) s += g->PhiQ2[(size_t)r * nq + c] * v[c];
+        dpv[r] = (dpv[r] - s) / (2.0 * h);
+      }
+    }
+    for (int r = 0; r < nc; ++r) {
+      rhs[nq + r] = -dpv[r] - g->phitt[r];
+      for (int c = 0; c < nq; ++c) {
+        A[(size_t)c * n + nq + r] = g->PhiQ[(size_t)r * nq + c];
+        A[(size_t)(nq + r) * n + c] = g->PhiQ[(size_t)r * nq + c];
+      }
+    }
+  }
+  if (fmb_lu_factor(n, A, g->piv)) return FMB_AUG_SINGULAR;
+  fmb_lu_solve(n, A, g->piv, rhs);
+  if (a) memcpy(a, rhs, (size_t)nq * sizeof(double));
+  if (lambda) memcpy(lambda, rhs + nq, (size_t)nc * sizeof(double));
+  for (int i = 0; i < n; ++i)
+    if (!isfinite(rhs[i])) return FMB_AUG_NOT_FINITE;
+  return 0;
+}
+
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st, fmbDiag* diag) {
   const int nq = m->nq, nc = m->nc, n = nq + nc;
   const double t0 = m->solver.t0;
@@ -57,19 +148,17 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
   }
   double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-  double* PhiQ2 = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
   double* phi = calloc((size_t)nc + 1, sizeof(double));
   double* phit = calloc((size_t)nc + 1, sizeof(double));
   double* phitt = calloc((size_t)nc + 1, sizeof(double));
   double* G = calloc((size_t)nc * nc + 1, sizeof(double));
   int* piv = calloc((size_t)n + 1, sizeof(int));
-  double* A = calloc((size_t)n * n, sizeof(double));
   double* rhs = calloc((size_t)n + 1, sizeof(double));
   double* q0 = calloc((size_t)nq, sizeof(double));
   double* v0 = calloc((size_t)nq, sizeof(double));
-  double* qs = calloc((size_t)nq, sizeof(double));
+  fmbAugmented* aug = NULL;
   int rc = 0;
-  if (!PhiQ || !PhiQ2 || !phi || !phit || !phitt || !G || !piv || !A || !rhs || !q0 || !v0 || !qs) {
+  if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs || !q0 || !v0) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -175,81 +264,40 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   st->ic_velocity_correction = norm2(v0, nq);
 
   /* augmented system for accelerations and multipliers */
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    double* Mb = calloc((size_t)bi->nq * bi->nq, sizeof(double));
-    if (!Mb || fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, Mb)) {
-      free(Mb);
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g", bi->name, t0);
-      rc = FMB_EXIT_SOLVER;
-      goto done;
-    }
-    for (int c = 0; c < bi->nq; ++c)
-      for (int r = 0; r < bi->nq; ++r) A[(size_t)(bi->qadr + c) * n + bi->qadr + r] = Mb[(size_t)c * bi->nq + r];
-    free(Mb);
-  }
-  if (fmb_generalized_forces(m, w, t0, q, v, rhs)) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
+  aug = fmb_augmented_new(m);
+  if (!aug) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  if (nc > 0) {
-    fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt);
-    /* (Phi_q v)_q v by a central difference along v */
-    double vn = norm2(v, nq);
-    double h = vn > 0 ? 1e-5 * (1.0 + norm2(q, nq)) / vn : 0.0;
-    double* dpv = phit; /* reuse: holds (Phi_q v)_q v below */
-    memset(dpv, 0, (size_t)nc * sizeof(double));
-    if (h > 0) {
-      for (int i = 0; i < nq; ++i) qs[i] = q[i] + h * v[i];
-      fmb_constraints_all(m, w, t0, qs, v, NULL, PhiQ2, NULL, NULL);
-      for (int r = 0; r < nc; ++r)
-        for (int c = 0; c < nq; ++c) dpv[r] += PhiQ2[(size_t)r * nq + c] * v[c];
-      for (int i = 0; i < nq; ++i) qs[i] = q[i] - h * v[i];
-      fmb_constraints_all(m, w, t0, qs, v, NULL, PhiQ2, NULL, NULL);
-      for (int r = 0; r < nc; ++r) {
-        double s = 0.0;
-        for (int c = 0; c < nq; ++c) s += PhiQ2[(size_t)r * nq + c] * v[c];
-        dpv[r] = (dpv[r] - s) / (2.0 * h);
-      }
-    }
-    for (int r = 0; r < nc; ++r) {
-      rhs[nq + r] = -dpv[r] - phitt[r];
-      for (int c = 0; c < nq; ++c) {
-        A[(size_t)c * n + nq + r] = PhiQ[(size_t)r * nq + c];
-        A[(size_t)(nq + r) * n + c] = PhiQ[(size_t)r * nq + c];
-      }
-    }
-  }
-  if (fmb_lu_factor(n, A, piv)) {
+  int arc = fmb_augmented_solve(m, w, aug, t0, q, v, yp + nq, y + 2 * nq);
+  memcpy(yp, v, (size_t)nq * sizeof(double));
+  if (arc == FMB_AUG_MASS_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
+                 m->body[aug->failed_body].name, t0);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_FORCES_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_SINGULAR) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
                  "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
                  "with redundant joints): cannot compute initial accelerations");
     rc = FMB_EXIT_BAD_INPUT;
-    goto done;
+  } else if (arc == FMB_AUG_NOT_FINITE) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
+    rc = FMB_EXIT_SOLVER;
   }
-  fmb_lu_solve(n, A, piv, rhs);
-  memcpy(yp, v, (size_t)nq * sizeof(double));
-  memcpy(yp + nq, rhs, (size_t)nq * sizeof(double));
-  memcpy(y + 2 * nq, rhs + nq, (size_t)nc * sizeof(double));
-  for (int i = 0; i < n; ++i)
-    if (!isfinite(rhs[i])) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
-      rc = FMB_EXIT_SOLVER;
-      break;
-    }
 done:
+  fmb_augmented_free(aug);
   free(PhiQ);
-  free(PhiQ2);
   free(phi);
   free(phit);
   free(phitt);
   free(G);
   free(piv);
-  free(A);
   free(rhs);
   free(q0);
   free(v0);
-  free(qs);
   return rc;
 }

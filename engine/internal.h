@@ -89,6 +89,7 @@ struct fmbModel {
   int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
   int need_work; /* a work or energy.balance column: integrate every joint's power */
+  int need_multipliers; /* a reaction or power column: multipliers recomputed at each row */
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
   int initial_static; /* scene `initial: static`: runs start from the static or steady state */
@@ -200,10 +201,15 @@ void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, c
 int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols);
 void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* pos,
                           double* vel);
-double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y);
+double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lambda);
+/* multipliers consistent with (q, v) at t (ic.c's augmented system; IDA's own between steps are
+   interpolated outside its error test), or y's when that system cannot be solved */
+const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y);
 /* force (global x, y) and torque (about the joint's point) that joint j's constraint forces exert
    on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
-int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y, double out[3]);
+int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lambda, double out[3]);
 /* work done by each joint since t0 (njoint entries, filled by the integrator before each row) and
    the force elements' potential energy at t0 (energy.balance) */
 double* fmb_workspace_work(fmbWorkspace* w);
@@ -240,6 +246,17 @@ void fmb_lu_solve(int n, const double* LU, const int* piv, double* b);
 int fmb_cholesky(int n, double* A);                        /* lower, in place; 0 ok, else k+1 */
 
 /* ---- ic.c ---- */
+typedef struct fmbAugmented {
+  double *A, *rhs, *PhiQ, *PhiQ2, *phi, *phit, *phitt, *qs, *Mb;
+  int* piv;
+  int failed_body;
+} fmbAugmented;
+enum { FMB_AUG_MASS_FAILED = 1, FMB_AUG_FORCES_FAILED, FMB_AUG_SINGULAR, FMB_AUG_NOT_FINITE };
+fmbAugmented* fmb_augmented_new(const fmbModel* m);
+void fmb_augmented_free(fmbAugmented* g);
+/* accelerations a (nq) and multipliers lambda (nc) consistent with q, v at t; either may be NULL */
+int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
+                        double* a, double* lambda);
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
                            fmbDiag* diag);
 

@@ -83,8 +83,10 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
       if (has_power && (o->id = lookup(power_names, qty)) >= 0) {
         o->kind = o->id == 0 ? FMB_OUT_JOINT_POWER : FMB_OUT_JOINT_WORK;
         if (o->id == 1) m->need_work = 1;
+        if (o->id == 0 && ji->nrows > 0) m->need_multipliers = 1;
       } else if (ji->nrows > 0 && (o->id = lookup(reaction_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT_REACTION;
+        m->need_multipliers = 1;
       } else if (ji->type->output_lookup && (o->id = ji->type->output_lookup(ji->self, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT;
       }
@@ -362,6 +364,7 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
   double cpos = 0.0, cvel = 0.0;
   if (m->need_energy) fmb_energy(m, w, t, q, v, &e);
   if (m->need_constraint) fmb_constraint_norms(m, w, t, q, v, &cpos, &cvel);
+  const double* lam = m->need_multipliers ? fmb_output_multipliers(m, w, t, y) : y + 2 * m->nq;
   double* work = fmb_workspace_plugin(w);
   for (int i = 0; i < m->noutput; ++i) {
     const fmbOutput* o = &m->output[i];
@@ -382,11 +385,11 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
       case FMB_OUT_JOINT:
         if (fmb_joint_output(m, w, o->owner, o->id, t, q, v, &val)) val = NAN;
         break;
-      case FMB_OUT_JOINT_POWER: val = fmb_joint_power(m, w, o->owner, t, y); break;
+      case FMB_OUT_JOINT_POWER: val = fmb_joint_power(m, w, o->owner, t, q, v, lam); break;
       case FMB_OUT_JOINT_WORK: val = fmb_workspace_work(w)[o->owner]; break;
       case FMB_OUT_JOINT_REACTION: {
         double r[3];
-        val = fmb_joint_reaction(m, w, o->owner, t, y, r) ? NAN : r[o->id];
+        val = fmb_joint_reaction(m, w, o->owner, t, q, v, lam, r) ? NAN : r[o->id];
         break;
       }
       case FMB_OUT_ENERGY: {

@@ -36,6 +36,8 @@ struct fmbWorkspace {
   size_t* cache_adr;
   int cache_valid;
   double* work_done; /* njoint: accumulated work of each joint (integrate.c fills it) */
+  struct fmbAugmented* aug; /* outputs' multipliers (need_multipliers only) */
+  double* lambda;
   double spring_energy0;
 };
 
@@ -82,6 +84,14 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->ewt_default = calloc(2 * nq, sizeof(double));
   w->Qg = calloc(nq, sizeof(double));
   w->work_done = calloc((size_t)m->njoint + 1, sizeof(double));
+  if (m->need_multipliers) {
+    w->aug = fmb_augmented_new(m);
+    w->lambda = calloc((size_t)m->nc + 1, sizeof(double));
+    if (!w->aug || !w->lambda) {
+      fmb_workspace_free(w);
+      return NULL;
+    }
+  }
   if (!w->work_done || !w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
       !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fdcol || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
     fmb_workspace_free(w);
@@ -117,6 +127,8 @@ void fmb_workspace_free(fmbWorkspace* w) {
   if (!w) return;
   free(w->cache_adr);
   free(w->work_done);
+  fmb_augmented_free(w->aug);
+  free(w->lambda);
   double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
                     w->K, w->C, w->M, w->fdcol, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
@@ -126,6 +138,11 @@ void fmb_workspace_free(fmbWorkspace* w) {
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
 double* fmb_workspace_work(fmbWorkspace* w) { return w->work_done; }
+
+const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y) {
+  if (!w->aug || fmb_augmented_solve(m, w, w->aug, t, y, y + m->nq, NULL, w->lambda)) return y + 2 * m->nq;
+  return w->lambda;
+}
 double* fmb_workspace_spring_energy0(fmbWorkspace* w) { return &w->spring_energy0; }
 
 /* ---------------------------------------------------------------------------------------------
@@ -547,9 +564,9 @@ void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const do
 /* power joint j feeds into the system: of its constraint forces -Phi_q^T lambda, that is
    -lambda^T Phi_q v = lambda^T Phi_t (zero for a scleronomic joint), plus that of its applied
    forces, Q . v (a spring's includes the rate of its potential, a damper's is <= 0) */
-double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y) {
+double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lam) {
   const fmbJointInst* ji = &m->joint[j];
-  const double *q = y, *v = y + m->nq, *lam = y + 2 * m->nq;
   double p = 0.0;
   if (ji->type->force) {
     const int ncol = fmb_joint_cols(m, ji, w->cols);
@@ -566,9 +583,9 @@ double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
    the resultant F and its moment about the frame origin r; every material point p of a body with
    a frame has dp/dtheta = Ĩ (p - r) and dangle/dtheta = 1 (rigid body and beam alike), so the
    torque about the joint's point P is Q_theta - (P - r) x F. */
-int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y, double out[3]) {
+int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lam, double out[3]) {
   const fmbJointInst* ji = &m->joint[j];
-  const double *q = y, *v = y + m->nq, *lam = y + 2 * m->nq;
   int k = 1;
   if (ji->body[1] < 0 || m->body[ji->body[1]].nq < 3) k = 0;
   if (ji->nrows == 0 || ji->body[k] < 0 || m->body[ji->body[k]].nq < 3) return -1;
