@@ -34,15 +34,128 @@ static double norm2(const double* x, int n) {
   return sqrt(s);
 }
 
-/* G = Phi_q Phi_q^T (column-major nc x nc) from the row-major nc x nq Phi_q; LU in place */
-static int gram_factor(int nc, int nq, const double* PhiQ, double* G, int* piv) {
+/* G = Phi_q Phi_q^T (column-major nc x nc) from the row-major nc x nq Phi_q; LU in place. A
+   redundant row (drop[r]) gets an identity row and column: its correction is zero. */
+static int gram_factor(int nc, int nq, const double* PhiQ, const unsigned char* drop, double* G, int* piv) {
   for (int i = 0; i < nc; ++i)
     for (int k = 0; k < nc; ++k) {
       double s = 0.0;
-      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)i * nq + c] * PhiQ[(size_t)k * nq + c];
+      if (drop[i] || drop[k])
+        s = i == k;
+      else
+        for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)i * nq + c] * PhiQ[(size_t)k * nq + c];
       G[(size_t)k * nc + i] = s;
     }
   return fmb_lu_factor(nc, G, piv);
+}
+
+/* Rows of Phi_q that depend on the others (relative tolerance FMB_RANK_TOL): marked in drop[].
+   Returns the rank, or -1 out of memory. */
+#define FMB_RANK_TOL 1e-9
+static int mark_dependent_rows(int nc, int nq, const double* PhiQ, unsigned char* drop) {
+  int* order = malloc(sizeof(int) * (size_t)nc);
+  double* work = malloc(sizeof(double) * ((size_t)nc * nq + nc));
+  if (!order || !work) {
+    free(order);
+    free(work);
+    return -1;
+  }
+  const int rank = fmb_independent_rows(nc, nq, PhiQ, FMB_RANK_TOL, order, work);
+  memset(drop, 0, (size_t)nc);
+  for (int k = rank; k < nc; ++k) drop[order[k]] = 1;
+  free(order);
+  free(work);
+  return rank;
+}
+
+/* Gauss-Newton projection of q onto Phi(q, t) = 0 with the independent rows, the minimum-norm
+   correction dq = -Phi_q^T (Phi_q Phi_q^T)^-1 Phi each step; the redundant rows are re-found
+   when the Gram matrix turns singular. Returns 0 converged, 1 not (res: the last residual). */
+static int project_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
+                             double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs,
+                             unsigned char* drop, double* res, int* iters) {
+  const int nq = m->nq, nc = m->nc;
+  for (int it = 0; it < 50; ++it) {
+    *iters = it;
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt)) return 1;
+    *res = max_abs(phi, nc); /* every row: redundant ones must hold too */
+    if (*res <= FMB_IC_PHI_TOL) return 0;
+    if (gram_factor(nc, nq, PhiQ, drop, G, piv)) {
+      if (mark_dependent_rows(nc, nq, PhiQ, drop) < 0 || gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
+    }
+    for (int r = 0; r < nc; ++r) rhs[r] = drop[r] ? 0.0 : phi[r];
+    fmb_lu_solve(nc, G, piv, rhs);
+    for (int c = 0; c < nq; ++c) {
+      double s = 0.0;
+      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+      q[c] -= s;
+    }
+  }
+  return 1;
+}
+
+/* A row that depends on the others at q may do so on the whole motion (redundant: two pins that
+   say the same thing) or only at q (a singular configuration, e.g. a linkage started flat). Move
+   a little along the constraint manifold (a tangent step of 1e-3 of the coordinates' scale,
+   projected back) and look again: returns 1 when fewer rows depend there (singular at q). */
+static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                         const unsigned char* drop, int rank) {
+  const int nq = m->nq, nc = m->nc;
+  double* qs = malloc(sizeof(double) * (size_t)nq);
+  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
+  double* phi = calloc((size_t)nc, sizeof(double));
+  double* phit = calloc((size_t)nc, sizeof(double));
+  double* phitt = calloc((size_t)nc, sizeof(double));
+  double* G = calloc((size_t)nc * nc, sizeof(double));
+  double* rhs = calloc((size_t)nc, sizeof(double));
+  int* piv = calloc((size_t)nc, sizeof(int));
+  unsigned char* d2 = malloc((size_t)nc);
+  int singular = 0;
+  if (qs && PhiQ && phi && phit && phitt && G && rhs && piv && d2) {
+    /* a fixed, generic direction with its Phi_q component removed: a tangent */
+    for (int i = 0; i < nq; ++i) qs[i] = sin(1.7 * i + 0.3);
+    memcpy(d2, drop, (size_t)nc);
+    fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt);
+    if (!gram_factor(nc, nq, PhiQ, d2, G, piv)) {
+      for (int r = 0; r < nc; ++r) {
+        double s = 0.0;
+        for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * qs[c];
+        rhs[r] = d2[r] ? 0.0 : s;
+      }
+      fmb_lu_solve(nc, G, piv, rhs);
+      const double h = 1e-3 * (1.0 + norm2(q, nq)) / fmax(norm2(qs, nq), 1e-300);
+      for (int c = 0; c < nq; ++c) {
+        double s = 0.0;
+        for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+        qs[c] = q[c] + h * (qs[c] - s);
+      }
+      double res = 0.0;
+      int iters = 0;
+      if (project_positions(m, w, t, qs, v, PhiQ, phi, phit, phitt, G, piv, rhs, d2, &res, &iters) == 0 &&
+          mark_dependent_rows(nc, nq, PhiQ, d2) > rank)
+        singular = 1;
+    }
+  }
+  free(qs);
+  free(PhiQ);
+  free(phi);
+  free(phit);
+  free(phitt);
+  free(G);
+  free(rhs);
+  free(piv);
+  free(d2);
+  return singular;
+}
+
+/* "joint 'a' row 2, joint 'b' row 1" for the marked rows */
+void fmb_name_rows(const fmbModel* m, const unsigned char* drop, char* buf, size_t len) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (int j = 0; j < m->njoint && used + 80 < len; ++j)
+    for (int r = 0; r < m->joint[j].nrows; ++r)
+      if (drop[m->joint[j].rowadr + r])
+        used += (size_t)snprintf(buf + used, len - used, "%sjoint '%s' row %d", used ? ", " : "", m->joint[j].name, r + 1);
 }
 
 /* Accelerations and multipliers consistent with (q, v) at t, from the augmented system
@@ -85,7 +198,7 @@ void fmb_augmented_free(fmbAugmented* g) {
 }
 
 int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
-                        double* a, double* lambda) {
+                        const unsigned char* drop, double tikhonov, double* a, double* lambda) {
   const int nq = m->nq, nc = m->nc, n = nq + nc;
   double *A = g->A, *rhs = g->rhs;
   memset(A, 0, (size_t)n * n * sizeof(double));
@@ -119,8 +232,19 @@ int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, dou
         dpv[r] = (dpv[r] - s) / (2.0 * h);
       }
     }
+    double mdiag = 0.0, pmax = 0.0;
+    for (int i = 0; i < nq; ++i) mdiag = fmax(mdiag, fabs(A[(size_t)i * n + i]));
+    for (size_t k = 0; k < (size_t)nc * nq; ++k) pmax = fmax(pmax, fabs(g->PhiQ[k]));
+    /* Tikhonov: -eps on the multipliers' diagonal, eps relative to Phi_q M^-1 Phi_q^T's scale */
+    const double eps = tikhonov * pmax * pmax / fmax(mdiag, 1e-300);
     for (int r = 0; r < nc; ++r) {
+      if (drop && drop[r]) { /* out of the equations: lambda_r = 0 */
+        rhs[nq + r] = 0.0;
+        A[(size_t)(nq + r) * n + nq + r] = 1.0;
+        continue;
+      }
       rhs[nq + r] = -dpv[r] - g->phitt[r];
+      A[(size_t)(nq + r) * n + nq + r] = -eps;
       for (int c = 0; c < nq; ++c) {
         A[(size_t)c * n + nq + r] = g->PhiQ[(size_t)r * nq + c];
         A[(size_t)(nq + r) * n + c] = g->PhiQ[(size_t)r * nq + c];
@@ -174,24 +298,21 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   memcpy(q0, q, (size_t)nq * sizeof(double));
   memcpy(v0, v, (size_t)nq * sizeof(double));
 
+  unsigned char* drop = fmb_workspace_redundant(w, NULL);
   if (nc > 0) {
     double res = 0.0;
-    int it, converged = 0;
-    for (it = 0; it < 50; ++it) {
-      if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt)) break;
-      res = max_abs(phi, nc);
-      if (res <= FMB_IC_PHI_TOL) {
-        converged = 1;
+    int it = 0, converged = 0, rank = nc;
+    /* project with the rows independent at q0, then again with those independent at the result */
+    for (int round = 0; round < 3 && !converged; ++round) {
+      if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt) || (rank = mark_dependent_rows(nc, nq, PhiQ, drop)) < 0)
         break;
-      }
-      if (gram_factor(nc, nq, PhiQ, G, piv)) break;
-      memcpy(rhs, phi, (size_t)nc * sizeof(double));
-      fmb_lu_solve(nc, G, piv, rhs);
-      for (int c = 0; c < nq; ++c) {
-        double s = 0.0;
-        for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-        q[c] -= s;
-      }
+      if (project_positions(m, w, t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &res, &it)) break;
+      unsigned char* before = malloc((size_t)nc);
+      if (!before) break;
+      memcpy(before, drop, (size_t)nc);
+      rank = mark_dependent_rows(nc, nq, PhiQ, drop);
+      converged = memcmp(before, drop, (size_t)nc) == 0;
+      free(before);
     }
     if (!converged) {
       /* far from the origin double precision cannot resolve FMB_IC_PHI_TOL: say so */
@@ -201,22 +322,36 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
         snprintf(far, sizeof far, "; coordinates reach %.3g, too far out for double precision to hold joints to %g",
                  qmax, FMB_IC_PHI_TOL);
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g, tolerance %g, after %d projection steps, "
-                   "or redundant constraints): check the joints' points, the bodies' initial poses, and that no joint repeats another%s",
+                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g, tolerance %g, after %d projection "
+                   "steps): check the joints' points and the bodies' initial poses; joints that repeat each other must agree%s",
                    t0, res, FMB_IC_PHI_TOL, it, far);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
+    if (rank < nc) {
+      char rows[600];
+      fmb_name_rows(m, drop, rows, sizeof rows);
+      if (singular_here(m, w, t0, q, v, drop, rank)) {
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                     "the mechanism starts in a singular configuration at t = %g: %s depend%s on the other joints' "
+                     "equations here but not nearby (a dead point or a flat linkage); start it away from that position",
+                     t0, rows, rank == nc - 1 ? "s" : "");
+        rc = FMB_EXIT_BAD_INPUT;
+        goto done;
+      }
+    } else {
+      memset(drop, 0, (size_t)nc);
+    }
     /* velocities */
-    if (gram_factor(nc, nq, PhiQ, G, piv)) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "redundant constraints: the joints' equations are not independent");
+    if (gram_factor(nc, nq, PhiQ, drop, G, piv)) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints' equations are not independent at t = %g", t0);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
     for (int r = 0; r < nc; ++r) {
       double s = phit[r];
       for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
-      rhs[r] = s;
+      rhs[r] = drop[r] ? 0.0 : s;
     }
     fmb_lu_solve(nc, G, piv, rhs);
     for (int c = 0; c < nq; ++c) {
@@ -270,7 +405,7 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  int arc = fmb_augmented_solve(m, w, aug, t0, q, v, yp + nq, y + 2 * nq);
+  int arc = fmb_augmented_solve(m, w, aug, t0, q, v, fmb_workspace_redundant(w, NULL), 0.0, yp + nq, y + 2 * nq);
   memcpy(yp, v, (size_t)nq * sizeof(double));
   if (arc == FMB_AUG_MASS_FAILED) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",

@@ -310,6 +310,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   if (!opt || !opt->quiet)
     fprintf(stderr, "initial conditions: position correction %.3g, velocity correction %.3g\n",
             st->ic_position_correction, st->ic_velocity_correction);
+  int nredundant = 0;
+  const unsigned char* redundant = fmb_workspace_redundant(ctx.w, &nredundant);
+  if (nredundant && (!opt || !opt->quiet)) {
+    char rows[600];
+    fmb_name_rows(m, redundant, rows, sizeof rows);
+    fprintf(stderr, "redundant constraints: %s repeat%s the other joints' equations: left out of the equations, their "
+            "share of the reactions by the minimum-norm rule\n", rows, nredundant == 1 ? "s" : "");
+  }
 
   int bad = fmb_check_mass(m, ctx.w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(y) + m->nq, 0.0);
   if (bad) {

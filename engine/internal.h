@@ -213,6 +213,8 @@ int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
 /* work done by each joint since t0 (njoint entries, filled by the integrator before each row) and
    the force elements' potential energy at t0 (energy.balance) */
 double* fmb_workspace_work(fmbWorkspace* w);
+/* per constraint row: 1 = redundant, out of the equations; *count (may be NULL) = how many */
+unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count);
 double* fmb_workspace_spring_energy0(fmbWorkspace* w);
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
@@ -244,6 +246,7 @@ void fmb_vector_use_fast_ops(struct _generic_N_Vector* v);
 int fmb_lu_factor(int n, double* A, int* piv);             /* column-major, in place; 0 ok */
 void fmb_lu_solve(int n, const double* LU, const int* piv, double* b);
 int fmb_cholesky(int n, double* A);                        /* lower, in place; 0 ok, else k+1 */
+int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order, double* work);
 
 /* ---- ic.c ---- */
 typedef struct fmbAugmented {
@@ -256,7 +259,11 @@ fmbAugmented* fmb_augmented_new(const fmbModel* m);
 void fmb_augmented_free(fmbAugmented* g);
 /* accelerations a (nq) and multipliers lambda (nc) consistent with q, v at t; either may be NULL */
 int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
-                        double* a, double* lambda);
+                        const unsigned char* drop, double tikhonov, double* a, double* lambda);
+/* "joint 'a' row 2, ..." for the constraint rows marked in rows[] */
+void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size_t len);
+/* Tikhonov shift (relative) that makes the multipliers of redundant rows minimum-norm */
+#define FMB_MIN_NORM_SHIFT 1e-10
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
                            fmbDiag* diag);
 

@@ -349,9 +349,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   for (int k = 0; k < 2; ++k)
     if (library[k] >= 0 && check_library_keys(p, library[k], reference_keys[k])) return -1;
   if (m->nq == 0) return fmb_parse_error(p, bodies, "the scene has no moving body (no generalized coordinates)");
-  if (m->nc > m->nq)
-    return fmb_parse_error(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
-                         m->nc, m->nq);
+  /* more constraint rows than coordinates: redundant (run, ic.c) or contradictory (refused there) */
   m->ny = 2 * m->nq + 2 * m->nc;
   if (m->solver.max_order == 0) m->solver.max_order = m->bdf_order_cap;
   if (m->solver.positions_only < 0) m->solver.positions_only = m->bodies_prefer_positions;

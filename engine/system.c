@@ -10,7 +10,13 @@
  * their `residual`, joints supply Phi, Phi_q, Phi_t, force elements supply Q. The iteration
  * matrix dF/dy + cj dF/dy' is assembled into the fixed CSC pattern of pattern.c; blocks a plugin
  * does not provide analytically are differentiated numerically over that plugin's own
- * coordinates. Nothing here allocates: all scratch lives in the workspace made at setup. */
+ * coordinates. Nothing here allocates: all scratch lives in the workspace made at setup.
+ *
+ * Redundant constraint rows (rows of Phi_q that depend on the others on the whole motion, e.g.
+ * two pins that say the same thing; found by ic.c) are taken out of the equations: their rows
+ * become F_lambda = lambda_r, F_mu = mu_r, so the Newton matrix stays regular while the
+ * independent rows still fix the same motion (docs/mechanisms.md). Their share of the reactions
+ * is restored in the outputs by the minimum-norm rule (ic.c's fmb_augmented_solve). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -36,6 +42,8 @@ struct fmbWorkspace {
   size_t* cache_adr;
   int cache_valid;
   double* work_done; /* njoint: accumulated work of each joint (integrate.c fills it) */
+  unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
+  int nredundant_cap; /* nc */
   struct fmbAugmented* aug; /* outputs' multipliers (need_multipliers only) */
   double* lambda;
   double spring_energy0;
@@ -84,6 +92,12 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->ewt_default = calloc(2 * nq, sizeof(double));
   w->Qg = calloc(nq, sizeof(double));
   w->work_done = calloc((size_t)m->njoint + 1, sizeof(double));
+  w->redundant = calloc((size_t)m->nc + 1, 1);
+  w->nredundant_cap = m->nc;
+  if (!w->redundant) {
+    fmb_workspace_free(w);
+    return NULL;
+  }
   if (m->need_multipliers) {
     w->aug = fmb_augmented_new(m);
     w->lambda = calloc((size_t)m->nc + 1, sizeof(double));
@@ -127,6 +141,7 @@ void fmb_workspace_free(fmbWorkspace* w) {
   if (!w) return;
   free(w->cache_adr);
   free(w->work_done);
+  free(w->redundant);
   fmb_augmented_free(w->aug);
   free(w->lambda);
   double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
@@ -138,9 +153,21 @@ void fmb_workspace_free(fmbWorkspace* w) {
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
 double* fmb_workspace_work(fmbWorkspace* w) { return w->work_done; }
+unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
+  if (count) {
+    *count = 0;
+    for (int r = 0; w->redundant && r < w->nredundant_cap; ++r) *count += w->redundant[r];
+  }
+  return w->redundant;
+}
 
 const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y) {
-  if (!w->aug || fmb_augmented_solve(m, w, w->aug, t, y, y + m->nq, NULL, w->lambda)) return y + 2 * m->nq;
+  int nred = 0;
+  fmb_workspace_redundant(w, &nred);
+  /* with redundant rows the multipliers are not unique: the minimum-norm ones, the limit of the
+     Tikhonov-regularized system as its shift -> 0 */
+  if (!w->aug || fmb_augmented_solve(m, w, w->aug, t, y, y + m->nq, NULL, nred ? FMB_MIN_NORM_SHIFT : 0.0, NULL, w->lambda))
+    return y + 2 * m->nq;
   return w->lambda;
 }
 double* fmb_workspace_spring_energy0(fmbWorkspace* w) { return &w->spring_energy0; }
@@ -265,6 +292,11 @@ int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const doub
       const double* row = w->phi_q + (size_t)r * (size_t)ncol;
       double pv = 0.0;
       const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
+      if (w->redundant[ji->rowadr + r]) {
+        Fl[ji->rowadr + r] = l;
+        Fm[ji->rowadr + r] = u;
+        continue;
+      }
       for (int c = 0; c < ncol; ++c) {
         pv += row[c] * v[w->cols[c]];
         Fv[w->cols[c]] += row[c] * l;
@@ -382,9 +414,14 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     int rc = joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt);
     if (rc) return rc;
     for (int r = 0; r < nr; ++r)
+      if (w->redundant[ji->rowadr + r]) {
+        sink_add(&s, Fl + ji->rowadr + r, Yl + ji->rowadr + r, 1.0);
+        sink_add(&s, Fm + ji->rowadr + r, Ym + ji->rowadr + r, 1.0);
+      }
+    for (int r = 0; r < nr; ++r)
       for (int c = 0; c < ncol; ++c) {
         const double d = w->phi_q[(size_t)r * ncol + c];
-        if (d == 0.0) continue;
+        if (d == 0.0 || w->redundant[ji->rowadr + r]) continue;
         sink_add(&s, Fl + ji->rowadr + r, Yq + cols[c], d);
         sink_add(&s, Fm + ji->rowadr + r, Yv + cols[c], d);
         sink_add(&s, Fv + cols[c], Yl + ji->rowadr + r, d);
@@ -403,6 +440,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
       for (int r = 0; r < nr; ++r) {
         double dpv = 0.0;
         const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
+        if (w->redundant[ji->rowadr + r]) continue;
         for (int k = 0; k < ncol; ++k) {
           const double dphiq = (w->phi_q2[(size_t)r * ncol + k] - w->phi_q[(size_t)r * ncol + k]) / h;
           if (dphiq == 0.0) continue;
