@@ -410,6 +410,10 @@ FMB_API int fmb_model_nbody(const fmbModel* m);
 FMB_API int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type);
 /* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
+/* the constraints at t0 after the initial projection: degrees of freedom, redundant equations by
+   joint name and row, and whether the start is a singular configuration. 0, or an exit code with
+   *diag filled (joints that cannot be satisfied). */
+FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 

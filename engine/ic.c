@@ -94,6 +94,10 @@ static int project_positions(const fmbModel* m, fmbWorkspace* w, double t, doubl
   return 1;
 }
 
+static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
+                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs, unsigned char* drop,
+                            int* rank, double* res, int* it);
+
 /* A row that depends on the others at q may do so on the whole motion (redundant: two pins that
    say the same thing) or only at q (a singular configuration, e.g. a linkage started flat). Move
    a little along the constraint manifold (a tangent step of 1e-3 of the coordinates' scale,
@@ -130,9 +134,8 @@ static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const dou
         qs[c] = q[c] + h * (qs[c] - s);
       }
       double res = 0.0;
-      int iters = 0;
-      if (project_positions(m, w, t, qs, v, PhiQ, phi, phit, phitt, G, piv, rhs, d2, &res, &iters) == 0 &&
-          mark_dependent_rows(nc, nq, PhiQ, d2) > rank)
+      int iters = 0, rank2 = 0;
+      if (settle_positions(m, w, t, qs, v, PhiQ, phi, phit, phitt, G, piv, rhs, d2, &rank2, &res, &iters) && rank2 > rank)
         singular = 1;
     }
   }
@@ -146,6 +149,85 @@ static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const dou
   free(piv);
   free(d2);
   return singular;
+}
+
+/* Project q onto the constraints with the rows independent at q, then again with those
+   independent at the result, until the set settles: 1 when converged (drop[] marks the dependent
+   rows, *rank their complement's size), 0 when the joints cannot be satisfied. */
+static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
+                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs, unsigned char* drop,
+                            int* rank, double* res, int* it) {
+  const int nq = m->nq, nc = m->nc;
+  unsigned char* before = malloc((size_t)nc);
+  int converged = 0;
+  for (int round = 0; before && round < 3 && !converged; ++round) {
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt) || (*rank = mark_dependent_rows(nc, nq, PhiQ, drop)) < 0)
+      break;
+    if (project_positions(m, w, t, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, res, it)) break;
+    memcpy(before, drop, (size_t)nc);
+    *rank = mark_dependent_rows(nc, nq, PhiQ, drop);
+    converged = memcmp(before, drop, (size_t)nc) == 0;
+  }
+  free(before);
+  return converged;
+}
+
+int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  memset(diag, 0, sizeof *diag);
+  fmbWorkspace* w = fmb_workspace_new(m);
+  double* q = calloc((size_t)nq + 1, sizeof(double));
+  double* v = calloc((size_t)nq + 1, sizeof(double));
+  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* phit = calloc((size_t)nc + 1, sizeof(double));
+  double* phitt = calloc((size_t)nc + 1, sizeof(double));
+  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
+  double* rhs = calloc((size_t)nc + 1, sizeof(double));
+  int* piv = calloc((size_t)nc + 1, sizeof(int));
+  int rc = 0;
+  if (!w || !q || !v || !PhiQ || !phi || !phit || !phitt || !G || !rhs || !piv) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory checking the constraints");
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, q + m->body[b].qadr, v + m->body[b].qadr);
+  int rank = 0, it = 0;
+  double res = 0.0;
+  unsigned char* drop = fmb_workspace_redundant(w, NULL);
+  if (nc > 0 && !settle_positions(m, w, m->solver.t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps)",
+                 m->solver.t0, res, it);
+    rc = FMB_EXIT_BAD_INPUT;
+    goto done;
+  }
+  fprintf(f, "degrees of freedom: %d (%d coordinates, %d constraint equations of rank %d)\n", nq - rank, nq, nc, rank);
+  char rows[600] = "";
+  fmb_name_rows(m, drop, rows, sizeof rows);
+  if (rank == nc) {
+    fprintf(f, "redundant equations: none\nsingular configuration at t = %g: no\n", m->solver.t0);
+  } else if (singular_here(m, w, m->solver.t0, q, v, drop, rank)) {
+    fprintf(f, "redundant equations: none found (see below)\n");
+    fprintf(f, "singular configuration at t = %g: yes: %s depend%s on the others here but not nearby (the degrees of "
+            "freedom above hold only at this instant); the run refuses to start here\n", m->solver.t0, rows,
+            rank == nc - 1 ? "s" : "");
+  } else {
+    fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n", rows);
+    fprintf(f, "singular configuration at t = %g: no\n", m->solver.t0);
+  }
+done:
+  fmb_workspace_free(w);
+  free(q);
+  free(v);
+  free(PhiQ);
+  free(phi);
+  free(phit);
+  free(phitt);
+  free(G);
+  free(rhs);
+  free(piv);
+  return rc;
 }
 
 /* "joint 'a' row 2, joint 'b' row 1" for the marked rows */
@@ -301,19 +383,8 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   unsigned char* drop = fmb_workspace_redundant(w, NULL);
   if (nc > 0) {
     double res = 0.0;
-    int it = 0, converged = 0, rank = nc;
-    /* project with the rows independent at q0, then again with those independent at the result */
-    for (int round = 0; round < 3 && !converged; ++round) {
-      if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt) || (rank = mark_dependent_rows(nc, nq, PhiQ, drop)) < 0)
-        break;
-      if (project_positions(m, w, t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &res, &it)) break;
-      unsigned char* before = malloc((size_t)nc);
-      if (!before) break;
-      memcpy(before, drop, (size_t)nc);
-      rank = mark_dependent_rows(nc, nq, PhiQ, drop);
-      converged = memcmp(before, drop, (size_t)nc) == 0;
-      free(before);
-    }
+    int it = 0, rank = nc;
+    const int converged = settle_positions(m, w, t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it);
     if (!converged) {
       /* far from the origin double precision cannot resolve FMB_IC_PHI_TOL: say so */
       const double qmax = max_abs(q, nq);

@@ -234,6 +234,30 @@ static void progress_end(Progress* pr) {
   if (pr->on && pr->tty && pr->shown) fputc('\n', stderr);
 }
 
+/* A row left out as redundant must keep holding: if it stops (the joints were dependent only at
+   t0, or only on part of the motion) the run would silently lose a joint. Checked at each row. */
+static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, const double* y, double* phi, fmbDiag* diag) {
+  int count = 0;
+  const unsigned char* drop = fmb_workspace_redundant(w, &count);
+  if (!count || fmb_constraints_all(m, w, t, y, y + m->nq, phi, NULL, NULL, NULL)) return 0;
+  double scale = 1.0;
+  for (int i = 0; i < m->nq; ++i) scale = fmax(scale, fabs(y[i]));
+  for (int r = 0; r < m->nc; ++r)
+    if (drop[r] && fabs(phi[r]) > 1e3 * (m->solver.atol + m->solver.rtol * scale)) {
+      unsigned char one[1024] = {0};
+      char name[200] = "";
+      if (r < (int)sizeof one) {
+        one[r] = 1;
+        fmb_name_rows(m, one, name, sizeof name);
+      }
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "stopped at t = %.6g: %s, left out as redundant at the start, no longer holds (residual %.3g): the "
+                   "joints repeat each other only on part of the motion; remove the repeated joint", t, name, phi[r]);
+      return 1;
+    }
+  return 0;
+}
+
 /* a body's own validity check (e.g. a beam deforming beyond its length: a runaway solution) */
 static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* diag) {
   for (int b = 1; b < m->nbody; ++b) {
@@ -281,6 +305,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   ctx.stop = opt ? opt->stop : NULL;
   SUNContext sun = NULL;
   N_Vector y = NULL, yp = NULL, id = NULL, atol = NULL, work = NULL, workatol = NULL;
+  double* redundant_phi = NULL; /* the redundant rows' residuals, checked at each row */
   SUNMatrix A = NULL;
   SUNLinearSolver LS = NULL;
   void* ida = NULL;
@@ -312,6 +337,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
             st->ic_position_correction, st->ic_velocity_correction);
   int nredundant = 0;
   const unsigned char* redundant = fmb_workspace_redundant(ctx.w, &nredundant);
+  if (nredundant) redundant_phi = calloc((size_t)m->nc, sizeof(double));
   if (nredundant && (!opt || !opt->quiet)) {
     char rows[600];
     fmb_name_rows(m, redundant, rows, sizeof rows);
@@ -452,7 +478,8 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       IDAGetQuad(ida, &tq, work);
       memcpy(fmb_workspace_work(ctx.w), N_VGetArrayPointer(work), sizeof(double) * (size_t)m->njoint);
     }
-    if (invalid_state(m, t, N_VGetArrayPointer(y), diag)) {
+    if (invalid_state(m, t, N_VGetArrayPointer(y), diag) ||
+        (redundant_phi && redundant_row_broken(m, ctx.w, t, N_VGetArrayPointer(y), redundant_phi, diag))) {
       rc = FMB_EXIT_SOLVER;
       break;
     }
@@ -500,6 +527,7 @@ done:
   if (atol) N_VDestroy(atol);
   if (work) N_VDestroy(work);
   if (workatol) N_VDestroy(workatol);
+  free(redundant_phi);
   if (ctx.ewt) N_VDestroy(ctx.ewt);
   if (sun) SUNContext_Free(&sun);
   fmb_workspace_free(ctx.w);
