@@ -4,8 +4,53 @@
  *    norm rule each pin carries half of the single pin's reaction;
  *  - a parallelogram with a third, redundant crank follows the 1-DOF pendulum in the crank angle
  *    (integrated here with RK4); the coupler (which translates on a circle) and each crank (which
- *    turns about its pivot) obey Newton's and Euler's laws with the reported pin forces. */
+ *    turns about its pivot) obey Newton's and Euler's laws with the reported pin forces;
+ *  - `flexmbd check`'s report (fmb_check_constraints): the degrees of freedom counted by hand, the
+ *    redundant rows by joint name, and a parallelogram started flat reported as singular (and
+ *    refused by the run, exit 2). */
+#include <stdlib.h>
+#include <string.h>
+
 #include "testlib.h"
+
+/* the check report of a scene, in buf */
+static int check_report(const char* rel, const char* const* ov, int nov, char* buf, size_t len) {
+  char path[1024];
+  fmbDiag d;
+  buf[0] = '\0';
+  fmbModel* m = fmb_load(fmbt_path(rel, path, sizeof path), ov, nov, fmb_builtin_registry(), &d);
+  if (!m) return -1;
+  FILE* f = tmpfile();
+  int rc = fmb_check_constraints(m, f, &d);
+  rewind(f);
+  size_t n = fread(buf, 1, len - 1, f);
+  buf[n] = '\0';
+  fclose(f);
+  fmb_free(m);
+  return rc;
+}
+
+static void check_command(void) {
+  char r[2048];
+  ENSURE(check_report("scenes/fourbar.yaml", NULL, 0, r, sizeof r) == 0);
+  ENSURE(strstr(r, "degrees of freedom: 0 (9 coordinates, 9 constraint equations of rank 9)") != NULL); /* driven */
+  ENSURE(strstr(r, "redundant equations: none") != NULL);
+  ENSURE(check_report("tests/mechanisms/scenes/parallelogram3.yaml", NULL, 0, r, sizeof r) == 0);
+  ENSURE(strstr(r, "degrees of freedom: 1 (12 coordinates, 12 constraint equations of rank 11)") != NULL);
+  ENSURE(strstr(r, "redundant equations: joint 'o3' row 2") != NULL);
+  ENSURE(check_report("tests/mechanisms/scenes/pendulum_two_pins.yaml", NULL, 0, r, sizeof r) == 0);
+  ENSURE(strstr(r, "degrees of freedom: 1") != NULL && strstr(r, "joint 'pin2' row 1, joint 'pin2' row 2") != NULL);
+  ENSURE(strstr(r, "singular configuration at t = 0: no") != NULL);
+  const char* flat[] = {"bodies.crank1.angle=0", "bodies.crank2.angle=0", "bodies.crank1.position=[0.5,0]",
+                        "bodies.crank2.position=[2.5,0]", "bodies.coupler.position=[2,0]"};
+  ENSURE(check_report("scenes/parallelogram.yaml", flat, 5, r, sizeof r) == 0);
+  ENSURE(strstr(r, "singular configuration at t = 0: yes") != NULL);
+  printf("check on a parallelogram started flat:\n%s", r);
+  fmbStats st;
+  fmbDiag d;
+  ENSURE(fmbt_run("scenes/parallelogram.yaml", flat, 5, "flat.csv", &st, &d) == FMB_EXIT_BAD_INPUT);
+  ENSURE(strstr(d.msg, "singular configuration") != NULL);
+}
 
 static void two_pins(void) {
   fmbtCsv one, two;
@@ -85,5 +130,6 @@ static void three_cranks(void) {
 int main(void) {
   two_pins();
   three_cranks();
+  check_command();
   return fmbt_finish("test_redundant");
 }
