@@ -279,6 +279,63 @@ void fmb_augmented_free(fmbAugmented* g) {
   free(g);
 }
 
+/* dx = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T + eps)^-1 r: the correction of least kinetic-energy norm
+   that removes the constraint residual r to first order (mass-orthogonal projection, as in Bayo &
+   Ledesma 1996), from [M Phi_q^T; Phi_q -eps I] [dx; mu] = [0; -r]. Uses g->PhiQ as evaluated. */
+static int mass_projection(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, const double* q, const double* v,
+                           const double* r, double* dx) {
+  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  double *A = g->A, *rhs = g->rhs;
+  memset(A, 0, (size_t)n * n * sizeof(double));
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, g->Mb)) return 1;
+    for (int c = 0; c < bi->nq; ++c)
+      for (int k = 0; k < bi->nq; ++k) A[(size_t)(bi->qadr + c) * n + bi->qadr + k] = g->Mb[(size_t)c * bi->nq + k];
+  }
+  double mdiag = 0.0, pmax = 0.0;
+  for (int i = 0; i < nq; ++i) mdiag = fmax(mdiag, fabs(A[(size_t)i * n + i]));
+  for (size_t k = 0; k < (size_t)nc * nq; ++k) pmax = fmax(pmax, fabs(g->PhiQ[k]));
+  const double eps = FMB_MIN_NORM_SHIFT * pmax * pmax / fmax(mdiag, 1e-300);
+  for (int i = 0; i < nq; ++i) rhs[i] = 0.0;
+  for (int k = 0; k < nc; ++k) {
+    rhs[nq + k] = -r[k];
+    A[(size_t)(nq + k) * n + nq + k] = -eps;
+    for (int c = 0; c < nq; ++c) {
+      A[(size_t)c * n + nq + k] = g->PhiQ[(size_t)k * nq + c];
+      A[(size_t)(nq + k) * n + c] = g->PhiQ[(size_t)k * nq + c];
+    }
+  }
+  if (fmb_lu_factor(n, A, g->piv)) return 1;
+  fmb_lu_solve(n, A, g->piv, rhs);
+  memcpy(dx, rhs, sizeof(double) * (size_t)nq);
+  return 0;
+}
+
+int fmb_project_state(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, double* q, double* v) {
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  const double scale = 1.0 + norm2(q, nq);
+  double* dx = g->qs;
+  int converged = 0;
+  for (int it = 0; it < 8; ++it) { /* positions: Newton on Phi(q) = 0 with mass-orthogonal steps */
+    if (fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt)) return 1;
+    if (norm2(g->phi, nc) <= 1e-14 * scale) {
+      converged = 1;
+      break;
+    }
+    if (mass_projection(m, w, g, q, v, g->phi, dx)) return 1;
+    for (int c = 0; c < nq; ++c) q[c] += dx[c];
+  }
+  /* velocities: one step, Phi_q v + Phi_t is linear in v */
+  if (fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt)) return 1;
+  for (int k = 0; k < nc; ++k)
+    for (int c = 0; c < nq; ++c) g->phit[k] += g->PhiQ[(size_t)k * nq + c] * v[c];
+  if (mass_projection(m, w, g, q, v, g->phit, dx)) return 1;
+  for (int c = 0; c < nq; ++c) v[c] += dx[c];
+  return converged ? 0 : 1;
+}
+
 int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
                         const unsigned char* drop, double tikhonov, double* a, double* lambda) {
   const int nq = m->nq, nc = m->nc, n = nq + nc;

@@ -57,6 +57,10 @@ typedef struct fmbSolverSettings {
      the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
   enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
   int max_order; /* BDF order cap */
+  /* ggl (default): the stabilized index-2 DAE of system.c; projected: index-1 equations with
+     minimum-norm multipliers, positions and velocities projected at every output row, which
+     passes singular configurations (integrate.c, docs/mechanisms.md) */
+  enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
 } fmbSolverSettings;
@@ -260,6 +264,9 @@ void fmb_augmented_free(fmbAugmented* g);
 /* accelerations a (nq) and multipliers lambda (nc) consistent with q, v at t; either may be NULL */
 int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
                         const unsigned char* drop, double tikhonov, double* a, double* lambda);
+/* project q onto Phi(q, t) = 0 and v onto Phi_q v + Phi_t = 0 (mass-orthogonal corrections with
+   a Tikhonov shift, so rank-deficient Phi_q is fine); 0, or 1 not converged */
+int fmb_project_state(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, double* q, double* v);
 /* "joint 'a' row 2, ..." for the constraint rows marked in rows[] */
 void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size_t len);
 /* Tikhonov shift (relative) that makes the multipliers of redundant rows minimum-norm */
