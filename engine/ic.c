@@ -172,6 +172,42 @@ static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double
   return converged;
 }
 
+int fmb_count_redundant(const fmbModel* m) {
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  fmbWorkspace* w = fmb_workspace_new(m);
+  double* q = calloc((size_t)nq + 1, sizeof(double));
+  double* v = calloc((size_t)nq + 1, sizeof(double));
+  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* phit = calloc((size_t)nc + 1, sizeof(double));
+  double* phitt = calloc((size_t)nc + 1, sizeof(double));
+  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
+  double* rhs = calloc((size_t)nc + 1, sizeof(double));
+  int* piv = calloc((size_t)nc + 1, sizeof(int));
+  int count = 0;
+  if (w && q && v && PhiQ && phi && phit && phitt && G && rhs && piv) {
+    for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, q + m->body[b].qadr, v + m->body[b].qadr);
+    int rank = nc, it = 0;
+    double res = 0.0;
+    unsigned char* drop = fmb_workspace_redundant(w, NULL);
+    if (settle_positions(m, w, m->solver.t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it) &&
+        rank < nc && !singular_here(m, w, m->solver.t0, q, v, drop, rank))
+      count = nc - rank;
+  }
+  fmb_workspace_free(w);
+  free(q);
+  free(v);
+  free(PhiQ);
+  free(phi);
+  free(phit);
+  free(phitt);
+  free(G);
+  free(rhs);
+  free(piv);
+  return count;
+}
+
 int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
   const int nq = m->nq, nc = m->nc;
   memset(diag, 0, sizeof *diag);
@@ -465,6 +501,13 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
                      "equations here but not nearby (a dead point or a flat linkage); start it away from that position",
                      t0, rows, rank == nc - 1 ? "s" : "");
         rc = FMB_EXIT_BAD_INPUT;
+        goto done;
+      }
+      if (m->nredundant != nc - rank) {
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                     "internal: %d redundant constraint rows at t = %g (%s), %d found when the scene was loaded", nc - rank,
+                     t0, rows, m->nredundant);
+        rc = FMB_EXIT_SOLVER;
         goto done;
       }
     } else {

@@ -93,6 +93,7 @@ struct fmbModel {
   int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
   int need_work; /* a work or energy.balance column: integrate every joint's power */
+  int nredundant; /* constraint rows that repeat the others at t0 (found at load, ic.c) */
   int need_multipliers; /* a reaction or power column: multipliers recomputed at each row */
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
@@ -253,6 +254,9 @@ int fmb_cholesky(int n, double* A);                        /* lower, in place; 0
 int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order, double* work);
 
 /* ---- ic.c ---- */
+/* constraint rows that depend on the others at the initial state and nearby (redundant, not a
+   singular start); 0 when none or when the joints cannot be satisfied (the run says why) */
+int fmb_count_redundant(const fmbModel* m);
 typedef struct fmbAugmented {
   double *A, *rhs, *PhiQ, *PhiQ2, *phi, *phit, *phitt, *qs, *Mb;
   int* piv;

@@ -362,6 +362,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   } else {
     fmb_outputs_default(m);
   }
+  m->nredundant = fmb_count_redundant(m);
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
   return check_resources(p, m);
 }
