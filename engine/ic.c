@@ -172,97 +172,85 @@ static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double
   return converged;
 }
 
-int fmb_count_redundant(const fmbModel* m) {
+/* The constraints at the scene's initial state, projected: what fmb_count_redundant and
+   fmb_check_constraints both report. */
+typedef struct {
+  fmbWorkspace* w;
+  double *q, *v, *PhiQ, *phi, *phit, *phitt, *G, *rhs;
+  int* piv;
+  int settled, rank, singular, iters;
+  double res;
+} Start;
+
+/* 0, or -1 out of memory; s->settled = 0 when the joints cannot be satisfied */
+static int analyze_start(const fmbModel* m, Start* s) {
   const int nq = m->nq, nc = m->nc;
+  memset(s, 0, sizeof *s);
+  s->w = fmb_workspace_new(m);
+  s->q = calloc((size_t)nq + 1, sizeof(double));
+  s->v = calloc((size_t)nq + 1, sizeof(double));
+  s->PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+  s->phi = calloc((size_t)nc + 1, sizeof(double));
+  s->phit = calloc((size_t)nc + 1, sizeof(double));
+  s->phitt = calloc((size_t)nc + 1, sizeof(double));
+  s->G = calloc((size_t)nc * nc + 1, sizeof(double));
+  s->rhs = calloc((size_t)nc + 1, sizeof(double));
+  s->piv = calloc((size_t)nc + 1, sizeof(int));
+  if (!s->w || !s->q || !s->v || !s->PhiQ || !s->phi || !s->phit || !s->phitt || !s->G || !s->rhs || !s->piv) return -1;
+  for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, s->q + m->body[b].qadr, s->v + m->body[b].qadr);
+  s->rank = nc;
+  s->settled = 1;
   if (nc == 0) return 0;
-  fmbWorkspace* w = fmb_workspace_new(m);
-  double* q = calloc((size_t)nq + 1, sizeof(double));
-  double* v = calloc((size_t)nq + 1, sizeof(double));
-  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
-  double* phi = calloc((size_t)nc + 1, sizeof(double));
-  double* phit = calloc((size_t)nc + 1, sizeof(double));
-  double* phitt = calloc((size_t)nc + 1, sizeof(double));
-  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
-  double* rhs = calloc((size_t)nc + 1, sizeof(double));
-  int* piv = calloc((size_t)nc + 1, sizeof(int));
-  int count = 0;
-  if (w && q && v && PhiQ && phi && phit && phitt && G && rhs && piv) {
-    for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, q + m->body[b].qadr, v + m->body[b].qadr);
-    int rank = nc, it = 0;
-    double res = 0.0;
-    unsigned char* drop = fmb_workspace_redundant(w, NULL);
-    if (settle_positions(m, w, m->solver.t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it) &&
-        rank < nc && !singular_here(m, w, m->solver.t0, q, v, drop, rank))
-      count = nc - rank;
-  }
-  fmb_workspace_free(w);
-  free(q);
-  free(v);
-  free(PhiQ);
-  free(phi);
-  free(phit);
-  free(phitt);
-  free(G);
-  free(rhs);
-  free(piv);
+  unsigned char* drop = fmb_workspace_redundant(s->w, NULL);
+  s->settled = settle_positions(m, s->w, m->solver.t0, s->q, s->v, s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->piv,
+                                s->rhs, drop, &s->rank, &s->res, &s->iters);
+  s->singular = s->settled && s->rank < nc && singular_here(m, s->w, m->solver.t0, s->q, s->v, drop, s->rank);
+  return 0;
+}
+
+static void start_free(Start* s) {
+  fmb_workspace_free(s->w);
+  double* bufs[] = {s->q, s->v, s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->rhs};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(s->piv);
+}
+
+int fmb_count_redundant(const fmbModel* m) {
+  Start s;
+  const int count = analyze_start(m, &s) == 0 && s.settled && !s.singular ? m->nc - s.rank : 0;
+  start_free(&s);
   return count;
 }
 
 int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
   const int nq = m->nq, nc = m->nc;
+  const double t0 = m->solver.t0;
   memset(diag, 0, sizeof *diag);
-  fmbWorkspace* w = fmb_workspace_new(m);
-  double* q = calloc((size_t)nq + 1, sizeof(double));
-  double* v = calloc((size_t)nq + 1, sizeof(double));
-  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-  double* phi = calloc((size_t)nc + 1, sizeof(double));
-  double* phit = calloc((size_t)nc + 1, sizeof(double));
-  double* phitt = calloc((size_t)nc + 1, sizeof(double));
-  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
-  double* rhs = calloc((size_t)nc + 1, sizeof(double));
-  int* piv = calloc((size_t)nc + 1, sizeof(int));
+  Start s;
   int rc = 0;
-  if (!w || !q || !v || !PhiQ || !phi || !phit || !phitt || !G || !rhs || !piv) {
+  if (analyze_start(m, &s)) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory checking the constraints");
     rc = FMB_EXIT_SOLVER;
-    goto done;
-  }
-  for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, q + m->body[b].qadr, v + m->body[b].qadr);
-  int rank = 0, it = 0;
-  double res = 0.0;
-  unsigned char* drop = fmb_workspace_redundant(w, NULL);
-  if (nc > 0 && !settle_positions(m, w, m->solver.t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it)) {
+  } else if (!s.settled) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps)",
-                 m->solver.t0, res, it);
+                 "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps)", t0,
+                 s.res, s.iters);
     rc = FMB_EXIT_BAD_INPUT;
-    goto done;
-  }
-  fprintf(f, "degrees of freedom: %d (%d coordinates, %d constraint equations of rank %d)\n", nq - rank, nq, nc, rank);
-  char rows[600] = "";
-  fmb_name_rows(m, drop, rows, sizeof rows);
-  if (rank == nc) {
-    fprintf(f, "redundant equations: none\nsingular configuration at t = %g: no\n", m->solver.t0);
-  } else if (singular_here(m, w, m->solver.t0, q, v, drop, rank)) {
-    fprintf(f, "redundant equations: none found (see below)\n");
-    fprintf(f, "singular configuration at t = %g: yes: %s depend%s on the others here but not nearby (the degrees of "
-            "freedom above hold only at this instant); the run refuses to start here\n", m->solver.t0, rows,
-            rank == nc - 1 ? "s" : "");
   } else {
-    fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n", rows);
-    fprintf(f, "singular configuration at t = %g: no\n", m->solver.t0);
+    char rows[600] = "";
+    fmb_name_rows(m, fmb_workspace_redundant(s.w, NULL), rows, sizeof rows);
+    fprintf(f, "degrees of freedom: %d (%d coordinates, %d constraint equations of rank %d)\n", nq - s.rank, nq, nc, s.rank);
+    if (s.rank == nc)
+      fprintf(f, "redundant equations: none\nsingular configuration at t = %g: no\n", t0);
+    else if (s.singular)
+      fprintf(f, "redundant equations: none found (see below)\nsingular configuration at t = %g: yes: %s depend%s on the "
+              "others here but not nearby (the degrees of freedom above hold only at this instant); the run refuses to "
+              "start here\n", t0, rows, s.rank == nc - 1 ? "s" : "");
+    else
+      fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n"
+              "singular configuration at t = %g: no\n", rows, t0);
   }
-done:
-  fmb_workspace_free(w);
-  free(q);
-  free(v);
-  free(PhiQ);
-  free(phi);
-  free(phit);
-  free(phitt);
-  free(G);
-  free(rhs);
-  free(piv);
+  start_free(&s);
   return rc;
 }
 

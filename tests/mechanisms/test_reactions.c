@@ -31,35 +31,17 @@ static void pendulum(void) {
   fmbt_csv_free(&c);
 }
 
-static double spinup_balance(double rtol, double* work) {
-  char r[64], a[64];
+/* largest drift of energy.balance and largest |work| of the column `work` of a scene at rtol */
+static double balance_drift(const char* scene, double rtol, const char* outputs, const char* work_col, double* work) {
+  char r[64], a[64], o[200];
   snprintf(r, sizeof r, "solver.rtol=%g", rtol);
   snprintf(a, sizeof a, "solver.atol=%g", rtol * 1e-2);
-  const char* ov[] = {r, a, "outputs=[beam.tip_v, energy.total, energy.balance, spin.work]"};
+  snprintf(o, sizeof o, "outputs=%s", outputs ? outputs : "");
+  const char* ov[] = {r, a, o};
   fmbtCsv c;
   fmbStats st;
-  ENSURE(fmbt_run_read("scenes/paper/spinup_w4.yaml", ov, 3, "spinup_balance.csv", &c, &st) == 0);
-  const double *b = fmbt_col(&c, "energy.balance"), *w = fmbt_col(&c, "spin.work");
-  double drift = 0;
-  *work = 0;
-  if (b && w)
-    for (int i = 0; i < c.nrow; ++i) {
-      drift = fmax(drift, fabs(b[i] - b[0]));
-      *work = fmax(*work, fabs(w[i]));
-    }
-  fmbt_csv_free(&c);
-  return drift;
-}
-
-static double rotor_balance(double rtol, double* work) {
-  char r[64], a[64];
-  snprintf(r, sizeof r, "solver.rtol=%g", rtol);
-  snprintf(a, sizeof a, "solver.atol=%g", rtol * 1e-2);
-  const char* ov[] = {r, a};
-  fmbtCsv c;
-  fmbStats st;
-  ENSURE(fmbt_run_read("scenes/rotor.yaml", ov, 2, "rotor_balance.csv", &c, &st) == 0);
-  const double *b = fmbt_col(&c, "energy.balance"), *w = fmbt_col(&c, "motor.work");
+  ENSURE(fmbt_run_read(scene, ov, outputs ? 3 : 2, "balance.csv", &c, &st) == 0);
+  const double *b = fmbt_col(&c, "energy.balance"), *w = fmbt_col(&c, work_col);
   double drift = 0;
   *work = 0;
   if (b && w)
@@ -74,13 +56,16 @@ static double rotor_balance(double rtol, double* work) {
 int main(void) {
   pendulum();
   double w6, w8;
-  const double d6 = spinup_balance(1e-6, &w6), d8 = spinup_balance(1e-8, &w8);
+  const char* spin_out = "[beam.tip_v, energy.total, energy.balance, spin.work]";
+  const double d6 = balance_drift("scenes/paper/spinup_w4.yaml", 1e-6, spin_out, "spin.work", &w6),
+               d8 = balance_drift("scenes/paper/spinup_w4.yaml", 1e-8, spin_out, "spin.work", &w8);
   printf("spin-up w0 = 4 (complete beam): drive work up to %.4g J; energy.balance drift %.2e J (rtol 1e-6), %.2e J (rtol 1e-8)\n",
          w6, d6, d8);
   ENSURE(w6 > 10.0);               /* the drive does real work ... */
   ENSURE(d6 < 1e-5 * w6);          /* ... and the balance holds to the tolerance's order */
   ENSURE(d8 < 1e-7 * w8 && d8 < d6);
-  const double r6 = rotor_balance(1e-6, &w6), r8 = rotor_balance(1e-8, &w8);
+  const double r6 = balance_drift("scenes/rotor.yaml", 1e-6, NULL, "motor.work", &w6),
+               r8 = balance_drift("scenes/rotor.yaml", 1e-8, NULL, "motor.work", &w8);
   printf("rotor (torque table, 3 complete blades): torque work %.4g J; energy.balance drift %.2e J (rtol 1e-6), %.2e J (rtol 1e-8)\n",
          w6, r6, r8);
   ENSURE(w6 > 20.0);
