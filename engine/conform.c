@@ -193,6 +193,7 @@ static void check_params(Report* r, const char* path, const char* type, const fm
       case FMB_PARAM_CHOICE: bad_case(r, path, type, ex, s, reg, p->key, "no_such_choice"), ncase++; break;
       case FMB_PARAM_BODY: bad_case(r, path, type, ex, s, reg, p->key, "no_such_body"), ncase++; break;
       case FMB_PARAM_JOINT: bad_case(r, path, type, ex, s, reg, p->key, "no_such_joint"), ncase++; break;
+      case FMB_PARAM_TABLE: bad_case(r, path, type, ex, s, reg, p->key, "[[0, 1, 2]]"), ncase++; break;
     }
   }
   /* the keys parse reads are declared: an unknown key's message lists what was read */

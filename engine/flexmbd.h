@@ -80,6 +80,10 @@ FMB_API int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned fl
 /* an angle in radians: a bare number is radians, `120 deg` / `2.1 rad` say their unit. With
    FMB_POSE a bare number beyond 2*pi in magnitude draws a warning (degrees written as radians?) */
 FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
+/* a piecewise-linear table: an inline list of [t, value] pairs or the name of a CSV file of
+   "t,value" rows (one header line allowed; relative to the scene's folder). t strictly
+   increasing, at least two rows. *x and *y are malloc'ed (the caller frees them, also on error). */
+FMB_API int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, double** x, double** y, int* n);
 /* one of a NULL-terminated list of words; *out is the index */
 FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out);
@@ -131,7 +135,8 @@ typedef enum {
   FMB_PARAM_VEC2,   /* fmb_get_vec2 */
   FMB_PARAM_CHOICE, /* fmb_get_choice; the words in `choices` */
   FMB_PARAM_BODY,   /* fmb_get_body */
-  FMB_PARAM_JOINT   /* fmb_get_joint */
+  FMB_PARAM_JOINT,  /* fmb_get_joint */
+  FMB_PARAM_TABLE   /* fmb_get_table: [[t, value], ...] or a CSV file name */
 } fmbParamKind;
 
 typedef struct fmbParam {
@@ -423,6 +428,10 @@ FMB_API int fmb_model_nbody(const fmbModel* m);
 FMB_API int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type);
 /* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
+/* the constraints at t0 after the initial projection: degrees of freedom, redundant equations by
+   joint name and row, and whether the start is a singular configuration. 0, or an exit code with
+   *diag filled (joints that cannot be satisfied). */
+FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 

@@ -35,15 +35,234 @@ static double norm2(const double* x, int n) {
   return sqrt(s);
 }
 
-/* G = Phi_q Phi_q^T (column-major nc x nc) from the row-major nc x nq Phi_q; LU in place */
-static int gram_factor(int nc, int nq, const double* PhiQ, double* G, int* piv) {
+/* G = Phi_q Phi_q^T (column-major nc x nc) from the row-major nc x nq Phi_q; LU in place. A
+   redundant row (drop[r]) gets an identity row and column: its correction is zero. */
+static int gram_factor(int nc, int nq, const double* PhiQ, const unsigned char* drop, double* G, int* piv) {
   for (int i = 0; i < nc; ++i)
     for (int k = 0; k < nc; ++k) {
       double s = 0.0;
-      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)i * nq + c] * PhiQ[(size_t)k * nq + c];
+      if (drop[i] || drop[k])
+        s = i == k;
+      else
+        for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)i * nq + c] * PhiQ[(size_t)k * nq + c];
       G[(size_t)k * nc + i] = s;
     }
   return fmb_lu_factor(nc, G, piv);
+}
+
+/* Rows of Phi_q that depend on the others (relative tolerance FMB_RANK_TOL): marked in drop[].
+   Returns the rank, or -1 out of memory. */
+#define FMB_RANK_TOL 1e-9
+static int mark_dependent_rows(int nc, int nq, const double* PhiQ, unsigned char* drop) {
+  int* order = malloc(sizeof(int) * (size_t)nc);
+  double* work = malloc(sizeof(double) * ((size_t)nc * nq + nc));
+  if (!order || !work) {
+    free(order);
+    free(work);
+    return -1;
+  }
+  const int rank = fmb_independent_rows(nc, nq, PhiQ, FMB_RANK_TOL, order, work);
+  memset(drop, 0, (size_t)nc);
+  for (int k = rank; k < nc; ++k) drop[order[k]] = 1;
+  free(order);
+  free(work);
+  return rank;
+}
+
+/* Gauss-Newton projection of q onto Phi(q, t) = 0 with the independent rows, the minimum-norm
+   correction dq = -Phi_q^T (Phi_q Phi_q^T)^-1 Phi each step; the redundant rows are re-found
+   when the Gram matrix turns singular. Returns 0 converged, 1 not (res: the last residual). */
+static int project_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
+                             double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs,
+                             unsigned char* drop, double* res, int* iters) {
+  const int nq = m->nq, nc = m->nc;
+  for (int it = 0; it < 50; ++it) {
+    *iters = it;
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt)) return 1;
+    *res = max_abs(phi, nc); /* every row: redundant ones must hold too */
+    if (*res <= FMB_IC_PHI_TOL) return 0;
+    if (gram_factor(nc, nq, PhiQ, drop, G, piv)) {
+      if (mark_dependent_rows(nc, nq, PhiQ, drop) < 0 || gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
+    }
+    for (int r = 0; r < nc; ++r) rhs[r] = drop[r] ? 0.0 : phi[r];
+    fmb_lu_solve(nc, G, piv, rhs);
+    for (int c = 0; c < nq; ++c) {
+      double s = 0.0;
+      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+      q[c] -= s;
+    }
+  }
+  return 1;
+}
+
+static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
+                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs, unsigned char* drop,
+                            int* rank, double* res, int* it);
+
+/* A row that depends on the others at q may do so on the whole motion (redundant: two pins that
+   say the same thing) or only at q (a singular configuration, e.g. a linkage started flat). Move
+   a little along the constraint manifold (a tangent step of 1e-3 of the coordinates' scale,
+   projected back) and look again: returns 1 when fewer rows depend there (singular at q). */
+static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                         const unsigned char* drop, int rank) {
+  const int nq = m->nq, nc = m->nc;
+  double* qs = malloc(sizeof(double) * (size_t)nq);
+  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
+  double* phi = calloc((size_t)nc, sizeof(double));
+  double* phit = calloc((size_t)nc, sizeof(double));
+  double* phitt = calloc((size_t)nc, sizeof(double));
+  double* G = calloc((size_t)nc * nc, sizeof(double));
+  double* rhs = calloc((size_t)nc, sizeof(double));
+  int* piv = calloc((size_t)nc, sizeof(int));
+  unsigned char* d2 = malloc((size_t)nc);
+  int singular = 0;
+  if (qs && PhiQ && phi && phit && phitt && G && rhs && piv && d2) {
+    /* a fixed, generic direction with its Phi_q component removed: a tangent */
+    for (int i = 0; i < nq; ++i) qs[i] = sin(1.7 * i + 0.3);
+    memcpy(d2, drop, (size_t)nc);
+    fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt);
+    if (!gram_factor(nc, nq, PhiQ, d2, G, piv)) {
+      for (int r = 0; r < nc; ++r) {
+        double s = 0.0;
+        for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * qs[c];
+        rhs[r] = d2[r] ? 0.0 : s;
+      }
+      fmb_lu_solve(nc, G, piv, rhs);
+      const double h = 1e-3 * (1.0 + norm2(q, nq)) / fmax(norm2(qs, nq), 1e-300);
+      for (int c = 0; c < nq; ++c) {
+        double s = 0.0;
+        for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+        qs[c] = q[c] + h * (qs[c] - s);
+      }
+      double res = 0.0;
+      int iters = 0, rank2 = 0;
+      if (settle_positions(m, w, t, qs, v, PhiQ, phi, phit, phitt, G, piv, rhs, d2, &rank2, &res, &iters) && rank2 > rank)
+        singular = 1;
+    }
+  }
+  free(qs);
+  free(PhiQ);
+  free(phi);
+  free(phit);
+  free(phitt);
+  free(G);
+  free(rhs);
+  free(piv);
+  free(d2);
+  return singular;
+}
+
+/* Project q onto the constraints with the rows independent at q, then again with those
+   independent at the result, until the set settles: 1 when converged (drop[] marks the dependent
+   rows, *rank their complement's size), 0 when the joints cannot be satisfied. */
+static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
+                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs, unsigned char* drop,
+                            int* rank, double* res, int* it) {
+  const int nq = m->nq, nc = m->nc;
+  unsigned char* before = malloc((size_t)nc);
+  int converged = 0;
+  for (int round = 0; before && round < 3 && !converged; ++round) {
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt) || (*rank = mark_dependent_rows(nc, nq, PhiQ, drop)) < 0)
+      break;
+    if (project_positions(m, w, t, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, res, it)) break;
+    memcpy(before, drop, (size_t)nc);
+    *rank = mark_dependent_rows(nc, nq, PhiQ, drop);
+    converged = memcmp(before, drop, (size_t)nc) == 0;
+  }
+  free(before);
+  return converged;
+}
+
+/* The constraints at the scene's initial state, projected: what fmb_count_redundant and
+   fmb_check_constraints both report. */
+typedef struct {
+  fmbWorkspace* w;
+  double *q, *v, *PhiQ, *phi, *phit, *phitt, *G, *rhs;
+  int* piv;
+  int settled, rank, singular, iters;
+  double res;
+} Start;
+
+/* 0, or -1 out of memory; s->settled = 0 when the joints cannot be satisfied */
+static int analyze_start(const fmbModel* m, Start* s) {
+  const int nq = m->nq, nc = m->nc;
+  memset(s, 0, sizeof *s);
+  s->w = fmb_workspace_new(m);
+  s->q = calloc((size_t)nq + 1, sizeof(double));
+  s->v = calloc((size_t)nq + 1, sizeof(double));
+  s->PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+  s->phi = calloc((size_t)nc + 1, sizeof(double));
+  s->phit = calloc((size_t)nc + 1, sizeof(double));
+  s->phitt = calloc((size_t)nc + 1, sizeof(double));
+  s->G = calloc((size_t)nc * nc + 1, sizeof(double));
+  s->rhs = calloc((size_t)nc + 1, sizeof(double));
+  s->piv = calloc((size_t)nc + 1, sizeof(int));
+  if (!s->w || !s->q || !s->v || !s->PhiQ || !s->phi || !s->phit || !s->phitt || !s->G || !s->rhs || !s->piv) return -1;
+  for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, s->q + m->body[b].qadr, s->v + m->body[b].qadr);
+  s->rank = nc;
+  s->settled = 1;
+  if (nc == 0) return 0;
+  unsigned char* drop = fmb_workspace_redundant(s->w, NULL);
+  s->settled = settle_positions(m, s->w, m->solver.t0, s->q, s->v, s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->piv,
+                                s->rhs, drop, &s->rank, &s->res, &s->iters);
+  s->singular = s->settled && s->rank < nc && singular_here(m, s->w, m->solver.t0, s->q, s->v, drop, s->rank);
+  return 0;
+}
+
+static void start_free(Start* s) {
+  fmb_workspace_free(s->w);
+  double* bufs[] = {s->q, s->v, s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->rhs};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(s->piv);
+}
+
+int fmb_count_redundant(const fmbModel* m) {
+  Start s;
+  const int count = analyze_start(m, &s) == 0 && s.settled && !s.singular ? m->nc - s.rank : 0;
+  start_free(&s);
+  return count;
+}
+
+int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  const double t0 = m->solver.t0;
+  memset(diag, 0, sizeof *diag);
+  Start s;
+  int rc = 0;
+  if (analyze_start(m, &s)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory checking the constraints");
+    rc = FMB_EXIT_SOLVER;
+  } else if (!s.settled) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps)", t0,
+                 s.res, s.iters);
+    rc = FMB_EXIT_BAD_INPUT;
+  } else {
+    char rows[600] = "";
+    fmb_name_rows(m, fmb_workspace_redundant(s.w, NULL), rows, sizeof rows);
+    fprintf(f, "degrees of freedom: %d (%d coordinates, %d constraint equations of rank %d)\n", nq - s.rank, nq, nc, s.rank);
+    if (s.rank == nc)
+      fprintf(f, "redundant equations: none\nsingular configuration at t = %g: no\n", t0);
+    else if (s.singular)
+      fprintf(f, "redundant equations: none found (see below)\nsingular configuration at t = %g: yes: %s depend%s on the "
+              "others here but not nearby (the degrees of freedom above hold only at this instant); the run refuses to "
+              "start here\n", t0, rows, s.rank == nc - 1 ? "s" : "");
+    else
+      fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n"
+              "singular configuration at t = %g: no\n", rows, t0);
+  }
+  start_free(&s);
+  return rc;
+}
+
+/* "joint 'a' row 2, joint 'b' row 1" for the marked rows */
+void fmb_name_rows(const fmbModel* m, const unsigned char* drop, char* buf, size_t len) {
+  size_t used = 0;
+  buf[0] = '\0';
+  for (int j = 0; j < m->njoint && used + 80 < len; ++j)
+    for (int r = 0; r < m->joint[j].nrows; ++r)
+      if (drop[m->joint[j].rowadr + r])
+        used += (size_t)snprintf(buf + used, len - used, "%sjoint '%s' row %d", used ? ", " : "", m->joint[j].name, r + 1);
 }
 
 /* gamma = -(Phi_q v)_q v - Phi_tt, the right side of Phi_q a = gamma; fills PhiQ (dense nc x nq).
@@ -71,6 +290,146 @@ static void acceleration_rhs(const fmbModel* m, fmbWorkspace* w, double t0, cons
     }
   }
   for (int r = 0; r < nc; ++r) gamma[r] = -dpv[r] - phitt[r];
+}
+
+/* Accelerations and multipliers consistent with (q, v) at t, from the augmented system
+ *     [M      Phi_q^T] [a     ]   [Q    ]
+ *     [Phi_q  0      ] [lambda] = [gamma],   gamma = -(Phi_q v)_q v - Phi_tt
+ * (the index-1 form of the equations of motion). The initial conditions start IDA from it, and
+ * the reaction outputs use it: IDA's multipliers are algebraic unknowns outside its error test,
+ * so between steps their interpolated values can be off by per cent where the positions are
+ * exact to the tolerance. Scratch is allocated once per model (dense: nq + nc squared). */
+fmbAugmented* fmb_augmented_new(const fmbModel* m) {
+  fmbAugmented* g = calloc(1, sizeof *g);
+  if (!g) return NULL;
+  const size_t nq = (size_t)m->nq, nc = (size_t)m->nc, n = nq + nc;
+  size_t mb = 1;
+  for (int b = 1; b < m->nbody; ++b)
+    if ((size_t)m->body[b].nq > mb) mb = (size_t)m->body[b].nq;
+  g->A = calloc(n * n, sizeof(double));
+  g->rhs = calloc(n + 1, sizeof(double));
+  g->piv = calloc(n + 1, sizeof(int));
+  g->PhiQ = calloc((nc ? nc : 1) * nq, sizeof(double));
+  g->PhiQ2 = calloc((nc ? nc : 1) * nq, sizeof(double));
+  g->phi = calloc(nc + 1, sizeof(double));
+  g->phit = calloc(nc + 1, sizeof(double));
+  g->phitt = calloc(nc + 1, sizeof(double));
+  g->qs = calloc(nq, sizeof(double));
+  g->Mb = calloc(mb * mb, sizeof(double));
+  if (!g->A || !g->rhs || !g->piv || !g->PhiQ || !g->PhiQ2 || !g->phi || !g->phit || !g->phitt || !g->qs || !g->Mb) {
+    fmb_augmented_free(g);
+    return NULL;
+  }
+  return g;
+}
+
+void fmb_augmented_free(fmbAugmented* g) {
+  if (!g) return;
+  double* bufs[] = {g->A, g->rhs, g->PhiQ, g->PhiQ2, g->phi, g->phit, g->phitt, g->qs, g->Mb};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(g->piv);
+  free(g);
+}
+
+/* dx = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T + eps)^-1 r: the correction of least kinetic-energy norm
+   that removes the constraint residual r to first order (mass-orthogonal projection, as in Bayo &
+   Ledesma 1996), from [M Phi_q^T; Phi_q -eps I] [dx; mu] = [0; -r]. Uses g->PhiQ as evaluated. */
+static int mass_projection(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, const double* q, const double* v,
+                           const double* r, double* dx) {
+  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  double *A = g->A, *rhs = g->rhs;
+  memset(A, 0, (size_t)n * n * sizeof(double));
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, g->Mb)) return 1;
+    for (int c = 0; c < bi->nq; ++c)
+      for (int k = 0; k < bi->nq; ++k) A[(size_t)(bi->qadr + c) * n + bi->qadr + k] = g->Mb[(size_t)c * bi->nq + k];
+  }
+  double mdiag = 0.0, pmax = 0.0;
+  for (int i = 0; i < nq; ++i) mdiag = fmax(mdiag, fabs(A[(size_t)i * n + i]));
+  for (size_t k = 0; k < (size_t)nc * nq; ++k) pmax = fmax(pmax, fabs(g->PhiQ[k]));
+  const double eps = FMB_MIN_NORM_SHIFT * pmax * pmax / fmax(mdiag, 1e-300);
+  for (int i = 0; i < nq; ++i) rhs[i] = 0.0;
+  for (int k = 0; k < nc; ++k) {
+    rhs[nq + k] = -r[k];
+    A[(size_t)(nq + k) * n + nq + k] = -eps;
+    for (int c = 0; c < nq; ++c) {
+      A[(size_t)c * n + nq + k] = g->PhiQ[(size_t)k * nq + c];
+      A[(size_t)(nq + k) * n + c] = g->PhiQ[(size_t)k * nq + c];
+    }
+  }
+  if (fmb_lu_factor(n, A, g->piv)) return 1;
+  fmb_lu_solve(n, A, g->piv, rhs);
+  memcpy(dx, rhs, sizeof(double) * (size_t)nq);
+  return 0;
+}
+
+int fmb_project_state(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, double* q, double* v) {
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  const double scale = 1.0 + norm2(q, nq);
+  double* dx = g->qs;
+  int converged = 0;
+  for (int it = 0; it < 8; ++it) { /* positions: Newton on Phi(q) = 0 with mass-orthogonal steps */
+    if (fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt)) return 1;
+    if (norm2(g->phi, nc) <= 1e-14 * scale) {
+      converged = 1;
+      break;
+    }
+    if (mass_projection(m, w, g, q, v, g->phi, dx)) return 1;
+    for (int c = 0; c < nq; ++c) q[c] += dx[c];
+  }
+  /* velocities: one step, Phi_q v + Phi_t is linear in v */
+  if (fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt)) return 1;
+  for (int k = 0; k < nc; ++k)
+    for (int c = 0; c < nq; ++c) g->phit[k] += g->PhiQ[(size_t)k * nq + c] * v[c];
+  if (mass_projection(m, w, g, q, v, g->phit, dx)) return 1;
+  for (int c = 0; c < nq; ++c) v[c] += dx[c];
+  return converged ? 0 : 1;
+}
+
+int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
+                        const unsigned char* drop, double tikhonov, double* a, double* lambda) {
+  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  double *A = g->A, *rhs = g->rhs;
+  memset(A, 0, (size_t)n * n * sizeof(double));
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, g->Mb)) {
+      g->failed_body = b;
+      return FMB_AUG_MASS_FAILED;
+    }
+    for (int c = 0; c < bi->nq; ++c)
+      for (int r = 0; r < bi->nq; ++r) A[(size_t)(bi->qadr + c) * n + bi->qadr + r] = g->Mb[(size_t)c * bi->nq + r];
+  }
+  if (fmb_generalized_forces(m, w, t, q, v, rhs)) return FMB_AUG_FORCES_FAILED;
+  if (nc > 0) {
+    acceleration_rhs(m, w, t, q, v, g->PhiQ, g->PhiQ2, g->phi, g->phit, g->phitt, g->qs, rhs + nq);
+    double mdiag = 0.0, pmax = 0.0;
+    for (int i = 0; i < nq; ++i) mdiag = fmax(mdiag, fabs(A[(size_t)i * n + i]));
+    for (size_t k = 0; k < (size_t)nc * nq; ++k) pmax = fmax(pmax, fabs(g->PhiQ[k]));
+    /* Tikhonov: -eps on the multipliers' diagonal, eps relative to Phi_q M^-1 Phi_q^T's scale */
+    const double eps = tikhonov * pmax * pmax / fmax(mdiag, 1e-300);
+    for (int r = 0; r < nc; ++r) {
+      if (drop && drop[r]) { /* out of the equations: lambda_r = 0 */
+        rhs[nq + r] = 0.0;
+        A[(size_t)(nq + r) * n + nq + r] = 1.0;
+        continue;
+      }
+      A[(size_t)(nq + r) * n + nq + r] = -eps;
+      for (int c = 0; c < nq; ++c) {
+        A[(size_t)c * n + nq + r] = g->PhiQ[(size_t)r * nq + c];
+        A[(size_t)(nq + r) * n + c] = g->PhiQ[(size_t)r * nq + c];
+      }
+    }
+  }
+  if (fmb_lu_factor(n, A, g->piv)) return FMB_AUG_SINGULAR;
+  fmb_lu_solve(n, A, g->piv, rhs);
+  if (a) memcpy(a, rhs, (size_t)nq * sizeof(double));
+  if (lambda) memcpy(lambda, rhs + nq, (size_t)nc * sizeof(double));
+  for (int i = 0; i < n; ++i)
+    if (!isfinite(rhs[i])) return FMB_AUG_NOT_FINITE;
+  return 0;
 }
 
 static int model_has_sparse_body(const fmbModel* m) {
@@ -301,20 +660,17 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
   }
   double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-  double* PhiQ2 = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
   double* phi = calloc((size_t)nc + 1, sizeof(double));
   double* phit = calloc((size_t)nc + 1, sizeof(double));
   double* phitt = calloc((size_t)nc + 1, sizeof(double));
   double* G = calloc((size_t)nc * nc + 1, sizeof(double));
   int* piv = calloc((size_t)n + 1, sizeof(int));
-  const int sparse = model_has_sparse_body(m);
-  double* A = sparse ? NULL : calloc((size_t)n * n, sizeof(double));
   double* rhs = calloc((size_t)n + 1, sizeof(double));
   double* q0 = calloc((size_t)nq, sizeof(double));
   double* v0 = calloc((size_t)nq, sizeof(double));
-  double* qs = calloc((size_t)nq, sizeof(double));
+  fmbAugmented* aug = NULL;
   int rc = 0;
-  if (!PhiQ || !PhiQ2 || !phi || !phit || !phitt || !G || !piv || (!A && !sparse) || !rhs || !q0 || !v0 || !qs) {
+  if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs || !q0 || !v0) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -330,25 +686,11 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   memcpy(q0, q, (size_t)nq * sizeof(double));
   memcpy(v0, v, (size_t)nq * sizeof(double));
 
+  unsigned char* drop = fmb_workspace_redundant(w, NULL);
   if (nc > 0) {
     double res = 0.0;
-    int it, converged = 0;
-    for (it = 0; it < 50; ++it) {
-      if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt)) break;
-      res = max_abs(phi, nc);
-      if (res <= FMB_IC_PHI_TOL) {
-        converged = 1;
-        break;
-      }
-      if (gram_factor(nc, nq, PhiQ, G, piv)) break;
-      memcpy(rhs, phi, (size_t)nc * sizeof(double));
-      fmb_lu_solve(nc, G, piv, rhs);
-      for (int c = 0; c < nq; ++c) {
-        double s = 0.0;
-        for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-        q[c] -= s;
-      }
-    }
+    int it = 0, rank = nc;
+    const int converged = settle_positions(m, w, t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it);
     if (!converged) {
       /* far from the origin double precision cannot resolve FMB_IC_PHI_TOL: say so */
       const double qmax = max_abs(q, nq);
@@ -357,22 +699,43 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
         snprintf(far, sizeof far, "; coordinates reach %.3g, too far out for double precision to hold joints to %g",
                  qmax, FMB_IC_PHI_TOL);
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g, tolerance %g, after %d projection steps, "
-                   "or redundant constraints): check the joints' points, the bodies' initial poses, and that no joint repeats another%s",
+                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g, tolerance %g, after %d projection "
+                   "steps): check the joints' points and the bodies' initial poses; joints that repeat each other must agree%s",
                    t0, res, FMB_IC_PHI_TOL, it, far);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
+    if (rank < nc) {
+      char rows[600];
+      fmb_name_rows(m, drop, rows, sizeof rows);
+      if (singular_here(m, w, t0, q, v, drop, rank)) {
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                     "the mechanism starts in a singular configuration at t = %g: %s depend%s on the other joints' "
+                     "equations here but not nearby (a dead point or a flat linkage); start it away from that position",
+                     t0, rows, rank == nc - 1 ? "s" : "");
+        rc = FMB_EXIT_BAD_INPUT;
+        goto done;
+      }
+      if (m->nredundant != nc - rank) {
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                     "internal: %d redundant constraint rows at t = %g (%s), %d found when the scene was loaded", nc - rank,
+                     t0, rows, m->nredundant);
+        rc = FMB_EXIT_SOLVER;
+        goto done;
+      }
+    } else {
+      memset(drop, 0, (size_t)nc);
+    }
     /* velocities */
-    if (gram_factor(nc, nq, PhiQ, G, piv)) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "redundant constraints: the joints' equations are not independent");
+    if (gram_factor(nc, nq, PhiQ, drop, G, piv)) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints' equations are not independent at t = %g", t0);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
     for (int r = 0; r < nc; ++r) {
       double s = phit[r];
       for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
-      rhs[r] = s;
+      rhs[r] = drop[r] ? 0.0 : s;
     }
     fmb_lu_solve(nc, G, piv, rhs);
     for (int c = 0; c < nq; ++c) {
@@ -419,55 +782,56 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   st->ic_position_correction = norm2(q0, nq);
   st->ic_velocity_correction = norm2(v0, nq);
 
-  if (sparse) {
-    acceleration_rhs(m, w, t0, q, v, PhiQ, PhiQ2, phi, phit, phitt, qs, rhs + nq);
-    rc = sparse_accelerations(m, w, t0, y, yp, PhiQ, rhs + nq, diag);
+  if (model_has_sparse_body(m)) {
+    /* a body declared a sparse pattern (a banded beam): the dense augmented system would take
+       (nq + nc)^2 memory and cubic time; sparse Newton for a, lambda and the auxiliary unknowns */
+    int nred = 0;
+    fmb_workspace_redundant(w, &nred);
+    if (nred > 0) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                   "redundant constraints with a body that declares a sparse pattern (a banded beam) are not "
+                   "supported yet: remove the repeated joint, or set the beam's `assembly: dense`");
+      rc = FMB_EXIT_BAD_INPUT;
+      goto done;
+    }
+    double* PhiQ2 = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+    double* qs = calloc((size_t)nq + 1, sizeof(double));
+    if (!PhiQ2 || !qs) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
+      rc = FMB_EXIT_SOLVER;
+    } else {
+      acceleration_rhs(m, w, t0, q, v, PhiQ, PhiQ2, phi, phit, phitt, qs, rhs + nq);
+      rc = sparse_accelerations(m, w, t0, y, yp, PhiQ, rhs + nq, diag);
+    }
+    free(PhiQ2);
+    free(qs);
     goto done;
   }
   /* augmented system for accelerations and multipliers */
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    double* Mb = calloc((size_t)bi->nq * bi->nq, sizeof(double));
-    if (!Mb || fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, Mb)) {
-      free(Mb);
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g", bi->name, t0);
-      rc = FMB_EXIT_SOLVER;
-      goto done;
-    }
-    for (int c = 0; c < bi->nq; ++c)
-      for (int r = 0; r < bi->nq; ++r) A[(size_t)(bi->qadr + c) * n + bi->qadr + r] = Mb[(size_t)c * bi->nq + r];
-    free(Mb);
-  }
-  if (fmb_generalized_forces(m, w, t0, q, v, rhs)) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
+  aug = fmb_augmented_new(m);
+  if (!aug) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  if (nc > 0) {
-    acceleration_rhs(m, w, t0, q, v, PhiQ, PhiQ2, phi, phit, phitt, qs, rhs + nq);
-    for (int r = 0; r < nc; ++r)
-      for (int c = 0; c < nq; ++c) {
-        A[(size_t)c * n + nq + r] = PhiQ[(size_t)r * nq + c];
-        A[(size_t)(nq + r) * n + c] = PhiQ[(size_t)r * nq + c];
-      }
-  }
-  if (fmb_lu_factor(n, A, piv)) {
+  int arc = fmb_augmented_solve(m, w, aug, t0, q, v, fmb_workspace_redundant(w, NULL), 0.0, yp + nq, y + 2 * nq);
+  memcpy(yp, v, (size_t)nq * sizeof(double));
+  if (arc == FMB_AUG_MASS_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
+                 m->body[aug->failed_body].name, t0);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_FORCES_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_SINGULAR) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
                  "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
                  "with redundant joints): cannot compute initial accelerations");
     rc = FMB_EXIT_BAD_INPUT;
-    goto done;
+  } else if (arc == FMB_AUG_NOT_FINITE) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
+    rc = FMB_EXIT_SOLVER;
   }
-  fmb_lu_solve(n, A, piv, rhs);
-  memcpy(yp, v, (size_t)nq * sizeof(double));
-  memcpy(yp + nq, rhs, (size_t)nq * sizeof(double));
-  memcpy(y + 2 * nq, rhs + nq, (size_t)nc * sizeof(double));
-  for (int i = 0; i < n; ++i)
-    if (!isfinite(rhs[i])) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
-      rc = FMB_EXIT_SOLVER;
-      break;
-    }
   /* the bodies' auxiliary unknowns, consistent with (q, v, a) */
   for (int b = 1; b < m->nbody && !rc; ++b) {
     const fmbBodyInst* bi = &m->body[b];
@@ -479,17 +843,15 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     }
   }
 done:
+  fmb_augmented_free(aug);
   free(PhiQ);
-  free(PhiQ2);
   free(phi);
   free(phit);
   free(phitt);
   free(G);
   free(piv);
-  free(A);
   free(rhs);
   free(q0);
   free(v0);
-  free(qs);
   return rc;
 }

@@ -45,8 +45,10 @@ typedef enum {
   FMB_OUT_FRAME,       /* body frame quantity: index into frame_names */
   FMB_OUT_BODY,        /* body plugin output */
   FMB_OUT_JOINT,       /* joint plugin output */
-  FMB_OUT_JOINT_POWER, /* power of a joint's constraint forces, lambda^T Phi_t */
-  FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total */
+  FMB_OUT_JOINT_POWER, /* power a joint feeds in: constraint forces lambda^T Phi_t + its forces Q . v */
+  FMB_OUT_JOINT_WORK,  /* that power integrated from t0 (an IDA quadrature) */
+  FMB_OUT_JOINT_REACTION, /* 0 x, 1 y: force on body2 at its point; 2 torque about that point */
+  FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total 5 balance */
   FMB_OUT_CONSTRAINT,  /* 0 position 1 velocity */
   FMB_OUT_SHAPE        /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
 } fmbOutKind;
@@ -67,6 +69,10 @@ typedef struct fmbSolverSettings {
      the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
   enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
   int max_order; /* BDF order cap */
+  /* ggl (default): the stabilized index-2 DAE of system.c; projected: index-1 equations with
+     minimum-norm multipliers, positions and velocities projected at every output row, which
+     passes singular configurations (integrate.c, docs/mechanisms.md) */
+  enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
 } fmbSolverSettings;
@@ -95,6 +101,9 @@ struct fmbModel {
   fmbOutput* output;
   int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
+  int need_work; /* a work or energy.balance column: integrate every joint's power */
+  int nredundant; /* constraint rows that repeat the others at t0 (found at load, ic.c) */
+  int need_multipliers; /* a reaction or power column: multipliers recomputed at each row */
   int bdf_order_cap; /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
   int initial_static; /* scene `initial: static`: runs start from the static or steady state */
@@ -206,7 +215,21 @@ int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols);
 int fmb_joint_support(const fmbModel* m, fmbWorkspace* w, int j, int* sup);
 void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* pos,
                           double* vel);
-double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y);
+double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lambda);
+/* multipliers consistent with (q, v) at t (ic.c's augmented system; IDA's own between steps are
+   interpolated outside its error test), or y's when that system cannot be solved */
+const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y);
+/* force (global x, y) and torque (about the joint's point) that joint j's constraint forces exert
+   on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
+int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lambda, double out[3]);
+/* work done by each joint since t0 (njoint entries, filled by the integrator before each row) and
+   the force elements' potential energy at t0 (energy.balance) */
+double* fmb_workspace_work(fmbWorkspace* w);
+/* per constraint row: 1 = redundant, out of the equations; *count (may be NULL) = how many */
+unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count);
+double* fmb_workspace_spring_energy0(fmbWorkspace* w);
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
 /* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1.
@@ -238,8 +261,30 @@ void fmb_vector_use_fast_ops(struct _generic_N_Vector* v);
 int fmb_lu_factor(int n, double* A, int* piv);             /* column-major, in place; 0 ok */
 void fmb_lu_solve(int n, const double* LU, const int* piv, double* b);
 int fmb_cholesky(int n, double* A);                        /* lower, in place; 0 ok, else k+1 */
+int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order, double* work);
 
 /* ---- ic.c ---- */
+/* constraint rows that depend on the others at the initial state and nearby (redundant, not a
+   singular start); 0 when none or when the joints cannot be satisfied (the run says why) */
+int fmb_count_redundant(const fmbModel* m);
+typedef struct fmbAugmented {
+  double *A, *rhs, *PhiQ, *PhiQ2, *phi, *phit, *phitt, *qs, *Mb;
+  int* piv;
+  int failed_body;
+} fmbAugmented;
+enum { FMB_AUG_MASS_FAILED = 1, FMB_AUG_FORCES_FAILED, FMB_AUG_SINGULAR, FMB_AUG_NOT_FINITE };
+fmbAugmented* fmb_augmented_new(const fmbModel* m);
+void fmb_augmented_free(fmbAugmented* g);
+/* accelerations a (nq) and multipliers lambda (nc) consistent with q, v at t; either may be NULL */
+int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
+                        const unsigned char* drop, double tikhonov, double* a, double* lambda);
+/* project q onto Phi(q, t) = 0 and v onto Phi_q v + Phi_t = 0 (mass-orthogonal corrections with
+   a Tikhonov shift, so rank-deficient Phi_q is fine); 0, or 1 not converged */
+int fmb_project_state(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, double* q, double* v);
+/* "joint 'a' row 2, ..." for the constraint rows marked in rows[] */
+void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size_t len);
+/* Tikhonov shift (relative) that makes the multipliers of redundant rows minimum-norm */
+#define FMB_MIN_NORM_SHIFT 1e-10
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
                            fmbDiag* diag);
 

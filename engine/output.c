@@ -14,7 +14,11 @@
 #include "internal.h"
 
 static const char* const frame_names[] = {"x", "y", "theta", "omega", "vx", "vy", NULL};
-static const char* const energy_names[] = {"kinetic", "strain", "gravity", "spring", "total", NULL};
+static const char* const energy_names[] = {"kinetic", "strain", "gravity", "spring", "total", "balance", NULL};
+/* outputs the engine provides for joints: power and work for any joint that constrains or
+   applies forces, the reaction for a constraining one */
+static const char* const power_names[] = {"power", "work", NULL};
+static const char* const reaction_names[] = {"reaction_x", "reaction_y", "reaction_torque", NULL};
 static const char* const constraint_names[] = {"position", "velocity", NULL};
 
 static int lookup(const char* const* names, const char* s) {
@@ -45,6 +49,7 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
     o->kind = FMB_OUT_ENERGY;
     o->id = lookup(energy_names, qty);
     m->need_energy = 1;
+    if (o->id == 5) m->need_work = 1; /* balance = energy minus the work done on the system */
     list_names(avail, sizeof avail, energy_names);
   } else if (strcmp(owner, "constraint") == 0) {
     o->kind = FMB_OUT_CONSTRAINT;
@@ -74,13 +79,19 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
     } else {
       const fmbJointInst* ji = &m->joint[j];
       o->owner = j;
-      if (ji->nrows > 0 && strcmp(qty, "power") == 0) {
-        o->kind = FMB_OUT_JOINT_POWER;
-        o->id = 0;
+      const int has_power = ji->nrows > 0 || ji->type->force;
+      if (has_power && (o->id = lookup(power_names, qty)) >= 0) {
+        o->kind = o->id == 0 ? FMB_OUT_JOINT_POWER : FMB_OUT_JOINT_WORK;
+        if (o->id == 1) m->need_work = 1;
+        if (o->id == 0 && ji->nrows > 0) m->need_multipliers = 1;
+      } else if (ji->nrows > 0 && (o->id = lookup(reaction_names, qty)) >= 0) {
+        o->kind = FMB_OUT_JOINT_REACTION;
+        m->need_multipliers = 1;
       } else if (ji->type->output_lookup && (o->id = ji->type->output_lookup(ji->self, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT;
       }
-      if (ji->nrows > 0) list_names(avail, sizeof avail, (const char* const[]){"power", NULL});
+      if (has_power) list_names(avail, sizeof avail, power_names);
+      if (ji->nrows > 0) list_names(avail, sizeof avail, reaction_names);
       list_names(avail, sizeof avail, ji->type->output_names);
     }
   }
@@ -353,6 +364,7 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
   double cpos = 0.0, cvel = 0.0;
   if (m->need_energy) fmb_energy(m, w, t, q, v, &e);
   if (m->need_constraint) fmb_constraint_norms(m, w, t, q, v, &cpos, &cvel);
+  const double* lam = m->need_multipliers ? fmb_output_multipliers(m, w, t, y) : y + 2 * m->nq;
   double* work = fmb_workspace_plugin(w);
   for (int i = 0; i < m->noutput; ++i) {
     const fmbOutput* o = &m->output[i];
@@ -373,10 +385,22 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
       case FMB_OUT_JOINT:
         if (fmb_joint_output(m, w, o->owner, o->id, t, q, v, &val)) val = NAN;
         break;
-      case FMB_OUT_JOINT_POWER: val = fmb_joint_power(m, w, o->owner, t, y); break;
+      case FMB_OUT_JOINT_POWER: val = fmb_joint_power(m, w, o->owner, t, q, v, lam); break;
+      case FMB_OUT_JOINT_WORK: val = fmb_workspace_work(w)[o->owner]; break;
+      case FMB_OUT_JOINT_REACTION: {
+        double r[3];
+        val = fmb_joint_reaction(m, w, o->owner, t, q, v, lam, r) ? NAN : r[o->id];
+        break;
+      }
       case FMB_OUT_ENERGY: {
-        const double parts[5] = {e.kinetic, e.strain, e.gravity, e.spring,
-                                 e.kinetic + e.strain + e.gravity + e.spring};
+        double balance = 0.0;
+        if (o->id == 5) { /* T + U - W: the joints' work includes their springs', so their
+                             potential enters only through its value at t0 */
+          balance = e.kinetic + e.strain + e.gravity + *fmb_workspace_spring_energy0(w);
+          for (int j = 0; j < m->njoint; ++j) balance -= fmb_workspace_work(w)[j];
+        }
+        const double parts[6] = {e.kinetic, e.strain, e.gravity, e.spring,
+                                 e.kinetic + e.strain + e.gravity + e.spring, balance};
         val = parts[o->id];
         break;
       }

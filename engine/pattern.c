@@ -234,6 +234,12 @@ int fmb_pattern_build(fmbModel* m) {
   int err = !S || !cols;
   /* F_q = q' - v - Phi_q^T mu: the diagonals under q and v */
   err = err || add_block(&rs, 0, nq, 0, nq, 1) || add_block(&rs, 0, nq, nq, nq, 1);
+  /* F_lambda, F_mu of a redundant row are lambda_r, mu_r themselves (system.c): the diagonals,
+     only in models that have such rows (explicit zeros change KLU's pivoting, and with it the
+     roundoff of every run: the 170-degree pendulum's period moved by 7e-6) */
+  const int nc = m->nc;
+  if (m->nredundant > 0)
+    err = err || add_block(&rs, 2 * nq, nc, 2 * nq, nc, 1) || add_block(&rs, 2 * nq + nc, nc, 2 * nq + nc, nc, 1);
   for (int b = 1; b < m->nbody && !err; ++b) err = body_block(m, &rs, &m->body[b]);
   for (int j = 0; j < m->njoint && !err; ++j) {
     const fmbJointInst* ji = &m->joint[j];

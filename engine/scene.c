@@ -40,10 +40,12 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps)");
+  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps, formulation)");
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
+  static const char* const formulations[] = {"ggl", "projected", NULL}; /* order of FMB_FORM_* */
+  int formulation = FMB_FORM_GGL;
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
@@ -56,8 +58,10 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_choice(p, node, "linear_solver", 0, solvers, &linear_solver) ||
       fmb_get_choice(p, node, "error_control", 0, controls, &s->positions_only) ||
       fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
-      fmb_get_int(p, node, "max_order", 0, 1, 5, &s->max_order))
+      fmb_get_int(p, node, "max_order", 0, 1, 5, &s->max_order) ||
+      fmb_get_choice(p, node, "formulation", 0, formulations, &formulation))
     return -1;
+  s->formulation = formulation;
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->max_steps_per_output = max_steps;
   s->linear_solver = linear_solver;
@@ -356,9 +360,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   for (int k = 0; k < 2; ++k)
     if (library[k] >= 0 && check_library_keys(p, library[k], reference_keys[k])) return -1;
   if (m->nq == 0) return fmb_parse_error(p, bodies, "the scene has no moving body (no generalized coordinates)");
-  if (m->nc > m->nq)
-    return fmb_parse_error(p, joints, "the joints impose %d constraint equations on %d coordinates: the mechanism is over-constrained",
-                         m->nc, m->nq);
+  /* more constraint rows than coordinates: redundant (run, ic.c) or contradictory (refused there) */
   m->zoff = 2 * m->nq + 2 * m->nc;
   m->ny = m->zoff + m->nz;
   if (m->solver.max_order == 0) m->solver.max_order = m->bdf_order_cap;
@@ -368,6 +370,7 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   } else {
     fmb_outputs_default(m);
   }
+  m->nredundant = fmb_count_redundant(m);
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
   return check_resources(p, m);
 }

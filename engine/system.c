@@ -10,7 +10,13 @@
  * their `residual`, joints supply Phi, Phi_q, Phi_t, force elements supply Q. The iteration
  * matrix dF/dy + cj dF/dy' is assembled into the fixed CSC pattern of pattern.c; blocks a plugin
  * does not provide analytically are differentiated numerically over that plugin's own
- * coordinates. Nothing here allocates: all scratch lives in the workspace made at setup. */
+ * coordinates. Nothing here allocates: all scratch lives in the workspace made at setup.
+ *
+ * Redundant constraint rows (rows of Phi_q that depend on the others on the whole motion, e.g.
+ * two pins that say the same thing; found by ic.c) are taken out of the equations: their rows
+ * become F_lambda = lambda_r, F_mu = mu_r, so the Newton matrix stays regular while the
+ * independent rows still fix the same motion (docs/mechanisms.md). Their share of the reactions
+ * is restored in the outputs by the minimum-norm rule (ic.c's fmb_augmented_solve). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,6 +41,12 @@ struct fmbWorkspace {
   double* cache;
   size_t* cache_adr;
   int cache_valid;
+  double* work_done; /* njoint: accumulated work of each joint (integrate.c fills it) */
+  unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
+  int nredundant_cap; /* nc */
+  struct fmbAugmented* aug; /* outputs' multipliers (need_multipliers only) */
+  double* lambda;
+  double spring_energy0;
 };
 
 #define FMB_BLOCK_CACHE_BYTES ((size_t)256 << 20)
@@ -90,7 +102,22 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->vpert = calloc(nq, sizeof(double));
   w->ewt_default = calloc(2 * nq, sizeof(double));
   w->Qg = calloc(nq, sizeof(double));
-  if (!w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
+  w->work_done = calloc((size_t)m->njoint + 1, sizeof(double));
+  w->redundant = calloc((size_t)m->nc + 1, 1);
+  w->nredundant_cap = m->nc;
+  if (!w->redundant) {
+    fmb_workspace_free(w);
+    return NULL;
+  }
+  if (m->need_multipliers) {
+    w->aug = fmb_augmented_new(m);
+    w->lambda = calloc((size_t)m->nc + 1, sizeof(double));
+    if (!w->aug || !w->lambda) {
+      fmb_workspace_free(w);
+      return NULL;
+    }
+  }
+  if (!w->work_done || !w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
       !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fdcol || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
     fmb_workspace_free(w);
     return NULL;
@@ -124,6 +151,10 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
 void fmb_workspace_free(fmbWorkspace* w) {
   if (!w) return;
   free(w->cache_adr);
+  free(w->work_done);
+  free(w->redundant);
+  fmb_augmented_free(w->aug);
+  free(w->lambda);
   double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
                     w->K, w->C, w->M, w->fdcol, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
@@ -132,6 +163,25 @@ void fmb_workspace_free(fmbWorkspace* w) {
 }
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
+double* fmb_workspace_work(fmbWorkspace* w) { return w->work_done; }
+unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
+  if (count) {
+    *count = 0;
+    for (int r = 0; w->redundant && r < w->nredundant_cap; ++r) *count += w->redundant[r];
+  }
+  return w->redundant;
+}
+
+const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y) {
+  int nred = 0;
+  fmb_workspace_redundant(w, &nred);
+  /* with redundant rows the multipliers are not unique: the minimum-norm ones, the limit of the
+     Tikhonov-regularized system as its shift -> 0 */
+  if (!w->aug || fmb_augmented_solve(m, w, w->aug, t, y, y + m->nq, NULL, nred ? FMB_MIN_NORM_SHIFT : 0.0, NULL, w->lambda))
+    return y + 2 * m->nq;
+  return w->lambda;
+}
+double* fmb_workspace_spring_energy0(fmbWorkspace* w) { return &w->spring_energy0; }
 
 /* ---------------------------------------------------------------------------------------------
  * joints' view of the bodies */
@@ -311,6 +361,11 @@ int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const doub
       const double* row = w->phi_q + (size_t)r * (size_t)ncol;
       double pv = 0.0;
       const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
+      if (w->redundant[ji->rowadr + r]) {
+        Fl[ji->rowadr + r] = l;
+        Fm[ji->rowadr + r] = u;
+        continue;
+      }
       for (int c = 0; c < ncol; ++c) {
         pv += row[c] * v[w->cols[c]];
         Fv[w->cols[c]] += row[c] * l;
@@ -448,9 +503,14 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     int rc = joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt);
     if (rc) return rc;
     for (int r = 0; r < nr; ++r)
+      if (w->redundant[ji->rowadr + r]) {
+        sink_add(&s, Fl + ji->rowadr + r, Yl + ji->rowadr + r, 1.0);
+        sink_add(&s, Fm + ji->rowadr + r, Ym + ji->rowadr + r, 1.0);
+      }
+    for (int r = 0; r < nr; ++r)
       for (int c = 0; c < ncol; ++c) {
         const double d = w->phi_q[(size_t)r * ncol + c];
-        if (d == 0.0) continue;
+        if (d == 0.0 || w->redundant[ji->rowadr + r]) continue;
         sink_add(&s, Fl + ji->rowadr + r, Yq + cols[c], d);
         sink_add(&s, Fm + ji->rowadr + r, Yv + cols[c], d);
         sink_add(&s, Fv + cols[c], Yl + ji->rowadr + r, d);
@@ -469,6 +529,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
       for (int r = 0; r < nr; ++r) {
         double dpv = 0.0;
         const double l = lam[ji->rowadr + r], u = mu[ji->rowadr + r];
+        if (w->redundant[ji->rowadr + r]) continue;
         for (int sk = 0; sk < ji->nsup; ++sk) {
           const int k = ji->sup[sk];
           const double dphiq = (w->phi_q2[(size_t)r * ncol + k] - w->phi_q[(size_t)r * ncol + k]) / h;
@@ -628,14 +689,51 @@ void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const do
   *vel = sqrt(sv);
 }
 
-/* power of joint j's constraint forces on the system: -lambda^T Phi_q v = lambda^T Phi_t */
-double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* y) {
+/* power joint j feeds into the system: of its constraint forces -Phi_q^T lambda, that is
+   -lambda^T Phi_q v = lambda^T Phi_t (zero for a scleronomic joint), plus that of its applied
+   forces, Q . v (a spring's includes the rate of its potential, a damper's is <= 0) */
+double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lam) {
   const fmbJointInst* ji = &m->joint[j];
-  const double *q = y, *v = y + m->nq, *lam = y + 2 * m->nq;
-  if (ji->nrows == 0 || joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) return 0.0;
   double p = 0.0;
+  if (ji->type->force) {
+    const int ncol = fmb_joint_cols(m, ji, w->cols);
+    if (joint_force(m, w, j, t, q, v, w->jQ)) return NAN;
+    for (int c = 0; c < ncol; ++c) p += w->jQ[c] * v[w->cols[c]];
+  }
+  if (ji->nrows == 0) return p;
+  if (joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) return NAN;
   for (int r = 0; r < ji->nrows; ++r) p += lam[ji->rowadr + r] * w->phi_t[r];
   return p;
+}
+
+/* The constraint force -Phi_q^T lambda restricted to a body's frame coordinates (x, y, theta) is
+   the resultant F and its moment about the frame origin r; every material point p of a body with
+   a frame has dp/dtheta = Ĩ (p - r) and dangle/dtheta = 1 (rigid body and beam alike), so the
+   torque about the joint's point P is Q_theta - (P - r) x F. */
+int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                       const double* lam, double out[3]) {
+  const fmbJointInst* ji = &m->joint[j];
+  int k = 1;
+  if (ji->body[1] < 0 || m->body[ji->body[1]].nq < 3) k = 0;
+  if (ji->nrows == 0 || ji->body[k] < 0 || m->body[ji->body[k]].nq < 3) return -1;
+  const fmbBodyInst* bi = &m->body[ji->body[k]];
+  if (joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) return -1;
+  const int ncol = ji->ncol, c0 = k == 0 ? 0 : (ji->body[0] >= 0 ? m->body[ji->body[0]].nq : 0);
+  double Q[3] = {0.0, 0.0, 0.0};
+  for (int i = 0; i < 3; ++i)
+    for (int r = 0; r < ji->nrows; ++r) Q[i] -= w->phi_q[(size_t)r * ncol + c0 + i] * lam[ji->rowadr + r];
+  const double* qb = q + bi->qadr;
+  double P[2] = {qb[0], qb[1]}, local[2], ang;
+  int body = -1;
+  if (ji->type->attachment && ji->type->attachment(ji->self, k, &body, local) == 0 && body == ji->body[k] &&
+      bi->type->marker(bi->self, qb, local, P, &ang, NULL, NULL, w->plugin + bi->workadr))
+    return -1;
+  const double sign = k == 1 ? 1.0 : -1.0; /* Newton's third law: what body1 feels, reversed */
+  out[0] = sign * Q[0];
+  out[1] = sign * Q[1];
+  out[2] = sign * (Q[2] - ((P[0] - qb[0]) * Q[1] - (P[1] - qb[1]) * Q[0]));
+  return 0;
 }
 
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,

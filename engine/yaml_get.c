@@ -403,6 +403,96 @@ int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, in
   return 0;
 }
 
+/* a table file's path is taken relative to the scene's folder */
+static void sibling_path(const char* scene, const char* name, char* out, size_t len) {
+  const char* slash = strrchr(scene, '/');
+  if (name[0] == '/' || !slash)
+    snprintf(out, len, "%s", name);
+  else
+    snprintf(out, len, "%.*s/%s", (int)(slash - scene), scene, name);
+}
+
+/* one row "x,y" of a table file; 1 = blank or comment, 0 = a row, -1 = not two numbers */
+static int table_file_row(char* line, double xy[2]) {
+  line[strcspn(line, "\r\n")] = '\0';
+  char* s = line + strspn(line, " \t");
+  if (!*s || *s == '#') return 1;
+  char* comma = strchr(s, ',');
+  if (!comma) return -1;
+  *comma = '\0';
+  char* a = s + strspn(s, " \t");
+  char* b = comma + 1 + strspn(comma + 1, " \t");
+  for (char* e = a + strlen(a); e > a && (e[-1] == ' ' || e[-1] == '\t');) *--e = '\0';
+  for (char* e = b + strlen(b); e > b && (e[-1] == ' ' || e[-1] == '\t');) *--e = '\0';
+  return parse_number(a, &xy[0]) || parse_number(b, &xy[1]) ? -1 : 0;
+}
+
+/* rows of a table: from the inline list or the file, into x/y (NULL = count only) */
+static int table_rows(fmbParser* p, fmbNode n, const char* key, double* x, double* y, int* count) {
+  int rows = 0;
+  if (fmbp_is_seq(p, n)) {
+    rows = fmbp_seq_len(p, n);
+    for (int i = 0; i < rows; ++i) {
+      fmbNode row = fmbp_seq_item(p, n, i);
+      if (!fmbp_is_seq(p, row) || fmbp_seq_len(p, row) != 2)
+        return fmb_parse_error(p, row, "expected a pair [t, value] in the table '%s'", key);
+      double v[2];
+      for (int k = 0; k < 2; ++k)
+        if (number_at(p, fmbp_seq_item(p, row, k), key, 0, &v[k])) return -1;
+      if (x) x[i] = v[0], y[i] = v[1];
+    }
+    *count = rows;
+    return 0;
+  }
+  const char* name = fmbp_scalar(p, n);
+  char path[1024], line[512];
+  sibling_path(p->path, name, path, sizeof path);
+  FILE* f = fopen(path, "r");
+  if (!f) return fmb_parse_error(p, n, "cannot read the table file '%s' for '%s': %s", path, key, strerror(errno));
+  int lineno = 0, header_ok = 1;
+  while (fgets(line, sizeof line, f)) {
+    ++lineno;
+    double v[2];
+    int r = table_file_row(line, v);
+    if (r == 1) continue;
+    if (r < 0 && header_ok && rows == 0) { /* one header line of column names is allowed */
+      header_ok = 0;
+      continue;
+    }
+    if (r < 0) {
+      fclose(f);
+      return fmb_parse_error(p, n, "table file '%s' line %d: expected two numbers 't,value'", path, lineno);
+    }
+    if (x) x[rows] = v[0], y[rows] = v[1];
+    ++rows;
+  }
+  fclose(f);
+  *count = rows;
+  return 0;
+}
+
+int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, double** x, double** y, int* n) {
+  fmbNode node = fmb_find_key(p, map, key);
+  *x = *y = NULL;
+  *n = 0;
+  if (node < 0) return absent(p, map, key, flags, "a table: a list of [t, value] pairs or a CSV file name");
+  if (!fmbp_is_seq(p, node) && !fmbp_scalar(p, node))
+    return fmb_parse_error(p, node, "expected a list of [t, value] pairs or a CSV file name for '%s'", key);
+  int rows = 0;
+  if (table_rows(p, node, key, NULL, NULL, &rows)) return -1;
+  if (rows < 2) return fmb_parse_error(p, node, "the table '%s' needs at least two rows, has %d", key, rows);
+  *x = malloc(sizeof(double) * (size_t)rows);
+  *y = malloc(sizeof(double) * (size_t)rows);
+  if (!*x || !*y) return fmb_parse_error(p, node, "out of memory");
+  if (table_rows(p, node, key, *x, *y, &rows)) return -1;
+  *n = rows;
+  for (int i = 1; i < rows; ++i)
+    if (!((*x)[i] > (*x)[i - 1]))
+      return fmb_parse_error(p, node, "the table '%s' must have strictly increasing t (row %d: %g after %g)", key, i + 1,
+                             (*x)[i], (*x)[i - 1]);
+  return 0;
+}
+
 int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
                    int* out) {
   if (!p || !key || !choices || !out) return -1;

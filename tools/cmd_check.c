@@ -1,4 +1,5 @@
-/* cmd_check.c — `flexmbd check SCENE.yaml [--set PATH=VALUE]...`: load, validate, describe. */
+/* cmd_check.c — `flexmbd check SCENE.yaml [--set PATH=VALUE]...`: load, validate, describe, and
+ * report the constraints at t0 (degrees of freedom, redundant equations, singular start). */
 #include <stdio.h>
 #include <string.h>
 
@@ -25,6 +26,8 @@ int fmb_cmd_check(int argc, char** argv) {
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   fmb_describe(m, stdout);
+  int rc = fmb_check_constraints(m, stdout, &diag);
+  if (rc) fmb_cli_print_diag(&diag);
   fmb_free(m);
-  return 0;
+  return rc;
 }

@@ -16,6 +16,7 @@ static void print_range(const fmbParam* p) {
   }
   if (p->kind == FMB_PARAM_BODY) printf(" a body name (or ground)");
   if (p->kind == FMB_PARAM_JOINT) printf(" a joint named earlier");
+  if (p->kind == FMB_PARAM_TABLE) printf(" [[t, value], ...] or a CSV file");
 }
 
 static void print_params(const fmbParam* params) {

@@ -1,0 +1,162 @@
+/* time_law.c — the laws of time of drives and loads (time_law.h): one implementation for all. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "time_law.h"
+
+const char* const fmbj_law_names[] = {"constant", "ramp", "harmonic", "spinup", "table", NULL};
+
+static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
+  if (fmb_get_table(p, item, "table", FMB_REQUIRED, &law->t, &law->s, &law->n)) return -1;
+  law->integral = calloc((size_t)law->n, sizeof(double));
+  if (!law->integral) return fmb_parse_error(p, item, "out of memory");
+  for (int i = 1; i < law->n; ++i) /* trapezoid rule: exact for a piecewise-linear s */
+    law->integral[i] = law->integral[i - 1] + 0.5 * (law->s[i] + law->s[i - 1]) * (law->t[i] - law->t[i - 1]);
+  law->integral_at_zero = 0.0;
+  law->integral_at_zero = fmbj_law_eval(law, 0.0).integral; /* evaluated with a zero offset */
+  return 0;
+}
+
+static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
+  switch (law->kind) {
+    case FMB_LAW_RAMP:
+    case FMB_LAW_SPINUP: return fmb_get_double(p, item, "ramp_time", FMB_REQUIRED | FMB_POSITIVE, &law->ramp_time);
+    case FMB_LAW_HARMONIC:
+      return fmb_get_double(p, item, "frequency", FMB_REQUIRED | FMB_POSITIVE, &law->frequency) ||
+                     fmb_get_angle(p, item, "phase", 0, &law->phase)
+                 ? -1
+                 : 0;
+    case FMB_LAW_TABLE: return table_setup(p, item, law);
+    default: return 0;
+  }
+}
+
+int fmbj_law_parse(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
+  memset(law, 0, sizeof *law);
+  int kind = FMB_LAW_CONSTANT;
+  if (fmb_get_choice(p, item, "law", 0, fmbj_law_names, &kind)) return -1;
+  law->kind = (fmbLawKind)kind;
+  return parse_kind(p, item, law);
+}
+
+void fmbj_law_free(fmbTimeLaw* law) {
+  free(law->t);
+  free(law->s);
+  free(law->integral);
+  law->t = law->s = law->integral = NULL;
+}
+
+const char* fmbj_law_name(const fmbTimeLaw* law) { return fmbj_law_names[law->kind]; }
+
+/* piecewise-linear table: s, slope and the integral from t[0] (s held at the end values) */
+static fmbLawValue table_eval(const fmbTimeLaw* law, double t) {
+  fmbLawValue v = {0, 0, 0, 0};
+  const int n = law->n;
+  if (t <= law->t[0]) {
+    v.s = law->s[0];
+    v.integral = law->s[0] * (t - law->t[0]);
+  } else if (t >= law->t[n - 1]) {
+    v.s = law->s[n - 1];
+    v.integral = law->integral[n - 1] + law->s[n - 1] * (t - law->t[n - 1]);
+  } else {
+    int lo = 0, hi = n - 1; /* bisection: t[lo] <= t < t[hi] */
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      if (law->t[mid] <= t)
+        lo = mid;
+      else
+        hi = mid;
+    }
+    const double h = t - law->t[lo];
+    v.rate = (law->s[hi] - law->s[lo]) / (law->t[hi] - law->t[lo]);
+    v.s = law->s[lo] + v.rate * h;
+    v.integral = law->integral[lo] + 0.5 * (law->s[lo] + v.s) * h;
+  }
+  v.integral -= law->integral_at_zero;
+  return v;
+}
+
+fmbLawValue fmbj_law_eval(const fmbTimeLaw* law, double t) {
+  fmbLawValue v = {1.0, 0.0, 0.0, t};
+  switch (law->kind) {
+    case FMB_LAW_CONSTANT: break;
+    case FMB_LAW_RAMP: {
+      const double T = law->ramp_time;
+      if (t < T) {
+        v.s = t / T;
+        v.rate = 1.0 / T;
+        v.integral = 0.5 * t * t / T;
+      } else {
+        v.integral = t - 0.5 * T;
+      }
+      break;
+    }
+    case FMB_LAW_HARMONIC: {
+      const double w = law->frequency, a = w * t + law->phase;
+      v.s = sin(a);
+      v.rate = w * cos(a);
+      v.accel = -w * w * sin(a);
+      v.integral = (cos(law->phase) - cos(a)) / w;
+      break;
+    }
+    case FMB_LAW_SPINUP: { /* Liu, Hong & Liu (2009), Eq. 41, per unit omega0 */
+      const double T = law->ramp_time, k = 2.0 * M_PI / T, r = T / (2.0 * M_PI);
+      if (t <= T) {
+        v.s = (t - r * sin(k * t)) / T;
+        v.rate = (1.0 - cos(k * t)) / T;
+        v.accel = k * sin(k * t) / T;
+        v.integral = (0.5 * t * t + r * r * (cos(k * t) - 1.0)) / T;
+      } else {
+        v.integral = t - 0.5 * T;
+      }
+      break;
+    }
+    case FMB_LAW_TABLE: return table_eval(law, t);
+  }
+  return v;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+const char* const fmbj_motion_names[] = {"constant", "ramp", "harmonic", "spinup", "table", NULL};
+
+int fmbj_motion_parse(fmbParser* p, fmbNode item, int angular, fmbMotion* mo) {
+  memset(mo, 0, sizeof *mo);
+  int kind = 0;
+  if (fmb_get_choice(p, item, "profile", FMB_REQUIRED, fmbj_motion_names, &kind)) return -1;
+  mo->law.kind = (fmbLawKind)kind; /* the same order as the laws */
+  mo->integrate = kind == FMB_LAW_CONSTANT || kind == FMB_LAW_RAMP || kind == FMB_LAW_SPINUP;
+  mo->magnitude = 1.0;
+  int rc = 0;
+  switch (mo->law.kind) {
+    case FMB_LAW_CONSTANT:
+    case FMB_LAW_RAMP: rc = fmb_get_double(p, item, "speed", FMB_REQUIRED, &mo->magnitude); break;
+    case FMB_LAW_SPINUP: rc = fmb_get_double(p, item, "omega0", FMB_REQUIRED, &mo->magnitude); break;
+    case FMB_LAW_HARMONIC:
+      rc = angular ? fmb_get_angle(p, item, "amplitude", FMB_REQUIRED, &mo->magnitude)
+                   : fmb_get_double(p, item, "amplitude", FMB_REQUIRED, &mo->magnitude);
+      break;
+    case FMB_LAW_TABLE: break;
+  }
+  return rc || parse_kind(p, item, &mo->law) ? -1 : 0;
+}
+
+void fmbj_motion_eval(const fmbMotion* mo, double t, double f[3]) {
+  const fmbLawValue v = fmbj_law_eval(&mo->law, t);
+  const double a = mo->magnitude;
+  if (mo->integrate) {
+    f[0] = a * v.integral;
+    f[1] = a * v.s;
+    f[2] = a * v.rate;
+  } else {
+    f[0] = a * v.s;
+    f[1] = a * v.rate;
+    f[2] = a * v.accel;
+  }
+}
+
+const char* fmbj_motion_name(const fmbMotion* mo) {
+  static const char* const described[] = {"constant speed", "speed ramp", "harmonic", "spin-up (Eq. 41)", "table"};
+  return described[mo->law.kind];
+}

@@ -1,0 +1,74 @@
+/* time_law.h — the time laws that drives, prismatic drives and loads share (time_law.c).
+ *
+ * A law is a dimensionless shape s(t) with its rate, second rate and integral from 0:
+ *   constant  s = 1
+ *   ramp      s = min(t / ramp_time, 1)
+ *   harmonic  s = sin(frequency t + phase)
+ *   spinup    s = t/Tn - sin(2 pi t/Tn)/(2 pi) for t <= Tn, 1 after: the speed profile of
+ *             Liu, Hong & Liu (2009), Eq. 41 (its integral is the paper's spin-up angle)
+ *   table     s piecewise linear through [t, value] rows, held at the end values outside
+ * A load multiplies its force and torque by s(t); a prescribed motion (fmbMotion) is either a
+ * magnitude times the integral of s (constant, ramp, spinup: laws of the speed) or a magnitude
+ * times s itself (harmonic, table: laws of the position). */
+#ifndef FLEXMBD_TIME_LAW_H
+#define FLEXMBD_TIME_LAW_H
+#include "flexmbd.h"
+
+typedef enum { FMB_LAW_CONSTANT, FMB_LAW_RAMP, FMB_LAW_HARMONIC, FMB_LAW_SPINUP, FMB_LAW_TABLE } fmbLawKind;
+
+typedef struct {
+  fmbLawKind kind;
+  double ramp_time, frequency, phase;
+  int n;                        /* table rows */
+  double *t, *s, *integral;     /* table points; integral of s from t[0] to t[i] */
+  double integral_at_zero;      /* of s from t[0] to 0 (tables may start before or after 0) */
+} fmbTimeLaw;
+
+/* s, ds/dt, d2s/dt2 and the integral of s from 0 to t */
+typedef struct {
+  double s, rate, accel, integral;
+} fmbLawValue;
+
+/* keys: `law` (default constant) and the law's own: ramp_time (ramp, spinup), frequency, phase
+   (harmonic), table (table: [[t, s], ...] or a CSV file name) */
+int fmbj_law_parse(fmbParser* p, fmbNode item, fmbTimeLaw* law);
+fmbLawValue fmbj_law_eval(const fmbTimeLaw* law, double t);
+void fmbj_law_free(fmbTimeLaw* law);
+const char* fmbj_law_name(const fmbTimeLaw* law);
+
+/* A prescribed coordinate f(t) (a drive's relative angle, a prismatic drive's displacement).
+   Keys: `profile` (required) and its keys, compatible with the drive's original profiles:
+     constant (speed):              f = speed t
+     ramp     (speed, ramp_time):   the speed ramps linearly to `speed` over ramp_time
+     spinup   (omega0, ramp_time):  Eq. 41, the speed rises smoothly to omega0 over ramp_time
+     harmonic (amplitude, frequency, phase):  f = amplitude sin(frequency t + phase)
+     table    (table):              f piecewise linear through the [t, f] rows */
+typedef struct {
+  fmbTimeLaw law;
+  double magnitude;
+  int integrate; /* f = magnitude * integral of s (speed laws) or magnitude * s (position laws) */
+} fmbMotion;
+
+/* angular: f is an angle (a drive): amplitude may carry a unit (`10 deg`, fmb_get_angle) */
+int fmbj_motion_parse(fmbParser* p, fmbNode item, int angular, fmbMotion* motion);
+extern const char* const fmbj_law_names[], * const fmbj_motion_names[];
+
+/* the keys the two parsers read, for the types' fmbParam tables (UNIT: of f, "rad" or "m") */
+#define FMBJ_LAW_KEYS(what)                                                                                         \
+  {.key = "ramp_time", .kind = FMB_PARAM_NUMBER, .flags = FMB_POSITIVE, .unit = "s", .doc = what "ramp, spinup: rise time (required)"}, \
+      {.key = "frequency", .kind = FMB_PARAM_NUMBER, .flags = FMB_POSITIVE, .unit = "rad/s", .doc = what "harmonic (required)"}, \
+      {.key = "phase", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = what "harmonic"},          \
+      {.key = "table", .kind = FMB_PARAM_TABLE, .doc = what "table: [[t, value], ...] or a CSV file (required)"}
+#define FMBJ_LAW_PARAMS                                                                                             \
+  {.key = "law", .kind = FMB_PARAM_CHOICE, .choices = fmbj_law_names, .fallback = "constant", .doc = "time law s(t) scaling force and torque"}, \
+      FMBJ_LAW_KEYS("")
+#define FMBJ_MOTION_PARAMS(UNIT)                                                                                    \
+  {.key = "profile", .kind = FMB_PARAM_CHOICE, .flags = FMB_REQUIRED, .choices = fmbj_motion_names, .doc = "f(t), docs/scenes.md"}, \
+      {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "constant, ramp: (final) speed (required)"}, \
+      {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "spinup: final speed (required)"},     \
+      {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = UNIT, .doc = "harmonic: f = amplitude sin(frequency t + phase) (required)"}, \
+      FMBJ_LAW_KEYS("")
+/* f, f', f'' */
+void fmbj_motion_eval(const fmbMotion* motion, double t, double f[3]);
+const char* fmbj_motion_name(const fmbMotion* motion);
+#endif
