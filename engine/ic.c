@@ -432,11 +432,6 @@ int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, dou
   return 0;
 }
 
-static int model_has_sparse_body(const fmbModel* m) {
-  for (int b = 1; b < m->nbody; ++b)
-    if (m->body[b].pnnz >= 0) return 1;
-  return 0;
-}
 
 typedef struct {
   long n, cap;
@@ -782,7 +777,7 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   st->ic_position_correction = norm2(q0, nq);
   st->ic_velocity_correction = norm2(v0, nq);
 
-  if (model_has_sparse_body(m)) {
+  if (fmb_model_has_sparse_body(m)) {
     /* a body declared a sparse pattern (a banded beam): the dense augmented system would take
        (nq + nc)^2 memory and cubic time; sparse Newton for a, lambda and the auxiliary unknowns */
     int nred = 0;

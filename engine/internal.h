@@ -191,6 +191,8 @@ typedef struct fmbWorkspace fmbWorkspace;
 fmbWorkspace* fmb_workspace_new(const fmbModel* m);
 void fmb_workspace_free(fmbWorkspace* w);
 double* fmb_workspace_plugin(fmbWorkspace* w);
+/* a body declared its own sparse pattern (pattern op): dense whole-model systems are avoided */
+int fmb_model_has_sparse_body(const fmbModel* m);
 /* F(t, y, yp) of the stabilized index-2 (GGL) system; returns 0, >0 recoverable, <0 fatal */
 int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
                         double* F);

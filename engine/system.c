@@ -109,7 +109,9 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
     fmb_workspace_free(w);
     return NULL;
   }
-  if (m->need_multipliers) {
+  /* reactions from multipliers recomputed by the dense augmented system, except with a body that
+     declared a sparse pattern (a banded beam: (nq + nc)^2 memory), where IDA's own are used */
+  if (m->need_multipliers && !fmb_model_has_sparse_body(m)) {
     w->aug = fmb_augmented_new(m);
     w->lambda = calloc((size_t)m->nc + 1, sizeof(double));
     if (!w->aug || !w->lambda) {
@@ -160,6 +162,12 @@ void fmb_workspace_free(fmbWorkspace* w) {
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
   free(w->cols);
   free(w);
+}
+
+int fmb_model_has_sparse_body(const fmbModel* m) {
+  for (int b = 1; b < m->nbody; ++b)
+    if (m->body[b].pnnz >= 0) return 1;
+  return 0;
 }
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
