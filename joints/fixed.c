@@ -31,18 +31,6 @@ static int fixed_nrows(const void* self) {
   (void)self;
   return 3;
 }
-static void fixed_bodies(const void* self, int body[2]) {
-  const Fixed* f = self;
-  body[0] = f->tp.body[0];
-  body[1] = f->tp.body[1];
-}
-static int fixed_attachment(const void* self, int k, int* body, double local[2]) {
-  const Fixed* f = self;
-  *body = f->tp.body[k];
-  local[0] = f->tp.point[k][0];
-  local[1] = f->tp.point[k][1];
-  return 0;
-}
 
 static int fixed_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                             double* phi_tt) {
@@ -72,9 +60,9 @@ const fmbJointType fmb_joint_fixed = {
     .parse = fixed_parse,
     .describe = fixed_describe,
     .destroy = fixed_destroy,
-    .bodies = fixed_bodies,
+    .bodies = fmbj_two_point_bodies,
     .nrows = fixed_nrows,
-    .attachment = fixed_attachment,
+    .attachment = fmbj_two_point_attachment,
     .constraint = fixed_constraint,
     .params = fixed_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\n",

@@ -57,18 +57,6 @@ static void prismatic_destroy(void* self) {
   free(s);
 }
 static int prismatic_nrows(const void* self) { return ((const Prismatic*)self)->driven ? 3 : 2; }
-static void prismatic_bodies(const void* self, int body[2]) {
-  const Prismatic* s = self;
-  body[0] = s->tp.body[0];
-  body[1] = s->tp.body[1];
-}
-static int prismatic_attachment(const void* self, int k, int* body, double local[2]) {
-  const Prismatic* s = self;
-  *body = s->tp.body[k];
-  local[0] = s->tp.point[k][0];
-  local[1] = s->tp.point[k][1];
-  return 0;
-}
 
 typedef struct {
   double e[2], n[2]; /* axis and normal, global */
@@ -213,9 +201,9 @@ const fmbJointType fmb_joint_prismatic = {
     .parse = prismatic_parse,
     .describe = prismatic_describe,
     .destroy = prismatic_destroy,
-    .bodies = prismatic_bodies,
+    .bodies = fmbj_two_point_bodies,
     .nrows = prismatic_nrows,
-    .attachment = prismatic_attachment,
+    .attachment = fmbj_two_point_attachment,
     .constraint = prismatic_constraint,
     .force = prismatic_force,
     .energy = prismatic_energy,

@@ -17,18 +17,6 @@ static int revolute_nrows(const void* self) {
   (void)self;
   return 2;
 }
-static void revolute_bodies(const void* self, int body[2]) {
-  const fmbTwoPoint* tp = self;
-  body[0] = tp->body[0];
-  body[1] = tp->body[1];
-}
-static int revolute_attachment(const void* self, int k, int* body, double local[2]) {
-  const fmbTwoPoint* tp = self;
-  *body = tp->body[k];
-  local[0] = tp->point[k][0];
-  local[1] = tp->point[k][1];
-  return 0;
-}
 
 static int revolute_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                                double* phi_tt) {
@@ -65,9 +53,9 @@ const fmbJointType fmb_joint_revolute = {
     .parse = revolute_parse,
     .describe = revolute_describe,
     .destroy = revolute_destroy,
-    .bodies = revolute_bodies,
+    .bodies = fmbj_two_point_bodies,
     .nrows = revolute_nrows,
-    .attachment = revolute_attachment,
+    .attachment = fmbj_two_point_attachment,
     .constraint = revolute_constraint,
     .output_names = revolute_outputs,
     .output_lookup = revolute_lookup,

@@ -26,20 +26,7 @@ static int spring_parse(fmbParser* p, fmbNode item, void** self) {
 }
 
 static void spring_destroy(void* self) { free(self); }
-static void spring_bodies(const void* self, int body[2]) {
-  const Spring* s = self;
-  body[0] = s->tp.body[0];
-  body[1] = s->tp.body[1];
-}
 
-/* the two ends, for drawing (engine/vtk.c) */
-static int spring_attachment(const void* self, int k, int* body, double local[2]) {
-  const Spring* s = self;
-  *body = s->tp.body[k];
-  local[0] = s->tp.point[k][0];
-  local[1] = s->tp.point[k][1];
-  return 0;
-}
 
 /* length, its rate, unit vector from point1 to point2; D (2 x ld) = d(p1 - p2)/dq */
 static int spring_geometry(const Spring* s, const fmbJointEval* ev, double* D, int ld, double* len, double* rate,
@@ -121,8 +108,8 @@ const fmbJointType fmb_joint_spring = {
     .parse = spring_parse,
     .describe = spring_describe,
     .destroy = spring_destroy,
-    .bodies = spring_bodies,
-    .attachment = spring_attachment,
+    .bodies = fmbj_two_point_bodies,
+    .attachment = fmbj_two_point_attachment,
     .force = spring_force,
     .energy = spring_energy,
     .output_names = spring_outputs,

@@ -35,3 +35,17 @@ int fmbj_point_gap(const fmbJointEval* ev, const fmbTwoPoint* tp, double gap[2],
   gap[1] = p[0][1] - p[1][1];
   return 0;
 }
+
+void fmbj_two_point_bodies(const void* self, int body[2]) {
+  const fmbTwoPoint* tp = self;
+  body[0] = tp->body[0];
+  body[1] = tp->body[1];
+}
+
+int fmbj_two_point_attachment(const void* self, int k, int* body, double local[2]) {
+  const fmbTwoPoint* tp = self;
+  *body = tp->body[k];
+  local[0] = tp->point[k][0];
+  local[1] = tp->point[k][1];
+  return 0;
+}

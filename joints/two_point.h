@@ -16,6 +16,9 @@ typedef struct {
       {.key = "point1", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body1, body frame"}, \
       {.key = "point2", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body2, body frame"}
 int fmbj_parse_two_points(fmbParser* p, fmbNode item, fmbTwoPoint* tp);
+/* the `bodies` and `attachment` ops of a joint whose state begins with its fmbTwoPoint */
+void fmbj_two_point_bodies(const void* self, int body[2]);
+int fmbj_two_point_attachment(const void* self, int k, int* body, double local[2]);
 /* positions of both points; with ld > 0, rows r0 and r0+1 of phi_q receive d(p1 - p2)/dq */
 int fmbj_point_gap(const fmbJointEval* ev, const fmbTwoPoint* tp, double gap[2], double* phi_q, int ld, double ang[2],
                    double* dang);
