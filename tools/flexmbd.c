@@ -10,34 +10,35 @@ typedef struct {
   const char* name;
   int (*main)(int argc, char** argv);
   const char* usage; /* one or more lines, each starting with the command's name */
+  int own_help;      /* the command prints a longer --help itself */
 } Command;
 
 static const Command commands[] = {
     {"run", fmb_cmd_run,
      "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR]\n"
      "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
-     "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each"},
-    {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run"},
+     "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each", 0},
+    {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run", 0},
     {"compare", fmb_cmd_compare,
-     "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance"},
+     "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance", 1},
     {"regress", fmb_cmd_regress,
-     "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references"},
-    {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs"},
+     "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references", 1},
+    {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs", 0},
     {"conform", fmb_cmd_conform,
-     "conform [--plugin x.so]... [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure"},
+     "conform [--plugin x.so]... [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure", 0},
     {"plot", fmb_cmd_plot,
      "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
-     "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)"},
-    {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene"},
+     "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)", 0},
+    {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene", 0},
     {"static", fmb_cmd_static,
-     "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive"},
+     "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive", 0},
     {"modes", fmb_cmd_modes,
      "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv] [--animate DIR]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state"},
+     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state", 0},
     {"campbell", fmb_cmd_campbell,
      "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-o campbell.csv] [--plot campbell.png]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC)"},
+     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC)", 0},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 
@@ -54,11 +55,24 @@ int main(int argc, char** argv) {
   }
   const char* cmd = argv[1];
   if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
+    for (int i = 0; argc == 3 && i < NCOMMANDS; ++i)
+      if (strcmp(argv[2], commands[i].name) == 0) {
+        printf("usage: flexmbd %s\n", commands[i].usage);
+        return 0;
+      }
     usage(stdout);
     return 0;
   }
+  /* `flexmbd CMD --help` and `flexmbd help CMD`: that command's lines of the usage */
+  const int help = argc == 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0);
   for (int i = 0; i < NCOMMANDS; ++i)
-    if (strcmp(cmd, commands[i].name) == 0) return commands[i].main(argc, argv);
+    if (strcmp(cmd, commands[i].name) == 0) {
+      if (help && !commands[i].own_help) {
+        printf("usage: flexmbd %s\n", commands[i].usage);
+        return 0;
+      }
+      return commands[i].main(argc, argv);
+    }
   fprintf(stderr, "flexmbd: unknown command '%s'\n", cmd);
   usage(stderr);
   return FMB_EXIT_BAD_INPUT;
