@@ -52,6 +52,7 @@ typedef struct Rule {
 typedef struct BeamExact {
   double L, rho, A, Izz, Emod;
   int ne, integration;
+  int banded; /* `assembly`: K, C, M over the banded pattern (exact_pattern) instead of dense */
   double pos0[2], angle0, vel0[2], omega0;
   /* derived */
   double le, mu, EA, EI;
@@ -204,6 +205,11 @@ static double element_elastic(const BeamExact* b, const double D[8], double f[8]
  * ------------------------------------------------------------------------------------------- */
 static const char* const exact_models[] = {"zoac", "foac", "complete", "exact", NULL}; /* as beam.c's */
 static const char* const exact_integrations[] = {"reduced", "full", NULL};
+static const char* const exact_assemblies[] = {"auto", "dense", "banded", NULL}; /* as beam.c's */
+enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
+/* `assembly: auto` is banded from this many elements on, as for the other models (beam.c);
+   docs/models.md, "Banded assembly", has the measured crossover */
+enum { BANDED_FROM_ELEMENTS = 64 };
 
 static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   BeamExact* b = calloc(1, sizeof *b);
@@ -217,6 +223,9 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, exact_models, &model); /* "exact": beam.c chose this table */
   err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, exact_integrations, &b->integration);
+  int assembly = ASSEMBLY_AUTO;
+  err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, exact_assemblies, &assembly);
+  b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
   err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
   err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
   err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
@@ -265,6 +274,25 @@ static void exact_initial(const void* self, double* q0, double* v0) {
  * Residual and Jacobian. At each mass point the coordinates that move it are the frame's x, y,
  * theta and the element's (up to 8) dofs; J_j is the body-frame vector d(a_b)/d(q_j'').
  * ------------------------------------------------------------------------------------------- */
+/* The banded layout (exact_pattern's pair order): frame columns j < 3 over all nc rows; frame rows
+   i < 3 over the nc - 3 deformation columns; then element blocks, element 0 over its 5 free dofs
+   (the root stretch and node 1), each later element over its 8, column-major in the element's dof
+   order (li, lj: the position of i, j among the element's free dofs). */
+static long exact_npair(const BeamExact* b) {
+  const long nc = 3 + b->n;
+  return 3 * nc + 3 * (nc - 3) + 25 + 64L * (b->ne - 1);
+}
+
+static size_t jac_at(const BeamExact* b, int banded, int e, int i, int li, int j, int lj) {
+  const size_t nc = (size_t)(3 + b->n);
+  if (!banded) return (size_t)j * nc + (size_t)i;
+  if (j < 3) return (size_t)j * nc + (size_t)i;
+  if (i < 3) return 3 * nc + (size_t)i * (nc - 3) + (size_t)(j - 3);
+  const size_t base = 3 * nc + 3 * (nc - 3) + (e == 0 ? 0 : 25 + 64 * (size_t)(e - 1));
+  const int nd = e == 0 ? 5 : 8;
+  return base + (size_t)lj * (size_t)nd + (size_t)li;
+}
+
 typedef struct PointFrame {
   int ncol, col[11];
   double J[11][2];
@@ -350,18 +378,18 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
      C_ij = w J_i.dF/dv_j,   dF/dtheta' = -2 theta' rho + 2 I~rho_t,   dF/dp_j' = 2 theta' I~J_j
      K_ij = w (dJ_i/dq_j . F + J_i . dF/dq_j),  dJ_{x,y}/dtheta = -I~J_{x,y},  dJ_theta/dp_j = I~J_j,
             dF/dtheta = -I~G0,  dF/dp_j = (theta'' I~ - theta'^2) J_j
-   plus the elastic Hessian of each element in the p block. */
-static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                          double* K, double* C, double* M, double* work) {
-  (void)work;
-  const BeamExact* b = self;
-  const size_t nc = (size_t)(3 + b->n);
+   plus the elastic Hessian of each element in the p block.
+   One assembly serves both layouts: entry (i, j) of element e's contribution goes to jac_at's
+   slot, the dense column-major nc x nc block or the banded pattern's pair (exact_pattern). */
+static int exact_fill(const BeamExact* b, int banded, const fmbEnv* env, const double* q, const double* v,
+                      const double* a, double* K, double* C, double* M) {
+  const size_t nc = (size_t)(3 + b->n), nv = banded ? (size_t)exact_npair(b) : nc * nc;
   double c, s, G0[2];
   frame_terms(env, q, a, &c, &s, G0);
   const double om = v[2], al = a[2];
-  if (K) memset(K, 0, sizeof(double) * nc * nc);
-  if (C) memset(C, 0, sizeof(double) * nc * nc);
-  if (M) memset(M, 0, sizeof(double) * nc * nc);
+  if (K) memset(K, 0, sizeof(double) * nv);
+  if (C) memset(C, 0, sizeof(double) * nv);
+  if (M) memset(M, 0, sizeof(double) * nv);
   for (int e = 0; e < b->ne; ++e) {
     double X[8], D[8], Xd[8], Xdd[8], f[8], Ke[64];
     element_state(b, q, v, a, e, D, X, Xd, Xdd);
@@ -390,7 +418,7 @@ static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, 
         for (int ii = 0; ii < pf.ncol; ++ii) {
           const int i = pf.col[ii];
           const double* Ji = pf.J[ii];
-          const size_t at = (size_t)j * nc + (size_t)i;
+          const size_t at = jac_at(b, banded, e, i, ii - 3, j, jj - 3);
           if (M) M[at] += w * (Ji[0] * Jj[0] + Ji[1] * Jj[1]);
           if (C) C[at] += w * (Ji[0] * dFv[0] + Ji[1] * dFv[1]);
           if (K) {
@@ -404,17 +432,56 @@ static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, 
     }
     if (K) {
       element_elastic(b, D, f, Ke);
-      for (int l2 = 0; l2 < 8; ++l2) {
+      for (int l2 = 0, lj = 0; l2 < 8; ++l2) {
         const int j = edof(e, l2);
         if (j < 0) continue;
-        for (int l1 = 0; l1 < 8; ++l1) {
+        for (int l1 = 0, li = 0; l1 < 8; ++l1) {
           const int i = edof(e, l1);
-          if (i >= 0) K[(size_t)j * nc + (size_t)i] += Ke[l2 * 8 + l1];
+          if (i >= 0) K[jac_at(b, banded, e, i, li++, j, lj)] += Ke[l2 * 8 + l1];
         }
+        ++lj;
       }
     }
   }
   return 0;
+}
+
+static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                          double* K, double* C, double* M, double* work) {
+  (void)work;
+  return exact_fill(self, 0, env, q, v, a, K, C, M);
+}
+
+/* fmbBodyType.pattern_jacobian: the same K, C, M, one value per pair of exact_pattern */
+static int exact_pattern_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v,
+                                  const double* a, const double* z, double* K, double* C, double* M, double* work) {
+  (void)z, (void)work;
+  return exact_fill(self, 1, env, q, v, a, K, C, M); /* the engine checks the values are finite */
+}
+
+/* fmbBodyType.pattern (banded assembly only): the frame's columns x, y, theta over every row, its
+   rows over every other column (the frame couples to every point), then per element e the block
+   of its own dofs (node 0's stretch a and node 1's four for e = 0, nodes e and e+1's eight
+   otherwise: neighbouring blocks overlap at their shared node, which the engine sums). The
+   order is jac_at's. Memory and work are O(ne), against O(ne^2) for the dense block. */
+static long exact_pattern(const void* self, int* rows, int* cols) {
+  const BeamExact* b = self;
+  if (!b->banded) return -1;
+  const int nc = 3 + b->n;
+  long k = 0;
+  if (!rows) return exact_npair(b);
+  for (int j = 0; j < 3; ++j)
+    for (int i = 0; i < nc; ++i) rows[k] = i, cols[k++] = j;
+  for (int i = 0; i < 3; ++i)
+    for (int j = 3; j < nc; ++j) rows[k] = i, cols[k++] = j;
+  for (int e = 0; e < b->ne; ++e) {
+    int dof[8], nd = 0;
+    for (int l = 0; l < 8; ++l)
+      if (edof(e, l) >= 0) dof[nd++] = edof(e, l);
+    for (int lj = 0; lj < nd; ++lj)
+      for (int li = 0; li < nd; ++li) rows[k] = dof[li], cols[k++] = dof[lj];
+  }
+  return k;
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -584,10 +651,11 @@ static int exact_output(const void* self, int id, const double* q, const double*
 
 static void exact_describe(const void* self, FILE* f) {
   const BeamExact* b = self;
-  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s)\n", b->ne,
-          b->integration == INTEGRATION_FULL ? "full" : "reduced",
+  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly\n",
+          b->ne, b->integration == INTEGRATION_FULL ? "full" : "reduced",
           b->integration == INTEGRATION_FULL ? "axial at 5, bending at 3 Gauss points"
-                                             : "axial at 3 Lobatto, bending at 2 Gauss points");
+                                             : "axial at 3 Lobatto, bending at 2 Gauss points",
+          b->banded ? "banded" : "dense");
 }
 
 /* as for the other beam models: undamped axial modes near 5e5 rad/s */
@@ -627,6 +695,8 @@ static const fmbParam exact_params[] = {
     {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = exact_models, .doc = "exact here"},
     {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
      .doc = "reduced: axial at 3 Lobatto, bending at 2 Gauss points; full: 5 and 3 Gauss points"},
+    {.key = "assembly", .kind = FMB_PARAM_CHOICE, .fallback = "auto", .choices = exact_assemblies,
+     .doc = "body Jacobian layout: banded (O(n), the default from 64 elements) or dense"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
@@ -654,6 +724,8 @@ const fmbBodyType fmb_body_beam_exact = {
     .velocity_error_test = exact_velocity_error_test,
     .invalid_state = exact_invalid_state,
     .reuse_blocks = exact_reuse_blocks,
+    .pattern = exact_pattern,
+    .pattern_jacobian = exact_pattern_jacobian,
     .params = exact_params,
     .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
                "model: exact\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",

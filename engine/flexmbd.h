@@ -252,6 +252,13 @@ typedef struct fmbBodyType {
      count, else fills them. -1 (or a NULL op) = one dense block. The engine then differentiates
      the body over that pattern, grouping columns that share no row (engine/fd.c). */
   long (*pattern)(const void* self, int* rows, int* cols);
+  /* The analytic K = d[R; Rz]/d[q; z], C = dR/dv, M = dR/da over the declared pattern: one value
+     per (row, column) pair, in the order `pattern` lists the pairs (the engine sums duplicates,
+     so a body may list each element's block and add into it as it assembles); C and M are 0 in
+     the z columns. z is NULL when naux = 0. Nonzero = not evaluable (IDA cuts the step). The
+     engine uses it instead of differencing over the pattern; NULL = differences (engine/fd.c). */
+  int (*pattern_jacobian)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                          const double* z, double* K, double* C, double* M, double* work);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

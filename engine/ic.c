@@ -486,7 +486,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     if ((size_t)(bi->nq + bi->nz) > nrb) nrb = (size_t)(bi->nq + bi->nz);
-    if (bi->pnnz >= 0 && fmb_fd_sparse_scratch(bi) > nscr) nscr = fmb_fd_sparse_scratch(bi);
+    if (bi->pnnz >= 0 && fmb_body_sparse_scratch(bi) > nscr) nscr = fmb_body_sparse_scratch(bi);
   }
   double* Rb = calloc(nrb, sizeof(double));
   double* scratch = calloc(nscr, sizeof(double));
@@ -545,7 +545,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
       const int nb = bi->nq;
       if (bi->pnnz >= 0) {
         double *K = blk, *C = K + bi->pnnz, *M = C + bi->pnnz;
-        if (fmb_fd_body_sparse(bi, &m->env, q + bi->qadr, v + bi->qadr, a + bi->qadr, z + bi->zadr, ewt + bi->qadr,
+        if (fmb_body_sparse_blocks(bi, &m->env, q + bi->qadr, v + bi->qadr, a + bi->qadr, z + bi->zadr, ewt + bi->qadr,
                                ewt + nq + bi->qadr, K, C, M, fmb_workspace_plugin(w) + bi->workadr, scratch))
           rc = FMB_EXIT_SOLVER, why = "the equations of motion are not finite";
         for (int c = 0; c < nb + bi->nz && !rc; ++c)

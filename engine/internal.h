@@ -25,6 +25,10 @@ typedef struct fmbBodyInst {
   int* prowind;
   int ncolor;
   int *color_ptr, *color_col; /* columns of colour k: color_col[color_ptr[k] .. color_ptr[k+1]) */
+  /* with an analytic pattern_jacobian: the declared pairs' count and each pair's entry in the CSC
+     (duplicates share one), so the op's values in pair order are summed into place */
+  long npair;
+  long* ppos;
 } fmbBodyInst;
 
 typedef struct fmbJointInst {
@@ -339,6 +343,13 @@ size_t fmb_fd_sparse_scratch(const fmbBodyInst* b);
 int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                        const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
                        double* work, double* scratch);
+/* ---- pattern.c: a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
+   pattern_jacobian when it has one, else by differences (fmb_fd_body_sparse); scratch doubles:
+   fmb_body_sparse_scratch ---- */
+size_t fmb_body_sparse_scratch(const fmbBodyInst* b);
+int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                           const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
+                           double* work, double* scratch);
 /* a body's rows [R; Rz] at (q, v, a, z): residual_aux when it has auxiliary unknowns */
 int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                   const double* z, double* R, double* work);

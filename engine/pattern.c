@@ -9,6 +9,7 @@
  * runs of consecutive rows per column, bucketed by column, sorted and merged. Within a column
  * the rows of one run are consecutive, which lets the assembly write a block column with one
  * binary search. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -96,6 +97,23 @@ static int body_pattern(fmbBodyInst* b) {
   }
   for (int c = 0; c < n; ++c) b->pcolptr[c + 1] += b->pcolptr[c];
   b->pnnz = nnz;
+  /* an analytic pattern_jacobian returns values in pair order: where each pair lands */
+  if (b->type->pattern_jacobian) {
+    b->npair = npair;
+    b->ppos = malloc(sizeof(long) * (size_t)(npair + 1));
+    if (!b->ppos) goto fail;
+    for (long k = 0; k < npair; ++k) {
+      long lo = b->pcolptr[cols[k]], hi = b->pcolptr[cols[k] + 1] - 1;
+      while (lo < hi) { /* rows are sorted within a column */
+        const long mid = (lo + hi) / 2;
+        if (b->prowind[mid] < rows[k])
+          lo = mid + 1;
+        else
+          hi = mid;
+      }
+      b->ppos[k] = lo;
+    }
+  }
   free(rows);
   free(cols);
   free(key);
@@ -140,8 +158,37 @@ fail:
   return -1;
 }
 
+/* K, C, M of a sparse body (internal.h). The analytic op's pair-order values sit in scratch and are
+   summed into their CSC entries: duplicate pairs (element blocks sharing a node) add up. */
+size_t fmb_body_sparse_scratch(const fmbBodyInst* b) {
+  const size_t fd = fmb_fd_sparse_scratch(b), exact = 3 * (size_t)b->npair;
+  return b->type && b->type->pattern_jacobian && exact > fd ? exact : fd;
+}
+
+int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                           const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
+                           double* work, double* scratch) {
+  if (!b->type->pattern_jacobian)
+    return fmb_fd_body_sparse(b, env, q, v, a, z, ewt_q, ewt_v, K, C, M, work, scratch);
+  double *Kp = scratch, *Cp = Kp + b->npair, *Mp = Cp + b->npair;
+  const int rc = b->type->pattern_jacobian(b->self, env, q, v, a, z, Kp, Cp, Mp, work);
+  if (rc) return rc;
+  memset(K, 0, sizeof(double) * (size_t)b->pnnz);
+  memset(C, 0, sizeof(double) * (size_t)b->pnnz);
+  memset(M, 0, sizeof(double) * (size_t)b->pnnz);
+  for (long k = 0; k < b->npair; ++k) {
+    K[b->ppos[k]] += Kp[k];
+    C[b->ppos[k]] += Cp[k];
+    M[b->ppos[k]] += Mp[k];
+  }
+  for (long k = 0; k < b->pnnz; ++k)
+    if (!isfinite(K[k]) || !isfinite(C[k]) || !isfinite(M[k])) return 1; /* a wild trial step: IDA cuts it */
+  return 0;
+}
+
 void fmb_pattern_free(fmbModel* m) {
   for (int b = 0; m->body && b < m->nbody; ++b) {
+    free(m->body[b].ppos);
     free(m->body[b].pcolptr);
     free(m->body[b].prowind);
     free(m->body[b].color_ptr);

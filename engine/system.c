@@ -76,7 +76,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   size_t nblk = m->check_definiteness ? nb * nb : 1, nfd = 7 * nb;
   for (int b = 1; b < m->nbody; ++b) {
     if (block_size(&m->body[b]) > nblk) nblk = block_size(&m->body[b]);
-    if (m->body[b].pnnz >= 0 && fmb_fd_sparse_scratch(&m->body[b]) > nfd) nfd = fmb_fd_sparse_scratch(&m->body[b]);
+    if (m->body[b].pnnz >= 0 && fmb_body_sparse_scratch(&m->body[b]) > nfd) nfd = fmb_body_sparse_scratch(&m->body[b]);
   }
   w->max_rows = mr;
   w->max_nq = (int)nb;
@@ -447,7 +447,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
       M = C + nn;
     }
     if (!reuse) {
-      int rc = bi->pnnz >= 0 ? fmb_fd_body_sparse(bi, &m->env, q + a0, v + a0, vp + a0, y + m->zoff + bi->zadr,
+      int rc = bi->pnnz >= 0 ? fmb_body_sparse_blocks(bi, &m->env, q + a0, v + a0, vp + a0, y + m->zoff + bi->zadr,
                                                   ewt + a0, ewt + nq + a0, K, C, M, w->plugin + bi->workadr, w->fd)
                              : fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, K, C, M);
       if (rc) {
