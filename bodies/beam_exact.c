@@ -677,6 +677,20 @@ static int exact_reuse_blocks(const void* self) {
   return 0;
 }
 
+/* fmbBodyType.length_scale: a unit of the frame angle, the root stretch or a slope moves the
+   centreline by up to L metres, a unit of x, y or a nodal displacement by one metre. So one atol
+   in metres holds the tip to the same accuracy whatever L is (docs/models.md, "Tolerances"). */
+static void exact_length_scale(const void* self, double* metres_per_unit) {
+  const BeamExact* b = self;
+  metres_per_unit[0] = metres_per_unit[1] = 1.0;
+  metres_per_unit[2] = metres_per_unit[3] = b->L;
+  for (int i = 0; i < b->ne; ++i) {
+    double* nd = metres_per_unit + 4 + 4 * i;
+    nd[0] = nd[1] = 1.0;
+    nd[2] = nd[3] = b->L;
+  }
+}
+
 static const char* exact_invalid_state(const void* self, const double* q, const double* v) {
   (void)v;
   const BeamExact* b = self;
@@ -727,6 +741,7 @@ const fmbBodyType fmb_body_beam_exact = {
     .reuse_blocks = exact_reuse_blocks,
     .pattern = exact_pattern,
     .pattern_jacobian = exact_pattern_jacobian,
+    .length_scale = exact_length_scale,
     .params = exact_params,
     .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
                "model: exact\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",

@@ -259,6 +259,12 @@ typedef struct fmbBodyType {
      engine uses it instead of differencing over the pattern; NULL = differences (engine/fd.c). */
   int (*pattern_jacobian)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
                           const double* z, double* K, double* C, double* M, double* work);
+  /* Each coordinate's length scale into metres_per_unit[ncoord]: the metres a point of the body
+     moves per unit of the coordinate (1 for a displacement; the length L for a slope, a stretch
+     or an angle that swings the body). The engine divides the scene's atol by it for that
+     coordinate and its velocity (engine/integrate.c), so one atol in metres controls slopes and
+     displacements alike at any size of the body. NULL = atol as given for every coordinate. */
+  void (*length_scale)(const void* self, double* metres_per_unit);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

@@ -501,6 +501,17 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     idv[i] = i < ndiff ? 1.0 : 0.0;
     atv[i] = i < 2 * m->nq ? m->solver.atol : 1e30;
   }
+  /* a body that gives its coordinates' length scales (fmbBodyType.length_scale) gets atol in
+     metres of motion: atol / scale for a coordinate and its velocity (atv[nq + i]) */
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->type->length_scale) continue;
+    bi->type->length_scale(bi->self, atv + m->nq + bi->qadr); /* the velocity slot as scratch */
+    for (int i = bi->qadr; i < bi->qadr + bi->nq; ++i) {
+      const double scale = atv[m->nq + i] > 0.0 ? atv[m->nq + i] : 1.0;
+      atv[i] = atv[m->nq + i] = m->solver.atol / scale;
+    }
+  }
   ida = IDACreate(sun);
   ctx.ida = ida;
   if (!ida || IDAInit(ida, ctx.projected ? projected_residual_fn : residual_fn, t, yi, ypi) != IDA_SUCCESS ||
