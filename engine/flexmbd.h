@@ -24,8 +24,8 @@ extern "C" {
 /* The plugin ABI: the layout of fmbPlugin, fmbBodyType, fmbJointType, fmbParam and the signatures
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
-   the optional centreline op and the optional naux, residual_aux, aux_initial and pattern ops
-   (added to 2 before any release of it). */
+   the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
+   pattern_jacobian and length_scale ops (added to 2 before any release of it). */
 #define FMB_ABI_VERSION 2
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
