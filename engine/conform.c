@@ -556,8 +556,8 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   const char* const* own = joint ? jt->output_names : bt->output_names;
   const void* self = joint ? m->joint[m->njoint - 1].self : m->body[m->nbody - 1].self;
   int (*lookup)(const void*, const char*) = joint ? jt->output_lookup : bt->output_lookup;
-  for (; own && lookup && *own; ++own)
-    if (lookup(self, *own) >= 0) snprintf(outputs + strlen(outputs), sizeof outputs - strlen(outputs), ", probe.%s", *own);
+  for (const char* const* names = own; own && *own; ++own)
+    if (fmb_type_output_id(lookup, self, names, *own) >= 0) snprintf(outputs + strlen(outputs), sizeof outputs - strlen(outputs), ", probe.%s", *own);
   const int has_coordinates = !joint && m->body[m->nbody - 1].nq > 0;
   if (ic == 0) {
     if (joint)

@@ -186,7 +186,8 @@ typedef struct fmbBodyType {
   void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
                  double* work);
   /* named outputs beyond the frame's x, y, theta, omega, vx, vy (which the engine provides for
-     every body with ncoord >= 3): lookup returns an id >= 0 or -1; output evaluates one id. */
+     every body with ncoord >= 3): lookup returns an id >= 0 or -1 (NULL: the id is the name's
+     index in output_names); output evaluates one id. */
   const char* const* output_names; /* NULL-terminated, for listings */
   int (*output_lookup)(const void* self, const char* quantity);
   int (*output)(const void* self, int id, const double* q, const double* v, double* value, double* work);
@@ -291,7 +292,7 @@ typedef struct fmbJointType {
                     double* phi_tt);
   int (*force)(const void* self, const fmbJointEval* ev, double* Q); /* adds to Q */
   double (*energy)(const void* self, const fmbJointEval* ev);       /* spring potential */
-  const char* const* output_names;
+  const char* const* output_names; /* as for bodies: NULL output_lookup = the index in this list */
   int (*output_lookup)(const void* self, const char* quantity);
   int (*output)(const void* self, int id, const fmbJointEval* ev, double* value);
   void (*describe)(const void* self, FILE* f);

@@ -197,6 +197,10 @@ void fmb_workspace_free(fmbWorkspace* w);
 double* fmb_workspace_plugin(fmbWorkspace* w);
 /* a body declared its own sparse pattern (pattern op): dense whole-model systems are avoided */
 int fmb_model_has_sparse_body(const fmbModel* m);
+/* a type's output id for `quantity`: its output_lookup op, or without one the index in its
+   output_names (-1: none) */
+int fmb_type_output_id(int (*output_lookup)(const void*, const char*), const void* self, const char* const* names,
+                       const char* quantity);
 /* F(t, y, yp) of the stabilized index-2 (GGL) system; returns 0, >0 recoverable, <0 fatal */
 int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
                         double* F);

@@ -27,6 +27,12 @@ static int lookup(const char* const* names, const char* s) {
   return -1;
 }
 
+int fmb_type_output_id(int (*output_lookup)(const void*, const char*), const void* self, const char* const* names,
+                       const char* quantity) {
+  if (output_lookup) return output_lookup(self, quantity);
+  return names ? lookup(names, quantity) : -1;
+}
+
 static void list_names(char* buf, size_t len, const char* const* names) {
   size_t used = strlen(buf);
   for (int i = 0; names && names[i] && used + 30 < len; ++i)
@@ -71,7 +77,7 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
       o->owner = b;
       if (bi->nq >= 3 && (o->id = lookup(frame_names, qty)) >= 0) {
         o->kind = FMB_OUT_FRAME;
-      } else if (bi->type->output_lookup && (o->id = bi->type->output_lookup(bi->self, qty)) >= 0) {
+      } else if ((o->id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, qty)) >= 0) {
         o->kind = FMB_OUT_BODY;
       }
       if (bi->nq >= 3) list_names(avail, sizeof avail, frame_names);
@@ -87,7 +93,7 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
       } else if (ji->nrows > 0 && (o->id = lookup(reaction_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT_REACTION;
         m->need_multipliers = 1;
-      } else if (ji->type->output_lookup && (o->id = ji->type->output_lookup(ji->self, qty)) >= 0) {
+      } else if ((o->id = fmb_type_output_id(ji->type->output_lookup, ji->self, ji->type->output_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT;
       }
       if (has_power) list_names(avail, sizeof avail, power_names);

@@ -123,7 +123,7 @@ static const char* missing_body_op(const fmbBodyType* t) {
   if (!t->initial) return "initial";
   if (!t->residual) return "residual";
   if (!t->marker) return "marker";
-  if (t->output_lookup && !t->output) return "output (output_lookup is set)";
+  if ((t->output_lookup || t->output_names) && !t->output) return "output (output_names or output_lookup is set)";
   return NULL;
 }
 
@@ -133,7 +133,7 @@ static const char* missing_joint_op(const fmbJointType* t) {
   if (!t->bodies) return "bodies";
   if (t->nrows && !t->constraint) return "constraint (nrows is set)";
   if (!t->nrows && !t->force) return "force (a joint without nrows must be a force element)";
-  if (t->output_lookup && !t->output) return "output (output_lookup is set)";
+  if ((t->output_lookup || t->output_names) && !t->output) return "output (output_names or output_lookup is set)";
   return NULL;
 }
 

@@ -62,12 +62,6 @@ static int drive_constraint(const void* self, const fmbJointEval* ev, double* ph
 }
 
 static const char* const drive_outputs[] = {"angle", "speed", NULL};
-static int drive_lookup(const void* self, const char* q) {
-  (void)self;
-  for (int i = 0; drive_outputs[i]; ++i)
-    if (strcmp(q, drive_outputs[i]) == 0) return i;
-  return -1;
-}
 /* angle: the joint's relative angle (angle2 - angle1) as the bodies are, which on the
    constraint manifold is angle0 + f(t); speed: the prescribed relative speed f'(t) */
 static int drive_output(const void* self, int id, const fmbJointEval* ev, double* value) {
@@ -108,7 +102,6 @@ const fmbJointType fmb_joint_drive = {
     .nrows = drive_nrows,
     .constraint = drive_constraint,
     .output_names = drive_outputs,
-    .output_lookup = drive_lookup,
     .output = drive_output,
     .describe = drive_describe,
     .params = drive_params,

@@ -155,12 +155,6 @@ static double prismatic_energy(const void* self, const fmbJointEval* ev) {
 }
 
 static const char* const prismatic_outputs[] = {"displacement", "velocity", "tension", NULL};
-static int prismatic_lookup(const void* self, const char* q) {
-  (void)self;
-  for (int i = 0; prismatic_outputs[i]; ++i)
-    if (strcmp(q, prismatic_outputs[i]) == 0) return i;
-  return -1;
-}
 /* slide along the axis, its rate, and the spring-damper's tension */
 static int prismatic_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   const Prismatic* ps = self;
@@ -208,7 +202,6 @@ const fmbJointType fmb_joint_prismatic = {
     .force = prismatic_force,
     .energy = prismatic_energy,
     .output_names = prismatic_outputs,
-    .output_lookup = prismatic_lookup,
     .output = prismatic_output,
     .params = prismatic_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\nstiffness: 20\nrest_displacement: 0.1\n",

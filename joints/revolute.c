@@ -27,10 +27,6 @@ static int revolute_constraint(const void* self, const fmbJointEval* ev, double*
 }
 
 static const char* const revolute_outputs[] = {"angle", NULL};
-static int revolute_lookup(const void* self, const char* q) {
-  (void)self;
-  return strcmp(q, "angle") == 0 ? 0 : -1;
-}
 /* relative angle body2 - body1 at the pin */
 static int revolute_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   (void)id;
@@ -58,7 +54,6 @@ const fmbJointType fmb_joint_revolute = {
     .attachment = fmbj_two_point_attachment,
     .constraint = revolute_constraint,
     .output_names = revolute_outputs,
-    .output_lookup = revolute_lookup,
     .output = revolute_output,
     .params = revolute_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\n",

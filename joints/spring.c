@@ -74,12 +74,6 @@ static double spring_energy(const void* self, const fmbJointEval* ev) {
 }
 
 static const char* const spring_outputs[] = {"length", "tension", NULL};
-static int spring_lookup(const void* self, const char* q) {
-  (void)self;
-  for (int i = 0; spring_outputs[i]; ++i)
-    if (strcmp(q, spring_outputs[i]) == 0) return i;
-  return -1;
-}
 static int spring_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   const Spring* s = self;
   const int ld = fmb_eval_ncoord(ev, 0) + fmb_eval_ncoord(ev, 1);
@@ -113,7 +107,6 @@ const fmbJointType fmb_joint_spring = {
     .force = spring_force,
     .energy = spring_energy,
     .output_names = spring_outputs,
-    .output_lookup = spring_lookup,
     .output = spring_output,
     .params = spring_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0.1]\nstiffness: 50\nrest_length: 0.3\n",

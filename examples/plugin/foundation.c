@@ -133,12 +133,6 @@ static void bar_energy(const void* self, const fmbEnv* env, const double* q, con
 
 /* outputs beyond the frame's: the bed's total reaction and the bar's lowest point */
 static const char* const bar_outputs[] = {"reaction", "lowest", NULL};
-static int bar_output_lookup(const void* self, const char* name) {
-  (void)self;
-  for (int i = 0; bar_outputs[i]; ++i)
-    if (strcmp(name, bar_outputs[i]) == 0) return i;
-  return -1;
-}
 static int bar_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
   (void)work;
   const Bar* b = self;
@@ -182,7 +176,6 @@ static const fmbBodyType foundation_bar = {
     .jacobian = bar_jacobian,
     .energy = bar_energy,
     .output_names = bar_outputs,
-    .output_lookup = bar_output_lookup,
     .output = bar_output,
     .describe = bar_describe,
     .params = bar_params,
