@@ -3,23 +3,7 @@
 # Each case checks the exit code, the first stderr line (path, "error:", the reason) and that no
 # output file is left behind or an existing one is left untouched. POSIX sh + grep + sed only.
 set -u
-if [ $# -ne 3 ]; then
-  echo "usage: $0 FLEXMBD SOURCE_DIR WORK_DIR" >&2
-  exit 2
-fi
-bin=$1
-src=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work" || exit 1
-scene=$src/scenes/pendulum.yaml
-fails=0
-skips=0
-
-fail() {
-  echo "FAIL $1: $2" >&2
-  fails=$((fails + 1))
-}
+. "$(dirname "$0")/../file_test_lib.sh" "$@"
 
 # expect NAME EXIT PREFIX FRAGMENT -- ARGS...: run $wrap flexmbd ARGS; the first stderr line with
 # "error:" (or else the first line) must start with PREFIX and contain FRAGMENT
@@ -113,5 +97,4 @@ expect good-run 0 "initial conditions:" "position correction" -- run "$scene" -o
 rows=$(grep -c . "$out" 2>/dev/null || echo 0)
 [ "$rows" = 12 ] || fail good-run "$rows lines in $out, expected a header and 11 rows"
 
-echo "file errors: $fails failures, $skips skipped"
-[ "$fails" -eq 0 ]
+file_test_done "file errors"

@@ -10,24 +10,8 @@
 #   - no temporary file is left beside the output in any case.
 # POSIX sh + grep + sed + awk.
 set -u
-if [ $# -ne 3 ]; then
-  echo "usage: $0 FLEXMBD SOURCE_DIR WORK_DIR" >&2
-  exit 2
-fi
-bin=$1
-src=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work" || exit 1
-scene=$src/scenes/pendulum.yaml
+. "$(dirname "$0")/../file_test_lib.sh" "$@"
 bad_run=$src/tests/bad_scenes/56-joints-unsatisfiable.yaml # fails after the output would be opened
-fails=0
-skips=0
-
-fail() {
-  echo "FAIL $1: $2" >&2
-  fails=$((fails + 1))
-}
 
 # run NAME EXPECTED_EXIT ARGS...: stdout/stderr into $work
 run() {
@@ -184,5 +168,4 @@ else
   skips=$((skips + 1))
 fi
 
-echo "file safety: $fails failures, $skips skipped"
-[ "$fails" -eq 0 ]
+file_test_done "file safety"
