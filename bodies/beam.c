@@ -827,29 +827,13 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
 /* ---------------------------------------------------------------------------------------------
  * Outputs.
  * ------------------------------------------------------------------------------------------- */
-enum { OUT_TIP_U, OUT_TIP_V, OUT_TIP_U_RATE, OUT_TIP_V_RATE, OUT_TIP_X, OUT_TIP_Y, OUT_ANG_MOMENTUM, OUT_NTIP };
-enum { OUT_NODE_BASE = 1000, OUT_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
-
-static const char* const beam_output_names[] = {"tip_u",   "tip_v",   "tip_u_rate", "tip_v_rate", "tip_x",
-                                                "tip_y",   "ang_momentum", "nodeK_u", "nodeK_v", "nodeK_x",
-                                                "nodeK_y", NULL};
+enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
+       OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
+       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_NTIP = FMB_BEAM_NTIP };
+enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 
 static int beam_output_lookup(const void* self, const char* quantity) {
-  const Beam* b = self;
-  for (int i = 0; i < OUT_NTIP; ++i)
-    if (strcmp(quantity, beam_output_names[i]) == 0) return i;
-  if (strncmp(quantity, "node", 4) == 0) {
-    const char* s = quantity + 4;
-    char* end;
-    if (*s < '0' || *s > '9') return -1;
-    long k = strtol(s, &end, 10);
-    if (k < 0 || k > b->ne || end[0] != '_' || end[1] == '\0' || end[2] != '\0') return -1;
-    static const char comp[] = "uvxy";
-    const char* at = strchr(comp, end[1]);
-    if (!at) return -1;
-    return OUT_NODE_BASE + OUT_NODE_STRIDE * (int)k + (int)(at - comp);
-  }
-  return -1;
+  return fmb_beam_output_lookup(((const Beam*)self)->ne, quantity);
 }
 
 /* axial (with w_c in coupled models) and transverse deformation at reference (x, 0), rates */
@@ -1008,7 +992,7 @@ const fmbBodyType fmb_body_beam = {
     .nwork = beam_nwork,
     .jacobian = NULL,
     .energy = beam_energy,
-    .output_names = beam_output_names,
+    .output_names = fmb_beam_output_names,
     .output_lookup = beam_output_lookup,
     .output = beam_output,
     .describe = beam_describe,

@@ -599,22 +599,12 @@ static void exact_energy(const void* self, const fmbEnv* env, const double* q, c
 
 /* the same output names and meanings as bodies/beam.c: tip_u/tip_v = the tip's axial and
    transverse displacement in the frame (the complete model's u(L) and w2(L)) */
-enum { OUT_TIP_U, OUT_TIP_V, OUT_TIP_U_RATE, OUT_TIP_V_RATE, OUT_TIP_X, OUT_TIP_Y, OUT_ANG_MOMENTUM, OUT_NTIP };
-enum { OUT_NODE_BASE = 1000, OUT_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
-static const char* const exact_output_names[] = {"tip_u",   "tip_v",   "tip_u_rate", "tip_v_rate", "tip_x",
-                                                 "tip_y",   "ang_momentum", "nodeK_u", "nodeK_v", "nodeK_x",
-                                                 "nodeK_y", NULL};
-
+enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
+       OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
+       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_NTIP = FMB_BEAM_NTIP };
+enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 static int exact_output_lookup(const void* self, const char* quantity) {
-  const BeamExact* b = self;
-  for (int i = 0; i < OUT_NTIP; ++i)
-    if (strcmp(quantity, exact_output_names[i]) == 0) return i;
-  long k;
-  char comp, extra;
-  if (sscanf(quantity, "node%ld_%c%c", &k, &comp, &extra) == 2 && quantity[4] >= '0' && quantity[4] <= '9' && k >= 0 &&
-      k <= b->ne && strchr("uvxy", comp))
-    return OUT_NODE_BASE + OUT_NODE_STRIDE * (int)k + (int)(strchr("uvxy", comp) - "uvxy");
-  return -1;
+  return fmb_beam_output_lookup(((const BeamExact*)self)->ne, quantity);
 }
 
 static int exact_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
@@ -731,7 +721,7 @@ const fmbBodyType fmb_body_beam_exact = {
     .marker = exact_marker,
     .jacobian = exact_jacobian,
     .energy = exact_energy,
-    .output_names = exact_output_names,
+    .output_names = fmb_beam_output_names,
     .output_lookup = exact_output_lookup,
     .output = exact_output,
     .describe = exact_describe,

@@ -4,6 +4,8 @@
 #ifndef FLEXMBD_BEAM_SECTION_H
 #define FLEXMBD_BEAM_SECTION_H
 #include <math.h>
+#include <stdlib.h>
+#include <string.h>
 
 #include "flexmbd.h"
 
@@ -48,5 +50,25 @@ static inline void fmb_beam_locate(double le, int ne, double x, int* e, double* 
   if (k > ne - 1) k = ne - 1;
   *e = k;
   *xi = x / le - k;
+}
+/* The outputs every beam model gives (the same ids, so `--models` compares like with like): the
+   tip's deformation, its rates and position, the angular momentum, and nodeK_u/v/x/y at node K. */
+enum { FMB_BEAM_TIP_U, FMB_BEAM_TIP_V, FMB_BEAM_TIP_U_RATE, FMB_BEAM_TIP_V_RATE, FMB_BEAM_TIP_X, FMB_BEAM_TIP_Y,
+       FMB_BEAM_ANG_MOMENTUM, FMB_BEAM_NTIP };
+enum { FMB_BEAM_NODE_BASE = 1000, FMB_BEAM_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
+static const char* const fmb_beam_output_names[] = {"tip_u", "tip_v", "tip_u_rate", "tip_v_rate", "tip_x", "tip_y",
+                                                    "ang_momentum", "nodeK_u", "nodeK_v", "nodeK_x", "nodeK_y", NULL};
+
+/* the output id of `quantity` for a beam of ne elements, or -1 */
+static inline int fmb_beam_output_lookup(int ne, const char* quantity) {
+  for (int i = 0; i < FMB_BEAM_NTIP; ++i)
+    if (strcmp(quantity, fmb_beam_output_names[i]) == 0) return i;
+  if (strncmp(quantity, "node", 4) != 0 || quantity[4] < '0' || quantity[4] > '9') return -1;
+  char* end;
+  const long k = strtol(quantity + 4, &end, 10);
+  if (k < 0 || k > ne || end[0] != '_' || end[1] == '\0' || end[2] != '\0') return -1;
+  static const char comp[] = "uvxy";
+  const char* at = strchr(comp, end[1]);
+  return at ? FMB_BEAM_NODE_BASE + FMB_BEAM_NODE_STRIDE * (int)k + (int)(at - comp) : -1;
 }
 #endif
