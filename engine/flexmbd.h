@@ -536,6 +536,24 @@ FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* 
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
 
+/* ---------------------------------------------------------------------------------------------
+ * Writing a file without losing one (engine/safe_file.c): the content goes to a temporary file
+ * beside `path` that replaces it only on fmb_safe_close(f, 1); fmb_safe_close(f, 0) removes the
+ * temporary file and leaves `path` as it was. "-" and non-regular paths (a FIFO, /dev/null) are
+ * written straight through and never removed. The caller owns the handle until fmb_safe_close.
+ * ------------------------------------------------------------------------------------------- */
+typedef struct fmbSafeFile fmbSafeFile;
+/* NULL with the reason (e.g. strerror's) in err on failure */
+FMB_API fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen);
+FMB_API FILE* fmb_safe_stream(fmbSafeFile* f); /* a stdio stream over it (closed by fmb_safe_close) */
+FMB_API int fmb_safe_fd(const fmbSafeFile* f);
+FMB_API int fmb_safe_is_temporary(const fmbSafeFile* f);
+/* the file to write when another program writes it (gnuplot): the temporary file, or the target
+   written through; NULL for stdout */
+FMB_API const char* fmb_safe_write_path(const fmbSafeFile* f);
+/* keep != 0: put the content in place (rename); 0: discard it. 0, or -1 with errno on failure */
+FMB_API int fmb_safe_close(fmbSafeFile* f, int keep);
+
 #ifdef __cplusplus
 }
 #endif

@@ -220,27 +220,21 @@ void fmb_outputs_default(fmbModel* m) {
 
 /* ------------------------------------------------------------------------------------------ */
 
-/* The writer never deletes, replaces or truncates a file this run did not create:
- *  - a regular (or not yet existing) target is written to a temporary file beside it
- *    (".NAME.XXXXXX", same directory, so same file system) that fmb_csv_close renames onto the
- *    target once the run has written its header: a run that stops on bad input before that
- *    leaves the target as it was; one that stops later replaces it with the rows it has;
- *  - "-" (stdout) and non-regular targets (/dev/null, a FIFO, a terminal) are written straight
- *    through and never removed;
- *  - a symbolic link is followed: the file it names is the target, the link stays.
+/* The writer never deletes, replaces or truncates a file this run did not create: it writes
+ * through fmb_safe_open (engine/safe_file.c), and fmb_csv_close puts the rows in place once the
+ * run has written its header: a run that stops on bad input before that leaves the target as it
+ * was; one that stops later replaces it with the rows it has.
  * Whole rows only: a row is formatted in memory and written with one write loop; if that fails
  * (disk full) the temporary file is cut back to the last complete row. Signals only set a flag
  * (tools/cmd_run.c), so a row is never left half written by SIGINT or SIGTERM. */
 struct fmbCsv {
+  fmbSafeFile* file;
   int fd;
-  int through;       /* stdout or a non-regular target: written in place, never removed */
-  char* target;      /* the file the rows are for (symbolic links resolved) */
-  char* temp;        /* the temporary file beside it, NULL when written through */
-  off_t complete;    /* bytes of whole lines in the temporary file */
+  off_t complete; /* bytes of whole lines written */
   int wrote_header;
   double* row;
   int nrow;
-  char* line;        /* one formatted row */
+  char* line; /* one formatted row */
   size_t cap;
 };
 
@@ -262,64 +256,22 @@ static int write_line(fmbCsv* c, const char* buf, size_t len) {
     return 0;
   }
   const int err = errno;
-  if (c->temp && ftruncate(c->fd, c->complete) == 0) lseek(c->fd, c->complete, SEEK_SET);
+  if (fmb_safe_is_temporary(c->file) && ftruncate(c->fd, c->complete) == 0) lseek(c->fd, c->complete, SEEK_SET);
   errno = err;
   return -1;
 }
 
-static fmbCsv* csv_fail(fmbCsv* c, fmbDiag* diag, const char* path, const char* what) {
-  fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", what);
-  fmb_csv_close(c); /* no header written: removes the temporary file, if any */
-  return NULL;
-}
-
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
   fmbCsv* c = calloc(1, sizeof *c);
-  if (!c) return csv_fail(NULL, diag, path, "out of memory");
-  c->fd = -1;
-  if (!path || strcmp(path, "-") == 0) {
-    fflush(stdout);
-    c->fd = STDOUT_FILENO;
-    c->through = 1;
-    return c;
+  char err[700];
+  if (c) c->file = fmb_safe_open(path ? path : "-", err, sizeof err);
+  if (!c || !c->file) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s",
+                 c ? err : "out of memory");
+    free(c);
+    return NULL;
   }
-  struct stat st, lst;
-  const int exists = stat(path, &st) == 0;
-  if (!exists && lstat(path, &lst) == 0 && S_ISLNK(lst.st_mode))
-    return csv_fail(c, diag, path, "it is a symbolic link to a file that does not exist");
-  if (exists && S_ISDIR(st.st_mode)) return csv_fail(c, diag, path, strerror(EISDIR));
-  if (exists && !S_ISREG(st.st_mode)) {
-    /* a device or FIFO: write through, no truncation, never removed */
-    c->fd = open(path, O_WRONLY | O_NOCTTY | O_CLOEXEC);
-    if (c->fd < 0) return csv_fail(c, diag, path, strerror(errno));
-    c->through = 1;
-    return c;
-  }
-  if (exists && access(path, W_OK) != 0) return csv_fail(c, diag, path, strerror(errno));
-  c->target = exists ? realpath(path, NULL) : strdup(path);
-  if (!c->target) return csv_fail(c, diag, path, strerror(errno));
-  const char* slash = strrchr(c->target, '/');
-  const size_t dirlen = slash ? (size_t)(slash - c->target) + 1 : 0;
-  const char* base = slash ? slash + 1 : c->target;
-  const size_t n = dirlen + strlen(base) + 16;
-  c->temp = malloc(n);
-  if (!c->temp) return csv_fail(c, diag, path, "out of memory");
-  snprintf(c->temp, n, "%.*s.%s.XXXXXX", (int)dirlen, c->target, base);
-  c->fd = mkstemp(c->temp);
-  if (c->fd < 0) {
-    const int err = errno;
-    free(c->temp);
-    c->temp = NULL;
-    return csv_fail(c, diag, path, strerror(err));
-  }
-  /* the permissions a plain fopen(path, "w") would give: the old file's, or 0666 less umask */
-  mode_t mode = exists ? (st.st_mode & 07777) : 0666;
-  if (!exists) {
-    const mode_t mask = umask(0);
-    umask(mask);
-    mode &= ~mask;
-  }
-  if (fchmod(c->fd, mode) != 0) return csv_fail(c, diag, path, strerror(errno));
+  c->fd = fmb_safe_fd(c->file);
   return c;
 }
 
@@ -425,25 +377,12 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
   return fmb_csv_values(c, c->row);
 }
 
-/* A temporary file becomes the target if the header was written (the run got as far as its
-   first row: keep what it has), else it is removed and the target is left as it was. Returns 0,
-   or -1 with errno when the rows could not be put in place. */
+/* The rows are put in place if the header was written (the run got as far as its first row:
+   keep what it has), else the target is left as it was. Returns 0, or -1 with errno when the
+   rows could not be put in place. */
 int fmb_csv_close(fmbCsv* c) {
   if (!c) return 0;
-  int rc = 0;
-  if (c->temp) {
-    const int keep = c->wrote_header;
-    if (keep && fsync(c->fd) != 0 && errno != EINVAL) rc = -1;
-    if (close(c->fd) != 0) rc = -1;
-    if (keep && rc == 0 && rename(c->temp, c->target) != 0) rc = -1;
-    const int err = errno;
-    if (!keep || rc) unlink(c->temp);
-    errno = err;
-  } else if (c->fd > STDERR_FILENO) {
-    if (close(c->fd) != 0) rc = -1;
-  }
-  free(c->temp);
-  free(c->target);
+  const int rc = fmb_safe_close(c->file, c->wrote_header);
   free(c->line);
   free(c->row);
   free(c);

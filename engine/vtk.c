@@ -10,8 +10,10 @@
  *     to (a bar pinned at both ends is the line between its pins) and its frame's x and y axes;
  *   - a joint with constraint rows: a vertex at its first attachment point;
  *   - a force element with two attachments (a spring): the line between them.
- * The .pvd is closed after every step, so a run that stops leaves a valid collection of the steps
- * written so far, like its CSV. Numbers are printed as the CSV prints them (%.12g). */
+ * Every file goes through fmb_safe_open: written beside its target and renamed into place (each
+ * .vtu when complete, the .pvd when the run ends, also when it stops early, so a run that stops
+ * leaves a valid collection of the steps written so far, like its CSV). Numbers are printed as
+ * the CSV prints them (%.12g). */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -39,6 +41,7 @@ typedef struct {
 struct fmbVtk {
   char* dir;
   char* stem; /* the scene's file name without directory and extension */
+  fmbSafeFile* pvd_file; /* beside its target until the run closes it (engine/safe_file.c) */
   FILE* pvd;
   long step;
   int npoint, ncell;
@@ -193,7 +196,7 @@ static const char pvd_tail[] = "  </Collection>\n</VTKFile>\n";
 
 void fmb_vtk_close(fmbVtk* v) {
   if (!v) return;
-  if (v->pvd) fclose(v->pvd);
+  fmb_safe_close(v->pvd_file, 1);
   free(v->dir);
   free(v->stem);
   free(v->point);
@@ -223,9 +226,11 @@ fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag) {
   if (ext && ext != v->stem) *ext = '\0';
   char path[1200];
   snprintf(path, sizeof path, "%s/%s.pvd", dir, v->stem);
-  v->pvd = fopen(path, "w");
+  char err[300] = "";
+  v->pvd_file = fmb_safe_open(path, err, sizeof err);
+  v->pvd = fmb_safe_stream(v->pvd_file);
   if (!v->pvd) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the VTK collection: %s", strerror(errno));
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the VTK collection: %s", err[0] ? err : strerror(errno));
     fmb_vtk_close(v);
     return NULL;
   }
@@ -247,8 +252,12 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   char name[600], path[1400];
   snprintf(name, sizeof name, "%s_%06ld.vtu", v->stem, v->step);
   snprintf(path, sizeof path, "%s/%s", v->dir, name);
-  FILE* f = fopen(path, "w");
-  if (!f) return -1;
+  fmbSafeFile* sf = fmb_safe_open(path, NULL, 0);
+  FILE* f = fmb_safe_stream(sf);
+  if (!f) {
+    fmb_safe_close(sf, 0);
+    return -1;
+  }
   fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
              "  <UnstructuredGrid>\n    <FieldData>\n"
              "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.12g</DataArray>\n"
@@ -309,8 +318,8 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   for (int c = 0; c < v->ncell; ++c) fprintf(f, "%s%d", c ? " " : "", v->cell[c].type);
   array_close(f);
   fprintf(f, "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n</VTKFile>\n");
-  int bad = ferror(f);
-  if (fclose(f) != 0 || bad) return -1;
+  const int bad = ferror(f);
+  if (fmb_safe_close(sf, !bad) != 0 || bad) return -1;
   /* the new entry replaces the collection's closing tags, which follow it again */
   if (fseek(v->pvd, -(long)(sizeof pvd_tail - 1), SEEK_END) != 0) return -1;
   fprintf(v->pvd, "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"%s\"/>\n%s", t, name, pvd_tail);

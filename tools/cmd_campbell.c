@@ -42,19 +42,24 @@ static int parse_speeds(const char* text, double* out) {
 /* gnuplot: one curve per tracked mode; a failure here is a warning, the CSV stands. (Not through
    `flexmbd plot`: its CSV reader takes run outputs, whose first column is t.) */
 static void plot(const char* csv, const char* png, int count, const char* title) {
-  FILE* g = popen("gnuplot 2>/dev/null", "w");
+  /* gnuplot writes beside the figure; the figure is replaced only by a finished plot */
+  fmbSafeFile* fig = fmb_safe_open(png, NULL, 0);
+  const char* fig_path = fmb_safe_write_path(fig);
+  FILE* g = fig_path ? popen("gnuplot 2>/dev/null", "w") : NULL;
   if (!g) {
-    fprintf(stderr, "flexmbd campbell: gnuplot not available, no plot\n");
+    fprintf(stderr, "flexmbd campbell: %s, no plot\n", fig_path ? "gnuplot not available" : "cannot write the figure");
+    fmb_safe_close(fig, 0);
     return;
   }
   fprintf(g, "set terminal pngcairo size 900,650 noenhanced\nset output '%s'\nset datafile separator ','\n"
              "set key outside right\nset grid\nset xlabel 'hub speed (rad/s)'\nset ylabel 'frequency (rad/s)'\n"
              "set title '%s'\nplot ",
-          png, title);
+          fig_path, title);
   for (int k = 0; k < count; ++k)
     fprintf(g, "%s'%s' using 1:%d with linespoints pt 7 ps 0.5 title 'mode %d'", k ? ", " : "", csv, k + 2, k + 1);
   fprintf(g, ", x with lines dt 2 lc rgb 'gray' title '1x speed'\n");
-  if (pclose(g) != 0) fprintf(stderr, "flexmbd campbell: gnuplot failed, no plot (%s)\n", png);
+  const int ok = pclose(g) == 0;
+  if (fmb_safe_close(fig, ok) != 0 || !ok) fprintf(stderr, "flexmbd campbell: gnuplot failed, no plot (%s)\n", png);
 }
 
 int fmb_cmd_campbell(int argc, char** argv) {

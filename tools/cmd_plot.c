@@ -177,6 +177,18 @@ int fmb_cmd_plot(int argc, char** argv) {
     rc = FMB_EXIT_BAD_INPUT;
   }
   FILE* g = NULL;
+  /* gnuplot writes a temporary file beside the figure, which replaces it only if gnuplot made one */
+  fmbSafeFile* fig = NULL;
+  const char* fig_path = NULL;
+  if (!rc) {
+    char ferr[300] = "";
+    fig = fmb_safe_open(a.out, ferr, sizeof ferr);
+    fig_path = fmb_safe_write_path(fig);
+    if (!fig_path) {
+      fprintf(stderr, "flexmbd plot: cannot write '%s': %s\n", a.out, ferr[0] ? ferr : "not a file");
+      rc = FMB_EXIT_BAD_INPUT;
+    }
+  }
   if (!rc) {
     /* gnuplot reads the script from its stdin; its own messages go to our stderr */
     g = popen("gnuplot", "w");
@@ -186,9 +198,8 @@ int fmb_cmd_plot(int argc, char** argv) {
     }
   }
   if (!rc) {
-    remove(a.out); /* success is judged by the file gnuplot leaves */
     fprintf(g, "set terminal %s\nset output ", term);
-    quoted(g, a.out);
+    quoted(g, fig_path);
     fprintf(g, "\nset termoption noenhanced\nset datafile separator \",\"\nset key top right\nset grid\n");
     fprintf(g, "set xlabel ");
     quoted(g, a.xlabel ? a.xlabel : xcol);
@@ -232,13 +243,17 @@ int fmb_cmd_plot(int argc, char** argv) {
     fprintf(g, "\n");
     int status = pclose(g);
     struct stat st;
-    if (status != 0 || stat(a.out, &st) != 0 || st.st_size == 0) {
+    /* success is judged by the file gnuplot leaves */
+    const int made = status == 0 && stat(fig_path, &st) == 0 && st.st_size > 0;
+    if (fmb_safe_close(fig, made) != 0 || !made) {
       fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out, status);
       rc = FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(stderr, "flexmbd plot: wrote %s\n", a.out);
     }
+    fig = NULL;
   }
+  fmb_safe_close(fig, 0);
   for (int i = 0; i < loaded; ++i) fmb_table_free(&table[i]);
   return rc;
 }

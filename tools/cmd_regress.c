@@ -681,17 +681,16 @@ static int bless_job(Job* job, const Options* o) {
     free(text);
     return 0;
   }
-  /* write beside it and rename into place: never a half-written reference */
-  char tmp[700];
-  snprintf(tmp, sizeof tmp, "%s.tmp%ld", job->ref_path, (long)getpid());
-  FILE* f = fopen(tmp, "w");
-  int ok = f && fwrite(text, 1, n, f) == n;
-  if (f && fclose(f) != 0) ok = 0;
-  if (ok && rename(tmp, job->ref_path) != 0) ok = 0;
+  /* beside it and renamed into place: never a half-written reference */
+  char werr[300] = "";
+  fmbSafeFile* sf = fmb_safe_open(job->ref_path, werr, sizeof werr);
+  FILE* f = fmb_safe_stream(sf);
+  const int wrote = f && fwrite(text, 1, n, f) == n;
+  if (sf && !werr[0] && !wrote) snprintf(werr, sizeof werr, "%s", strerror(errno));
+  if (fmb_safe_close(sf, wrote) != 0 && !werr[0]) snprintf(werr, sizeof werr, "%s", strerror(errno));
   free(text);
-  if (!ok) {
-    remove(tmp);
-    say(job->why, sizeof job->why, "cannot write %s: %s", job->ref_path, strerror(errno));
+  if (!wrote || werr[0]) {
+    say(job->why, sizeof job->why, "cannot write %s: %s", job->ref_path, werr[0] ? werr : "write failed");
     job->bad_input = 1;
     return -1;
   }
@@ -717,9 +716,12 @@ static void xml_escaped(FILE* f, const char* s) {
 }
 
 static int write_junit(const char* path, Job* const* jobs, int n) {
-  FILE* f = fopen(path, "w");
+  char err[300] = "";
+  fmbSafeFile* sf = fmb_safe_open(path, err, sizeof err);
+  FILE* f = fmb_safe_stream(sf);
   if (!f) {
-    fprintf(stderr, "flexmbd regress: cannot write %s: %s\n", path, strerror(errno));
+    fprintf(stderr, "flexmbd regress: cannot write %s: %s\n", path, err[0] ? err : strerror(errno));
+    fmb_safe_close(sf, 0);
     return -1;
   }
   int nfail = 0, nerr = 0;
@@ -753,7 +755,11 @@ static int write_junit(const char* path, Job* const* jobs, int n) {
     fprintf(f, "</%s>\n  </testcase>\n", j->bad_input ? "error" : "failure");
   }
   fprintf(f, "</testsuite>\n</testsuites>\n");
-  return fclose(f) == 0 ? 0 : -1;
+  if (fmb_safe_close(sf, 1) != 0) {
+    fprintf(stderr, "flexmbd regress: cannot write %s: %s\n", path, strerror(errno));
+    return -1;
+  }
+  return 0;
 }
 
 static void print_table(Job* const* jobs, int n, const Options* o) {

@@ -3,9 +3,11 @@
  * side in one CSV as `beam.tip_v@complete`, ..., and one stats line per model
  * (`stats: model=M status=...`). A model whose run stops (ZOAC diverging, FOAC losing its mass's
  * definiteness) keeps its rows; later rows of its columns are `nan`, and the exit code is 3. */
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "csv_table.h"
@@ -98,9 +100,17 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
   fmbTable table[MAX_MODELS];
   memset(table, 0, sizeof table);
   int rc = 0, loaded = 0;
+  /* each model's own CSV, in a folder of this run's (nothing of the user's is touched) */
+  char partdir[600];
+  const char* tmp = getenv("TMPDIR");
+  snprintf(partdir, sizeof partdir, "%s/flexmbd-models-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+  if (!mkdtemp(partdir)) {
+    fprintf(stderr, "flexmbd run: cannot make a temporary folder %s: %s\n", partdir, strerror(errno));
+    return FMB_EXIT_BAD_INPUT;
+  }
   for (int k = 0; k < nmodel; ++k) {
     char part[1024];
-    if (snprintf(part, sizeof part, "%s.%s.part", out, model[k]) >= (int)sizeof part) {
+    if (snprintf(part, sizeof part, "%s/%s.csv", partdir, model[k]) >= (int)sizeof part) {
       fprintf(stderr, "flexmbd run: output path too long\n");
       rc = FMB_EXIT_BAD_INPUT;
       break;
@@ -138,9 +148,12 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     int longest = 0;
     for (int k = 0; k < nmodel; ++k)
       if (table[k].nrow > nrow) nrow = table[k].nrow, longest = k;
-    FILE* f = fopen(out, "w");
+    char err[300] = "";
+    fmbSafeFile* sf = fmb_safe_open(out, err, sizeof err); /* beside it, renamed into place */
+    FILE* f = fmb_safe_stream(sf);
     if (!f) {
-      fprintf(stderr, "flexmbd run: cannot write %s\n", out);
+      fprintf(stderr, "flexmbd run: cannot write %s: %s\n", out, err[0] ? err : "no stream");
+      fmb_safe_close(sf, 0);
       rc = FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(f, "t");
@@ -158,9 +171,13 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
           }
         fprintf(f, "\n");
       }
-      if (fclose(f)) rc = FMB_EXIT_BAD_INPUT;
+      if (fmb_safe_close(sf, 1)) {
+        fprintf(stderr, "flexmbd run: cannot write %s: %s\n", out, strerror(errno));
+        rc = FMB_EXIT_BAD_INPUT;
+      }
     }
   }
   for (int k = 0; k < nmodel; ++k) fmb_table_free(&table[k]);
+  rmdir(partdir);
   return rc;
 }

@@ -39,6 +39,12 @@ rc=$?
 [ $rc -eq 2 ] || { echo "FAIL: unknown column: exit $rc, expected 2"; fail=1; }
 grep -q "no CSV has a column 'beam.no_such'" bad.err || { echo "FAIL: unknown column message: $(cat bad.err)"; fail=1; }
 [ ! -e bad.png ] || { echo "FAIL: a figure was written for an unknown column"; fail=1; }
+# a plot gnuplot cannot draw (an empty y range) leaves an existing figure as it was, and no temporary file
+cp complete.png keep.png
+$flexmbd plot complete.csv beam.tip_v --yrange 1:1 -o keep.png 2>keep.err
+[ $? -eq 2 ] || { echo "FAIL: an undrawable plot: exit not 2"; fail=1; }
+cmp -s complete.png keep.png || { echo "FAIL: a failed plot changed the existing figure"; fail=1; }
+[ -z "$(ls -a | grep '^\.keep\.png\.')" ] || { echo "FAIL: a temporary figure was left behind"; fail=1; }
 $flexmbd plot complete.csv -o fig.jpg 2>/dev/null
 [ $? -eq 2 ] || { echo "FAIL: .jpg accepted"; fail=1; }
 [ $fail -eq 0 ] && echo "ok: PNG of one CSV ($(wc -c < complete.png) bytes), SVG overlay of 3 CSVs, log-scale PDF, bad column refused"
