@@ -71,6 +71,12 @@ static void load_and_run_misuse(const char* scene, const char* csv) {
   fmb_frame_point((const double[3]){1, 2, 0}, (const double[2]){0.5, 0}, pos, NULL, NULL, NULL);
   ENSURE(pos[0] == 1.5 && pos[1] == 2.0);
   ENSURE(fmb_model_solver(NULL, NULL) == -1);
+  /* the safe-file writer: NULL handles answer neutrally; a folder as the target is refused with why */
+  char why[200] = "";
+  ENSURE(fmb_safe_open(NULL, why, sizeof why) == NULL && why[0]);
+  ENSURE(fmb_safe_open("/tmp", why, sizeof why) == NULL && strstr(why, "directory"));
+  ENSURE(fmb_safe_stream(NULL) == NULL && fmb_safe_fd(NULL) == -1 && fmb_safe_write_path(NULL) == NULL);
+  ENSURE(!fmb_safe_is_temporary(NULL) && fmb_safe_close(NULL, 1) == 0);
 
   /* fmb_run: no model; stats and diag optional */
   fmbStats st;
