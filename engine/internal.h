@@ -259,7 +259,7 @@ struct _generic_SUNLinearSolver;
 struct _SUNContext;
 struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
 
-/* ---- integrate.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
+/* ---- integrator_ida.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
 struct _generic_SUNMatrix;
 void fmb_sparse_pattern_into(const fmbModel* m, struct _generic_SUNMatrix* J);
 

@@ -1,0 +1,56 @@
+/* integrator.h — integrators behind an ops table, as body and joint types are (docs/style.md).
+ * The run driver (integrate.c) owns what every run does: initial conditions, the CSV and VTK rows,
+ * the checks at each row (mass definiteness, a body's own validity, redundant rows), progress,
+ * interrupts and the failure message's frame. A backend owns how the state advances from one
+ * output time to the next and what it needs for that (its own vectors, matrices, solver).
+ *
+ * Built-in backends (integrator_*.c), chosen by fmb_integrator_for():
+ *   ida        IDA (BDF, variable order and step) on the GGL index-2 system of system.c, KLU
+ *   projected  the index-1 form with minimum-norm multipliers and projections onto the
+ *              constraints (solver.formulation: projected; passes singular configurations) */
+#ifndef FMB_INTEGRATOR_H
+#define FMB_INTEGRATOR_H
+
+#include <signal.h>
+#include <stddef.h>
+
+#include "internal.h"
+
+typedef struct {
+  const fmbModel* m;
+  fmbWorkspace* w;
+  const volatile sig_atomic_t* stop; /* may be NULL; non-zero: end after the step in progress */
+  const double* atol;                /* ny absolute tolerances, one per unknown (integrate.c) */
+} fmbIntegratorSetup;
+
+/* fmbIntegratorOps.advance's results */
+enum { FMB_ADVANCE_OK = 0, FMB_ADVANCE_FAILED = -1, FMB_ADVANCE_INTERRUPTED = -2 };
+
+typedef struct fmbIntegratorOps {
+  const char* name;
+  /* Set up from the consistent initial state y, yp (all ny unknowns: q, v, multipliers, a body's
+     auxiliary unknowns) at t0. NULL with *diag set on failure. When m->need_work, the joints'
+     powers (fmb_joint_power) are integrated from t0 into m->njoint work integrals. */
+  void* (*create)(const fmbIntegratorSetup* s, double t0, const double* y, const double* yp, fmbDiag* diag);
+  /* Advance to tout. On return *t_reached is where the state is and y, yp hold it (all ny
+     unknowns, the multipliers consistent with it: the outputs read them), also after a failure
+     (the last good state). FMB_ADVANCE_FAILED fills why (what stopped, what to try), and *h the
+     last step size tried. */
+  int (*advance)(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why, size_t why_len);
+  /* the work integrals at the last t_reached (called only when m->need_work) */
+  void (*work)(void* self, double* work);
+  /* counters so far (steps, residuals, jacobians, newton_iters, error_test_fails, conv_fails,
+     jacobians_reused); the driver fills the rest of fmbStats */
+  void (*stats)(const void* self, fmbStats* st);
+  /* optional: after each output row at t (e.g. a warning when the step rate explodes) */
+  void (*after_row)(void* self, double t);
+  void (*destroy)(void* self);
+} fmbIntegratorOps;
+
+extern const fmbIntegratorOps fmb_integrator_ida;
+extern const fmbIntegratorOps fmb_integrator_projected;
+
+/* the backend the model's solver settings ask for */
+const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m);
+
+#endif
