@@ -43,6 +43,8 @@ typedef struct {
   long fresh_steps, fresh_conv_fails; /* IDA's counters at the last fresh Jacobian */
   long fresh, reused;
   StepWatch watch;
+  int fell_back;       /* the reduced Newton solve failed once: KLU on the whole matrix since */
+  fmbStats before_reinit; /* IDA's counters up to the fallback's IDAReInit (which zeroes them) */
 } IdaRun;
 
 static int stop_requested(const IdaRun* c) { return c->stop && *c->stop; }
@@ -81,7 +83,7 @@ static int power_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector P, void* ud
   return 0;
 }
 
-static void ida_counters(void* ida, fmbStats* acc) {
+static void add_counters(void* ida, fmbStats* acc) {
   long v;
   if (IDAGetNumSteps(ida, &v) == IDA_SUCCESS) acc->steps += v;
   if (IDAGetNumResEvals(ida, &v) == IDA_SUCCESS) acc->residuals += v;
@@ -313,12 +315,45 @@ oom:
   return NULL;
 }
 
+/* The default solver (schur.c) is a modified Newton iteration: it drops the O(|mu|) part of the
+   position rows. If IDA gives up while using it, the cause may be that approximation rather than
+   the model, so the interval is retried once from the last good step with KLU on the whole matrix
+   (solver.linear_solver: klu_full), and the run says so; a failure after that is the model's and
+   is reported as such. Regular runs never come here: their steps are unchanged. */
+static int reduced_solve_failed(const IdaRun* c, int flag) {
+  return c->m->solver.linear_solver == FMB_LS_KLU && !c->fell_back &&
+         (flag == IDA_CONV_FAIL || flag == IDA_LSETUP_FAIL || flag == IDA_LSOLVE_FAIL || flag == IDA_ERR_FAIL);
+}
+
+static void add_counters(void* ida, fmbStats* acc);
+
+static int fall_back_to_full(IdaRun* c, double t_good, double tout, double* tret) {
+  c->fell_back = 1;
+  SUNLinearSolver full = SUNLinSol_KLU(c->y, c->A, c->sun);
+  double tq = t_good;
+  if (c->work) IDAGetQuad(c->ida, &tq, c->work);
+  add_counters(c->ida, &c->before_reinit);
+  if (!full || IDASetLinearSolver(c->ida, full, c->A) != IDA_SUCCESS || IDASetJacFn(c->ida, jacobian_fn) != IDA_SUCCESS ||
+      IDAReInit(c->ida, t_good, c->y, c->yp) != IDA_SUCCESS || (c->work && IDAQuadReInit(c->ida, c->work) != IDA_SUCCESS)) {
+    if (full) SUNLinSolFree(full);
+    return IDA_LINIT_FAIL;
+  }
+  SUNLinSolFree(c->LS);
+  c->LS = full;
+  c->fresh = 0; /* the next Jacobian recomputes the bodies' blocks */
+  fprintf(stderr, "note: t = %.6g: IDA failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+          "from the last good step with klu_full (the whole matrix)\n", t_good);
+  *tret = t_good;
+  return IDASolve(c->ida, tout, tret, c->y, c->yp, IDA_NORMAL);
+}
+
 static int ida_advance(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
                        size_t why_len) {
   IdaRun* c = self;
   const fmbModel* m = c->m;
   double tret = *t_reached;
-  const int flag = IDASolve(c->ida, tout, &tret, c->y, c->yp, IDA_NORMAL);
+  int flag = IDASolve(c->ida, tout, &tret, c->y, c->yp, IDA_NORMAL);
+  if (flag < 0 && !stop_requested(c) && reduced_solve_failed(c, flag)) flag = fall_back_to_full(c, tret, tout, &tret);
   *t_reached = tret;
   memcpy(y, N_VGetArrayPointer(c->y), sizeof(double) * (size_t)m->ny);
   memcpy(yp, N_VGetArrayPointer(c->yp), sizeof(double) * (size_t)m->ny);
@@ -350,9 +385,8 @@ static void ida_work(void* self, double* work) {
 
 static void ida_stats(const void* self, fmbStats* st) {
   const IdaRun* c = self;
-  fmbStats acc;
-  memset(&acc, 0, sizeof acc);
-  ida_counters(c->ida, &acc);
+  fmbStats acc = c->before_reinit; /* zero unless the run fell back to klu_full */
+  add_counters(c->ida, &acc);
   st->steps = acc.steps;
   st->residuals = acc.residuals;
   st->jacobians = acc.jacobians;

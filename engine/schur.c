@@ -46,6 +46,7 @@ typedef struct {
   klu_l_symbolic* symbolic;
   klu_l_numeric* numeric;
   long last_flag;
+  long setups, fail_from; /* fault injection for tests: setups from fail_from on fail (0: never) */
 } Schur;
 
 #define SCHUR(S) ((Schur*)(S)->content)
@@ -70,6 +71,7 @@ static int schur_initialize(SUNLinearSolver S) {
 /* S = J_RR - J_Rq D^-1 J_qR, column by column through a dense scratch column */
 static int schur_setup(SUNLinearSolver S, SUNMatrix A) {
   Schur* s = SCHUR(S);
+  if (s->fail_from && ++s->setups >= s->fail_from) return s->last_flag = SUNLS_PACKAGE_FAIL_UNREC;
   const fmbModel* m = s->m;
   const int nq = s->nq;
   const double* J = SUNSparseMatrix_Data(A);
@@ -307,6 +309,10 @@ SUNLinearSolver fmb_schur_klu_new(const fmbModel* m, SUNContext sun) {
   if (!S || !s) goto fail;
   s->m = m;
   s->nq = m->nq;
+  /* FMB_TEST_FAIL_REDUCED_SETUP=N makes the N-th and later setups fail: how the tests reach the
+     fallback to klu_full (integrator_ida.c), which no shipped scene needs */
+  const char* fault = getenv("FMB_TEST_FAIL_REDUCED_SETUP");
+  s->fail_from = fault ? strtol(fault, NULL, 10) : 0;
   s->nr = m->ny - m->nq;
   s->first_kept = malloc(sizeof(long) * (size_t)m->ny);
   s->diag_pos = malloc(sizeof(long) * (size_t)(m->nq + 1));

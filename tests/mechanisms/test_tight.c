@@ -2,7 +2,13 @@
  * 1e-12 on rigid mechanisms, against closed forms and against klu_full (the whole matrix):
  *  - the driven four-bar: rocker angle vs the circle-intersection solution;
  *  - a stiff slider: the 2 kg block on a 1e6 N/m spring along the slider axis (707 rad/s), vs
- *    s(t) = s_eq + (s0 - s_eq) cos(w t). */
+ *    s(t) = s_eq + (s0 - s_eq) cos(w t);
+ *  - the fallback: with the reduced solve made to fail (FMB_TEST_FAIL_REDUCED_SETUP, schur.c) the
+ *    four-bar at 1e-12 continues with klu_full from the last good step and still matches the
+ *    closed form (integrator_ida.c). */
+#define _POSIX_C_SOURCE 200809L
+#include <stdlib.h>
+
 #include "testlib.h"
 
 static double rocker_closed_form(double th2) {
@@ -46,6 +52,11 @@ static double stiff_slider(const char* solver) {
 }
 
 int main(void) {
+  setenv("FMB_TEST_FAIL_REDUCED_SETUP", "20", 1);
+  const double fallback = fourbar("klu");
+  unsetenv("FMB_TEST_FAIL_REDUCED_SETUP");
+  printf("four-bar with the reduced solve failing from its 20th setup on: rocker error %.2e rad\n", fallback);
+  ENSURE(fallback < 1e-10);
   const double f = fourbar("klu"), ff = fourbar("klu_full"), s = stiff_slider("klu"), sf = stiff_slider("klu_full");
   printf("rtol = atol = 1e-12: four-bar rocker error %.2e rad (klu), %.2e (klu_full); stiff slider error %.2e m (klu), "
          "%.2e (klu_full)\n", f, ff, s, sf);
