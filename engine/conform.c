@@ -5,6 +5,8 @@
  *             exit 2 at the key's own line, naming the key; the keys parse reads are declared
  *   jacobian  the analytic K, C, M (when the type has a jacobian op) against central
  *             differences of its residual
+ *   pattern   the sparse analytic Jacobian (pattern_jacobian) against central differences of
+ *             [R; Rz] over every entry, and the declared pattern holding every nonzero
  *   mass      M = dR/da symmetric and positive definite (Cholesky)
  *   marker    position and angle derivatives against central differences
  *   gravity   with has_gravity = 0 the residual and energy do not read env->gravity (it is NaN
@@ -64,7 +66,7 @@ static void lines_parse(Lines* l, const char* text) {
   while (text && *text && l->n < MAX_LINES) {
     const char* e = strchr(text, '\n');
     const int len = e ? (int)(e - text) : (int)strlen(text);
-    if (len > 0) snprintf(l->line[l->n++], sizeof l->line[0], "%.*s", len, text);
+    if (len > 0) snprintf(l->line[l->n++], sizeof l->line[0], "%.*s", len < 255 ? len : 255, text);
     text = e ? e + 1 : text + len;
   }
 }
@@ -85,7 +87,7 @@ static int lines_set(Lines* l, const char* key, const char* value) {
     if (l->n == MAX_LINES) return -1;
     i = l->n++;
   }
-  snprintf(l->line[i], sizeof l->line[0], "%s: %s", key, value);
+  snprintf(l->line[i], sizeof l->line[0], "%.120s: %.120s", key, value);
   return i;
 }
 
@@ -294,7 +296,11 @@ static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b,
   memcpy(Kd, Muse, (size_t)n * n * sizeof(double));
   const int chol = fmb_cholesky(n, Kd);
   result(r, asym <= 1e-9 * mmax, "mass", "M symmetric: max |M - M^T| / max |M| = %.2g", asym / mmax);
-  result(r, chol == 0, "mass", "M positive definite (Cholesky %s)", chol ? "breaks down" : "succeeds");
+  if (chol && t->indefinite_mass && t->indefinite_mass(bi->self))
+    result(r, SKIP, "mass", "M not positive definite at this perturbed state, as the type declares it can be: %s",
+           t->indefinite_mass(bi->self));
+  else
+    result(r, chol == 0, "mass", "M positive definite (Cholesky %s)", chol ? "breaks down" : "succeeds");
   /* marker: derivatives against differences, at two material points */
   static const double locals[2][2] = {{0.0, 0.0}, {0.3, 0.05}};
   double worst = 0.0;
@@ -327,6 +333,106 @@ static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b,
   result(r, finite, "gravity", "with has_gravity = 0 the residual and energy leave gravity out%s",
          finite ? "" : " (they read env->gravity or report a gravity energy)");
   free(buf);
+}
+
+/* The sparse Jacobian (fmbBodyType.pattern_jacobian) summed into dense blocks over [R; Rz] x
+   [q; z] (K), v (C), a (M), against central differences of residual_aux (or residual); every
+   difference outside the declared pattern must vanish (a missing pair would silently drop a
+   coupling from the Newton matrix). */
+static void check_pattern_jacobian(Report* r, const fmbModel* m, fmbWorkspace* w, int b, const double* y) {
+  const fmbBodyInst* bi = &m->body[b];
+  const fmbBodyType* t = bi->type;
+  if (!t->pattern_jacobian || !t->pattern) {
+    result(r, SKIP, "pattern", "no pattern_jacobian op");
+    return;
+  }
+  const long np = t->pattern(bi->self, NULL, NULL);
+  if (np < 0) { /* one dense block: the engine uses the jacobian op (checked above) */
+    result(r, SKIP, "pattern", "dense block at this size: the jacobian op serves it");
+    return;
+  }
+  const int n = bi->nq, nz = t->naux ? t->naux(bi->self) : 0, N = n + nz;
+  double* work = fmb_workspace_plugin(w) + bi->workadr;
+  const size_t NN = (size_t)N * N, Nn = (size_t)N * n;
+  double* buf = calloc(3 * (size_t)n + (size_t)nz + 3 * (size_t)N + 2 * (NN + 2 * Nn) + 3 * (size_t)np + 8, sizeof(double));
+  int* pr = calloc(2 * (size_t)np + 2, sizeof(int));
+  if (!buf || !pr) {
+    result(r, 0, "pattern", "out of memory");
+    free(buf);
+    free(pr);
+    return;
+  }
+  int* pc = pr + np + 1;
+  double *q = buf, *v = q + n, *a = v + n, *z = a + n, *F1 = z + nz, *Fm = F1 + N, *F0 = Fm + N;
+  double *Ka = F0 + N, *Ca = Ka + NN, *Ma = Ca + Nn, *Kd = Ma + Nn, *Cd = Kd + NN, *Md = Cd + Nn;
+  double *Kp = Md + Nn, *Cp = Kp + np, *Mp = Cp + np;
+  unsigned seed = 23;
+  for (int i = 0; i < n; ++i) {
+    q[i] = y[bi->qadr + i] + 1e-2 * urand(&seed);
+    v[i] = y[m->nq + bi->qadr + i] + 0.5 * urand(&seed);
+    a[i] = 0.5 * urand(&seed);
+  }
+  int rc = 0;
+  if (nz) rc |= t->aux_initial ? t->aux_initial(bi->self, &m->env, q, v, a, z, work) : 1;
+  for (int i = 0; i < nz; ++i) z[i] *= 1.0 + 0.01 * urand(&seed); /* off the consistent z: Rz != 0 */
+  t->pattern(bi->self, pr, pc);
+  rc |= t->pattern_jacobian(bi->self, &m->env, q, v, a, nz ? z : NULL, Kp, Cp, Mp, work);
+  for (long k = 0; k < np; ++k) {
+    if (pr[k] < 0 || pr[k] >= N || pc[k] < 0 || pc[k] >= N) {
+      result(r, 0, "pattern", "pair %ld = (%d, %d) outside the %d x %d block", k, pr[k], pc[k], N, N);
+      free(buf);
+      free(pr);
+      return;
+    }
+    Ka[(size_t)pc[k] * N + pr[k]] += Kp[k];
+    if (pc[k] < n) {
+      Ca[(size_t)pc[k] * N + pr[k]] += Cp[k];
+      Ma[(size_t)pc[k] * N + pr[k]] += Mp[k];
+    }
+  }
+  /* [R; Rz] at (q, v, a, z) */
+#define EVAL(F) (nz ? t->residual_aux(bi->self, &m->env, q, v, a, z, F, F + n, work) : t->residual(bi->self, &m->env, q, v, a, F, work))
+  double* xs[4] = {q, v, a, z};
+  for (int k = 0; k < 4; ++k) {
+    const int len = k == 3 ? nz : n;
+    for (int j = 0; j < len; ++j) {
+      const double x0 = xs[k][j], h = k == 2 ? 1.0 : 1e-6 * (1.0 + fabs(x0));
+      xs[k][j] = x0 + h;
+      rc |= EVAL(F1);
+      xs[k][j] = x0 - h;
+      rc |= EVAL(Fm);
+      xs[k][j] = x0;
+      double* col = k == 0 ? Kd + (size_t)j * N : k == 1 ? Cd + (size_t)j * N : k == 2 ? Md + (size_t)j * N : Kd + (size_t)(n + j) * N;
+      for (int i = 0; i < N; ++i) col[i] = (F1[i] - Fm[i]) / (2 * h);
+    }
+  }
+#undef EVAL
+  if (rc) {
+    result(r, 0, "pattern", "the residual or pattern_jacobian failed at the example's state");
+    free(buf);
+    free(pr);
+    return;
+  }
+  const double eK = rel_err(Ka, Kd, (int)NN, 1e-12), eC = rel_err(Ca, Cd, (int)Nn, 1e-12), eM = rel_err(Ma, Md, (int)Nn, 1e-12);
+  /* differences outside the pattern: mark the declared entries, then look at the rest */
+  double scale = 1e-300, outside = 0.0;
+  for (size_t i = 0; i < NN; ++i) scale = fmax(scale, fabs(Kd[i]));
+  for (size_t i = 0; i < Nn; ++i) scale = fmax(scale, fmax(fabs(Cd[i]), fabs(Md[i])));
+  memset(Ka, 0, NN * sizeof(double));
+  for (long k = 0; k < np; ++k) Ka[(size_t)pc[k] * N + pr[k]] = 1.0;
+  for (int c = 0; c < N; ++c)
+    for (int i = 0; i < N; ++i) {
+      if (Ka[(size_t)c * N + i] != 0.0) continue;
+      outside = fmax(outside, fabs(Kd[(size_t)c * N + i]));
+      if (c < n) outside = fmax(outside, fmax(fabs(Cd[(size_t)c * N + i]), fabs(Md[(size_t)c * N + i])));
+    }
+  result(r, eK < FD_TOL && eC < FD_TOL && eM < FD_TOL, "pattern",
+         "pattern_jacobian vs central differences over %d rows and columns (%ld pairs): K %.2g, C %.2g, M %.2g "
+         "(tolerance %g)", N, np, eK, eC, eM, FD_TOL);
+  result(r, outside < FD_TOL * scale, "pattern", "largest difference outside the declared pattern: %.2g of the largest entry",
+         outside / scale);
+  free(buf);
+  free(pr);
 }
 
 /* ---- joints: constraint rows and forces against differences -------------------------------- */
@@ -516,14 +622,21 @@ static void check_energy(Report* r, const char* base, const char* type, const Li
 
 int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, FILE* report) {
   if (!reg || !type_name || !work_dir || !report) return -1;
+  /* "TYPE:key=value,key=value" checks the example with those keys set (a variant such as
+     beam:model=exact, or a setting such as beam:assembly=banded) */
+  char name[128], label[300];
+  snprintf(label, sizeof label, "%s", type_name);
+  snprintf(name, sizeof name, "%.*s", (int)strcspn(type_name, ":"), type_name);
+  const char* extra = strchr(type_name, ':');
   const fmbBodyType* bt = NULL;
   const fmbJointType* jt = NULL;
   for (int i = 0; i < reg->nbodies && !bt; ++i)
-    if (strcmp(reg->bodies[i]->name, type_name) == 0) bt = reg->bodies[i];
+    if (strcmp(reg->bodies[i]->name, name) == 0) bt = reg->bodies[i];
   for (int i = 0; i < reg->njoints && !bt && !jt; ++i)
-    if (strcmp(reg->joints[i]->name, type_name) == 0) jt = reg->joints[i];
+    if (strcmp(reg->joints[i]->name, name) == 0) jt = reg->joints[i];
   if (!bt && !jt) return -1;
-  Report r = {report, type_name, 0};
+  type_name = name;
+  Report r = {report, label, 0};
   const int joint = jt != NULL;
   const char* example = joint ? jt->example : bt->example;
   if (!example) {
@@ -532,11 +645,28 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   }
   char base[1024], scene[1100];
   snprintf(base, sizeof base, "%s/conform-%s", work_dir, type_name);
-  snprintf(scene, sizeof scene, "%s.yaml", base);
   Lines ex;
   lines_parse(&ex, example);
+  for (const char* e = extra; e && *e;) { /* the "key=value" list after ':' */
+    ++e;
+    const size_t len = strcspn(e, ",");
+    char kv[256];
+    snprintf(kv, sizeof kv, "%.*s", (int)len, e);
+    char* eq = strchr(kv, '=');
+    if (!eq || eq == kv) {
+      result(&r, 0, "example", "'%s': expected TYPE:key=value[,key=value]", label);
+      return r.failed;
+    }
+    *eq = '\0';
+    lines_set(&ex, kv, eq + 1);
+    snprintf(base + strlen(base), sizeof base - strlen(base), "-%s-%s", kv, eq + 1);
+    e += len;
+  }
+  snprintf(scene, sizeof scene, "%s.yaml", base);
   SceneSpec s = {joint, -9.81, NULL};
-  check_params(&r, scene, type_name, joint ? jt->params : bt->params, &ex, &s, reg);
+  /* the declared parameters are the registered table's: a variant's own keys are checked by
+     the plain type's run */
+  if (!extra) check_params(&r, scene, type_name, joint ? jt->params : bt->params, &ex, &s, reg);
 
   fmbDiag d;
   fmbModel* m = scene_load(scene, type_name, &ex, &s, reg, &d, NULL);
@@ -544,6 +674,8 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
     result(&r, 0, "example", "the example does not load: %s:%d:%d: %s", d.file, d.line, d.col, d.msg);
     return r.failed;
   }
+  /* a variant (beam:model=exact) is its own ops table: check that one's outputs and damping */
+  if (bt && m->nbody > 1 && m->body[m->nbody - 1].type) bt = m->body[m->nbody - 1].type;
   fmbWorkspace* w = fmb_workspace_new(m);
   double* y = calloc((size_t)m->ny, sizeof(double));
   double* yp = calloc((size_t)m->ny, sizeof(double));
@@ -562,9 +694,10 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   if (ic == 0) {
     if (joint)
       check_joint_ops(&r, m, w, m->njoint - 1, y);
-    else if (m->body[m->nbody - 1].nq > 0)
+    else if (m->body[m->nbody - 1].nq > 0) {
       check_body_ops(&r, m, w, m->nbody - 1, y);
-    else
+      check_pattern_jacobian(&r, m, w, m->nbody - 1, y);
+    } else
       result(&r, 1, "dynamics", "no coordinates: nothing to differentiate");
   }
   if (!joint && m->body[m->nbody - 1].nq >= 3) strncat(outputs, ", probe.x, probe.omega", sizeof outputs - strlen(outputs) - 1);

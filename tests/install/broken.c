@@ -49,6 +49,9 @@ static int osc_residual(const void* self, const fmbEnv* env, const double* q, co
 #ifdef BREAK_ENERGY
   R[2] += 0.05 * v[2]; /* a friction the energy does not account for: energy leaks */
 #endif
+#ifdef BREAK_PATTERN
+  R[0] += 3.0 * (q[0] - q[1]), R[1] += 3.0 * (q[1] - q[0]); /* a coupling spring the pattern leaves out */
+#endif
   if (env->has_gravity) R[0] -= o->mass * env->gravity[0], R[1] -= o->mass * env->gravity[1];
   return 0;
 }
@@ -61,6 +64,9 @@ static int osc_jacobian(const void* self, const fmbEnv* env, const double* q, co
   K[0] = K[4] = K[8] = o->stiffness;
 #ifdef BREAK_JACOBIAN
   K[8] = 2 * o->stiffness; /* wrong: dR_theta/dtheta is k */
+#endif
+#ifdef BREAK_PATTERN
+  K[0] += 3.0, K[4] += 3.0, K[1] = K[3] = -3.0; /* right here; only the sparse pattern omits it */
 #endif
 #ifdef BREAK_ENERGY
   C[8] = 0.05;
@@ -77,12 +83,33 @@ static int osc_marker(const void* self, const double* q, const double local[2], 
   return 0;
 }
 
+/* the sparse form: the diagonal of K and M (BREAK_PATTERN: its coupling K[0][1] is left out) */
+static long osc_pattern(const void* self, int* rows, int* cols) {
+  (void)self;
+  for (int i = 0; rows && i < 3; ++i) rows[i] = cols[i] = i;
+  return 3;
+}
+static int osc_pattern_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                                const double* z, double* K, double* C, double* M, double* work) {
+  (void)env, (void)q, (void)v, (void)a, (void)z, (void)work;
+  const Osc* o = self;
+  for (int i = 0; i < 3; ++i) K[i] = o->stiffness, C[i] = 0.0;
+#ifdef BREAK_PATTERN
+  K[0] += 3.0, K[1] += 3.0;
+#endif
+  M[0] = M[1] = o->mass, M[2] = o->inertia;
+  return 0;
+}
+
 static void osc_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
                        double* work) {
   (void)work;
   const Osc* o = self;
   e->kinetic = 0.5 * o->mass * (v[0] * v[0] + v[1] * v[1]) + 0.5 * o->inertia * v[2] * v[2];
   e->strain = 0.5 * o->stiffness * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+#ifdef BREAK_PATTERN
+  e->strain += 1.5 * (q[0] - q[1]) * (q[0] - q[1]);
+#endif
   e->gravity = env->has_gravity ? -o->mass * (env->gravity[0] * q[0] + env->gravity[1] * q[1]) : 0.0;
 }
 
@@ -109,6 +136,10 @@ static const fmbBodyType oscillator = {
 #endif
     .marker = osc_marker,
     .jacobian = osc_jacobian,
+#ifndef BREAK_MASS /* (its M01 is not in the sparse form) */
+    .pattern = osc_pattern,
+    .pattern_jacobian = osc_pattern_jacobian,
+#endif
     .energy = osc_energy,
     .params = osc_params,
     .example = "mass: 2\ninertia: 0.5\nstiffness: 30\n",

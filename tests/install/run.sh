@@ -118,7 +118,7 @@ cc -std=c11 -O2 -shared -fPIC "$tut/point_mass.c" $(pkg-config --cflags --libs f
   fail "the tutorial's pkg-config line"
 
 # 5. broken plugins
-for b in ABI OPS ENTRY NAME JACOBIAN MASS ENERGY; do
+for b in ABI OPS ENTRY NAME JACOBIAN MASS ENERGY PATTERN; do
   cc -std=c11 -shared -fPIC -DBREAK_$b "$src/tests/install/broken.c" $(pkg-config --cflags --libs flexmbd) -lm \
     -o "$work/broken_$b.so" 2>/dev/null || fail "broken.c does not build with BREAK_$b"
 done
@@ -132,6 +132,8 @@ expect 2 "broken_ENTRY.so: error: not a flexmbd plugin: it has no symbol fmb_plu
   "$F" types --plugin "$work/broken_ENTRY.so"
 expect 1 'FAIL oscillator jacobian: analytic vs central differences: K 1, C 0, M 0' \
   "$F" conform --work "$work/conform" --plugin "$work/broken_JACOBIAN.so" oscillator
+expect 1 'FAIL oscillator pattern: largest difference outside the declared pattern: 0.09' \
+  "$F" conform --work "$work/conform" --plugin "$work/broken_PATTERN.so" oscillator
 expect 1 'FAIL oscillator mass: M symmetric' "$F" conform --work "$work/conform" --plugin "$work/broken_MASS.so" oscillator
 expect 1 'FAIL oscillator energy: a free run keeps the total energy' \
   "$F" conform --work "$work/conform" --plugin "$work/broken_ENERGY.so" oscillator
