@@ -7,7 +7,7 @@
  *    more than FMB_ASSEMBLY_TOL is an error unless the scene says `initial: assemble`: the
  *    projection would otherwise change the mechanism silently;
  * 2. velocities: the minimum-norm correction onto Phi_q v + Phi_t = 0;
- * 3. accelerations and multipliers from the augmented system
+ * 3. accelerations and multipliers from the augmented system (augmented.c)
  *        [M  Phi_q^T] [a     ]   [Q    ]
  *        [Phi_q   0 ] [lambda] = [gamma],   gamma = -(Phi_q v)_q v - Phi_tt,
  *    so IDA starts from F(t0, y0, y0') = 0. mu = 0. The sizes of the corrections are reported.
@@ -103,6 +103,22 @@ static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double
    say the same thing) or only at q (a singular configuration, e.g. a linkage started flat). Move
    a little along the constraint manifold (a tangent step of 1e-3 of the coordinates' scale,
    projected back) and look again: returns 1 when fewer rows depend there (singular at q). */
+int fmb_rank_deficient_at(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double tol) {
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
+  double* work = calloc((size_t)nc * nq + nc, sizeof(double));
+  int* order = calloc((size_t)nc, sizeof(int));
+  int nred = 0, deficient = 0;
+  fmb_workspace_redundant(w, &nred);
+  if (PhiQ && work && order && !fmb_constraints_all(m, w, t, q, v, NULL, PhiQ, NULL, NULL))
+    deficient = fmb_independent_rows(nc, nq, PhiQ, tol, order, work) < nc - nred;
+  free(PhiQ);
+  free(work);
+  free(order);
+  return deficient;
+}
+
 static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
                          const unsigned char* drop, int rank) {
   const int nq = m->nq, nc = m->nc;
@@ -264,174 +280,6 @@ void fmb_name_rows(const fmbModel* m, const unsigned char* drop, char* buf, size
       if (drop[m->joint[j].rowadr + r])
         used += (size_t)snprintf(buf + used, len - used, "%sjoint '%s' row %d", used ? ", " : "", m->joint[j].name, r + 1);
 }
-
-/* gamma = -(Phi_q v)_q v - Phi_tt, the right side of Phi_q a = gamma; fills PhiQ (dense nc x nq).
-   (Phi_q v)_q v by a central difference along v. */
-static void acceleration_rhs(const fmbModel* m, fmbWorkspace* w, double t0, const double* q, const double* v,
-                             double* PhiQ, double* PhiQ2, double* phi, double* phit, double* phitt, double* qs,
-                             double* gamma) {
-  const int nq = m->nq, nc = m->nc;
-  fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt);
-  double vn = norm2(v, nq);
-  double h = vn > 0 ? 1e-5 * (1.0 + norm2(q, nq)) / vn : 0.0;
-  double* dpv = phit; /* reuse: holds (Phi_q v)_q v below */
-  memset(dpv, 0, (size_t)nc * sizeof(double));
-  if (h > 0) {
-    for (int i = 0; i < nq; ++i) qs[i] = q[i] + h * v[i];
-    fmb_constraints_all(m, w, t0, qs, v, NULL, PhiQ2, NULL, NULL);
-    for (int r = 0; r < nc; ++r)
-      for (int c = 0; c < nq; ++c) dpv[r] += PhiQ2[(size_t)r * nq + c] * v[c];
-    for (int i = 0; i < nq; ++i) qs[i] = q[i] - h * v[i];
-    fmb_constraints_all(m, w, t0, qs, v, NULL, PhiQ2, NULL, NULL);
-    for (int r = 0; r < nc; ++r) {
-      double s = 0.0;
-      for (int c = 0; c < nq; ++c) s += PhiQ2[(size_t)r * nq + c] * v[c];
-      dpv[r] = (dpv[r] - s) / (2.0 * h);
-    }
-  }
-  for (int r = 0; r < nc; ++r) gamma[r] = -dpv[r] - phitt[r];
-}
-
-/* Accelerations and multipliers consistent with (q, v) at t, from the augmented system
- *     [M      Phi_q^T] [a     ]   [Q    ]
- *     [Phi_q  0      ] [lambda] = [gamma],   gamma = -(Phi_q v)_q v - Phi_tt
- * (the index-1 form of the equations of motion). The initial conditions start IDA from it, and
- * the reaction outputs use it: IDA's multipliers are algebraic unknowns outside its error test,
- * so between steps their interpolated values can be off by per cent where the positions are
- * exact to the tolerance. Scratch is allocated once per model (dense: nq + nc squared). */
-fmbAugmented* fmb_augmented_new(const fmbModel* m) {
-  fmbAugmented* g = calloc(1, sizeof *g);
-  if (!g) return NULL;
-  const size_t nq = (size_t)m->nq, nc = (size_t)m->nc, n = nq + nc;
-  size_t mb = 1;
-  for (int b = 1; b < m->nbody; ++b)
-    if ((size_t)m->body[b].nq > mb) mb = (size_t)m->body[b].nq;
-  g->A = calloc(n * n, sizeof(double));
-  g->rhs = calloc(n + 1, sizeof(double));
-  g->piv = calloc(n + 1, sizeof(int));
-  g->PhiQ = calloc((nc ? nc : 1) * nq, sizeof(double));
-  g->PhiQ2 = calloc((nc ? nc : 1) * nq, sizeof(double));
-  g->phi = calloc(nc + 1, sizeof(double));
-  g->phit = calloc(nc + 1, sizeof(double));
-  g->phitt = calloc(nc + 1, sizeof(double));
-  g->qs = calloc(nq, sizeof(double));
-  g->Mb = calloc(mb * mb, sizeof(double));
-  if (!g->A || !g->rhs || !g->piv || !g->PhiQ || !g->PhiQ2 || !g->phi || !g->phit || !g->phitt || !g->qs || !g->Mb) {
-    fmb_augmented_free(g);
-    return NULL;
-  }
-  return g;
-}
-
-void fmb_augmented_free(fmbAugmented* g) {
-  if (!g) return;
-  double* bufs[] = {g->A, g->rhs, g->PhiQ, g->PhiQ2, g->phi, g->phit, g->phitt, g->qs, g->Mb};
-  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
-  free(g->piv);
-  free(g);
-}
-
-/* dx = -M^-1 Phi_q^T (Phi_q M^-1 Phi_q^T + eps)^-1 r: the correction of least kinetic-energy norm
-   that removes the constraint residual r to first order (mass-orthogonal projection, as in Bayo &
-   Ledesma 1996), from [M Phi_q^T; Phi_q -eps I] [dx; mu] = [0; -r]. Uses g->PhiQ as evaluated. */
-static int mass_projection(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, const double* q, const double* v,
-                           const double* r, double* dx) {
-  const int nq = m->nq, nc = m->nc, n = nq + nc;
-  double *A = g->A, *rhs = g->rhs;
-  memset(A, 0, (size_t)n * n * sizeof(double));
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, g->Mb)) return 1;
-    for (int c = 0; c < bi->nq; ++c)
-      for (int k = 0; k < bi->nq; ++k) A[(size_t)(bi->qadr + c) * n + bi->qadr + k] = g->Mb[(size_t)c * bi->nq + k];
-  }
-  double mdiag = 0.0, pmax = 0.0;
-  for (int i = 0; i < nq; ++i) mdiag = fmax(mdiag, fabs(A[(size_t)i * n + i]));
-  for (size_t k = 0; k < (size_t)nc * nq; ++k) pmax = fmax(pmax, fabs(g->PhiQ[k]));
-  const double eps = FMB_MIN_NORM_SHIFT * pmax * pmax / fmax(mdiag, 1e-300);
-  for (int i = 0; i < nq; ++i) rhs[i] = 0.0;
-  for (int k = 0; k < nc; ++k) {
-    rhs[nq + k] = -r[k];
-    A[(size_t)(nq + k) * n + nq + k] = -eps;
-    for (int c = 0; c < nq; ++c) {
-      A[(size_t)c * n + nq + k] = g->PhiQ[(size_t)k * nq + c];
-      A[(size_t)(nq + k) * n + c] = g->PhiQ[(size_t)k * nq + c];
-    }
-  }
-  if (fmb_lu_factor(n, A, g->piv)) return 1;
-  fmb_lu_solve(n, A, g->piv, rhs);
-  memcpy(dx, rhs, sizeof(double) * (size_t)nq);
-  return 0;
-}
-
-int fmb_project_state(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, double* q, double* v) {
-  const int nq = m->nq, nc = m->nc;
-  if (nc == 0) return 0;
-  const double scale = 1.0 + norm2(q, nq);
-  double* dx = g->qs;
-  int converged = 0;
-  for (int it = 0; it < 8; ++it) { /* positions: Newton on Phi(q) = 0 with mass-orthogonal steps */
-    if (fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt)) return 1;
-    if (norm2(g->phi, nc) <= 1e-14 * scale) {
-      converged = 1;
-      break;
-    }
-    if (mass_projection(m, w, g, q, v, g->phi, dx)) return 1;
-    for (int c = 0; c < nq; ++c) q[c] += dx[c];
-  }
-  /* velocities: one step, Phi_q v + Phi_t is linear in v */
-  if (fmb_constraints_all(m, w, t, q, v, g->phi, g->PhiQ, g->phit, g->phitt)) return 1;
-  for (int k = 0; k < nc; ++k)
-    for (int c = 0; c < nq; ++c) g->phit[k] += g->PhiQ[(size_t)k * nq + c] * v[c];
-  if (mass_projection(m, w, g, q, v, g->phit, dx)) return 1;
-  for (int c = 0; c < nq; ++c) v[c] += dx[c];
-  return converged ? 0 : 1;
-}
-
-int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, const double* q, const double* v,
-                        const unsigned char* drop, double tikhonov, double* a, double* lambda) {
-  const int nq = m->nq, nc = m->nc, n = nq + nc;
-  double *A = g->A, *rhs = g->rhs;
-  memset(A, 0, (size_t)n * n * sizeof(double));
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, g->Mb)) {
-      g->failed_body = b;
-      return FMB_AUG_MASS_FAILED;
-    }
-    for (int c = 0; c < bi->nq; ++c)
-      for (int r = 0; r < bi->nq; ++r) A[(size_t)(bi->qadr + c) * n + bi->qadr + r] = g->Mb[(size_t)c * bi->nq + r];
-  }
-  if (fmb_generalized_forces(m, w, t, q, v, rhs)) return FMB_AUG_FORCES_FAILED;
-  if (nc > 0) {
-    acceleration_rhs(m, w, t, q, v, g->PhiQ, g->PhiQ2, g->phi, g->phit, g->phitt, g->qs, rhs + nq);
-    double mdiag = 0.0, pmax = 0.0;
-    for (int i = 0; i < nq; ++i) mdiag = fmax(mdiag, fabs(A[(size_t)i * n + i]));
-    for (size_t k = 0; k < (size_t)nc * nq; ++k) pmax = fmax(pmax, fabs(g->PhiQ[k]));
-    /* Tikhonov: -eps on the multipliers' diagonal, eps relative to Phi_q M^-1 Phi_q^T's scale */
-    const double eps = tikhonov * pmax * pmax / fmax(mdiag, 1e-300);
-    for (int r = 0; r < nc; ++r) {
-      if (drop && drop[r]) { /* out of the equations: lambda_r = 0 */
-        rhs[nq + r] = 0.0;
-        A[(size_t)(nq + r) * n + nq + r] = 1.0;
-        continue;
-      }
-      A[(size_t)(nq + r) * n + nq + r] = -eps;
-      for (int c = 0; c < nq; ++c) {
-        A[(size_t)c * n + nq + r] = g->PhiQ[(size_t)r * nq + c];
-        A[(size_t)(nq + r) * n + c] = g->PhiQ[(size_t)r * nq + c];
-      }
-    }
-  }
-  if (fmb_lu_factor(n, A, g->piv)) return FMB_AUG_SINGULAR;
-  fmb_lu_solve(n, A, g->piv, rhs);
-  if (a) memcpy(a, rhs, (size_t)nq * sizeof(double));
-  if (lambda) memcpy(lambda, rhs + nq, (size_t)nc * sizeof(double));
-  for (int i = 0; i < n; ++i)
-    if (!isfinite(rhs[i])) return FMB_AUG_NOT_FINITE;
-  return 0;
-}
-
 
 typedef struct {
   long n, cap;
@@ -789,17 +637,12 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
-    double* PhiQ2 = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-    double* qs = calloc((size_t)nq + 1, sizeof(double));
-    if (!PhiQ2 || !qs) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
+    if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt) || fmb_constraints_gamma(m, w, t0, q, v, rhs + nq)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the constraints are not finite at t = %g", t0);
       rc = FMB_EXIT_SOLVER;
     } else {
-      acceleration_rhs(m, w, t0, q, v, PhiQ, PhiQ2, phi, phit, phitt, qs, rhs + nq);
       rc = sparse_accelerations(m, w, t0, y, yp, PhiQ, rhs + nq, diag);
     }
-    free(PhiQ2);
-    free(qs);
     goto done;
   }
   /* augmented system for accelerations and multipliers */
@@ -813,7 +656,7 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   memcpy(yp, v, (size_t)nq * sizeof(double));
   if (arc == FMB_AUG_MASS_FAILED) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
-                 m->body[aug->failed_body].name, t0);
+                 m->body[fmb_augmented_failed_body(aug)].name, t0);
     rc = FMB_EXIT_SOLVER;
   } else if (arc == FMB_AUG_FORCES_FAILED) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);

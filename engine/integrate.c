@@ -12,6 +12,12 @@
 
 #include "integrator.h"
 
+/* how close to rank-deficient Phi_q must be where IDA failed for `formulation: auto` to switch to
+   the projected formulation: a row whose part independent of the others is below 1e-2 of the
+   largest row (a parallelogram within about half a degree of flat; IDA on the GGL system gave up
+   at 0.3 mrad before the flat position in scenes/parallelogram.yaml) */
+#define FMB_AUTO_SWITCH_RANK_TOL 1e-2
+
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
   return m->solver.formulation == FMB_FORM_PROJECTED ? &fmb_integrator_projected : &fmb_integrator_ida;
 }
@@ -23,6 +29,16 @@ void fmb_print_stats(const fmbStats* s, FILE* f) {
           "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
           s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
           s->error_test_fails, s->conv_fails, s->jacobians_reused, s->cpu_s);
+}
+
+static void add_stats(fmbStats* to, const fmbStats* from) {
+  to->steps += from->steps;
+  to->residuals += from->residuals;
+  to->jacobians += from->jacobians;
+  to->newton_iters += from->newton_iters;
+  to->error_test_fails += from->error_test_fails;
+  to->conv_fails += from->conv_fails;
+  to->jacobians_reused += from->jacobians_reused;
 }
 
 static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
@@ -183,7 +199,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   double* y = calloc((size_t)ny + 1, sizeof(double));
   double* yp = calloc((size_t)ny + 1, sizeof(double));
   double* atol = calloc((size_t)ny + 1, sizeof(double));
-  if (!w || !y || !yp || !atol) {
+  double* work_before = calloc((size_t)m->njoint + 1, sizeof(double)); /* work done before a switch */
+  fmbStats before_switch;                                               /* counters of the backend before it */
+  struct {
+    double t, h;
+    char why[1200];
+  } switched = {-1.0, 0.0, ""}; /* where formulation: auto left IDA, and IDA's reason */
+  memset(&before_switch, 0, sizeof before_switch);
+  if (!w || !y || !yp || !atol || !work_before) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -243,16 +266,50 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     const int flag = ops->advance(integ, tout, &tret, y, yp, &h, why, sizeof why);
     t = tret;
     if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && stop && *stop)) break;
+    if (flag == FMB_ADVANCE_FAILED && ops == &fmb_integrator_ida && m->solver.formulation == FMB_FORM_AUTO &&
+        m->nz == 0 && fmb_rank_deficient_at(m, w, tret, y, y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
+      /* a singular configuration: the GGL system's Newton matrix is singular here; the projected
+         formulation (minimum-norm multipliers) passes it. From the last good state on, for the
+         rest of the run; the work integrals go on from their values. */
+      if (!opt || !opt->quiet)
+        fprintf(stderr, "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
+                "the mechanism can change branch); continuing with the projected formulation (set solver.formulation: "
+                "ggl to stop instead)\n", tret);
+      fmbStats sofar;
+      memset(&sofar, 0, sizeof sofar);
+      ops->stats(integ, &sofar);
+      ops->destroy(integ);
+      ops = &fmb_integrator_projected;
+      if (m->need_work && m->njoint > 0) memcpy(work_before, fmb_workspace_work(w), sizeof(double) * (size_t)m->njoint);
+      integ = ops->create(&setup, t, y, yp, diag);
+      if (!integ) {
+        rc = diag->code ? diag->code : FMB_EXIT_SOLVER;
+        break;
+      }
+      add_stats(&before_switch, &sofar);
+      switched.t = tret;
+      switched.h = h;
+      snprintf(switched.why, sizeof switched.why, "%s", why);
+      --k;
+      continue;
+    }
     if (flag != FMB_ADVANCE_OK) {
       bad = fmb_check_mass(m, w, tret, y, y + m->nq, 1e-5);
       if (bad)
         mass_failure(m, bad, tret, diag);
+      else if (switched.t >= 0 && tret - switched.t < dt) /* no further: IDA's reason is the one to give */
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s (the projected "
+                     "formulation, tried from t = %.6g, did not get further)", tret, switched.h, switched.why, switched.t);
       else
         fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h, why);
       rc = FMB_EXIT_SOLVER;
       break;
     }
-    if (m->need_work && m->njoint > 0) ops->work(integ, fmb_workspace_work(w));
+    if (m->need_work && m->njoint > 0) {
+      double* work = fmb_workspace_work(w);
+      ops->work(integ, work);
+      for (int j = 0; j < m->njoint; ++j) work[j] += work_before[j];
+    }
     if (invalid_state(m, t, y, diag) || (redundant_phi && redundant_row_broken(m, w, t, y, redundant_phi, diag))) {
       rc = FMB_EXIT_SOLVER;
       break;
@@ -292,6 +349,8 @@ done:
     ops->stats(integ, st);
     ops->destroy(integ);
   }
+  add_stats(st, &before_switch);
+  free(work_before);
   free(redundant_phi);
   free(y);
   free(yp);

@@ -140,6 +140,14 @@ static void ida_error_handler(int code, const char* module, const char* function
    extreme values, not the mechanism's geometry, then explain a singular matrix. */
 static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, size_t len) {
   const int joints = m->nc > 0;
+  if (ymax > 1e100 && flag == IDA_REP_RES_ERR) { /* both: what happened, and the likely cause */
+    snprintf(buf, len,
+             "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial "
+             "values: the state reached a magnitude of %.3g, a parameter is far beyond a physical scale (check masses, "
+             "stiffnesses, forces and their units)",
+             ymax);
+    return;
+  }
   if (ymax > 1e100 && (flag == IDA_CONV_FAIL || flag == IDA_LSETUP_FAIL || flag == IDA_LSOLVE_FAIL || flag == IDA_ERR_FAIL)) {
     snprintf(buf, len,
              "the solution reached a magnitude of %.3g: the state is blowing up or a parameter is far beyond a physical "
@@ -352,6 +360,8 @@ static int ida_advance(void* self, double tout, double* t_reached, double* y, do
   IdaRun* c = self;
   const fmbModel* m = c->m;
   double tret = *t_reached;
+  double ymax = 0.0; /* the state's magnitude, from the last good row on (fmax skips NaN) */
+  for (int i = 0; i < m->ny; ++i) ymax = fmax(ymax, fmax(fabs(y[i]), fabs(yp[i])));
   int flag = IDASolve(c->ida, tout, &tret, c->y, c->yp, IDA_NORMAL);
   if (flag < 0 && !stop_requested(c) && reduced_solve_failed(c, flag)) flag = fall_back_to_full(c, tret, tout, &tret);
   *t_reached = tret;
@@ -362,8 +372,7 @@ static int ida_advance(void* self, double tout, double* t_reached, double* y, do
   *h = hcur;
   if (flag >= 0) return FMB_ADVANCE_OK;
   if (stop_requested(c)) return FMB_ADVANCE_INTERRUPTED;
-  double ymax = 0.0;
-  for (int i = 0; i < m->ny; ++i) ymax = fmax(ymax, fabs(y[i]));
+  for (int i = 0; i < m->ny; ++i) ymax = fmax(ymax, fmax(fabs(y[i]), fabs(yp[i])));
   char advice[600], floor_note[200] = "";
   failure_advice(m, flag, ymax, advice, sizeof advice);
   /* a stop at the step floor names the key that sets it and where its value came from */

@@ -1,11 +1,26 @@
-/* integrator_projected.c — solver.formulation: projected (docs/mechanisms.md). IDA integrates the
- * index-1 equations q' = v, v' = a(q, v, t), with a and the multipliers from the augmented system
- * [M Phi_q^T; Phi_q -eps I] (ic.c): with eps a Tikhonov shift the multipliers are the
- * minimum-norm ones and stay defined where Phi_q loses rank, so the motion passes singular
- * configurations. Drift off the constraints is removed by projecting at every output row
- * (fmb_project_state), after which IDA restarts. Small dense systems: IDA's difference-quotient
- * Jacobian over the 2 nq unknowns. */
-#include <idas/idas.h>
+/* integrator_projected.c — solver.formulation: projected (docs/mechanisms.md). CVODE (BDF,
+ * variable order and step) integrates the index-1 equations
+ *
+ *     q' = v,   v' = a(q, v, t),   [M Phi_q^T; Phi_q -eps I] [a; lambda] = [Q; gamma]
+ *
+ * with a and the multipliers from the sparse augmented system (augmented.c): with eps a Tikhonov
+ * shift the multipliers are the minimum-norm ones and stay defined where Phi_q loses rank, so the
+ * motion passes singular configurations. After every step CVODE calls our projection
+ * (CVodeSetProjFn): positions onto Phi = 0 and velocities onto Phi_q v + Phi_t = 0 by
+ * mass-orthogonal corrections (Bayo & Ledesma 1996), and the local error estimate onto the
+ * constraints' tangent space, so the error test measures the error along the manifold
+ * (Eich 1993; the coordinate projection of Hairer & Wanner VII.2). Projecting every step keeps
+ * the history of the multistep method on the manifold: no restarts, the order stays up (the
+ * earlier version projected only at output rows and restarted IDA at order 1 there).
+ *
+ * Newton's linear systems: CVODE's dense difference-quotient Jacobian over the 2 nq unknowns for
+ * small models; for larger ones GMRES without a matrix (Jacobian-vector products by differences,
+ * one right-hand side each), which keeps the cost per step linear in the model's size but is
+ * less robust at flat positions (PROJ_DENSE_MAX).
+ * The work integrals of m->need_work ride along as extra unknowns (their powers come from the
+ * same solve), untouched by the projection. */
+#include <cvode/cvode.h>
+#include <cvode/cvode_proj.h>
 #include <math.h>
 #include <nvector/nvector_serial.h>
 #include <stdio.h>
@@ -13,50 +28,71 @@
 #include <string.h>
 #include <sundials/sundials_context.h>
 #include <sunlinsol/sunlinsol_dense.h>
+#include <sunlinsol/sunlinsol_spgmr.h>
 #include <sunmatrix/sunmatrix_dense.h>
 
 #include "integrator.h"
+
+/* up to this many unknowns (2 nq + work integrals) the Newton matrix is dense; beyond, matrix-free
+   GMRES. Measured on rows of N parallelograms passing flat positions (bench/mechanisms.sh): the
+   dense path costs N^2 per step (3.3 s for 2 s of N = 50) and passes at rtol 1e-8 and 1e-9;
+   GMRES is linear (0.63 s for N = 50) but at rtol 1e-9 its runs stop at a flat position (N = 10,
+   20, 50: error test at the minimum step, not helped by tighter GMRES tolerances), so dense goes
+   as far as N = 20 linkages (246 unknowns, 0.54 s for 2 s) */
+#define PROJ_DENSE_MAX 256
 
 typedef struct {
   const fmbModel* m;
   fmbWorkspace* w;
   const volatile sig_atomic_t* stop;
   SUNContext sun;
-  void* ida;
-  N_Vector y, yp, id, atol, work, workatol; /* [q, v] and its rates */
+  void* cvode;
+  N_Vector y, atol; /* [q, v, work] */
   SUNMatrix A;
   SUNLinearSolver LS;
   fmbAugmented* aug;
   double *accel, *lambda; /* nq, nc */
-  fmbStats before_reinit; /* IDA's counters up to the last IDAReInit (which zeroes them) */
-  char ida_msg[512];
+  int nwork;              /* work integrals carried (njoint or 0) */
+  char msg[512];
 } ProjRun;
 
-static int proj_residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void* ud) {
-  ProjRun* c = ud;
-  if (c->stop && *c->stop) return -1;
-  const int nq = c->m->nq;
-  const double *q = N_VGetArrayPointer(y), *v = q + nq, *qp = N_VGetArrayPointer(yp), *vp = qp + nq;
-  double* f = N_VGetArrayPointer(F);
-  for (int i = 0; i < 2 * nq; ++i)
-    if (!isfinite(q[i]) || !isfinite(qp[i])) return 1;
-  if (fmb_augmented_solve(c->m, c->w, c->aug, t, q, v, NULL, FMB_MIN_NORM_SHIFT, c->accel, c->lambda)) return 1;
-  for (int i = 0; i < nq; ++i) {
-    f[i] = qp[i] - v[i];
-    f[nq + i] = vp[i] - c->accel[i];
+/* the powers of the joints (their work's rates) at (q, v) with the multipliers lambda */
+static int joint_powers(ProjRun* c, double t, const double* q, const double* v, double* p) {
+  for (int j = 0; j < c->nwork; ++j) {
+    p[j] = fmb_joint_power(c->m, c->w, j, t, q, v, c->lambda);
+    if (!isfinite(p[j])) return 1;
   }
   return 0;
 }
 
-static int proj_power_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector P, void* ud) {
-  (void)yp;
+static int proj_rhs(sunrealtype t, N_Vector Y, N_Vector Yd, void* ud) {
   ProjRun* c = ud;
-  double* p = N_VGetArrayPointer(P);
-  const double* yv = N_VGetArrayPointer(y);
-  if (fmb_augmented_solve(c->m, c->w, c->aug, t, yv, yv + c->m->nq, NULL, FMB_MIN_NORM_SHIFT, NULL, c->lambda)) return 1;
-  for (int j = 0; j < c->m->njoint; ++j) {
-    p[j] = fmb_joint_power(c->m, c->w, j, t, yv, yv + c->m->nq, c->lambda);
-    if (!isfinite(p[j])) return 1;
+  if (c->stop && *c->stop) return -1;
+  const int nq = c->m->nq;
+  const double *q = N_VGetArrayPointer(Y), *v = q + nq;
+  double* f = N_VGetArrayPointer(Yd);
+  for (int i = 0; i < 2 * nq; ++i)
+    if (!isfinite(q[i])) return 1;
+  if (fmb_augmented_solve(c->m, c->w, c->aug, t, q, v, NULL, FMB_MIN_NORM_SHIFT, f + nq, c->lambda)) return 1;
+  memcpy(f, v, sizeof(double) * (size_t)nq);
+  return joint_powers(c, t, q, v, f + 2 * nq);
+}
+
+/* CVProjFn: ycur onto the constraints in place, corr = the change; err (may be NULL) onto the
+   tangent space of the projected state (positions' and velocities' parts alike: both
+   constraints have Phi_q as their Jacobian in the unknowns they constrain) */
+static int proj_project(sunrealtype t, N_Vector ycur, N_Vector corr, sunrealtype eps, N_Vector err, void* ud) {
+  (void)eps;
+  ProjRun* c = ud;
+  const int nq = c->m->nq;
+  double *y = N_VGetArrayPointer(ycur), *dy = N_VGetArrayPointer(corr);
+  memcpy(dy, y, sizeof(double) * 2 * (size_t)nq);
+  if (fmb_project_state(c->m, c->w, c->aug, t, y, y + nq)) return 1; /* recoverable: a smaller step */
+  for (int i = 0; i < 2 * nq; ++i) dy[i] = y[i] - dy[i];
+  for (int i = 2 * nq; i < 2 * nq + c->nwork; ++i) dy[i] = 0.0;
+  if (err) {
+    double* e = N_VGetArrayPointer(err);
+    if (fmb_project_tangent(c->w, c->aug, e) || fmb_project_tangent(c->w, c->aug, e + nq)) return 1;
   }
   return 0;
 }
@@ -65,28 +101,17 @@ static void proj_error_handler(int code, const char* module, const char* functio
   (void)code;
   (void)module;
   ProjRun* c = ud;
-  snprintf(c->ida_msg, sizeof c->ida_msg, "%s: %s", function, msg);
-}
-
-static void add_counters(void* ida, fmbStats* acc) {
-  long v;
-  if (IDAGetNumSteps(ida, &v) == IDA_SUCCESS) acc->steps += v;
-  if (IDAGetNumResEvals(ida, &v) == IDA_SUCCESS) acc->residuals += v;
-  if (IDAGetNumJacEvals(ida, &v) == IDA_SUCCESS) acc->jacobians += v;
-  if (IDAGetNumNonlinSolvIters(ida, &v) == IDA_SUCCESS) acc->newton_iters += v;
-  if (IDAGetNumErrTestFails(ida, &v) == IDA_SUCCESS) acc->error_test_fails += v;
-  if (IDAGetNumNonlinSolvConvFails(ida, &v) == IDA_SUCCESS) acc->conv_fails += v;
+  snprintf(c->msg, sizeof c->msg, "%s: %s", function, msg);
 }
 
 static void proj_destroy(void* self) {
   ProjRun* c = self;
   if (!c) return;
-  if (c->ida) IDAFree(&c->ida);
+  if (c->cvode) CVodeFree(&c->cvode);
   if (c->LS) SUNLinSolFree(c->LS);
   if (c->A) SUNMatDestroy(c->A);
-  N_Vector* vs[] = {&c->y, &c->yp, &c->id, &c->atol, &c->work, &c->workatol};
-  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i)
-    if (*vs[i]) N_VDestroy(*vs[i]);
+  if (c->y) N_VDestroy(c->y);
+  if (c->atol) N_VDestroy(c->atol);
   fmb_augmented_free(c->aug);
   free(c->accel);
   free(c->lambda);
@@ -95,58 +120,55 @@ static void proj_destroy(void* self) {
 }
 
 static void* proj_create(const fmbIntegratorSetup* s, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  (void)yp0;
   const fmbModel* m = s->m;
-  const int n = 2 * m->nq;
   ProjRun* c = calloc(1, sizeof *c);
   if (!c || SUNContext_Create(NULL, &c->sun) != 0) goto oom;
   c->m = m;
   c->w = s->w;
   c->stop = s->stop;
+  c->nwork = m->need_work ? m->njoint : 0;
+  const int nq = m->nq, n = 2 * nq + c->nwork;
   c->y = N_VNew_Serial(n, c->sun);
-  c->yp = N_VNew_Serial(n, c->sun);
-  c->id = N_VNew_Serial(n, c->sun);
   c->atol = N_VNew_Serial(n, c->sun);
   c->aug = fmb_augmented_new(m);
-  c->accel = calloc((size_t)m->nq + 1, sizeof(double));
+  c->accel = calloc((size_t)nq + 1, sizeof(double));
   c->lambda = calloc((size_t)m->nc + 1, sizeof(double));
-  if (!c->y || !c->yp || !c->id || !c->atol || !c->aug || !c->accel || !c->lambda) goto oom;
+  if (!c->y || !c->atol || !c->aug || !c->accel || !c->lambda) goto oom;
   fmb_vector_use_fast_ops(c->y);
-  memcpy(N_VGetArrayPointer(c->y), y0, sizeof(double) * (size_t)n);
-  memcpy(N_VGetArrayPointer(c->yp), yp0, sizeof(double) * (size_t)n);
-  memcpy(N_VGetArrayPointer(c->atol), s->atol, sizeof(double) * (size_t)n);
-  const int ndiff = m->solver.positions_only ? m->nq : n;
-  for (int i = 0; i < n; ++i) N_VGetArrayPointer(c->id)[i] = i < ndiff ? 1.0 : 0.0;
-  c->ida = IDACreate(c->sun);
-  if (!c->ida || IDAInit(c->ida, proj_residual_fn, t0, c->y, c->yp) != IDA_SUCCESS ||
-      IDASVtolerances(c->ida, m->solver.rtol, c->atol) != IDA_SUCCESS || IDASetUserData(c->ida, c) != IDA_SUCCESS ||
-      IDASetErrHandlerFn(c->ida, proj_error_handler, c) != IDA_SUCCESS || IDASetId(c->ida, c->id) != IDA_SUCCESS ||
-      IDASetSuppressAlg(c->ida, SUNTRUE) != IDA_SUCCESS || IDASetMaxOrd(c->ida, m->solver.max_order) != IDA_SUCCESS ||
-      IDASetMaxNumSteps(c->ida, m->solver.max_steps_per_output) != IDA_SUCCESS ||
-      (m->solver.max_step > 0 && IDASetMaxStep(c->ida, m->solver.max_step) != IDA_SUCCESS) ||
-      IDASetMinStep(c->ida, m->solver.min_step) != IDA_SUCCESS) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up IDA: %s", c->ida_msg);
+  double *y = N_VGetArrayPointer(c->y), *at = N_VGetArrayPointer(c->atol);
+  memcpy(y, y0, sizeof(double) * 2 * (size_t)nq);
+  memcpy(at, s->atol, sizeof(double) * 2 * (size_t)nq);
+  /* velocities in the error test unless the scene keeps only positions (a huge atol) */
+  if (m->solver.positions_only)
+    for (int i = nq; i < 2 * nq; ++i) at[i] = 1e30;
+  for (int j = 0; j < c->nwork; ++j) { /* as the IDA backend: a constraint's work is not controlled */
+    y[2 * nq + j] = 0.0;
+    at[2 * nq + j] = m->joint[j].nrows > 0 ? 1e30 : m->solver.atol;
+  }
+  c->cvode = CVodeCreate(CV_BDF, c->sun);
+  if (!c->cvode || CVodeInit(c->cvode, proj_rhs, t0, c->y) != CV_SUCCESS ||
+      CVodeSVtolerances(c->cvode, m->solver.rtol, c->atol) != CV_SUCCESS || CVodeSetUserData(c->cvode, c) != CV_SUCCESS ||
+      CVodeSetErrHandlerFn(c->cvode, proj_error_handler, c) != CV_SUCCESS ||
+      CVodeSetMaxOrd(c->cvode, m->solver.max_order) != CV_SUCCESS ||
+      CVodeSetMaxNumSteps(c->cvode, m->solver.max_steps_per_output) != CV_SUCCESS ||
+      (m->solver.max_step > 0 && CVodeSetMaxStep(c->cvode, m->solver.max_step) != CV_SUCCESS) ||
+      CVodeSetMinStep(c->cvode, m->solver.min_step) != CV_SUCCESS) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up CVODE: %s", c->msg);
     proj_destroy(c);
     return NULL;
   }
-  c->A = SUNDenseMatrix(n, n, c->sun);
-  c->LS = c->A ? SUNLinSol_Dense(c->y, c->A, c->sun) : NULL;
-  if (!c->A || !c->LS || IDASetLinearSolver(c->ida, c->LS, c->A) != IDA_SUCCESS) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up the linear solver");
+  if (n <= PROJ_DENSE_MAX) {
+    c->A = SUNDenseMatrix(n, n, c->sun);
+    c->LS = c->A ? SUNLinSol_Dense(c->y, c->A, c->sun) : NULL;
+  } else {
+    c->LS = SUNLinSol_SPGMR(c->y, SUN_PREC_NONE, 10, c->sun);
+  }
+  if (!c->LS || CVodeSetLinearSolver(c->cvode, c->LS, c->A) != CV_SUCCESS ||
+      (m->nc > 0 && CVodeSetProjFn(c->cvode, proj_project) != CV_SUCCESS)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up the projected integrator: %s", c->msg);
     proj_destroy(c);
     return NULL;
-  }
-  if (m->need_work && m->njoint > 0) { /* as in integrator_ida.c */
-    c->work = N_VNew_Serial(m->njoint, c->sun);
-    c->workatol = N_VNew_Serial(m->njoint, c->sun);
-    if (!c->work || !c->workatol) goto oom;
-    N_VConst(0.0, c->work);
-    for (int j = 0; j < m->njoint; ++j) N_VGetArrayPointer(c->workatol)[j] = m->joint[j].nrows > 0 ? 1e30 : m->solver.atol;
-    if (IDAQuadInit(c->ida, proj_power_fn, c->work) != IDA_SUCCESS || IDASetQuadErrCon(c->ida, SUNTRUE) != IDA_SUCCESS ||
-        IDAQuadSVtolerances(c->ida, m->solver.rtol, c->workatol) != IDA_SUCCESS) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up the work integrals: %s", c->ida_msg);
-      proj_destroy(c);
-      return NULL;
-    }
   }
   return c;
 oom:
@@ -159,44 +181,30 @@ static int proj_advance(void* self, double tout, double* t_reached, double* y, d
                         size_t why_len) {
   ProjRun* c = self;
   const fmbModel* m = c->m;
-  const int n = 2 * m->nq;
+  const int nq = m->nq;
   double tret = *t_reached;
-  int flag = IDASolve(c->ida, tout, &tret, c->y, c->yp, IDA_NORMAL);
+  const int flag = CVode(c->cvode, tout, c->y, &tret, CV_NORMAL);
   double hcur = 0.0;
-  IDAGetCurrentStep(c->ida, &hcur);
+  CVodeGetCurrentStep(c->cvode, &hcur);
   *h = hcur;
   *t_reached = tret;
-  memcpy(y, N_VGetArrayPointer(c->y), sizeof(double) * (size_t)n);
+  memcpy(y, N_VGetArrayPointer(c->y), sizeof(double) * 2 * (size_t)nq);
+  /* the row: CVODE's interpolant between projected steps is on the constraints only to the
+     tolerance; the copy written out is projected exactly (CVODE's own state is not touched) */
   int proj_failed = 0;
-  if (flag >= 0) {
-    /* back onto the constraints, with the multipliers for the outputs, at every row (measured on
-       scenes/parallelogram.yaml: projecting only once the drift exceeds the tolerance, or
-       Baumgarte's stabilization instead, let the linkage slip onto the crossed branch at a flat
-       passage or made the error erratic in alpha; every row gives errors that fall with rtol:
-       4.7e-5, 3.4e-6, 2.1e-7 rad at rtol 1e-8, 1e-9, 1e-10) */
-    if (fmb_project_state(m, c->w, c->aug, tret, y, y + m->nq) ||
-        fmb_augmented_solve(m, c->w, c->aug, tret, y, y + m->nq, NULL, FMB_MIN_NORM_SHIFT, yp + m->nq, y + 2 * m->nq))
-      proj_failed = 1;
-    memcpy(yp, y + m->nq, sizeof(double) * (size_t)m->nq);
-    memcpy(N_VGetArrayPointer(c->y), y, sizeof(double) * (size_t)n);
-    memcpy(N_VGetArrayPointer(c->yp), yp, sizeof(double) * (size_t)n);
-    add_counters(c->ida, &c->before_reinit);
-    if (c->work) {
-      double tq = tret;
-      IDAGetQuad(c->ida, &tq, c->work);
-    }
-    if (!proj_failed && IDAReInit(c->ida, tret, c->y, c->yp) != IDA_SUCCESS) proj_failed = 1;
-    if (!proj_failed && c->work) IDAQuadReInit(c->ida, c->work); /* IDAReInit restarted the integration */
-    if (!proj_failed) return FMB_ADVANCE_OK;
-  }
+  if (fmb_project_state(m, c->w, c->aug, tret, y, y + nq) ||
+      fmb_augmented_solve(m, c->w, c->aug, tret, y, y + nq, NULL, FMB_MIN_NORM_SHIFT, yp + nq, y + 2 * nq))
+    proj_failed = 1;
+  memcpy(yp, y + nq, sizeof(double) * (size_t)nq);
+  if (flag >= 0 && !proj_failed) return FMB_ADVANCE_OK;
   if (c->stop && *c->stop) return FMB_ADVANCE_INTERRUPTED;
-  if (proj_failed) {
+  if (flag >= 0) {
     snprintf(why, why_len, "the projection onto the constraints did not converge (the mechanism may have left its "
-             "assembled configurations); try a tighter rtol or a smaller solver.output_step");
+             "assembled configurations); try a tighter rtol");
   } else {
-    char* flag_name = IDAGetReturnFlagName(flag);
+    char* flag_name = CVodeGetReturnFlagName(flag);
     snprintf(why, why_len, "the integrator of the projected formulation stopped: try a tighter rtol or a smaller "
-             "solver.max_step [IDA %s: %s]", flag_name ? flag_name : "?", c->ida_msg);
+             "solver.max_step [CVODE %s: %s]", flag_name ? flag_name : "?", c->msg);
     free(flag_name);
   }
   return FMB_ADVANCE_FAILED;
@@ -204,19 +212,19 @@ static int proj_advance(void* self, double tout, double* t_reached, double* y, d
 
 static void proj_work(void* self, double* work) {
   ProjRun* c = self;
-  memcpy(work, N_VGetArrayPointer(c->work), sizeof(double) * (size_t)c->m->njoint);
+  memcpy(work, N_VGetArrayPointer(c->y) + 2 * c->m->nq, sizeof(double) * (size_t)c->nwork);
 }
 
 static void proj_stats(const void* self, fmbStats* st) {
   const ProjRun* c = self;
-  fmbStats acc = c->before_reinit;
-  add_counters(c->ida, &acc);
-  st->steps = acc.steps;
-  st->residuals = acc.residuals;
-  st->jacobians = acc.jacobians;
-  st->newton_iters = acc.newton_iters;
-  st->error_test_fails = acc.error_test_fails;
-  st->conv_fails = acc.conv_fails;
+  long v = 0;
+  void* cv = c->cvode;
+  if (CVodeGetNumSteps(cv, &v) == CV_SUCCESS) st->steps = v;
+  if (CVodeGetNumRhsEvals(cv, &v) == CV_SUCCESS) st->residuals = v;
+  if (CVodeGetNumJacEvals(cv, &v) == CV_SUCCESS) st->jacobians = v;
+  if (CVodeGetNumNonlinSolvIters(cv, &v) == CV_SUCCESS) st->newton_iters = v;
+  if (CVodeGetNumErrTestFails(cv, &v) == CV_SUCCESS) st->error_test_fails = v;
+  if (CVodeGetNumNonlinSolvConvFails(cv, &v) == CV_SUCCESS) st->conv_fails = v;
   st->jacobians_reused = 0;
 }
 

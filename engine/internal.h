@@ -73,10 +73,12 @@ typedef struct fmbSolverSettings {
      the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
   enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
   int max_order; /* BDF order cap */
-  /* ggl (default): the stabilized index-2 DAE of system.c; projected: index-1 equations with
-     minimum-norm multipliers, positions and velocities projected at every output row, which
-     passes singular configurations (integrate.c, docs/mechanisms.md) */
-  enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1 } formulation;
+  /* ggl: the stabilized index-2 DAE of system.c (IDA); projected: index-1 equations with
+     minimum-norm multipliers, positions and velocities projected onto the constraints after every
+     step (CVODE), which passes singular configurations; auto (default): ggl, and where IDA fails
+     at a rank-deficient constraint Jacobian the run continues with projected (integrate.c,
+     docs/mechanisms.md) */
+  enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1, FMB_FORM_AUTO = 2 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */
   long max_steps_per_output;
 } fmbSolverSettings;
@@ -219,6 +221,13 @@ int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const d
                            double* Qtot);
 int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
                         double* phi, double* phi_q_dense, double* phi_t, double* phi_tt);
+/* gamma = -(Phi_q v)_q v - Phi_tt (nc), the right side of Phi_q a = gamma */
+int fmb_constraints_gamma(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* gamma);
+/* scratch for augmented.c: the joint column list, a joint's phi / phi_q / phi_t / phi_tt (0..3)
+   buffers, one nq vector */
+int* fmb_workspace_cols(fmbWorkspace* w);
+double* fmb_workspace_joint_scratch(fmbWorkspace* w, int which);
+double* fmb_workspace_qscratch(fmbWorkspace* w);
 void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, fmbEnergy* e);
 int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols);
 /* the joint's columns its equations can depend on (indices into fmb_joint_cols' list, increasing) */
@@ -277,11 +286,7 @@ int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order
 /* constraint rows that depend on the others at the initial state and nearby (redundant, not a
    singular start); 0 when none or when the joints cannot be satisfied (the run says why) */
 int fmb_count_redundant(const fmbModel* m);
-typedef struct fmbAugmented {
-  double *A, *rhs, *PhiQ, *PhiQ2, *phi, *phit, *phitt, *qs, *Mb;
-  int* piv;
-  int failed_body;
-} fmbAugmented;
+typedef struct fmbAugmented fmbAugmented; /* augmented.c: the index-1 system on a sparse matrix */
 enum { FMB_AUG_MASS_FAILED = 1, FMB_AUG_FORCES_FAILED, FMB_AUG_SINGULAR, FMB_AUG_NOT_FINITE };
 fmbAugmented* fmb_augmented_new(const fmbModel* m);
 void fmb_augmented_free(fmbAugmented* g);
@@ -291,6 +296,12 @@ int fmb_augmented_solve(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, dou
 /* project q onto Phi(q, t) = 0 and v onto Phi_q v + Phi_t = 0 (mass-orthogonal corrections with
    a Tikhonov shift, so rank-deficient Phi_q is fine); 0, or 1 not converged */
 int fmb_project_state(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t, double* q, double* v);
+/* x (nq) onto the tangent space Phi_q x = 0 of the last fmb_project_state (mass-orthogonally) */
+int fmb_project_tangent(fmbWorkspace* w, fmbAugmented* g, double* x);
+int fmb_augmented_failed_body(const fmbAugmented* g);
+/* 1 when Phi_q at (q, t) has lower rank, to the relative tolerance tol, than its rows less the
+   redundant ones: a singular configuration (or near one) */
+int fmb_rank_deficient_at(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double tol);
 /* "joint 'a' row 2, ..." for the constraint rows marked in rows[] */
 void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size_t len);
 /* Tikhonov shift (relative) that makes the multipliers of redundant rows minimum-norm */

@@ -44,8 +44,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
-  static const char* const formulations[] = {"ggl", "projected", NULL}; /* order of FMB_FORM_* */
-  int formulation = FMB_FORM_GGL;
+  static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
+  int formulation = FMB_FORM_AUTO;
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
@@ -370,6 +370,11 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   } else {
     fmb_outputs_default(m);
   }
+  /* the projected formulation works on q and v alone, with the bodies' mass matrices */
+  if (m->solver.formulation == FMB_FORM_PROJECTED && m->nz > 0)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
+                           "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
+                           "its assembly: dense, or use formulation: ggl)");
   m->nredundant = fmb_count_redundant(m);
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
   return check_resources(p, m);

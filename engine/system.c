@@ -588,6 +588,53 @@ int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const d
   return 0;
 }
 
+/* gamma = -(Phi_q v)_q v - Phi_tt, the right side of Phi_q a = gamma (the constraints
+   differentiated twice in time), joint by joint: (Phi_q v)_q v by a central difference of Phi_q v
+   along v with the step h = 1e-5 (1 + |q|) / |v|. Uses w->qpert. */
+int fmb_constraints_gamma(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* gamma) {
+  const int nq = m->nq;
+  double qn = 0.0, vn = 0.0;
+  for (int i = 0; i < nq; ++i) {
+    qn += q[i] * q[i];
+    vn += v[i] * v[i];
+  }
+  qn = sqrt(qn);
+  vn = sqrt(vn);
+  const double h = vn > 0 ? 1e-5 * (1.0 + qn) / vn : 0.0;
+  double* qs = w->qpert;
+  for (int pass = 0; pass < 3; ++pass) { /* q + h v, q - h v, then Phi_tt at q */
+    if (pass < 2 && h == 0.0) continue;
+    const double sgn = pass == 0 ? 1.0 : -1.0;
+    if (pass < 2)
+      for (int i = 0; i < nq; ++i) qs[i] = q[i] + sgn * h * v[i];
+    for (int j = 0; j < m->njoint; ++j) {
+      const fmbJointInst* ji = &m->joint[j];
+      if (ji->nrows == 0) continue;
+      const int ncol = fmb_joint_cols(m, ji, w->cols);
+      const int rc = joint_eval(m, w, j, t, pass < 2 ? qs : q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt);
+      if (rc) return rc;
+      for (int r = 0; r < ji->nrows; ++r) {
+        const int row = ji->rowadr + r;
+        if (pass == 2) {
+          gamma[row] = (h > 0 ? gamma[row] : 0.0) - w->phi_tt[r];
+          continue;
+        }
+        double s = 0.0;
+        for (int c = 0; c < ncol; ++c) s += w->phi_q[(size_t)r * ncol + c] * v[w->cols[c]];
+        gamma[row] = pass == 0 ? s : -(gamma[row] - s) / (2.0 * h);
+      }
+    }
+  }
+  return 0;
+}
+
+int* fmb_workspace_cols(fmbWorkspace* w) { return w->cols; }
+double* fmb_workspace_joint_scratch(fmbWorkspace* w, int which) {
+  double* const bufs[] = {w->phi, w->phi_q, w->phi_t, w->phi_tt};
+  return bufs[which];
+}
+double* fmb_workspace_qscratch(fmbWorkspace* w) { return w->vpert; }
+
 int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* phi,
                         double* phi_q_dense, double* phi_t, double* phi_tt) {
   if (phi_q_dense) memset(phi_q_dense, 0, (size_t)m->nc * (size_t)m->nq * sizeof(double));
