@@ -100,7 +100,8 @@ for k in range(n + 1):
 for k in range(n):
     out.append("  - {name: a%d, type: revolute, body1: crank%d, body2: coupler%d, point1: [0.5, 0.0], point2: [-1.0, 0.0]}" % (k + 1, k + 1, k + 1))
     out.append("  - {name: b%d, type: revolute, body1: crank%d, body2: coupler%d, point1: [0.5, 0.0], point2: [1.0, 0.0]}" % (k + 1, k + 2, k + 1))
-out.append("outputs: [crank1.theta, crank1.omega, crank2.theta, crank%d.theta, coupler%d.theta, energy.total, constraint.position]" % (n + 1, n))
+cols = ["crank1.theta", "crank1.omega", "crank2.theta", "crank%d.theta" % (n + 1), "coupler%d.theta" % n, "energy.total", "constraint.position"]
+out.append("outputs: [%s]" % ", ".join(dict.fromkeys(cols)))
 print("\n".join(out))
 PY
 }
