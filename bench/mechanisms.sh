@@ -59,17 +59,21 @@ PY
 
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 stat_field() { sed -n "s/.*$1=\([^ ]*\).*/\1/p"; }
+# run SCENE REPS times; sets $line (the last stats line) and $cpu (the median cpu_s)
+timed_runs() {
+  local cpus=() r
+  for r in $(seq "$REPS"); do
+    "$F" run "$1" -o "${1%.yaml}.csv" 2> "${1%.yaml}.err" || true
+    line=$(tail -1 "${1%.yaml}.err")
+    cpus+=("$(echo "$line" | stat_field cpu_s)")
+  done
+  cpu=$(printf '%s\n' "${cpus[@]}" | median)
+}
 
 echo "linkages,coordinates,constraint_rows,steps,cpu_s,cpu_per_simulated_s,status" > "$RES/mechanisms_chain.csv"
 for n in 1 2 5 10 20 50; do
   chain_scene "$n" > "$WORK/chain$n.yaml"
-  cpus=()
-  for r in $(seq "$REPS"); do
-    "$F" run "$WORK/chain$n.yaml" -o "$WORK/chain$n.csv" 2> "$WORK/chain$n.err" || true
-    line=$(tail -1 "$WORK/chain$n.err")
-    cpus+=("$(echo "$line" | stat_field cpu_s)")
-  done
-  cpu=$(printf '%s\n' "${cpus[@]}" | median)
+  timed_runs "$WORK/chain$n.yaml"
   steps=$(echo "$line" | stat_field steps)
   status=$(echo "$line" | stat_field status)
   nq=$((9 * n)); nc=$((8 * n))
@@ -125,13 +129,7 @@ PY
 echo "linkages,coordinates,steps,cpu_s,cpu_per_simulated_s,status" > "$RES/mechanisms_rows.csv"
 for n in 1 2 5 10 20 50; do
   row_scene "$n" 2 > "$WORK/row$n.yaml"
-  cpus=()
-  for r in $(seq "$REPS"); do
-    "$F" run "$WORK/row$n.yaml" -o "$WORK/row$n.csv" 2> "$WORK/row$n.err" || true
-    line=$(tail -1 "$WORK/row$n.err")
-    cpus+=("$(echo "$line" | stat_field cpu_s)")
-  done
-  cpu=$(printf '%s\n' "${cpus[@]}" | median)
+  timed_runs "$WORK/row$n.yaml"
   echo "$n,$((6 * n + 3)),$(echo "$line" | stat_field steps),$cpu,$(python3 -c "print($cpu / 2.0)"),$(echo "$line" | stat_field status)" \
     | tee -a "$RES/mechanisms_rows.csv"
 done
