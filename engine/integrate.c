@@ -142,25 +142,6 @@ static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* 
   return 0;
 }
 
-/* One absolute tolerance per unknown. q and v: solver.atol, or atol in metres of motion for a
-   body that gives its coordinates' length scales (fmbBodyType.length_scale): atol / scale for a
-   coordinate and its velocity. The multipliers of an index-2 system carry roundoff of order
-   eps/h^2 (Hairer & Wanner VII.3), so weighing them like positions in the Newton test makes small
-   steps fail: they get an absolute tolerance so large that only q and v decide convergence (they
-   are out of the error test as algebraic unknowns). */
-static void absolute_tolerances(const fmbModel* m, double* atv) {
-  for (int i = 0; i < m->ny; ++i) atv[i] = i < 2 * m->nq ? m->solver.atol : 1e30;
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    if (!bi->type->length_scale) continue;
-    bi->type->length_scale(bi->self, atv + m->nq + bi->qadr); /* the velocity slot as scratch */
-    for (int i = bi->qadr; i < bi->qadr + bi->nq; ++i) {
-      const double scale = atv[m->nq + i] > 0.0 ? atv[m->nq + i] : 1.0;
-      atv[i] = atv[m->nq + i] = m->solver.atol / scale;
-    }
-  }
-}
-
 int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* diag) {
   fmbStats local_stats;
   fmbDiag local_diag;
@@ -249,7 +230,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   }
   st->rows_written = 1;
 
-  absolute_tolerances(m, atol);
+  fmb_absolute_tolerances(m, atol);
   const fmbIntegratorSetup setup = {m, w, stop, atol};
   integ = ops->create(&setup, t, y, yp, diag);
   if (!integ) {

@@ -67,6 +67,10 @@ typedef struct fmbOutput {
 
 typedef struct fmbSolverSettings {
   double t0, t_end, rtol, atol, output_step, max_step;
+  /* 1 when the scene gave solver.atol (one value for every coordinate and velocity, as it always
+     was); 0 = derived from rtol and the bodies' scales (engine/tolerance.c). atol then holds the
+     derived value for one metre of a 1 m body, which the checks that take one scalar use. */
+  int atol_given;
   double min_step;     /* IDA's step floor: solver.min_step, default FMB_MIN_STEP_FRACTION (t_end - t0) */
   int min_step_given;  /* 1 when the scene set solver.min_step (named in messages either way) */
   /* Newton systems: KLU on the Schur complement of the position rows (schur.c, default), KLU on
@@ -88,6 +92,15 @@ typedef struct fmbSolverSettings {
    singular crossing with steps of 1e-14 s, 100,000 of them per output (47 s) before giving up.
    With a floor, the first failure there ends the run and the usual diagnosis says why. */
 #define FMB_MIN_STEP_FRACTION 1e-12
+
+/* Without solver.atol a coordinate's absolute tolerance is rtol times this fraction of its body's
+   length (engine/tolerance.c): the scenes' own rule before (rtol 1e-6 with atol 1e-8, 1e-8 with
+   1e-10, for bodies about a metre long), now kept when rtol is lowered. */
+#define FMB_ATOL_PER_RTOL 1e-2
+
+/* The absolute tolerance of each of the ny unknowns (q, v, then multipliers and auxiliary
+   unknowns): solver.atol as given, or derived from rtol and the bodies' scales (tolerance.c). */
+void fmb_absolute_tolerances(const fmbModel* m, double* atol);
 
 struct fmbModel {
   char path[512];

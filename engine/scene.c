@@ -28,6 +28,16 @@ static int name_taken(const fmbModel* m, const char* name) {
   return 0;
 }
 
+/* solver.atol: a number, or `auto` (as if absent: derived from rtol, engine/tolerance.c), which
+   lets `--set solver.atol=auto` compare a scene's own atol with the derived one */
+static int get_atol(fmbParser* p, fmbNode node, double* atol, int* is_auto) {
+  static const char* const words[] = {"auto", NULL};
+  const char* text = fmbp_scalar(p, fmb_find_key(p, node, "atol"));
+  int choice = 0;
+  *is_auto = text && strcmp(text, "auto") == 0;
+  return *is_auto ? fmb_get_choice(p, node, "atol", 0, words, &choice) : fmb_get_double(p, node, "atol", FMB_POSITIVE, atol);
+}
+
 static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   fmbSolverSettings* s = &m->solver;
   s->t0 = 0.0;
@@ -49,9 +59,10 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
+  int atol_is_auto = 0;
   if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
       fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) ||
-      fmb_get_double(p, node, "atol", FMB_POSITIVE, &s->atol) ||
+      get_atol(p, node, &s->atol, &atol_is_auto) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
       fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
       fmb_get_double(p, node, "min_step", FMB_POSITIVE, &s->min_step) ||
@@ -63,6 +74,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
     return -1;
   s->formulation = formulation;
   if (fmbp_check_unknown(p, node, "solver")) return -1;
+  s->atol_given = !atol_is_auto && fmb_find_key(p, node, "atol") >= 0;
+  if (!s->atol_given) s->atol = FMB_ATOL_PER_RTOL * s->rtol; /* a metre of a 1 m body (tolerance.c) */
   s->max_steps_per_output = max_steps;
   s->linear_solver = linear_solver;
   /* Tolerances outside these bounds give a wrong answer with exit 0 (atol = 1 lets a 1 m

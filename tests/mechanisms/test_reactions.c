@@ -37,10 +37,14 @@ static double balance_drift(const char* scene, double rtol, const char* outputs,
   snprintf(r, sizeof r, "solver.rtol=%g", rtol);
   snprintf(a, sizeof a, "solver.atol=%g", rtol * 1e-2);
   snprintf(o, sizeof o, "outputs=%s", outputs ? outputs : "");
-  const char* ov[] = {r, a, o};
+  /* full error control: the balance is a velocity quantity (kinetic energy, drive power), and the
+     spin-up's default (positions) leaves velocity errors untested, so its drift would not tighten
+     with rtol as this test asks (the scene used full before issue 16). The rotor (no outputs
+     override) keeps its own settings: the count below leaves both out. */
+  const char* ov[] = {r, a, o, "solver.error_control=full"};
   fmbtCsv c;
   fmbStats st;
-  ENSURE(fmbt_run_read(scene, ov, outputs ? 3 : 2, "balance.csv", &c, &st) == 0);
+  ENSURE(fmbt_run_read(scene, ov, outputs ? 4 : 2, "balance.csv", &c, &st) == 0);
   const double *b = fmbt_col(&c, "energy.balance"), *w = fmbt_col(&c, work_col);
   double drift = 0;
   *work = 0;

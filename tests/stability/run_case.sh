@@ -53,6 +53,14 @@ esac
 CSV=$OUT/$CASE.csv; ERR=$OUT/$CASE.err
 rm -f "$CSV"
 set +e
+# The matrix's checks (constraint drift <= 1e-6, energy) were calibrated on the paper spin-ups'
+# former solver settings, error_control: full with atol 1e-8; those scenes now run the beam
+# default (positions, atol from rtol, issue 16), which leaves velocity errors untested: the drift
+# then reaches 3e-6 to 3e-5 on omega30, stiff_E100, elements128/256, slender_I1e-6. The cases keep
+# the settings they were built for; an override of the case itself still wins (it comes later).
+case $SCENE in
+  */paper/spinup_w*) set -- --set solver.error_control=full --set solver.atol=1e-8 "$@" ;;
+esac
 "$F" run "$SCENE" -o "$CSV" --quiet "$@" 2> "$ERR"
 RC=$?
 set -e
