@@ -186,8 +186,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     double t, h;
     char why[1200];
   } switched = {-1.0, 0.0, ""}; /* where formulation: auto left IDA, and IDA's reason */
+  /* formulation: auto keeps the last row's state to start the projected formulation from */
+  const int may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
+  struct {
+    double t, *y, *yp;
+  } row = {m->solver.t0, may_switch ? calloc((size_t)ny + 1, sizeof(double)) : NULL,
+           may_switch ? calloc((size_t)ny + 1, sizeof(double)) : NULL};
   memset(&before_switch, 0, sizeof before_switch);
-  if (!w || !y || !yp || !atol || !work_before) {
+  if (!w || !y || !yp || !atol || !work_before || (may_switch && (!row.y || !row.yp))) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -229,6 +235,10 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     goto done;
   }
   st->rows_written = 1;
+  if (may_switch) {
+    memcpy(row.y, y, sizeof(double) * (size_t)ny);
+    memcpy(row.yp, yp, sizeof(double) * (size_t)ny);
+  }
 
   fmb_absolute_tolerances(m, atol);
   const fmbIntegratorSetup setup = {m, w, stop, atol};
@@ -247,11 +257,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     const int flag = ops->advance(integ, tout, &tret, y, yp, &h, why, sizeof why);
     t = tret;
     if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && stop && *stop)) break;
-    if (flag == FMB_ADVANCE_FAILED && ops == &fmb_integrator_ida && m->solver.formulation == FMB_FORM_AUTO &&
-        m->nz == 0 && fmb_rank_deficient_at(m, w, tret, y, y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
+    if (flag == FMB_ADVANCE_FAILED && ops == &fmb_integrator_ida && may_switch &&
+        fmb_rank_deficient_at(m, w, tret, y, y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
       /* a singular configuration: the GGL system's Newton matrix is singular here; the projected
-         formulation (minimum-norm multipliers) passes it. From the last good state on, for the
-         rest of the run; the work integrals go on from their values. */
+         formulation (minimum-norm multipliers) passes it, for the rest of the run. It starts from
+         the last output row, not from IDA's last good step: that one lies next to the singular
+         configuration, where a start with no step history failed (scenes/parallelogram.yaml at
+         rtol 1e-8: IDA gave up 2e-4 rad before the flat position, CVODE started there stopped at
+         it). The work integrals go on from the row's values. */
       if (!opt || !opt->quiet)
         fprintf(stderr, "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
                 "the mechanism can change branch); continuing with the projected formulation (set solver.formulation: "
@@ -262,6 +275,9 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       ops->destroy(integ);
       ops = &fmb_integrator_projected;
       if (m->need_work && m->njoint > 0) memcpy(work_before, fmb_workspace_work(w), sizeof(double) * (size_t)m->njoint);
+      t = row.t;
+      memcpy(y, row.y, sizeof(double) * (size_t)ny);
+      memcpy(yp, row.yp, sizeof(double) * (size_t)ny);
       integ = ops->create(&setup, t, y, yp, diag);
       if (!integ) {
         rc = diag->code ? diag->code : FMB_EXIT_SOLVER;
@@ -306,6 +322,11 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       break;
     }
     st->rows_written++;
+    if (may_switch && ops == &fmb_integrator_ida) {
+      row.t = t;
+      memcpy(row.y, y, sizeof(double) * (size_t)ny);
+      memcpy(row.yp, yp, sizeof(double) * (size_t)ny);
+    }
     if (ops->after_row) ops->after_row(integ, t);
     if (progress.on) {
       fmbStats now;
@@ -332,6 +353,8 @@ done:
   }
   add_stats(st, &before_switch);
   free(work_before);
+  free(row.y);
+  free(row.yp);
   free(redundant_phi);
   free(y);
   free(yp);
