@@ -51,10 +51,10 @@
 
 /* up to this many unknowns (2 nq + work integrals) the Newton matrix is dense; beyond, matrix-free
    GMRES. Measured on rows of N parallelograms passing flat positions (bench/mechanisms.sh): the
-   dense path costs N^2 per step (3.3 s for 2 s of N = 50) and passes at rtol 1e-8 and 1e-9;
-   GMRES is linear (0.63 s for N = 50) but at rtol 1e-9 its runs stop at a flat position (N = 10,
-   20, 50: error test at the minimum step, not helped by tighter GMRES tolerances), so dense goes
-   as far as N = 20 linkages (246 unknowns, 0.54 s for 2 s) */
+   dense path costs N^2 per step (0.68 s for 2 s of N = 20); GMRES is linear (0.64 s for N = 50)
+   but stopped at flat positions at tighter tolerances than dense did (N = 10, 20, 50 at rtol
+   1e-9 before the rtol/10 calibration, not helped by tighter GMRES tolerances), so dense goes as
+   far as N = 20 linkages (246 unknowns) */
 #define PROJ_DENSE_MAX 256
 
 typedef struct {
