@@ -1433,45 +1433,51 @@ static int beam_centreline(const void* self, int n, double* local) {
 }
 
 /* `model: exact` (the geometrically exact beam) is its own implementation behind the same type
-   name: bodies/beam_exact.c. The other three models are this file's. */
+   name: bodies/beam_exact.c. The other three models are this file's.
+   FMB_BEAM_FD_JACOBIAN=1 in the environment (read when a scene's beam is parsed) hands the item
+   the table without the analytic Jacobians (beam_fd), so the engine differences the residual as
+   before them: for comparing the two (test_beam_jacobian_run, bench/beam_jacobian.sh). */
 extern const fmbBodyType fmb_body_beam_exact;
+static const fmbBodyType beam_fd;
 static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   extern const fmbBodyType fmb_body_beam;
   int model = BEAM_COMPLETE;
   if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model)) return NULL;
-  return model == 3 ? &fmb_body_beam_exact : &fmb_body_beam;
+  if (model == 3) return &fmb_body_beam_exact;
+  const char* fd = getenv("FMB_BEAM_FD_JACOBIAN");
+  return fd && strcmp(fd, "1") == 0 ? &beam_fd : &fmb_body_beam;
 }
 
-const fmbBodyType fmb_body_beam = {
-    .name = "beam",
-    .abi = FMB_ABI_VERSION,
-    .parse = beam_parse,
-    .destroy = beam_destroy,
-    .ncoord = beam_ncoord,
-    .initial = beam_initial,
-    .residual = beam_residual,
-    .marker = beam_marker,
-    .nwork = beam_nwork,
-    .jacobian = beam_jacobian,
-    .energy = beam_energy,
-    .output_names = fmb_beam_output_names,
-    .output_lookup = beam_output_lookup,
-    .output = beam_output,
-    .describe = beam_describe,
-    .indefinite_mass = beam_indefinite_mass,
-    .max_bdf_order = beam_max_bdf_order,
-    .invalid_state = beam_invalid_state,
-    .velocity_error_test = beam_velocity_error_test,
-    .params = beam_params,
-    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
-               "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",
-    .example_damped = "damping: 0.05\n",
+/* the ops of both tables below (fmb_body_beam and beam_fd) */
+#define BEAM_OPS \
+    .name = "beam", \
+    .abi = FMB_ABI_VERSION, \
+    .parse = beam_parse, \
+    .destroy = beam_destroy, \
+    .ncoord = beam_ncoord, \
+    .initial = beam_initial, \
+    .residual = beam_residual, \
+    .marker = beam_marker, \
+    .nwork = beam_nwork, \
+    .energy = beam_energy, \
+    .output_names = fmb_beam_output_names, \
+    .output_lookup = beam_output_lookup, \
+    .output = beam_output, \
+    .describe = beam_describe, \
+    .indefinite_mass = beam_indefinite_mass, \
+    .max_bdf_order = beam_max_bdf_order, \
+    .invalid_state = beam_invalid_state, \
+    .velocity_error_test = beam_velocity_error_test, \
+    .params = beam_params, \
+    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n" \
+               "angular_velocity: 3\nvelocity: [0.2, 0.5]\n", \
+    .example_damped = "damping: 0.05\n", \
+    .centreline = beam_centreline, \
+    .variant = beam_variant, \
+    .naux = beam_naux, \
+    .residual_aux = beam_residual_aux, \
+    .aux_initial = beam_aux_initial, \
+    .pattern = beam_pattern
 
-    .centreline = beam_centreline,
-    .variant = beam_variant,
-    .naux = beam_naux,
-    .residual_aux = beam_residual_aux,
-    .aux_initial = beam_aux_initial,
-    .pattern = beam_pattern,
-    .pattern_jacobian = beam_pattern_jacobian,
-};
+const fmbBodyType fmb_body_beam = {BEAM_OPS, .jacobian = beam_jacobian, .pattern_jacobian = beam_pattern_jacobian};
+static const fmbBodyType beam_fd = {BEAM_OPS};
