@@ -49,6 +49,9 @@ typedef struct Beam {
   double nslope[4][3];
   double pw_out[FMB_GAUSS_MAX][5], pw_full[5];
   double G_full[4][3];
+  /* for the Jacobian: G at each point (h_j = G[j].c there) and the slope-product matrices
+     H[j][l] = int_0^x N2j' N2l' (dh_j/dd_l) at each point and over a whole element */
+  double G_out[FMB_GAUSS_MAX][4][3], H_out[FMB_GAUSS_MAX][4][4], H_full[4][4];
   double kb[4][4], ka; /* element bending stiffness, axial stiffness EA/le */
 } Beam;
 
@@ -170,6 +173,12 @@ static void beam_setup(Beam* b) {
   for (int g = 0; g < b->ng; ++g) int_weights(le, b->xg[g], b->pw_out[g]);
   int_weights(le, 1.0, b->pw_full);
   h_weights(b, b->pw_full, b->G_full);
+  for (int g = 0; g < b->ng; ++g) h_weights(b, b->pw_out[g], b->G_out[g]);
+  for (int j = 0; j < 4; ++j)
+    for (int l = 0; l < 4; ++l) {
+      b->H_full[j][l] = dot3(b->G_full[j], b->nslope[l]);
+      for (int g = 0; g < b->ng; ++g) b->H_out[g][j][l] = dot3(b->G_out[g][j], b->nslope[l]);
+    }
   double ei = b->Emod * b->Izz / (le * le * le);
   double kb[4][4] = {{12.0, 6.0 * le, -12.0, 6.0 * le},
                      {6.0 * le, 4.0 * le * le, -6.0 * le, 2.0 * le * le},
@@ -238,8 +247,13 @@ static void beam_destroy(void* self) { free(self); }
 
 static int beam_ncoord(const void* self) { return 3 + ((const Beam*)self)->n; }
 
-/* residual_serial's F and csum (5 ne), and one residual for beam_aux_initial (3 + 3 ne) */
-static size_t beam_nwork(const void* self) { return (size_t)9 * (size_t)((const Beam*)self)->ne + 3; }
+/* residual_serial's F and csum (5 ne), one residual for beam_aux_initial (3 + 3 ne), and the dense
+   Jacobian's scratch (jacobian_nwork; also when banded: the engine may ask for the dense M) */
+static size_t jacobian_nwork(const Beam* b);
+static size_t beam_nwork(const void* self) {
+  const Beam* b = self;
+  return (size_t)9 * (size_t)b->ne + 3 + jacobian_nwork(b);
+}
 
 static void beam_initial(const void* self, double* q0, double* v0) {
   const Beam* b = self;
@@ -285,13 +299,15 @@ static inline void point_forces(int model, double m, const double aRD[2], const 
 }
 
 /* The frame's motion as every point sees it: acceleration a0 and gravity f in the body frame,
-   angular velocity om (om2 = om^2) and acceleration al */
+   angular velocity om (om2 = om^2) and acceleration al; c, s = cos, sin theta */
 typedef struct {
-  double a0[2], f[2], om, om2, al;
+  double a0[2], f[2], om, om2, al, c, s;
 } FrameMotion;
 
 static void frame_motion(const fmbEnv* env, const double* q, const double* v, const double* a, FrameMotion* fm) {
   double c = cos(q[2]), s = sin(q[2]);
+  fm->c = c;
+  fm->s = s;
   fm->a0[0] = c * a[0] + s * a[1];
   fm->a0[1] = -s * a[0] + c * a[1];
   fm->f[0] = fm->f[1] = 0.0;
@@ -317,70 +333,100 @@ typedef struct {
   double frame[3];         /* body-frame force sums F_R (x, y) and the theta row */
 } ElementTerms;
 
-static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                          const double* pdd, const double prefix[3], ElementTerms* out) {
-  const int ng = b->ng, model = b->model;
-  const int coupled = model != BEAM_ZOAC;
+/* An element's nodal values of p, pd, pdd (gather) and, for the coupled models, its slope
+   polynomials cp, cv, ca and the quartics the coupling integrates: pp = w2'^2, pv = w2' w2d',
+   ha = w2' w2dd' + w2d'^2 (what h^T pdd + pd^T H pd integrates) */
+typedef struct {
+  double ua[2], d[4], uda[2], dd[4], udda[2], ddd[4];
+  double cp[3], cv[3], ca[3], pp[5], pv5[5], ha[5];
+} ElementState;
+
+static void element_state(const Beam* b, int e, const double* p, const double* pd, const double* pdd,
+                          ElementState* es) {
+  gather(p, e, es->ua, es->d);
+  gather(pd, e, es->uda, es->dd);
+  gather(pdd, e, es->udda, es->ddd);
+  if (b->model != BEAM_ZOAC) {
+    double vv[5];
+    slope_products(b, es->d, es->dd, es->cp, es->cv, es->pp, es->pv5);
+    slope_poly(b, es->ddd, es->ca);
+    poly_mul(es->cp, es->ca, es->ha);
+    poly_mul(es->cv, es->cv, vv);
+    for (int k = 0; k < 5; ++k) es->ha[k] += vv[k];
+  }
+}
+
+/* One quadrature point g of element e: its deformation, coupling and the force vectors of the
+   cross-section pair (point_forces), F = F0 + y F1. Shared by the residual (element_terms) and
+   its derivatives (element_derivs). */
+typedef struct {
+  double x, n1[2], w1, w2, w2s, w1d, w2d, w2sd, wc, wcd, M2;
+  double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
+} PointTerms;
+
+static void point_terms(const Beam* b, const FrameMotion* fm, int e, int g, const ElementState* es,
+                        const double prefix[3], PointTerms* pt) {
+  const int model = b->model;
   const double le = b->le, om = fm->om, om2 = fm->om2, al = fm->al;
   const double *a0 = fm->a0, *f = fm->f;
-  const double Ipp = prefix[0], Ipv = prefix[1], Iha = prefix[2];
-  const double mhalf = 0.5 * b->rho * b->A * le;
-  double ua[2], d[4], uda[2], dd[4], udda[2], ddd[4];
-  gather(p, e, ua, d);
-  gather(pd, e, uda, dd);
-  gather(pdd, e, udda, ddd);
-  double xe = e * le;
-  memset(out, 0, sizeof *out);
-  /* slope polynomials of p, pd, pdd and the quartic products the coupling needs:
-     w2'^2, w2' w2d', and w2' w2dd' + w2d'^2 (what h^T pdd + pd^T H pd integrates) */
-  double cp[3], pp[5], pv5[5], ha[5], fc_moment[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
-  if (coupled) {
-    double cv[3], ca[3], vv[5];
-    slope_products(b, d, dd, cp, cv, pp, pv5);
-    slope_poly(b, ddd, ca);
-    poly_mul(cp, ca, ha);
-    poly_mul(cv, cv, vv);
-    for (int k = 0; k < 5; ++k) ha[k] += vv[k];
+  const double* ns = b->ns_out[g];
+  const double* nd = b->nd_out[g];
+  double xi = b->xg[g], x = e * le + xi * le;
+  double n1[2] = {1.0 - xi, xi};
+  double w1 = n1[0] * es->ua[0] + n1[1] * es->ua[1], w2 = dot4(ns, es->d), w2s = dot4(nd, es->d);
+  double w1d = n1[0] * es->uda[0] + n1[1] * es->uda[1], w2d = dot4(ns, es->dd), w2sd = dot4(nd, es->dd);
+  double w1dd = n1[0] * es->udda[0] + n1[1] * es->udda[1], w2dd = dot4(ns, es->ddd), w2sdd = dot4(nd, es->ddd);
+  double wc = 0.0, wcd = 0.0, hacc = 0.0;
+  if (model != BEAM_ZOAC) {
+    /* inboard integrals + this element's part over [0, xi], in closed form */
+    const double* pw = b->pw_out[g];
+    wc = -0.5 * (prefix[0] + dot5(es->pp, pw)); /* w_c = -1/2 p^T H p */
+    wcd = -(prefix[1] + dot5(es->pv5, pw));     /* dw_c/dt = -p^T H pd */
+    hacc = prefix[2] + dot5(es->ha, pw);        /* h^T pdd + pd^T H pd */
   }
-  for (int g = 0; g < ng; ++g) {
-    double xi = b->xg[g], x = xe + xi * le;
+  /* The cross-section's two points y = -r, +r (weights m each): every force below is affine
+     in y, F = F0 + y F1, so the sums over the pair are exact in closed form,
+     sum (A + yB)(C + yD) = 2 (AC + r^2 BD); with M2 = 2m folded into F0 and F1, one pass
+     gives what the two points gave. The accelerations split the same way:
+       a_RD = a_RD0 + y a_RD1,  a_R = a_R0 + y a_R1,  a_C and f do not depend on y. */
+  const double M2 = 2.0 * (0.5 * b->rho * b->A * le) * b->wg[g];
+  const double aRD0[2] = {a0[0] - w2 * al - (x + w1) * om2 - 2.0 * w2d * om + w1dd,
+                          a0[1] + (x + w1) * al - w2 * om2 + 2.0 * w1d * om + w2dd};
+  const double aRD1[2] = {-al + w2s * om2 - w2sdd, -w2s * al - om2 - 2.0 * w2sd * om};
+  const double aR0[2] = {a0[0] - x * om2, a0[1] + x * al};
+  const double aR1[2] = {-al, -om2};
+  const double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
+  const double zero[2] = {0.0, 0.0};
+  point_forces(model, M2, aRD0, aR0, aC, f, pt->FR0, pt->FD0, pt->FC0);
+  point_forces(model, M2, aRD1, aR1, zero, zero, pt->FR1, pt->FD1, pt->FC1);
+  pt->x = x;
+  pt->n1[0] = n1[0];
+  pt->n1[1] = n1[1];
+  pt->w1 = w1, pt->w2 = w2, pt->w2s = w2s, pt->w1d = w1d, pt->w2d = w2d, pt->w2sd = w2sd;
+  pt->wc = wc, pt->wcd = wcd, pt->M2 = M2;
+}
+
+static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
+                          const double* pdd, const double prefix[3], ElementTerms* out) {
+  const int coupled = b->model != BEAM_ZOAC;
+  const double r2 = b->r * b->r;
+  ElementState es;
+  element_state(b, e, p, pd, pdd, &es);
+  memset(out, 0, sizeof *out);
+  double fc_moment[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
+  for (int g = 0; g < b->ng; ++g) {
     const double* ns = b->ns_out[g];
     const double* nd = b->nd_out[g];
-    double n1[2] = {1.0 - xi, xi};
-    double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
-    double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
-    double w1dd = n1[0] * udda[0] + n1[1] * udda[1], w2dd = dot4(ns, ddd), w2sdd = dot4(nd, ddd);
-    double wc = 0.0, wcd = 0.0, hacc = 0.0;
-    if (coupled) {
-      /* inboard integrals + this element's part over [0, xi], in closed form */
-      const double* pw = b->pw_out[g];
-      wc = -0.5 * (Ipp + dot5(pp, pw)); /* w_c = -1/2 p^T H p */
-      wcd = -(Ipv + dot5(pv5, pw));     /* dw_c/dt = -p^T H pd */
-      hacc = Iha + dot5(ha, pw);        /* h^T pdd + pd^T H pd */
-    }
-    /* The cross-section's two points y = -r, +r (weights m each): every force below is affine
-       in y, F = F0 + y F1, so the sums over the pair are exact in closed form,
-       sum (A + yB)(C + yD) = 2 (AC + r^2 BD); with M2 = 2m folded into F0 and F1, one pass
-       gives what the two points gave. The accelerations split the same way:
-         a_RD = a_RD0 + y a_RD1,  a_R = a_R0 + y a_R1,  a_C and f do not depend on y. */
-    const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
-    const double aRD0[2] = {a0[0] - w2 * al - (x + w1) * om2 - 2.0 * w2d * om + w1dd,
-                            a0[1] + (x + w1) * al - w2 * om2 + 2.0 * w1d * om + w2dd};
-    const double aRD1[2] = {-al + w2s * om2 - w2sdd, -w2s * al - om2 - 2.0 * w2sd * om};
-    const double aR0[2] = {a0[0] - x * om2, a0[1] + x * al};
-    const double aR1[2] = {-al, -om2};
-    const double aC[2] = {-wc * om2 - hacc, wc * al + 2.0 * wcd * om};
-    const double zero[2] = {0.0, 0.0};
-    double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
-    point_forces(model, M2, aRD0, aR0, aC, f, FR0, FD0, FC0);
-    point_forces(model, M2, aRD1, aR1, zero, zero, FR1, FD1, FC1);
+    PointTerms pt;
+    point_terms(b, fm, e, g, &es, prefix, &pt);
+    const double *FR0 = pt.FR0, *FD0 = pt.FD0, *FC0 = pt.FC0, *FR1 = pt.FR1, *FD1 = pt.FD1;
     out->frame[0] += FR0[0];
     out->frame[1] += FR0[1];
     /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
-    out->frame[2] += x * FR0[1] - r2 * FR1[0] + w1 * FD0[1] - r2 * w2s * FD1[1] - w2 * FD0[0] + wc * FC0[1];
+    out->frame[2] += pt.x * FR0[1] - r2 * FR1[0] + pt.w1 * FD0[1] - r2 * pt.w2s * FD1[1] - pt.w2 * FD0[0] + pt.wc * FC0[1];
     /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
-    out->rp_a[0] += n1[0] * FD0[0];
-    out->rp_a[1] += n1[1] * FD0[0];
+    out->rp_a[0] += pt.n1[0] * FD0[0];
+    out->rp_a[1] += pt.n1[1] * FD0[0];
     for (int j = 0; j < 4; ++j) out->rp_t[j] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0];
     if (coupled) {
       /* p rows: -h F_C[0]; h's own element part through the F_C-weighted moments of the
@@ -393,13 +439,152 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
     double Gm[4][3]; /* sum over points of F_C[0] G(xi_g) */
     h_weights(b, fc_moment, Gm);
     for (int j = 0; j < 4; ++j) {
-      out->F[j] = dot3(b->G_full[j], cp);
-      out->rp_t[j] -= dot3(Gm[j], cp);
+      out->F[j] = dot3(b->G_full[j], es.cp);
+      out->rp_t[j] -= dot3(Gm[j], es.cp);
     }
-    out->dprefix[0] = dot5(pp, b->pw_full);
-    out->dprefix[1] = dot5(pv5, b->pw_full);
-    out->dprefix[2] = dot5(ha, b->pw_full);
+    out->dprefix[0] = dot5(es.pp, b->pw_full);
+    out->dprefix[1] = dot5(es.pv5, b->pw_full);
+    out->dprefix[2] = dot5(es.ha, b->pw_full);
   }
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Derivatives of element_terms. An element's terms depend on few inputs (its "local inputs",
+ * the columns below): its six dofs in q, v and a, theta (through A^T a and A^T g), theta',
+ * x'', y'', theta'' and the three prefix integrals. element_derivs differentiates exactly what
+ * point_terms and element_terms compute, by the chain rule (docs/beam.md, "Jacobian"): each point
+ * scalar s gets its gradient ds over the local inputs, and as point_forces is linear in the
+ * accelerations, the force gradients are point_forces of the acceleration gradients. The
+ * coupling scalars' gradients are the h of §1: dw_c/dd_j = -h_j, h_j = G[j].cp, and the like.
+ * ------------------------------------------------------------------------------------------- */
+enum {
+  LQ = 0,   /* its dofs in q: ua[0], ua[1], d[0..3] (gather's order) */
+  LTH = 6,  /* theta */
+  LV = 7,   /* its dofs in v */
+  LOM = 13, /* theta' */
+  LA = 14,  /* its dofs in a */
+  LAX = 20, /* x'' */
+  LAY = 21, /* y'' */
+  LAL = 22, /* theta'' */
+  LP = 23,  /* the prefix integrals P_e (3) */
+  NL = 26
+};
+
+/* the gradients over the local inputs of element_terms' outputs, and the values F (what the
+   outboard tail multiplies) */
+typedef struct {
+  double rp[6][NL]; /* rp_a[0..1] then rp_t[0..3]: the rows of the local dofs, gather's order */
+  double F[4][NL], csum[NL], dprefix[3][NL], frame[3][NL];
+  double Fv[4];
+} ElementDerivs;
+
+static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
+                           const double* pdd, const double prefix[3], ElementDerivs* D) {
+  const int model = b->model, coupled = model != BEAM_ZOAC;
+  const double r2 = b->r * b->r, om = fm->om, om2 = fm->om2, al = fm->al;
+  ElementState es;
+  element_state(b, e, p, pd, pdd, &es);
+  memset(D, 0, sizeof *D);
+  /* the frame scalars' gradients, the same at every point: d(A^T a)/dtheta = (a0_y, -a0_x) */
+  double ga0[2][NL] = {{0.0}}, gf[2][NL] = {{0.0}}, gom[NL] = {0.0}, gom2[NL] = {0.0}, gal[NL] = {0.0};
+  ga0[0][LTH] = fm->a0[1], ga0[1][LTH] = -fm->a0[0];
+  ga0[0][LAX] = fm->c, ga0[1][LAX] = -fm->s;
+  ga0[0][LAY] = fm->s, ga0[1][LAY] = fm->c;
+  gf[0][LTH] = fm->f[1], gf[1][LTH] = -fm->f[0];
+  gom[LOM] = 1.0, gom2[LOM] = 2.0 * om, gal[LAL] = 1.0;
+  const double zero[2] = {0.0, 0.0};
+  for (int g = 0; g < b->ng; ++g) {
+    const double* ns = b->ns_out[g];
+    const double* nd = b->nd_out[g];
+    PointTerms pt;
+    point_terms(b, fm, e, g, &es, prefix, &pt);
+    const double x = pt.x, w1 = pt.w1, w2 = pt.w2, w2s = pt.w2s, wc = pt.wc;
+    /* the deformation scalars are linear in the element's dofs: their gradients are the shape
+       functions; the coupling's are h (of p, pd, pdd) at the point */
+    double gw1[NL] = {0.0}, gw2[NL] = {0.0}, gw2s[NL] = {0.0}, gw1d[NL] = {0.0}, gw2d[NL] = {0.0}, gw2sd[NL] = {0.0};
+    double gw1dd[NL] = {0.0}, gw2dd[NL] = {0.0}, gw2sdd[NL] = {0.0}, gwc[NL] = {0.0}, gwcd[NL] = {0.0}, ghacc[NL] = {0.0};
+    for (int k = 0; k < 2; ++k) gw1[LQ + k] = gw1d[LV + k] = gw1dd[LA + k] = pt.n1[k];
+    for (int j = 0; j < 4; ++j) {
+      gw2[LQ + 2 + j] = gw2d[LV + 2 + j] = gw2dd[LA + 2 + j] = ns[j];
+      gw2s[LQ + 2 + j] = gw2sd[LV + 2 + j] = gw2sdd[LA + 2 + j] = nd[j];
+    }
+    double h[4] = {0.0, 0.0, 0.0, 0.0};
+    if (coupled) {
+      /* w_c = -1/2 (P0 + pp.pw), w_c' = -(P1 + pv.pw), hacc = P2 + ha.pw (point_terms) */
+      for (int j = 0; j < 4; ++j) {
+        const double* G = b->G_out[g][j];
+        const double hp = dot3(G, es.cp), hv = dot3(G, es.cv), ha = dot3(G, es.ca);
+        h[j] = hp;
+        gwc[LQ + 2 + j] = -hp;
+        gwcd[LQ + 2 + j] = -hv;
+        gwcd[LV + 2 + j] = -hp;
+        ghacc[LQ + 2 + j] = ha;
+        ghacc[LV + 2 + j] = 2.0 * hv;
+        ghacc[LA + 2 + j] = hp;
+      }
+      gwc[LP] = -0.5;
+      gwcd[LP + 1] = -1.0;
+      ghacc[LP + 2] = 1.0;
+    }
+    for (int l = 0; l < NL; ++l) {
+      /* gradients of point_terms' accelerations, then of the forces */
+      const double tRD0[2] = {ga0[0][l] - al * gw2[l] - w2 * gal[l] - om2 * gw1[l] - (x + w1) * gom2[l] -
+                                  2.0 * om * gw2d[l] - 2.0 * pt.w2d * gom[l] + gw1dd[l],
+                              ga0[1][l] + al * gw1[l] + (x + w1) * gal[l] - om2 * gw2[l] - w2 * gom2[l] +
+                                  2.0 * om * gw1d[l] + 2.0 * pt.w1d * gom[l] + gw2dd[l]};
+      const double tRD1[2] = {-gal[l] + om2 * gw2s[l] + w2s * gom2[l] - gw2sdd[l],
+                              -al * gw2s[l] - w2s * gal[l] - gom2[l] - 2.0 * om * gw2sd[l] - 2.0 * pt.w2sd * gom[l]};
+      const double tR0[2] = {ga0[0][l] - x * gom2[l], ga0[1][l] + x * gal[l]};
+      const double tR1[2] = {-gal[l], -gom2[l]};
+      const double tC[2] = {-om2 * gwc[l] - wc * gom2[l] - ghacc[l],
+                            al * gwc[l] + wc * gal[l] + 2.0 * om * gwcd[l] + 2.0 * pt.wcd * gom[l]};
+      const double tf[2] = {gf[0][l], gf[1][l]};
+      double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
+      point_forces(model, pt.M2, tRD0, tR0, tC, tf, FR0, FD0, FC0);
+      point_forces(model, pt.M2, tRD1, tR1, zero, zero, FR1, FD1, FC1);
+      /* element_terms' sums, by the product rule */
+      D->frame[0][l] += FR0[0];
+      D->frame[1][l] += FR0[1];
+      D->frame[2][l] += x * FR0[1] - r2 * FR1[0] + w1 * FD0[1] + pt.FD0[1] * gw1[l] -
+                        r2 * (w2s * FD1[1] + pt.FD1[1] * gw2s[l]) - (w2 * FD0[0] + pt.FD0[0] * gw2[l]) +
+                        wc * FC0[1] + pt.FC0[1] * gwc[l];
+      D->rp[0][l] += pt.n1[0] * FD0[0];
+      D->rp[1][l] += pt.n1[1] * FD0[0];
+      for (int j = 0; j < 4; ++j) D->rp[2 + j][l] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0] - h[j] * FC0[0];
+      D->csum[l] += FC0[0];
+    }
+    /* -F_C[0] h_j(xi_g): h_j = G[j].cp depends on the dofs through H[j][m] = dh_j/dd_m */
+    if (coupled)
+      for (int j = 0; j < 4; ++j)
+        for (int m = 0; m < 4; ++m) D->rp[2 + j][LQ + 2 + m] -= pt.FC0[0] * b->H_out[g][j][m];
+  }
+  if (coupled)
+    for (int j = 0; j < 4; ++j) {
+      /* F_j = G_full[j].cp; dprefix = (pp, pv, ha).pw_full, whose d/dd_m are the h over the
+         whole element of p, pd, pdd as for w_c above */
+      const double hp = dot3(b->G_full[j], es.cp), hv = dot3(b->G_full[j], es.cv), ha = dot3(b->G_full[j], es.ca);
+      D->Fv[j] = hp;
+      for (int m = 0; m < 4; ++m) D->F[j][LQ + 2 + m] = b->H_full[j][m];
+      D->dprefix[0][LQ + 2 + j] = 2.0 * hp;
+      D->dprefix[1][LQ + 2 + j] = hv;
+      D->dprefix[1][LV + 2 + j] = hp;
+      D->dprefix[2][LQ + 2 + j] = ha;
+      D->dprefix[2][LV + 2 + j] = 2.0 * hv;
+      D->dprefix[2][LA + 2 + j] = hp;
+    }
+}
+
+/* index in p of an element's local dof l (0..5, gather's order), or -1 at the clamped root */
+static int ldof(int e, int l) { return l < 2 ? adof(e, l) : tdof(e, l - 2); }
+
+/* the elastic force's (add_elastic) derivative over an element's local dofs: K_e, and beta K_e
+   for the velocities */
+static void elastic_block(const Beam* b, double Ke[6][6]) {
+  memset(Ke, 0, sizeof(double) * 36);
+  Ke[0][0] = Ke[1][1] = b->ka;
+  Ke[0][1] = Ke[1][0] = -b->ka;
+  for (int j = 0; j < 4; ++j)
+    for (int m = 0; m < 4; ++m) Ke[2 + j][2 + m] = b->kb[j][m];
 }
 
 static void add_element_rows(int e, const ElementTerms* t, double* Rp) {
@@ -563,9 +748,59 @@ static int beam_aux_initial(const void* self, const fmbEnv* env, const double* q
   return residual_serial(b, env, q, v, a, R, work, z);
 }
 
-/* The banded assembly's pattern over [coordinates | aux]: element e's equations (its dof rows
-   and the recursions it feeds: P_(e+1), T_(e-1), S_e) read the frame, its dofs, and the sums
-   at its own and its neighbours' nodes; the frame rows read the frame and S_0. */
+/* Element e's block of the banded assembly over [coordinates | aux]: its equations (its dof rows
+   and the recursions it feeds: S_e, P_(e+1), T_(e-1)) by the columns they read (the frame, its
+   dofs, and the sums at its own and its neighbours' nodes), with where each one sits (-1: absent
+   at the root or an end) for beam_pattern_jacobian. */
+typedef struct {
+  int nr, nc, rows[16], cols[32];
+  int r_dof[6], c_dof[6];                             /* local dofs, gather's order */
+  int r_S[3], c_S[3], c_S1[3], c_P[3], r_P1[3], c_P1[3]; /* S_e, S_(e+1), P_e, P_(e+1) */
+  int c_T, r_T0, c_T0;                                /* T_e, T_(e-1) */
+} ElementBlock;
+
+static void element_block(const Beam* b, int e, ElementBlock* k) {
+  const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
+  int nr = 0, nc = 0;
+  for (int i = 0; i < 6; ++i) k->r_dof[i] = k->c_dof[i] = -1;
+  for (int i = 0; i < 3; ++i) k->r_S[i] = k->c_S[i] = k->c_S1[i] = k->c_P[i] = k->r_P1[i] = k->c_P1[i] = -1;
+  k->c_T = k->r_T0 = k->c_T0 = -1;
+  for (int i = 0; i < 3; ++i) k->cols[nc++] = i;
+  for (int l = 0; l < 6; ++l)
+    if (ldof(e, l) >= 0) {
+      k->r_dof[l] = nr;
+      k->c_dof[l] = nc;
+      k->rows[nr++] = k->cols[nc++] = 3 + ldof(e, l);
+    }
+  for (int i = 0; i < 3; ++i) {
+    k->r_S[i] = nr;
+    k->c_S[i] = nc;
+    k->rows[nr++] = k->cols[nc++] = nq + zS(b, e) + i;
+    if (e + 1 < ne) k->c_S1[i] = nc, k->cols[nc++] = nq + zS(b, e + 1) + i;
+    if (!coupled) continue;
+    k->c_P[i] = nc;
+    k->cols[nc++] = nq + zP(b, e) + i;
+    if (e + 1 < ne) {
+      k->r_P1[i] = nr;
+      k->c_P1[i] = nc;
+      k->rows[nr++] = k->cols[nc++] = nq + zP(b, e + 1) + i;
+    }
+  }
+  if (coupled) {
+    k->c_T = nc;
+    k->cols[nc++] = nq + zT(b, e);
+    if (e > 0) {
+      k->r_T0 = nr;
+      k->c_T0 = nc;
+      k->rows[nr++] = k->cols[nc++] = nq + zT(b, e - 1);
+    }
+  }
+  k->nr = nr;
+  k->nc = nc;
+}
+
+/* The banded assembly's pattern: the element blocks (element_block), row-major each; then the
+   frame rows, which read the frame and S_0; then P_0 = 0 and T_(ne-1) = 0. */
 static long beam_pattern(const void* self, int* rows, int* cols) {
   const Beam* b = self;
   if (!b->banded) return -1;
@@ -579,27 +814,11 @@ static long beam_pattern(const void* self, int* rows, int* cols) {
     }                      \
     ++n;                   \
   } while (0)
-  int rr[16], cc[32];
   for (int e = 0; e < ne; ++e) {
-    int nr = 0, nc = 0;
-    for (int k = 0; k < 3; ++k) cc[nc++] = k;
-    for (int j = 0; j < 2; ++j)
-      if (adof(e, j) >= 0) rr[nr++] = cc[nc++] = 3 + adof(e, j);
-    for (int j = 0; j < 4; ++j)
-      if (tdof(e, j) >= 0) rr[nr++] = cc[nc++] = 3 + tdof(e, j);
-    for (int k = 0; k < 3; ++k) {
-      rr[nr++] = cc[nc++] = nq + zS(b, e) + k;
-      if (e + 1 < ne) cc[nc++] = nq + zS(b, e + 1) + k;
-      if (!coupled) continue;
-      cc[nc++] = nq + zP(b, e) + k;
-      if (e + 1 < ne) rr[nr++] = cc[nc++] = nq + zP(b, e + 1) + k;
-    }
-    if (coupled) {
-      cc[nc++] = nq + zT(b, e);
-      if (e > 0) rr[nr++] = cc[nc++] = nq + zT(b, e - 1);
-    }
-    for (int i = 0; i < nr; ++i)
-      for (int j = 0; j < nc; ++j) PAIR(rr[i], cc[j]);
+    ElementBlock k;
+    element_block(b, e, &k);
+    for (int i = 0; i < k.nr; ++i)
+      for (int j = 0; j < k.nc; ++j) PAIR(k.rows[i], k.cols[j]);
   }
   for (int i = 0; i < 3; ++i)
     for (int k = 0; k < 3; ++k) {
@@ -612,6 +831,249 @@ static long beam_pattern(const void* self, int* rows, int* cols) {
   }
 #undef PAIR
   return n;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * The analytic Jacobians, from element_derivs.
+ * ------------------------------------------------------------------------------------------- */
+
+/* Adds s * (a local gradient T of element e, its prefix part excluded) to one row of K, C, M:
+   rq, rv, ra point at the row's entry in column 0 of each, st is the distance between columns. */
+static void add_local_row(int e, const double* T, double s, double* rq, double* rv, double* ra, size_t st) {
+  for (int l = 0; l < 6; ++l) {
+    const int i = ldof(e, l);
+    if (i < 0) continue;
+    const size_t c = (size_t)(3 + i) * st;
+    rq[c] += s * T[LQ + l];
+    rv[c] += s * T[LV + l];
+    ra[c] += s * T[LA + l];
+  }
+  rq[2 * st] += s * T[LTH];
+  rv[2 * st] += s * T[LOM];
+  ra[0] += s * T[LAX];
+  ra[st] += s * T[LAY];
+  ra[2 * st] += s * T[LAL];
+}
+
+/* Adds s * g (a gradient over all of q, v, a: g, g + nq, g + 2 nq) to one row of K, C, M */
+static void add_global_row(const double* g, double s, int nq, double* rq, double* rv, double* ra, size_t st) {
+  if (s == 0.0) return;
+  for (int c = 0; c < nq; ++c) {
+    rq[(size_t)c * st] += s * g[c];
+    rv[(size_t)c * st] += s * g[nq + c];
+    ra[(size_t)c * st] += s * g[2 * nq + c];
+  }
+}
+
+/* beam_nwork's part for the dense Jacobian beyond the residual's: the z of residual_serial
+   (7 ne), element_derivs' dprefix per element (3 NL ne) and the gradients of the prefix (3) and
+   the tail (1) over q, v, a (12 nq) */
+static size_t jacobian_nwork(const Beam* b) {
+  return (size_t)b->ne * (7 + 3 * NL) + (size_t)12 * (size_t)(3 + b->n);
+}
+
+/* Dense K, C, M (column-major nq x nq; NULL blocks are skipped only all together) of the residual
+   with the sums eliminated (residual_serial). Element e's rows read the prefix P_e (the sums of
+   dprefix over the elements inboard) and the tail T_e (the sums of csum outboard), so by the
+   chain rule
+     dR_e = (local) + sum_k dR_e/dP_k dP_e[k] - F_e dT_e,   dT_e = sum_(k>e) (local + dcsum_k/dP dP_k),
+   and the frame rows A(theta) S with S = sum_e frame_e. One sweep outboard to inboard carries
+   dT_e; dP_e (nonzero on the dofs of the nodes up to e only) is rebuilt from the stored dprefix
+   gradients, without cancellation, as the sweep moves inboard. */
+static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                         double* K, double* C, double* M, double* work) {
+  const Beam* b = self;
+  if (!K || !C || !M) return -1;
+  const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
+  const size_t st = (size_t)nq;
+  double* R = work + 5 * (size_t)ne; /* residual_serial's scratch, then R, z, dprefix gradients, dP, dT */
+  double* z = R + nq;
+  double* Dp = z + 7 * (size_t)ne;
+  double* dP = Dp + 3 * NL * (size_t)ne;
+  double* dT = dP + 9 * st;
+  if (residual_serial(b, env, q, v, a, R, work, z)) return 1;
+  memset(K, 0, sizeof(double) * st * st);
+  memset(C, 0, sizeof(double) * st * st);
+  memset(M, 0, sizeof(double) * st * st);
+  memset(dP, 0, sizeof(double) * 12 * st);
+  FrameMotion fm;
+  frame_motion(env, q, v, a, &fm);
+  const double zero[3] = {0.0, 0.0, 0.0};
+  ElementDerivs D;
+  /* the frame rows R_xy = A(theta) S: theta turns them (d/dtheta = (-R_y, R_x)), S_k moves them */
+  K[2 * st + 0] += -R[1];
+  K[2 * st + 1] += R[0];
+  const double W[3][3] = {{fm.c, -fm.s, 0.0}, {fm.s, fm.c, 0.0}, {0.0, 0.0, 1.0}};
+  if (coupled) {
+    /* dP_(ne-1): the dprefix gradients of every element but the last */
+    for (int e = 0; e < ne; ++e) {
+      element_derivs(b, &fm, e, q + 3, v + 3, a + 3, z + zP(b, e), &D);
+      memcpy(Dp + 3 * NL * (size_t)e, D.dprefix, sizeof D.dprefix);
+      if (e < ne - 1)
+        for (int k = 0; k < 3; ++k) add_local_row(e, D.dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
+    }
+  }
+  for (int e = ne - 1; e >= 0; --e) {
+    element_derivs(b, &fm, e, q + 3, v + 3, a + 3, coupled ? z + zP(b, e) : zero, &D);
+    /* the rows of its dofs: local, through P_e, and the tail -F_e T_e */
+    for (int l = 0; l < 6; ++l) {
+      const int i = ldof(e, l);
+      if (i < 0) continue;
+      double *rq = K + 3 + i, *rv = C + 3 + i, *ra = M + 3 + i;
+      add_local_row(e, D.rp[l], 1.0, rq, rv, ra, st);
+      if (!coupled) continue;
+      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D.rp[l][LP + k], nq, rq, rv, ra, st);
+      if (l < 2) continue; /* the tail acts on the transverse dofs (h) */
+      add_local_row(e, D.F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
+      add_global_row(dT, -D.Fv[l - 2], nq, rq, rv, ra, st);
+    }
+    /* the frame rows: S_k gathers frame_k of every element */
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 3; ++k) {
+        if (W[i][k] == 0.0) continue;
+        add_local_row(e, D.frame[k], W[i][k], K + i, C + i, M + i, st);
+        if (coupled)
+          for (int m = 0; m < 3; ++m) add_global_row(dP + 3 * st * m, W[i][k] * D.frame[k][LP + m], nq, K + i, C + i, M + i, st);
+      }
+    if (!coupled) continue;
+    /* dT_(e-1) = dT_e + dcsum_e */
+    add_local_row(e, D.csum, 1.0, dT, dT + st, dT + 2 * st, 1);
+    for (int m = 0; m < 3; ++m)
+      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D.csum[LP + m] * dP[3 * st * m + c];
+    /* dP_(e-1): element e-1's dofs drop out; its left node keeps element e-2's part */
+    if (e == 0) break;
+    for (int k = 0; k < 3; ++k) {
+      double* g = dP + 3 * st * k;
+      for (int l = 0; l < 6; ++l) {
+        const int i = ldof(e - 1, l);
+        if (i >= 0) g[3 + i] = g[st + 3 + i] = g[2 * st + 3 + i] = 0.0;
+      }
+      if (e >= 2) {
+        const double* T = Dp + 3 * NL * (size_t)(e - 2) + NL * k;
+        for (int l = 1; l < 6; l += (l == 1 ? 3 : 1)) { /* e-2's right node: ua[1], d[2], d[3] */
+          const int i = ldof(e - 2, l);
+          g[3 + i] += T[LQ + l];
+          g[st + 3 + i] += T[LV + l];
+          g[2 * st + 3 + i] += T[LA + l];
+        }
+      }
+    }
+  }
+  /* elastic and damping forces K (p + beta pd) */
+  double Ke[6][6];
+  elastic_block(b, Ke);
+  for (int e = 0; e < ne; ++e)
+    for (int lj = 0; lj < 6; ++lj) {
+      const int j = ldof(e, lj);
+      if (j < 0) continue;
+      for (int li = 0; li < 6; ++li) {
+        const int i = ldof(e, li);
+        if (i < 0) continue;
+        K[(size_t)(3 + j) * st + 3 + i] += Ke[li][lj];
+        C[(size_t)(3 + j) * st + 3 + i] += b->beta * Ke[li][lj];
+      }
+    }
+  return 0;
+}
+
+/* The banded assembly's K = d[R; Rz]/d[q; z], C, M, one value per pair of beam_pattern: each
+   element's block from element_derivs (its rows read P_e and T_e as unknowns, so no chain
+   through other elements), the recursions' unit entries, the frame rows A(theta) S_0. */
+static int beam_pattern_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v,
+                                 const double* a, const double* z, double* K, double* C, double* M, double* work) {
+  (void)work;
+  const Beam* b = self;
+  if (!b->banded || !z) return -1;
+  const int ne = b->ne, coupled = b->model != BEAM_ZOAC;
+  FrameMotion fm;
+  frame_motion(env, q, v, a, &fm);
+  const double zero[3] = {0.0, 0.0, 0.0};
+  double Ke[6][6];
+  elastic_block(b, Ke);
+  size_t base = 0;
+  for (int e = 0; e < ne; ++e) {
+    ElementBlock k;
+    ElementDerivs D;
+    element_block(b, e, &k);
+    element_derivs(b, &fm, e, q + 3, v + 3, a + 3, coupled ? z + zP(b, e) : zero, &D);
+    const size_t nv = (size_t)k.nr * (size_t)k.nc;
+    double *Kb = K + base, *Cb = C + base, *Mb = M + base;
+    memset(Kb, 0, sizeof(double) * nv);
+    memset(Cb, 0, sizeof(double) * nv);
+    memset(Mb, 0, sizeof(double) * nv);
+    /* s * T into row ri: its local columns, and the prefix columns P_e */
+#define ROW(ri, T, s)                                                                   \
+  do {                                                                                  \
+    const size_t ro_ = (size_t)(ri) * (size_t)k.nc;                                      \
+    for (int l_ = 0; l_ < 6; ++l_)                                                         \
+      if (k.c_dof[l_] >= 0) {                                                            \
+        Kb[ro_ + k.c_dof[l_]] += (s) * (T)[LQ + l_];                                       \
+        Cb[ro_ + k.c_dof[l_]] += (s) * (T)[LV + l_];                                       \
+        Mb[ro_ + k.c_dof[l_]] += (s) * (T)[LA + l_];                                       \
+      }                                                                                 \
+    Kb[ro_ + 2] += (s) * (T)[LTH];                                                       \
+    Cb[ro_ + 2] += (s) * (T)[LOM];                                                       \
+    Mb[ro_ + 0] += (s) * (T)[LAX];                                                       \
+    Mb[ro_ + 1] += (s) * (T)[LAY];                                                       \
+    Mb[ro_ + 2] += (s) * (T)[LAL];                                                       \
+    if (coupled)                                                                        \
+      for (int m_ = 0; m_ < 3; ++m_) Kb[ro_ + k.c_P[m_]] += (s) * (T)[LP + m_];               \
+  } while (0)
+    for (int l = 0; l < 6; ++l) {
+      const int ri = k.r_dof[l];
+      if (ri < 0) continue;
+      ROW(ri, D.rp[l], 1.0);
+      for (int m = 0; m < 6; ++m)
+        if (k.c_dof[m] >= 0) {
+          Kb[(size_t)ri * k.nc + k.c_dof[m]] += Ke[l][m];
+          Cb[(size_t)ri * k.nc + k.c_dof[m]] += b->beta * Ke[l][m];
+        }
+      if (coupled && l >= 2) { /* -F_j T_e */
+        ROW(ri, D.F[l - 2], -z[zT(b, e)]);
+        Kb[(size_t)ri * k.nc + k.c_T] -= D.Fv[l - 2];
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      /* S_e - S_(e+1) - frame_e */
+      const size_t r0 = (size_t)k.r_S[i] * k.nc;
+      Kb[r0 + k.c_S[i]] += 1.0;
+      if (k.c_S1[i] >= 0) Kb[r0 + k.c_S1[i]] -= 1.0;
+      ROW(k.r_S[i], D.frame[i], -1.0);
+      if (!coupled || k.r_P1[i] < 0) continue;
+      /* P_(e+1) - P_e - dprefix_e */
+      const size_t r1 = (size_t)k.r_P1[i] * k.nc;
+      Kb[r1 + k.c_P1[i]] += 1.0;
+      Kb[r1 + k.c_P[i]] -= 1.0;
+      ROW(k.r_P1[i], D.dprefix[i], -1.0);
+    }
+    if (coupled && k.r_T0 >= 0) {
+      /* T_(e-1) - T_e - csum_e */
+      const size_t r0 = (size_t)k.r_T0 * k.nc;
+      Kb[r0 + k.c_T0] += 1.0;
+      Kb[r0 + k.c_T] -= 1.0;
+      ROW(k.r_T0, D.csum, -1.0);
+    }
+#undef ROW
+    base += nv;
+  }
+  /* the frame rows R_xy = A(theta) S_0, R_theta = S_0[2]: pairs (i, k) and (i, S_0 + k) */
+  const double* S = z + zS(b, 0);
+  const double W[3][3] = {{fm.c, -fm.s, 0.0}, {fm.s, fm.c, 0.0}, {0.0, 0.0, 1.0}};
+  const double Rx = fm.c * S[0] - fm.s * S[1], Ry = fm.s * S[0] + fm.c * S[1];
+  for (int i = 0; i < 3; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const size_t at = base + 2 * (size_t)(3 * i + k);
+      K[at] = k == 2 ? (i == 0 ? -Ry : i == 1 ? Rx : 0.0) : 0.0;
+      K[at + 1] = W[i][k];
+      C[at] = C[at + 1] = M[at] = M[at + 1] = 0.0;
+    }
+  base += 18;
+  if (coupled) /* P_0 = 0, T_(ne-1) = 0 */
+    for (int k = 0; k < 4; ++k) {
+      K[base + k] = 1.0;
+      C[base + k] = M[base + k] = 0.0;
+    }
+  return 0;
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -971,44 +1433,51 @@ static int beam_centreline(const void* self, int n, double* local) {
 }
 
 /* `model: exact` (the geometrically exact beam) is its own implementation behind the same type
-   name: bodies/beam_exact.c. The other three models are this file's. */
+   name: bodies/beam_exact.c. The other three models are this file's.
+   FMB_BEAM_FD_JACOBIAN=1 in the environment (read when a scene's beam is parsed) hands the item
+   the table without the analytic Jacobians (beam_fd), so the engine differences the residual as
+   before them: for comparing the two (test_beam_jacobian_run, bench/beam_jacobian.sh). */
 extern const fmbBodyType fmb_body_beam_exact;
+static const fmbBodyType beam_fd;
 static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   extern const fmbBodyType fmb_body_beam;
   int model = BEAM_COMPLETE;
   if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model)) return NULL;
-  return model == 3 ? &fmb_body_beam_exact : &fmb_body_beam;
+  if (model == 3) return &fmb_body_beam_exact;
+  const char* fd = getenv("FMB_BEAM_FD_JACOBIAN");
+  return fd && strcmp(fd, "1") == 0 ? &beam_fd : &fmb_body_beam;
 }
 
-const fmbBodyType fmb_body_beam = {
-    .name = "beam",
-    .abi = FMB_ABI_VERSION,
-    .parse = beam_parse,
-    .destroy = beam_destroy,
-    .ncoord = beam_ncoord,
-    .initial = beam_initial,
-    .residual = beam_residual,
-    .marker = beam_marker,
-    .nwork = beam_nwork,
-    .jacobian = NULL,
-    .energy = beam_energy,
-    .output_names = fmb_beam_output_names,
-    .output_lookup = beam_output_lookup,
-    .output = beam_output,
-    .describe = beam_describe,
-    .indefinite_mass = beam_indefinite_mass,
-    .max_bdf_order = beam_max_bdf_order,
-    .invalid_state = beam_invalid_state,
-    .velocity_error_test = beam_velocity_error_test,
-    .params = beam_params,
-    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
-               "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",
-    .example_damped = "damping: 0.05\n",
+/* the ops of both tables below (fmb_body_beam and beam_fd) */
+#define BEAM_OPS \
+    .name = "beam", \
+    .abi = FMB_ABI_VERSION, \
+    .parse = beam_parse, \
+    .destroy = beam_destroy, \
+    .ncoord = beam_ncoord, \
+    .initial = beam_initial, \
+    .residual = beam_residual, \
+    .marker = beam_marker, \
+    .nwork = beam_nwork, \
+    .energy = beam_energy, \
+    .output_names = fmb_beam_output_names, \
+    .output_lookup = beam_output_lookup, \
+    .output = beam_output, \
+    .describe = beam_describe, \
+    .indefinite_mass = beam_indefinite_mass, \
+    .max_bdf_order = beam_max_bdf_order, \
+    .invalid_state = beam_invalid_state, \
+    .velocity_error_test = beam_velocity_error_test, \
+    .params = beam_params, \
+    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n" \
+               "angular_velocity: 3\nvelocity: [0.2, 0.5]\n", \
+    .example_damped = "damping: 0.05\n", \
+    .centreline = beam_centreline, \
+    .variant = beam_variant, \
+    .naux = beam_naux, \
+    .residual_aux = beam_residual_aux, \
+    .aux_initial = beam_aux_initial, \
+    .pattern = beam_pattern
 
-    .centreline = beam_centreline,
-    .variant = beam_variant,
-    .naux = beam_naux,
-    .residual_aux = beam_residual_aux,
-    .aux_initial = beam_aux_initial,
-    .pattern = beam_pattern,
-};
+const fmbBodyType fmb_body_beam = {BEAM_OPS, .jacobian = beam_jacobian, .pattern_jacobian = beam_pattern_jacobian};
+static const fmbBodyType beam_fd = {BEAM_OPS};
