@@ -49,7 +49,9 @@
 #include "integrator.h"
 
 /* Radau IIA (s = 3) nodes, collocation matrix inverse, its eigen-decomposition (T, T^-1 as in
-   RADAU5, checked in tests/integrators) and the error-estimate coefficients d_i (IV.8 (8.19)) */
+   RADAU5; T^-1 A^-1 T = diag(gamma, [[alpha, -beta], [beta, alpha]]) to 1e-15 when written, and a
+   wrong digit would show as lost order in tests/integrators) and the error-estimate coefficients
+   d_i (IV.8 (8.19)) */
 #define SQ6 2.449489742783178098197284
 static const double C1 = (4.0 - SQ6) / 10.0, C2 = (4.0 + SQ6) / 10.0;
 static const double AINV[3][3] = {{3.224744871391589, 1.1678400846904058, -0.2531972647421809},
