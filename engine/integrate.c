@@ -19,7 +19,9 @@
 #define FMB_AUTO_SWITCH_RANK_TOL 1e-2
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  return m->solver.formulation == FMB_FORM_PROJECTED ? &fmb_integrator_projected : &fmb_integrator_ida;
+  if (m->solver.formulation == FMB_FORM_PROJECTED) return &fmb_integrator_projected;
+  /* formulation: auto with radau5 stays on radau5 (the switch below is IDA's) */
+  return m->solver.integrator == FMB_INTEG_RADAU5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
 }
 
 void fmb_print_stats(const fmbStats* s, FILE* f) {

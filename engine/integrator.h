@@ -6,6 +6,8 @@
  *
  * Built-in backends (integrator_*.c), chosen by fmb_integrator_for():
  *   ida        IDA (BDF, variable order and step) on the GGL index-2 system of system.c, KLU
+ *   radau5     Radau IIA of order 5 (3 stages, after Hairer & Wanner's RADAU5) on the same GGL
+ *              system, KLU real and complex (solver.integrator: radau5)
  *   projected  the index-1 form with minimum-norm multipliers and projections onto the
  *              constraints (solver.formulation: projected; passes singular configurations) */
 #ifndef FMB_INTEGRATOR_H
@@ -49,6 +51,7 @@ typedef struct fmbIntegratorOps {
 
 extern const fmbIntegratorOps fmb_integrator_ida;
 extern const fmbIntegratorOps fmb_integrator_projected;
+extern const fmbIntegratorOps fmb_integrator_radau5;
 
 /* the backend the model's solver settings ask for */
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m);

@@ -50,12 +50,13 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps, formulation)");
+  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps, formulation, integrator)");
   fmbp_begin_item(p);
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
-  int formulation = FMB_FORM_AUTO;
+  static const char* const integrators[] = {"ida", "radau5", NULL}; /* order of FMB_INTEG_* */
+  int formulation = FMB_FORM_AUTO, integrator = FMB_INTEG_IDA;
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
@@ -70,9 +71,16 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_choice(p, node, "error_control", 0, controls, &s->positions_only) ||
       fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
       fmb_get_int(p, node, "max_order", 0, 1, 5, &s->max_order) ||
-      fmb_get_choice(p, node, "formulation", 0, formulations, &formulation))
+      fmb_get_choice(p, node, "formulation", 0, formulations, &formulation) ||
+      fmb_get_choice(p, node, "integrator", 0, integrators, &integrator))
     return -1;
   s->formulation = formulation;
+  s->integrator = integrator;
+  /* radau5 integrates the GGL system; the projected formulation has its own backend (CVODE) */
+  if (integrator == FMB_INTEG_RADAU5 && formulation == FMB_FORM_PROJECTED)
+    return fmb_parse_error(p, fmb_find_key(p, node, "integrator"),
+                           "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
+                           "integrator (CVODE): drop one of the two keys");
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->atol_given = !atol_is_auto && fmb_find_key(p, node, "atol") >= 0;
   if (!s->atol_given) s->atol = FMB_ATOL_PER_RTOL * s->rtol; /* a metre of a 1 m body (tolerance.c) */

@@ -1,0 +1,117 @@
+#!/usr/bin/env bash
+# bench/integrators.sh — work-precision of the GGL integrators (issue 16, goal 1; docs/performance.md,
+# "Integrators"): IDA (BDF, order capped at 2 for beams) and radau5 (Radau IIA order 5,
+# engine/integrator_radau.c) on the omega0 = 15 spin-up (scenes/paper/spinup_w15.yaml: 16 elements,
+# complete model, 20 s).
+#
+#   bash bench/integrators.sh [--reps N] [--rtols "1e-5 1e-6 ..."]
+#
+# For each integrator and rtol (default 1e-5 ... 1e-10, atol = rtol / 100): CPU s (median of REPS
+# runs' cpu_s, the stats line; default 3), steps, and the tip error max |beam.tip_v - reference| over
+# the 2001 output rows. The reference: IDA at rtol 1e-12 with atol derived from it (atol = rtol/100
+# = 1e-14 costs IDA minutes, in Newton failures), or radau5 at 1e-12 if IDA fails there; the csv
+# says which. Then the CPU each integrator needs for a tip error of 1e-6 m and 1e-7 m, interpolated
+# log-log between the two settings that bracket it, and the issue's ratios against IDA's best.
+# Results: bench/results/integrators.csv, and integrators.png (both lines, log-log) when gnuplot
+# is installed.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+F=${FLEXMBD:-$ROOT/build/flexmbd}
+RES=${RESULTS:-$ROOT/bench/results}
+WORK=$(mktemp -d /tmp/flexmbd-integrators.XXXXXX)
+trap 'rm -rf "$WORK"' EXIT
+REPS=3
+RTOLS="1e-5 1e-6 1e-7 1e-8 1e-9 1e-10"
+S=scenes/paper/spinup_w15.yaml
+C=beam.tip_v
+while [ $# -gt 0 ]; do
+  case $1 in
+    --reps) REPS=$2; shift ;;
+    --rtols) RTOLS=$2; shift ;;
+    -h|--help) sed -n 2,17p "$0"; exit 0 ;;
+    *) echo "integrators.sh: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+mkdir -p "$RES"
+median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
+field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" | tail -1; }
+
+REF="ida rtol 1e-12 (atol derived)"
+if ! "$F" run "$S" -o "$WORK/ref.csv" --quiet --set solver.rtol=1e-12 --set solver.atol=auto 2>/dev/null; then
+  REF="radau5 rtol 1e-12 atol 1e-14"
+  "$F" run "$S" -o "$WORK/ref.csv" --quiet --set solver.integrator=radau5 --set solver.rtol=1e-12 --set solver.atol=1e-14
+fi
+OUT=$RES/integrators.csv
+echo "integrator,rtol,atol,cpu_s,steps,residuals,jacobians,tip_error_m,reference" > "$OUT"
+# ida with error_control: positions (the beams' default) and full (IDA's best setting for a tip
+# error of 1e-6 m in issue 16's search of 40 settings: rtol 1e-8, atol 1e-10), radau5 with the default
+for cfg in ida:positions ida_full:full radau5:positions; do
+  integ=${cfg%%:*} ec=${cfg#*:}
+  for r in $RTOLS; do
+    a=$(awk -v r="$r" 'BEGIN { printf "%g", r / 100 }')
+    cpus="" line=""
+    for _ in $(seq "$REPS"); do
+      line=$("$F" run "$S" -o "$WORK/out.csv" --set solver.integrator=${integ%_full} --set solver.error_control=$ec \
+             --set solver.rtol=$r --set solver.atol=$a \
+             --reference "$WORK/ref.csv" --columns "$C" 2>&1 | tail -1)
+      cpus="$cpus $(echo "$line" | field cpu_s)"
+    done
+    stats=$("$F" run "$S" -o "$WORK/out.csv" --quiet --set solver.integrator=${integ%_full} --set solver.error_control=$ec \
+            --set solver.rtol=$r --set solver.atol=$a 2>&1 | tail -1)
+    printf '%s,%s,%s,%s,%s,%s,%s,%s,%s\n' $integ $r $a "$(echo $cpus | tr ' ' '\n' | median)" "$(echo "$stats" | field steps)" \
+      "$(echo "$stats" | field residuals)" "$(echo "$stats" | field jacobians)" "$(echo "$line" | field max_abs)" "$REF" >> "$OUT"
+  done
+done
+column -s, -t < "$OUT"
+
+# CPU for a tip error: log-log interpolation between the first pair of settings (by falling rtol)
+# whose errors bracket the target; "n/a" when no pair does
+echo
+awk -F, 'NR > 1 { n[$1]++; e[$1, n[$1]] = $8; c[$1, n[$1]] = $4 }
+function need(k, target,   i, x0, x1, y0, y1) {
+  if (e[k, 1] + 0 <= target) return c[k, 1] + 0 # the loosest setting already meets it: an upper bound
+  for (i = 1; i < n[k]; ++i)
+    if (e[k, i] + 0 > target && e[k, i + 1] + 0 <= target) {
+      x0 = log(e[k, i]); x1 = log(e[k, i + 1]); y0 = log(c[k, i]); y1 = log(c[k, i + 1])
+      return exp(y0 + (log(target) - x0) * (y1 - y0) / (x1 - x0))
+    }
+  return -1
+}
+function show(v) { return v < 0 ? "n/a" : sprintf("%.4f s", v) }
+END {
+  for (t = 1; t <= 2; ++t) {
+    target = t == 1 ? 1e-6 : 1e-7
+    ida = need("ida", target); full = need("ida_full", target); rad = need("radau5", target)
+    best = (ida > 0 && (full < 0 || ida < full)) ? ida : full
+    printf "tip error %g m: ida %s, ida_full %s, radau5 %s", target, show(ida), show(full), show(rad)
+    if (best > 0 && rad > 0) printf "; best ida / radau5 = %.1fx (goal %s)", best / rad, t == 1 ? ">= 5x" : ">= 10x"
+    printf "\n"
+  }
+}' "$OUT"
+awk -F, 'NR > 1 && $2 == "1e-6" { c[$1] = $4; e[$1] = $8 }
+END { for (k in c) if (k != "radau5" && c[k] > 0 && c["radau5"] > 0)
+  printf "rtol 1e-6: %s %.4f s (tip error %s m), radau5 %.4f s (tip error %s m): radau5 / %s = %.2f (goal <= 1)\n",
+         k, c[k], e[k], c["radau5"], e["radau5"], k, c["radau5"] / c[k] }' "$OUT"
+
+if command -v gnuplot >/dev/null; then
+  awk -F, -v d="$WORK" 'NR > 1 { print $8, $4 > (d "/" $1 ".dat") }' "$OUT"
+  gnuplot <<EOF
+set terminal pngcairo size 800,560 noenhanced
+set format x "%.0e"
+set format y "%g"
+set key top right
+set output "$RES/integrators.png"
+set logscale xy
+set xlabel "tip error max |beam.tip_v - reference| (m)"
+set ylabel "CPU (s), median of $REPS"
+set title "omega0 = 15 spin-up, 16 elements, complete, 20 s: rtol 1e-5 ... 1e-10, atol rtol/100"
+set grid
+plot "$WORK/ida.dat" using 1:2 with linespoints title "ida (BDF, order <= 2), error_control positions", \
+     "$WORK/ida_full.dat" using 1:2 with linespoints title "ida, error_control full", \
+     "$WORK/radau5.dat" using 1:2 with linespoints title "radau5 (Radau IIA, order 5)"
+EOF
+  echo "plot: $RES/integrators.png"
+fi
+echo "reference: $REF; results: $OUT"

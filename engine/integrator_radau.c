@@ -1,0 +1,752 @@
+/* integrator_radau.c — Radau IIA of order 5 (3 stages) on the GGL index-2 system of system.c,
+ * after Hairer & Wanner's RADAU5 (Solving ODEs II, 2nd ed.: IV.8 for the implementation, VI.1 and
+ * VII.4 for index-2 problems), written for the fully implicit F(t, y, y') = 0.
+ *
+ * Why: BDF above order 2 amplifies the undamped structural modes of a beam (integrator_ida.c), so
+ * IDA buys accuracy at the second-order rate. Radau IIA is L-stable at order 5 (order 5 in q and v
+ * also for index-2 systems, VII.4 Theorem 4.4 with s = 3: 2s - 1; order s = 3 in the multipliers).
+ *
+ * Unknowns are the stage increments Z_i = Y_i - y_n (IV.8 (8.2)); the stage derivatives follow
+ * from the collocation conditions as Y'_i = (1/h) sum_j (A^-1)_ij Z_j, and the stage equations
+ * are F(t_n + c_i h, y_n + Z_i, Y'_i) = 0, i = 1..3. Simplified Newton with J_y = dF/dy and
+ * J_y' = dF/dy' frozen at (t_n, y_n, y'_n):
+ *   (I (x) J_y + (1/h) A^-1 (x) J_y') dZ = -F,
+ * and with A^-1 = T Lambda T^-1, Lambda = diag(gamma, [[alpha, -beta], [beta, alpha]]), dZ = T dW
+ * (IV.8 (8.15)-(8.17)) this splits into one real system of size ny,
+ *   (J_y + gamma/h J_y') dW_1 = r_1      (exactly fmb_system_jacobian with cj = gamma/h),
+ * and one complex one, (J_y + (alpha + i beta)/h J_y') (dW_2 + i dW_3) = r_2 + i r_3, the real
+ * 2ny x 2ny system [[A, -B], [B, A]] written as complex numbers, solved with KLU's complex LU on
+ * the model's own pattern. J_y and J_y' are kept apart (two evaluations at cj = 0 and cj = 1, the
+ * second reassembling the bodies' blocks of the first: J is linear in cj), so a new step size
+ * costs two refactorizations and no new derivatives.
+ *
+ * Error estimate (IV.8 (8.19)-(8.20), RADAU5's ESTRAD with the mass matrix J_y'):
+ *   err = (J_y + gamma/h J_y')^-1 J_y' (y'_n + (1/h) sum_i d_i Z_i),
+ * with a second evaluation through the residual after a rejected or first step (8.20). lambda
+ * and mu (index 2) and the bodies' auxiliary unknowns carry an absolute tolerance of 1e30
+ * (tolerance.c), which leaves them out of both the error and the Newton norms; RADAU5's h-scaling
+ * of index-2 components (VII.4) is therefore not needed. Under solver.error_control: positions the
+ * velocities leave the error norm too, as in IDA. Tolerances are mapped as RADAU5 maps them
+ * (rtol' = 0.1 rtol^(2/3), atol' = atol rtol'/rtol): the embedded estimate is of order 3 while the
+ * solution is of order 5.
+ *
+ * Step size: RADAU5's controller with Gustafsson's predictive variant (IV.8 (8.21)-(8.25)), the
+ * Jacobian kept while Newton contracts fast (theta <= FMB_RADAU_THET) and the factorization kept
+ * while the step would change by less than 20 %. Dense output: the collocation polynomial
+ * (IV.8 (8.26)-(8.28)), also for the next step's Newton start. Work integrals (m->need_work): the
+ * joints' powers at the stages with the Radau quadrature (the method's own weights b_i = a_3i,
+ * order 5), and between steps the cubic through the powers at t_n and the stages; they are not in
+ * the error test (IDA's quadratures are, for applied forces).
+ *
+ * Everything is allocated in create(); advance() allocates only when KLU has to choose new pivots
+ * (a refactorization whose condition estimate has degraded), as SUNDIALS' own KLU module does. */
+#include <klu.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "integrator.h"
+
+/* Radau IIA (s = 3) nodes, collocation matrix inverse, its eigen-decomposition (T, T^-1 as in
+   RADAU5; T^-1 A^-1 T = diag(gamma, [[alpha, -beta], [beta, alpha]]) to 1e-15 when written, and a
+   wrong digit would show as lost order in tests/integrators) and the error-estimate coefficients
+   d_i (IV.8 (8.19)) */
+#define SQ6 2.449489742783178098197284
+static const double C1 = (4.0 - SQ6) / 10.0, C2 = (4.0 + SQ6) / 10.0;
+static const double AINV[3][3] = {{3.224744871391589, 1.1678400846904058, -0.2531972647421809},
+                                  {-3.5678400846904057, 0.7752551286084112, 1.053197264742181},
+                                  {5.531972647421811, -7.531972647421811, 5.0}};
+/* b_i = a_3i (stiffly accurate): the quadrature for the work integrals */
+static const double BQ[3] = {(16.0 - SQ6) / 36.0, (16.0 + SQ6) / 36.0, 1.0 / 9.0};
+static const double GAMMA = 3.6378342527444962, ALPHA = 2.6810828736277523, BETA = 3.0504301992474105;
+static const double T_[3][3] = {{9.1232394870892942792e-02, -0.14125529502095420843, -3.0029194105147424492e-02},
+                                {0.24171793270710701896, 0.20412935229379993199, 0.38294211275726193779},
+                                {0.96604818261509293619, 1.0, 0.0}};
+static const double TI[3][3] = {{4.3255798900631553510, 0.33919925181580986954, 0.54177053993587487119},
+                                {-4.1787185915519047273, -0.32768282076106238708, 0.47662355450055045196},
+                                {-0.50287263494578687595, 2.5719269498556054292, -0.59603920482822492497}};
+static const double DD[3] = {-(13.0 + 7.0 * SQ6) / 3.0, (-13.0 + 7.0 * SQ6) / 3.0, -1.0 / 3.0};
+
+/* RADAU5's defaults (IV.8; WORK(2..9) of the Fortran code): at most NIT Newton iterations, safety
+   factor, step ratio bounds 1/8 <= h/hnew <= 5.
+   THET: keep the Jacobian when Newton contracted by this factor or better. RADAU5's default is
+   0.001 for cheap Jacobians and its documentation suggests 0.1 when they are expensive, as ours
+   are (finite differences over the beam's dense blocks).
+   QUOT1, QUOT2: keep h (and the two factorizations) when the controller would change it by a ratio
+   in [QUOT1, QUOT2]. RADAU5 keeps it for [1, 1.2]; here a factorization pair of the 108 x 108
+   spin-up matrix costs as much as about 8 residuals, and the steps' ratios wander between 1.2 and
+   2 on smooth motion, so 1.2 refactorized at nearly every step (119 LU pairs for 203 steps at
+   rtol 1e-6, 0.15 s); up to 4, but for at most KEEP_MAX steps in a row above 1.2, so that h is
+   never held far below what the error allows (0.085 s for 291 steps, the same error; held without
+   a limit, h stayed where a ratio of 2-4 kept it, more steps for nothing). Must stay below 1/FACR
+   = 8, or h never grows at all. */
+#define FMB_RADAU_NIT 7
+#define FMB_RADAU_SAFE 0.9
+#define FMB_RADAU_FACL 5.0
+#define FMB_RADAU_FACR 0.125
+#define FMB_RADAU_QUOT1 1.0
+#define FMB_RADAU_QUOT2 4.0
+#define FMB_RADAU_KEEP_MAX 10
+#define FMB_RADAU_THET 0.1
+#define FMB_RADAU_MAX_SINGULAR 5
+
+typedef struct {
+  const fmbModel* m;
+  fmbWorkspace* w;
+  const volatile sig_atomic_t* stop;
+  int ny, nerr, nnewt; /* unknowns; components in the error norm (the first nerr); in the Newton norm */
+  double rtol;         /* RADAU5's mapped tolerance */
+  double *atol, *scal, *ewt;
+  double t, h, hold, t_end, hmax;
+  double *y, *yp;                 /* the state at t (last accepted step) */
+  double *z[3], *wt[3], *fz[3];   /* stage increments, transformed ones, residuals / right sides */
+  double *ys, *yps;               /* one stage's value and derivative */
+  double *cont[4];                /* dense output: y_{n+1} and the Newton-form differences */
+  double* e2rhs;                  /* complex right side, interleaved (2 ny) */
+  double *err, *err2;
+  /* Jacobian parts on the model's CSC pattern, and the two iteration matrices */
+  double *jy, *jyp, *e1, *e2;
+  SuiteSparse_long *colptr, *rowind;
+  klu_l_common common;
+  klu_l_symbolic* symbolic;
+  klu_l_numeric *num1, *num2;
+  double h_lu;                   /* the step the factorizations are for (0: none) */
+  int need_jac;                  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
+  int caljac;                    /* the Jacobian was evaluated at this step's start (t, y) */
+  int first, reject, have_cont, nsing;
+  int kept;                      /* consecutive steps that kept h although it could grow by > 1.2 */
+  double hacc, erracc, faccon, theta, fnewt;
+  /* work integrals */
+  int nwork;
+  double *work_old, *work_new, *p0, *pst[3], *work_out;
+  fmbStats st;
+  long lu_reuses;
+} RadauRun;
+
+static void radau_destroy(void* self) {
+  RadauRun* c = self;
+  if (!c) return;
+  if (c->num1) klu_l_free_numeric(&c->num1, &c->common);
+  if (c->num2) klu_zl_free_numeric(&c->num2, &c->common);
+  if (c->symbolic) klu_l_free_symbolic(&c->symbolic, &c->common);
+  double** vs[] = {&c->atol, &c->scal, &c->ewt, &c->y, &c->yp, &c->ys, &c->yps, &c->e2rhs, &c->err, &c->err2,
+                   &c->jy, &c->jyp, &c->e1, &c->e2, &c->work_old, &c->work_new, &c->p0, &c->work_out};
+  for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) free(*vs[i]);
+  for (int k = 0; k < 3; ++k) {
+    free(c->z[k]);
+    free(c->wt[k]);
+    free(c->fz[k]);
+    free(c->pst[k]);
+  }
+  for (int k = 0; k < 4; ++k) free(c->cont[k]);
+  free(c->colptr);
+  free(c->rowind);
+  free(c);
+}
+
+static double* dalloc(size_t n) { return calloc(n ? n : 1, sizeof(double)); }
+
+/* RADAU5's weights: scal_i = atol_i + rtol |y_i| */
+static void update_scal(RadauRun* c) {
+  for (int i = 0; i < c->ny; ++i) {
+    c->scal[i] = c->atol[i] + c->rtol * fabs(c->y[i]);
+    c->ewt[i] = 1.0 / c->scal[i];
+  }
+}
+
+/* the joints' powers at (t, y) into p (njoint) */
+static int powers(RadauRun* c, double t, const double* y, double* p) {
+  const fmbModel* m = c->m;
+  for (int j = 0; j < m->njoint; ++j) {
+    p[j] = fmb_joint_power(m, c->w, j, t, y, y + m->nq, y + 2 * m->nq);
+    if (!isfinite(p[j])) return 1;
+  }
+  return 0;
+}
+
+static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  const fmbModel* m = s->m;
+  const int ny = m->ny;
+  RadauRun* c = calloc(1, sizeof *c);
+  if (!c) goto oom;
+  c->m = m;
+  c->w = s->w;
+  c->stop = s->stop;
+  c->ny = ny;
+  const size_t n = (size_t)ny, nnz = (size_t)m->nnz;
+  c->atol = dalloc(n);
+  c->scal = dalloc(n);
+  c->ewt = dalloc(n);
+  c->y = dalloc(n);
+  c->yp = dalloc(n);
+  c->ys = dalloc(n);
+  c->yps = dalloc(n);
+  c->e2rhs = dalloc(2 * n);
+  c->err = dalloc(n);
+  c->err2 = dalloc(n);
+  c->jy = dalloc(nnz);
+  c->jyp = dalloc(nnz);
+  c->e1 = dalloc(nnz);
+  c->e2 = dalloc(2 * nnz);
+  c->colptr = calloc(n + 1, sizeof(SuiteSparse_long));
+  c->rowind = calloc(nnz ? nnz : 1, sizeof(SuiteSparse_long));
+  int ok = c->atol && c->scal && c->ewt && c->y && c->yp && c->ys && c->yps && c->e2rhs && c->err && c->err2 && c->jy &&
+           c->jyp && c->e1 && c->e2 && c->colptr && c->rowind;
+  for (int k = 0; k < 3; ++k) {
+    c->z[k] = dalloc(n);
+    c->wt[k] = dalloc(n);
+    c->fz[k] = dalloc(n);
+    ok = ok && c->z[k] && c->wt[k] && c->fz[k];
+  }
+  for (int k = 0; k < 4; ++k) ok = ok && (c->cont[k] = dalloc(n));
+  if (!ok) goto oom;
+  for (int i = 0; i <= ny; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
+  for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
+  klu_l_defaults(&c->common);
+  c->symbolic = klu_l_analyze(ny, c->colptr, c->rowind, &c->common);
+  if (!c->symbolic) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
+    radau_destroy(c);
+    return NULL;
+  }
+
+  /* RADAU5's tolerance map (see the head comment); the index-2 unknowns keep their 1e30 */
+  const fmbSolverSettings* so = &m->solver;
+  c->rtol = 0.1 * pow(so->rtol, 2.0 / 3.0);
+  const double quot = c->rtol / so->rtol;
+  const int ndiff = so->positions_only ? m->nq : 2 * m->nq;
+  for (int i = 0; i < ny; ++i) {
+    c->atol[i] = s->atol[i] >= 1e29 ? s->atol[i] : s->atol[i] * quot;
+    if (s->atol[i] < 1e29) c->nnewt++;
+    if (i < ndiff && s->atol[i] < 1e29) c->nerr++;
+  }
+  if (c->nnewt == 0) c->nnewt = 1;
+  if (c->nerr == 0) c->nerr = 1;
+  /* Newton's stopping tolerance, relative to the error weights (IV.8 (8.12), RADAU5's FNEWT) */
+  c->fnewt = fmax(10.0 * 2.220446049250313e-16 / c->rtol, fmin(0.03, sqrt(c->rtol)));
+
+  memcpy(c->y, y0, sizeof(double) * n);
+  memcpy(c->yp, yp0, sizeof(double) * n);
+  c->t = t0;
+  c->t_end = so->t_end;
+  c->hmax = so->max_step > 0 ? so->max_step : so->t_end - so->t0;
+  /* a small first step: RADAU5 leaves it to the caller; the first-step rejection (h / 10) and
+     the growth bound (8x per step) reach the dynamics' step within a few steps */
+  c->h = fmin(c->hmax, 1e-3 * so->output_step);
+  c->h = fmax(c->h, 10.0 * so->min_step);
+  c->first = 1;
+  c->need_jac = 1;
+  c->faccon = 1.0;
+  c->theta = 1.0;
+  update_scal(c);
+
+  if (m->need_work && m->njoint > 0) {
+    c->nwork = m->njoint;
+    const size_t nw = (size_t)m->njoint;
+    c->work_old = dalloc(nw);
+    c->work_new = dalloc(nw);
+    c->p0 = dalloc(nw);
+    c->work_out = dalloc(nw);
+    ok = c->work_old && c->work_new && c->p0 && c->work_out;
+    for (int k = 0; k < 3; ++k) ok = ok && (c->pst[k] = dalloc(nw));
+    if (!ok) goto oom;
+    if (powers(c, t0, c->y, c->p0)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: a joint's power is not finite at t = %g", t0);
+      radau_destroy(c);
+      return NULL;
+    }
+  }
+  return c;
+oom:
+  fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
+  radau_destroy(c);
+  return NULL;
+}
+
+/* J_y and J_y' at (t, y, y') from two evaluations of fmb_system_jacobian (J = J_y + cj J_y'):
+   cj = 0 with fresh derivatives, then cj = 1 reassembling the same bodies' blocks */
+static int evaluate_jacobian(RadauRun* c) {
+  const fmbModel* m = c->m;
+  int rc = fmb_system_jacobian(m, c->w, c->t, 0.0, c->y, c->yp, c->ewt, 0, c->jy, NULL);
+  if (rc) return rc;
+  rc = fmb_system_jacobian(m, c->w, c->t, 1.0, c->y, c->yp, c->ewt, 1, c->jyp, NULL);
+  if (rc) return rc;
+  for (long k = 0; k < m->nnz; ++k) c->jyp[k] -= c->jy[k];
+  c->st.jacobians++;
+  c->caljac = 1;
+  return 0;
+}
+
+/* a refactorization with the old pivot order, or a new factorization when that is missing or its
+   condition estimate has degraded (as SUNDIALS' KLU module decides); 0 ok, 1 singular */
+static int factor(RadauRun* c, klu_l_numeric** num, double* data, int complex_values) {
+  const double tiny = pow(2.220446049250313e-16, 2.0 / 3.0);
+  if (*num) {
+    const SuiteSparse_long ok =
+        complex_values ? klu_zl_refactor(c->colptr, c->rowind, data, c->symbolic, *num, &c->common)
+                       : klu_l_refactor(c->colptr, c->rowind, data, c->symbolic, *num, &c->common);
+    const SuiteSparse_long rc = ok ? (complex_values ? klu_zl_rcond(c->symbolic, *num, &c->common)
+                                                     : klu_l_rcond(c->symbolic, *num, &c->common))
+                                   : 0;
+    if (ok && rc && c->common.rcond >= tiny) return 0;
+    if (complex_values)
+      klu_zl_free_numeric(num, &c->common);
+    else
+      klu_l_free_numeric(num, &c->common);
+  }
+  *num = complex_values ? klu_zl_factor(c->colptr, c->rowind, data, c->symbolic, &c->common)
+                        : klu_l_factor(c->colptr, c->rowind, data, c->symbolic, &c->common);
+  return *num ? 0 : 1;
+}
+
+/* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized */
+static int decompose(RadauRun* c) {
+  const long nnz = c->m->nnz;
+  const double g = GAMMA / c->h, a = ALPHA / c->h, b = BETA / c->h;
+  for (long k = 0; k < nnz; ++k) {
+    c->e1[k] = c->jy[k] + g * c->jyp[k];
+    c->e2[2 * k] = c->jy[k] + a * c->jyp[k];
+    c->e2[2 * k + 1] = b * c->jyp[k];
+  }
+  if (factor(c, &c->num1, c->e1, 0) || factor(c, &c->num2, c->e2, 1)) {
+    c->h_lu = 0.0;
+    return 1;
+  }
+  c->h_lu = c->h;
+  return 0;
+}
+
+static int solve_real(RadauRun* c, double* b) { return klu_l_solve(c->symbolic, c->num1, c->ny, 1, b, &c->common) ? 0 : 1; }
+
+/* y += J_y' x on the CSC pattern */
+static void jyp_times(const RadauRun* c, const double* x, double* y) {
+  const fmbModel* m = c->m;
+  for (int col = 0; col < c->ny; ++col) {
+    const double xc = x[col];
+    if (xc == 0.0) continue;
+    for (long k = m->colptr[col]; k < m->colptr[col + 1]; ++k) y[m->rowind[k]] += c->jyp[k] * xc;
+  }
+}
+
+/* Y'_i = (1/h) sum_j (A^-1)_ij Z_j into out */
+static void stage_derivative(const RadauRun* c, int i, double h, double* out) {
+  const double a0 = AINV[i][0] / h, a1 = AINV[i][1] / h, a2 = AINV[i][2] / h;
+  const double *z0 = c->z[0], *z1 = c->z[1], *z2 = c->z[2];
+  for (int k = 0; k < c->ny; ++k) out[k] = a0 * z0[k] + a1 * z1[k] + a2 * z2[k];
+}
+
+enum { NEWTON_OK = 0, NEWTON_SLOW = 1, NEWTON_DIVERGED = 2, NEWTON_FATAL = 3 };
+
+/* The simplified Newton iteration of IV.8 (8.12)-(8.16) on the stage increments, started from
+   the current c->z. NEWTON_SLOW sets *hfac, RADAU5's prediction of a step that converges. */
+static int newton(RadauRun* c, int* newt_out, double* hfac) {
+  const fmbModel* m = c->m;
+  const int ny = c->ny;
+  const double h = c->h;
+  for (int k = 0; k < ny; ++k)
+    for (int i = 0; i < 3; ++i) c->wt[i][k] = TI[i][0] * c->z[0][k] + TI[i][1] * c->z[1][k] + TI[i][2] * c->z[2][k];
+  c->faccon = pow(fmax(c->faccon, 2.220446049250313e-16), 0.8);
+  c->theta = fabs(FMB_RADAU_THET);
+  double dynold = 0.0, thqold = 0.0;
+  int newt = 0;
+  for (;;) {
+    if (newt >= FMB_RADAU_NIT) {
+      *newt_out = newt;
+      return NEWTON_DIVERGED;
+    }
+    if (c->stop && *c->stop) return NEWTON_FATAL;
+    for (int i = 0; i < 3; ++i) {
+      for (int k = 0; k < ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
+      stage_derivative(c, i, h, c->yps);
+      const double ci = i == 0 ? C1 : i == 1 ? C2 : 1.0;
+      const int rc = fmb_system_residual(m, c->w, c->t + ci * h, c->ys, c->yps, c->fz[i]);
+      c->st.residuals++;
+      if (rc < 0) return NEWTON_FATAL;
+      if (rc > 0) { /* not finite: a smaller step */
+        *newt_out = newt;
+        return NEWTON_DIVERGED;
+      }
+    }
+    /* right sides -(T^-1 (x) I) F: real part into fz[0], complex interleaved into e2rhs */
+    for (int k = 0; k < ny; ++k) {
+      const double f0 = c->fz[0][k], f1 = c->fz[1][k], f2 = c->fz[2][k];
+      c->fz[0][k] = -(TI[0][0] * f0 + TI[0][1] * f1 + TI[0][2] * f2);
+      c->e2rhs[2 * k] = -(TI[1][0] * f0 + TI[1][1] * f1 + TI[1][2] * f2);
+      c->e2rhs[2 * k + 1] = -(TI[2][0] * f0 + TI[2][1] * f1 + TI[2][2] * f2);
+    }
+    if (solve_real(c, c->fz[0]) || !klu_zl_solve(c->symbolic, c->num2, ny, 1, c->e2rhs, &c->common)) {
+      *newt_out = newt;
+      return NEWTON_DIVERGED;
+    }
+    newt++;
+    c->st.newton_iters++;
+    double dyno = 0.0;
+    for (int k = 0; k < ny; ++k) {
+      const double e = c->ewt[k], a = c->fz[0][k] * e, b = c->e2rhs[2 * k] * e, d = c->e2rhs[2 * k + 1] * e;
+      dyno += a * a + b * b + d * d;
+    }
+    dyno = sqrt(dyno / (3.0 * c->nnewt));
+    if (!isfinite(dyno)) {
+      *newt_out = newt;
+      return NEWTON_DIVERGED;
+    }
+    /* convergence rate theta and the predicted error after NIT iterations (IV.8 (8.13)-(8.14)) */
+    if (newt > 1 && newt < FMB_RADAU_NIT) {
+      const double thq = dyno / dynold;
+      c->theta = newt == 2 ? thq : sqrt(thq * thqold);
+      thqold = thq;
+      if (c->theta < 0.99) {
+        c->faccon = c->theta / (1.0 - c->theta);
+        const double dyth = c->faccon * dyno * pow(c->theta, FMB_RADAU_NIT - 1 - newt) / c->fnewt;
+        if (dyth >= 1.0) {
+          const double qnewt = fmax(1e-4, fmin(20.0, dyth));
+          *hfac = 0.8 * pow(qnewt, -1.0 / (4.0 + FMB_RADAU_NIT - 1 - newt));
+          *newt_out = newt;
+          return NEWTON_SLOW;
+        }
+      } else {
+        *newt_out = newt;
+        return NEWTON_DIVERGED;
+      }
+    }
+    dynold = fmax(dyno, 2.220446049250313e-16);
+    for (int k = 0; k < ny; ++k) {
+      const double w0 = (c->wt[0][k] += c->fz[0][k]);
+      const double w1 = (c->wt[1][k] += c->e2rhs[2 * k]);
+      const double w2 = (c->wt[2][k] += c->e2rhs[2 * k + 1]);
+      c->z[0][k] = T_[0][0] * w0 + T_[0][1] * w1 + T_[0][2] * w2;
+      c->z[1][k] = T_[1][0] * w0 + T_[1][1] * w1 + T_[1][2] * w2;
+      c->z[2][k] = T_[2][0] * w0 + w1;
+    }
+    if (c->faccon * dyno <= c->fnewt) break;
+  }
+  *newt_out = newt;
+  return NEWTON_OK;
+}
+
+static double err_norm(const RadauRun* c, const double* e) {
+  double s = 0.0;
+  for (int k = 0; k < c->nerr; ++k) {
+    if (c->atol[k] >= 1e29) continue;
+    const double r = e[k] * c->ewt[k];
+    s += r * r;
+  }
+  return fmax(sqrt(s / c->nerr), 1e-10);
+}
+
+/* RADAU5's ESTRAD for F(t, y, y') = 0 (IV.8 (8.19)-(8.20)); -1 when a solve or residual failed */
+static double estimate_error(RadauRun* c) {
+  const int ny = c->ny;
+  const double h = c->h;
+  double* delta = c->ys; /* (1/h) sum d_i Z_i */
+  for (int k = 0; k < ny; ++k) delta[k] = (DD[0] * c->z[0][k] + DD[1] * c->z[1][k] + DD[2] * c->z[2][k]) / h;
+  for (int k = 0; k < ny; ++k) {
+    c->err[k] = 0.0;
+    c->yps[k] = c->yp[k] + delta[k];
+  }
+  jyp_times(c, c->yps, c->err);
+  if (solve_real(c, c->err)) return -1.0;
+  double err = err_norm(c, c->err);
+  if (err >= 1.0 && (c->first || c->reject)) {
+    /* (8.20): the estimate once more through the residual at y_n + err, which filters the stiff
+       components that the linear estimate overstates; F(t, y, -delta) = -(f(y) + M delta) */
+    for (int k = 0; k < ny; ++k) {
+      c->err2[k] = c->y[k] + c->err[k];
+      c->yps[k] = -delta[k];
+    }
+    const int rc = fmb_system_residual(c->m, c->w, c->t, c->err2, c->yps, c->err);
+    c->st.residuals++;
+    if (rc) return -1.0;
+    for (int k = 0; k < ny; ++k) c->err[k] = -c->err[k];
+    if (solve_real(c, c->err)) return -1.0;
+    err = err_norm(c, c->err);
+  }
+  return err;
+}
+
+/* the collocation polynomial of the step just accepted (IV.8 (8.26)), Newton form in s = (t -
+   t_{n+1})/h through s = 0, c2 - 1, c1 - 1 and -1 */
+static void store_dense_output(RadauRun* c) {
+  for (int k = 0; k < c->ny; ++k) {
+    const double z1 = c->z[0][k], z2 = c->z[1][k], z3 = c->z[2][k];
+    c->cont[0][k] = c->y[k];
+    c->cont[1][k] = (z2 - z3) / (C2 - 1.0);
+    const double ak = (z1 - z2) / (C1 - C2);
+    const double acont3 = (ak - z1 / C1) / C2;
+    c->cont[2][k] = (ak - c->cont[1][k]) / (C1 - 1.0);
+    c->cont[3][k] = c->cont[2][k] - acont3;
+  }
+  c->have_cont = 1;
+}
+
+/* y and y' of the last step's polynomial at t (within it) */
+static void dense_output(const RadauRun* c, double t, double* y, double* yp) {
+  const double s = (t - c->t) / c->hold, a = C2 - 1.0, b = C1 - 1.0;
+  for (int k = 0; k < c->ny; ++k) {
+    const double k1 = c->cont[1][k], k2 = c->cont[2][k], k3 = c->cont[3][k];
+    const double inner = k2 + (s - b) * k3;
+    y[k] = c->cont[0][k] + s * (k1 + (s - a) * inner);
+    yp[k] = (k1 + (s - a) * inner + s * (inner + (s - a) * k3)) / c->hold;
+  }
+}
+
+/* the Newton start: the last step's polynomial extrapolated to the new stages (RADAU5), zero on
+   the first step or after a failure where it cannot be trusted */
+static void starting_values(RadauRun* c, int zero) {
+  if (zero || !c->have_cont) {
+    for (int i = 0; i < 3; ++i) memset(c->z[i], 0, sizeof(double) * (size_t)c->ny);
+    return;
+  }
+  const double c3q = c->h / c->hold, cq[3] = {C1 * c3q, C2 * c3q, c3q}, a = C2 - 1.0, b = C1 - 1.0;
+  for (int k = 0; k < c->ny; ++k) {
+    const double k1 = c->cont[1][k], k2 = c->cont[2][k], k3 = c->cont[3][k];
+    for (int i = 0; i < 3; ++i) c->z[i][k] = cq[i] * (k1 + (cq[i] - a) * (k2 + (cq[i] - b) * k3));
+  }
+}
+
+/* work integrals at t within the last step: W_old + h int_0^theta p, p the cubic through the
+   powers at the step's start and its three stages, by 3-point Gauss-Legendre (exact for it) */
+static void work_at(RadauRun* c, double t, double* out) {
+  const double t_old = c->t - c->hold, theta = (t - t_old) / c->hold;
+  static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834}, gw[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+  const double nodes[4] = {0.0, C1, C2, 1.0};
+  double wgt[4] = {0, 0, 0, 0};
+  for (int g = 0; g < 3; ++g) {
+    const double s = 0.5 * theta * (gx[g] + 1.0);
+    for (int k = 0; k < 4; ++k) {
+      double l = 1.0;
+      for (int j = 0; j < 4; ++j)
+        if (j != k) l *= (s - nodes[j]) / (nodes[k] - nodes[j]);
+      wgt[k] += 0.5 * theta * gw[g] * l;
+    }
+  }
+  for (int j = 0; j < c->nwork; ++j)
+    out[j] = c->work_old[j] + c->hold * (wgt[0] * c->p0[j] + wgt[1] * c->pst[0][j] + wgt[2] * c->pst[1][j] + wgt[3] * c->pst[2][j]);
+}
+
+/* the joints' powers at the accepted stages, and the work to the step's end */
+static int accept_work(RadauRun* c, double t_old, double h) {
+  memcpy(c->work_old, c->work_new, sizeof(double) * (size_t)c->nwork);
+  for (int j = 0; j < c->nwork; ++j) c->p0[j] = c->pst[2][j]; /* the previous step's end */
+  for (int i = 0; i < 3; ++i) {
+    for (int k = 0; k < c->ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
+    const double ci = i == 0 ? C1 : i == 1 ? C2 : 1.0;
+    if (powers(c, t_old + ci * h, c->ys, c->pst[i])) return 1;
+  }
+  for (int j = 0; j < c->nwork; ++j)
+    c->work_new[j] = c->work_old[j] + h * (BQ[0] * c->pst[0][j] + BQ[1] * c->pst[1][j] + BQ[2] * c->pst[2][j]);
+  return 0;
+}
+
+typedef enum { FAIL_NONE, FAIL_STEPS, FAIL_MIN_STEP, FAIL_SINGULAR, FAIL_RESIDUAL, FAIL_JACOBIAN, FAIL_POWER } FailKind;
+
+static void describe_failure(const RadauRun* c, FailKind kind, char* why, size_t len) {
+  const fmbSolverSettings* so = &c->m->solver;
+  switch (kind) {
+    case FAIL_STEPS:
+      snprintf(why, len,
+               "too many steps between two outputs (solver.max_steps = %ld): the problem is very stiff or changing very "
+               "fast here. Try a larger solver.max_steps, a looser rtol, or solver.integrator: ida",
+               so->max_steps_per_output);
+      break;
+    case FAIL_MIN_STEP:
+      snprintf(why, len,
+               "the step fell to solver.min_step = %.3g (%s) after repeated Newton or error-test failures (Newton "
+               "contraction %.3g): the solution is blowing up or jumps, or the mechanism passes a singular "
+               "configuration. Check the model; solver.integrator: ida may pass where radau5 stops [radau5]",
+               so->min_step, so->min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)", c->theta);
+      break;
+    case FAIL_SINGULAR:
+      snprintf(why, len,
+               "the Newton matrix could not be factorized %d times in a row (it is singular): a singular mechanism "
+               "configuration (a dead point) or a mass matrix that lost definiteness [radau5]",
+               FMB_RADAU_MAX_SINGULAR);
+      break;
+    case FAIL_RESIDUAL: snprintf(why, len, "a plugin could not evaluate its equations [radau5]"); break;
+    case FAIL_JACOBIAN:
+      snprintf(why, len, "the Newton matrix could not be evaluated at the last good state [radau5]");
+      break;
+    case FAIL_POWER: snprintf(why, len, "a joint's power (the work outputs) is not finite [radau5]"); break;
+    default: snprintf(why, len, "the integrator stopped [radau5]"); break;
+  }
+}
+
+/* One accepted step from c->t (RADAU5's main loop, IV.8: labels 10 new Jacobian, 20 new LU, 30
+   new step); FAIL_NONE, or why none could be taken. *interrupted on a stop request. */
+static FailKind radau_step(RadauRun* c, int* interrupted) {
+  const fmbSolverSettings* so = &c->m->solver;
+  int zero_start = c->first;
+  c->caljac = 0;
+  for (;;) {
+    if (c->stop && *c->stop) {
+      *interrupted = 1;
+      return FAIL_NONE;
+    }
+    /* the last step ends on t_end exactly (RADAU5's LAST) */
+    c->h = fmin(c->h, c->hmax);
+    const int last = c->t + c->h * 1.0000001 >= c->t_end;
+    if (last) c->h = c->t_end - c->t;
+    if (c->h < so->min_step && !last) return FAIL_MIN_STEP;
+    if (c->need_jac) {
+      const int rc = evaluate_jacobian(c);
+      if (rc < 0) return FAIL_JACOBIAN;
+      if (rc > 0) {
+        c->h *= 0.5;
+        c->reject = 1;
+        continue;
+      }
+      c->need_jac = 0;
+      c->h_lu = 0.0;
+    }
+    if (c->h != c->h_lu) {
+      if (decompose(c)) {
+        if (++c->nsing >= FMB_RADAU_MAX_SINGULAR) return FAIL_SINGULAR;
+        c->h *= 0.5;
+        c->reject = 1;
+        c->need_jac = !c->caljac;
+        continue;
+      }
+      c->nsing = 0;
+      if (!c->caljac) c->lu_reuses++;
+    }
+    starting_values(c, zero_start);
+    int newt = 0;
+    double hfac = 0.5;
+    const int nr = newton(c, &newt, &hfac);
+    if (nr == NEWTON_FATAL) {
+      if (c->stop && *c->stop) {
+        *interrupted = 1;
+        return FAIL_NONE;
+      }
+      return FAIL_RESIDUAL;
+    }
+    if (nr != NEWTON_OK) {
+      /* RADAU5's "unexpected step rejection" (label 78) or its cut for slow convergence; a new
+         Jacobian unless this one is already fresh */
+      c->st.conv_fails++;
+      c->h *= nr == NEWTON_SLOW ? hfac : 0.5;
+      c->reject = 1;
+      zero_start = 1; /* the extrapolated start may be what failed */
+      c->need_jac = !c->caljac;
+      continue;
+    }
+    const double err = estimate_error(c);
+    if (err < 0.0) { /* a solve or the residual failed: as a Newton failure */
+      c->st.conv_fails++;
+      c->h *= 0.5;
+      c->reject = 1;
+      c->need_jac = !c->caljac;
+      continue;
+    }
+    /* step size (IV.8 (8.21)-(8.25)): the safety factor shrinks with the Newton iterations used */
+    const double cfac = FMB_RADAU_SAFE * (1 + 2 * FMB_RADAU_NIT);
+    const double fac = fmin(FMB_RADAU_SAFE, cfac / (newt + 2 * FMB_RADAU_NIT));
+    double quot = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, pow(err, 0.25) / fac));
+    double hnew = c->h / quot;
+    if (err >= 1.0) {
+      c->st.error_test_fails++;
+      c->reject = 1;
+      c->h = c->first ? 0.1 * c->h : hnew;
+      c->need_jac = !c->caljac;
+      continue;
+    }
+    /* accepted; Gustafsson's predictive controller (IV.8 (8.25)) */
+    if (c->st.steps > 0) {
+      double facgus = (c->hacc / c->h) * pow(err * err / c->erracc, 0.25) / FMB_RADAU_SAFE;
+      facgus = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, facgus));
+      quot = fmax(quot, facgus);
+      hnew = c->h / quot;
+    }
+    c->hacc = c->h;
+    c->erracc = fmax(1e-2, err);
+    const double t_old = c->t, h = c->h;
+    /* y_{n+1} = y_n + Z_3 (stiffly accurate); y'_{n+1} = Y'_3 */
+    stage_derivative(c, 2, h, c->yp);
+    for (int k = 0; k < c->ny; ++k) c->y[k] += c->z[2][k];
+    c->t = last ? c->t_end : t_old + h;
+    c->hold = h;
+    c->st.steps++;
+    store_dense_output(c);
+    if (c->nwork && accept_work(c, t_old, h)) return FAIL_POWER;
+    update_scal(c);
+    c->first = 0;
+    hnew = fmin(hnew, c->hmax);
+    if (c->reject) hnew = fmin(hnew, h);
+    c->reject = 0;
+    /* keep h and the factorizations when Newton converged fast and the step would change little;
+       keep the Jacobian (a new LU only) when Newton converged fast */
+    const double qt = hnew / h;
+    const int keep = c->theta <= FMB_RADAU_THET && qt >= FMB_RADAU_QUOT1 && qt <= FMB_RADAU_QUOT2 &&
+                     (qt <= 1.2 || c->kept < FMB_RADAU_KEEP_MAX);
+    c->kept = keep && qt > 1.2 ? c->kept + 1 : 0;
+    if (!keep) c->h = hnew;
+    c->need_jac = c->theta > FMB_RADAU_THET;
+    return FAIL_NONE;
+  }
+}
+
+static int radau_advance(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
+                         size_t why_len) {
+  RadauRun* c = self;
+  const fmbModel* m = c->m;
+  long steps = 0;
+  int interrupted = 0;
+  FailKind fail = FAIL_NONE;
+  while (c->t < tout - 1e-14 * fmax(1.0, fabs(tout))) {
+    if (steps >= m->solver.max_steps_per_output) {
+      fail = FAIL_STEPS;
+      break;
+    }
+    fail = radau_step(c, &interrupted);
+    if (fail != FAIL_NONE || interrupted) break;
+    steps++;
+  }
+  *h = c->h;
+  if (fail == FAIL_NONE && !interrupted) {
+    if (c->have_cont && tout < c->t) {
+      dense_output(c, tout, y, yp);
+      if (c->nwork) work_at(c, tout, c->work_out);
+    } else {
+      memcpy(y, c->y, sizeof(double) * (size_t)c->ny);
+      memcpy(yp, c->yp, sizeof(double) * (size_t)c->ny);
+      if (c->nwork) memcpy(c->work_out, c->work_new, sizeof(double) * (size_t)c->nwork);
+    }
+    *t_reached = tout;
+    return FMB_ADVANCE_OK;
+  }
+  /* the last good state: the end of the last accepted step */
+  memcpy(y, c->y, sizeof(double) * (size_t)c->ny);
+  memcpy(yp, c->yp, sizeof(double) * (size_t)c->ny);
+  *t_reached = c->t;
+  if (c->nwork) memcpy(c->work_out, c->work_new, sizeof(double) * (size_t)c->nwork);
+  if (interrupted) return FMB_ADVANCE_INTERRUPTED;
+  describe_failure(c, fail, why, why_len);
+  return FMB_ADVANCE_FAILED;
+}
+
+static void radau_work(void* self, double* work) {
+  RadauRun* c = self;
+  memcpy(work, c->work_out, sizeof(double) * (size_t)c->nwork);
+}
+
+static void radau_stats(const void* self, fmbStats* st) {
+  const RadauRun* c = self;
+  st->steps = c->st.steps;
+  st->residuals = c->st.residuals;
+  st->jacobians = c->st.jacobians;
+  st->newton_iters = c->st.newton_iters;
+  st->error_test_fails = c->st.error_test_fails;
+  st->conv_fails = c->st.conv_fails;
+  st->jacobians_reused = c->lu_reuses;
+}
+
+const fmbIntegratorOps fmb_integrator_radau5 = {
+    .name = "radau5",
+    .create = radau_create,
+    .advance = radau_advance,
+    .work = radau_work,
+    .stats = radau_stats,
+    .after_row = NULL,
+    .destroy = radau_destroy,
+};
