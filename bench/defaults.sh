@@ -28,8 +28,7 @@ while [ $# -gt 0 ]; do
   shift
 done
 mkdir -p "$RES"
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" | tail -1; }
+. bench/lib.sh
 
 # scene and its tracked column
 SCENES="scenes/paper/spinup_w15.yaml:beam.tip_v scenes/paper/spinup_w4.yaml:beam.tip_v scenes/paper/pendulum.yaml:beam.tip_v
@@ -48,11 +47,11 @@ for sc in $SCENES; do
     for _ in $(seq "$REPS"); do
       line=$("$F" run "$S" -o "$B.out.csv" --set solver.rtol=$r --set solver.atol=$a --set solver.error_control=$ec \
              --reference "$B.ref.csv" --columns "$C" 2>&1 | tail -1)
-      cpus="$cpus $(echo "$line" | field cpu_s)"
+      cpus="$cpus $(echo "$line" | stat_field cpu_s)"
     done
     cpu=$(echo $cpus | tr ' ' '\n' | median)
-    printf '%s,%s,%s,%s,%s,%s,%s,%s,%s\n' "$(basename "$S" .yaml)" "$C" $ec $a $r "$cpu" "$(echo "$line" | field steps)" \
-      "$(echo "$line" | field max_abs)" $REF | tee -a "$OUT"
+    printf '%s,%s,%s,%s,%s,%s,%s,%s,%s\n' "$(basename "$S" .yaml)" "$C" $ec $a $r "$cpu" "$(echo "$line" | stat_field steps)" \
+      "$(echo "$line" | stat_field max_abs)" $REF | tee -a "$OUT"
   done; done; done
 done
 rm -rf "$WORK"

@@ -57,8 +57,7 @@ print("\n".join(out + joints + ["outputs: [c1l.theta, k%d.x, k%d.y, energy.total
 PY
 }
 
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
-stat_field() { sed -n "s/.*$1=\([^ ]*\).*/\1/p"; }
+. bench/lib.sh
 # run SCENE REPS times; sets $line (the last stats line) and $cpu (the median cpu_s)
 timed_runs() {
   local cpus=() r
