@@ -18,7 +18,11 @@
  * 2ny x 2ny system [[A, -B], [B, A]] written as complex numbers, solved with KLU's complex LU on
  * the model's own pattern. J_y and J_y' are kept apart (two evaluations at cj = 0 and cj = 1, the
  * second reassembling the bodies' blocks of the first: J is linear in cj), so a new step size
- * costs two refactorizations and no new derivatives.
+ * costs two refactorizations and no new derivatives. By default (solver.linear_solver: klu) both
+ * systems are solved with the position rows eliminated (schur.c: their q-blocks are (gamma/h) I
+ * and ((alpha + i beta)/h) I up to O(|mu|), kept as their diagonals), so KLU factorizes two
+ * matrices with nq fewer rows: a modified simplified Newton iteration, as IDA's; klu_full keeps
+ * the whole matrices (the exact simplified Newton, for comparison and as a fallback by hand).
  *
  * Error estimate (IV.8 (8.19)-(8.20), RADAU5's ESTRAD with the mass matrix J_y'):
  *   err = (J_y + gamma/h J_y')^-1 J_y' (y'_n + (1/h) sum_i d_i Z_i),
