@@ -18,7 +18,11 @@
  * 2ny x 2ny system [[A, -B], [B, A]] written as complex numbers, solved with KLU's complex LU on
  * the model's own pattern. J_y and J_y' are kept apart (two evaluations at cj = 0 and cj = 1, the
  * second reassembling the bodies' blocks of the first: J is linear in cj), so a new step size
- * costs two refactorizations and no new derivatives.
+ * costs two refactorizations and no new derivatives. By default (solver.linear_solver: klu) both
+ * systems are solved with the position rows eliminated (schur.c: their q-blocks are (gamma/h) I
+ * and ((alpha + i beta)/h) I up to O(|mu|), kept as their diagonals), so KLU factorizes two
+ * matrices with nq fewer rows: a modified simplified Newton iteration, as IDA's; klu_full keeps
+ * the whole matrices (the exact simplified Newton, for comparison and as a fallback by hand).
  *
  * Error estimate (IV.8 (8.19)-(8.20), RADAU5's ESTRAD with the mass matrix J_y'):
  *   err = (J_y + gamma/h J_y')^-1 J_y' (y'_n + (1/h) sum_i d_i Z_i),
@@ -111,6 +115,9 @@ typedef struct {
   klu_l_common common;
   klu_l_symbolic* symbolic;
   klu_l_numeric *num1, *num2;
+  /* solver.linear_solver: klu (default): both systems with the position rows eliminated
+     (schur.c); klu_full: KLU on the whole matrices above */
+  fmbSchur *red1, *red2;
   double h_lu;                   /* the step the factorizations are for (0: none) */
   int need_jac;                  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
   int caljac;                    /* the Jacobian was evaluated at this step's start (t, y) */
@@ -130,6 +137,8 @@ static void radau_destroy(void* self) {
   if (c->num1) klu_l_free_numeric(&c->num1, &c->common);
   if (c->num2) klu_zl_free_numeric(&c->num2, &c->common);
   if (c->symbolic) klu_l_free_symbolic(&c->symbolic, &c->common);
+  fmb_schur_free(c->red1);
+  fmb_schur_free(c->red2);
   double** vs[] = {&c->atol, &c->scal, &c->ewt, &c->y, &c->yp, &c->ys, &c->yps, &c->e2rhs, &c->err, &c->err2,
                    &c->jy, &c->jyp, &c->e1, &c->e2, &c->work_old, &c->work_new, &c->p0, &c->work_out};
   for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) free(*vs[i]);
@@ -204,8 +213,13 @@ static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* 
   for (int i = 0; i <= ny; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
   for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
   klu_l_defaults(&c->common);
-  c->symbolic = klu_l_analyze(ny, c->colptr, c->rowind, &c->common);
-  if (!c->symbolic) {
+  if (m->solver.linear_solver == FMB_LS_KLU) {
+    c->red1 = fmb_schur_new(m, 0);
+    c->red2 = fmb_schur_new(m, 1);
+  } else {
+    c->symbolic = klu_l_analyze(ny, c->colptr, c->rowind, &c->common);
+  }
+  if (m->solver.linear_solver == FMB_LS_KLU ? !c->red1 || !c->red2 : !c->symbolic) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
     radau_destroy(c);
     return NULL;
@@ -309,7 +323,9 @@ static int decompose(RadauRun* c) {
     c->e2[2 * k] = c->jy[k] + a * c->jyp[k];
     c->e2[2 * k + 1] = b * c->jyp[k];
   }
-  if (factor(c, &c->num1, c->e1, 0) || factor(c, &c->num2, c->e2, 1)) {
+  const int failed = c->red1 ? fmb_schur_factor(c->red1, c->e1) || fmb_schur_factor(c->red2, c->e2)
+                            : factor(c, &c->num1, c->e1, 0) || factor(c, &c->num2, c->e2, 1);
+  if (failed) {
     c->h_lu = 0.0;
     return 1;
   }
@@ -317,7 +333,16 @@ static int decompose(RadauRun* c) {
   return 0;
 }
 
-static int solve_real(RadauRun* c, double* b) { return klu_l_solve(c->symbolic, c->num1, c->ny, 1, b, &c->common) ? 0 : 1; }
+/* in place: b = E1^-1 b, and b = E2^-1 b with b complex (interleaved); 0 ok, 1 failed */
+static int solve_real(RadauRun* c, double* b) {
+  if (c->red1) return fmb_schur_solve(c->red1, b);
+  return klu_l_solve(c->symbolic, c->num1, c->ny, 1, b, &c->common) ? 0 : 1;
+}
+
+static int solve_complex(RadauRun* c, double* b) {
+  if (c->red2) return fmb_schur_solve(c->red2, b);
+  return klu_zl_solve(c->symbolic, c->num2, c->ny, 1, b, &c->common) ? 0 : 1;
+}
 
 /* y += J_y' x on the CSC pattern */
 static void jyp_times(const RadauRun* c, const double* x, double* y) {
@@ -375,7 +400,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       c->e2rhs[2 * k] = -(TI[1][0] * f0 + TI[1][1] * f1 + TI[1][2] * f2);
       c->e2rhs[2 * k + 1] = -(TI[2][0] * f0 + TI[2][1] * f1 + TI[2][2] * f2);
     }
-    if (solve_real(c, c->fz[0]) || !klu_zl_solve(c->symbolic, c->num2, ny, 1, c->e2rhs, &c->common)) {
+    if (solve_real(c, c->fz[0]) || solve_complex(c, c->e2rhs)) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }

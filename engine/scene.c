@@ -81,6 +81,11 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
     return fmb_parse_error(p, fmb_find_key(p, node, "integrator"),
                            "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
                            "integrator (CVODE): drop one of the two keys");
+  /* radau5's systems are complex as well as real; SUNDIALS' dense LU is real only */
+  if (integrator == FMB_INTEG_RADAU5 && linear_solver == FMB_LS_DENSE)
+    return fmb_parse_error(p, fmb_find_key(p, node, "linear_solver"),
+                           "integrator: radau5 solves with KLU: linear_solver klu (the position rows eliminated, "
+                           "default) or klu_full (the whole matrix); dense is IDA's only");
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->atol_given = !atol_is_auto && fmb_find_key(p, node, "atol") >= 0;
   if (!s->atol_given) s->atol = FMB_ATOL_PER_RTOL * s->rtol; /* a metre of a 1 m body (tolerance.c) */
