@@ -54,8 +54,7 @@ if [ ! -x "$OLD_DIR/build/flexmbd" ]; then
   cmake -S "$OLD_DIR" -B "$OLD_DIR/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
   cmake --build "$OLD_DIR/build" -j2 --target flexmbd >/dev/null
 fi
-median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
-field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p" | tail -1; }
+. "$ROOT/bench/lib.sh" # median, stat_field
 
 REF="ida rtol 1e-12 (atol derived)"
 if ! "$F" run "$S" -o "$WORK/ref.csv" --quiet --set solver.rtol=1e-12 --set solver.atol=auto 2>/dev/null; then
@@ -96,11 +95,11 @@ for cfg in ida:positions:klu ida:full:klu radau5:positions:klu radau5:positions:
     cpus="" line=""
     for _ in $(seq "$REPS"); do
       line=$(run_cfg "$cfg" "$r" "$a" --reference "$WORK/ref.csv" --columns "$C")
-      cpus="$cpus $(echo "$line" | field cpu_s)"
+      cpus="$cpus $(echo "$line" | stat_field cpu_s)"
     done
     stats=$(run_cfg "$cfg" "$r" "$a" --quiet)
-    printf '%s,%s,%s,%s,%s,%s,%s,%s,%s\n' $name $r $a "$(echo $cpus | tr ' ' '\n' | median)" "$(echo "$stats" | field steps)" \
-      "$(echo "$stats" | field residuals)" "$(echo "$stats" | field jacobians)" "$(echo "$line" | field max_abs)" "$REF" >> "$OUT"
+    printf '%s,%s,%s,%s,%s,%s,%s,%s,%s\n' $name $r $a "$(echo $cpus | tr ' ' '\n' | median)" "$(echo "$stats" | stat_field steps)" \
+      "$(echo "$stats" | stat_field residuals)" "$(echo "$stats" | stat_field jacobians)" "$(echo "$line" | stat_field max_abs)" "$REF" >> "$OUT"
   done
 done
 column -s, -t < "$OUT"

@@ -44,17 +44,27 @@ struct fmbSchur {
   SuiteSparse_long *colptr, *rowind; /* S, CSC */
   /* the blocks the solves need, copied at factorization with D^-1 applied and kept-row indices
      made relative (a tight loop: the solves run once per Newton iteration, factorizations rarely) */
-  int *rq_ptr, *rq_run_ptr, *run_row, *run_len; /* J_Rq D^-1 by q column, in runs of consecutive */
+  int *rq_ptr, *rq_run_ptr, *run_row, *run_len; /* J_Rq by q column, in runs of consecutive */
   int *qr_ptr, *qr_row;                           /* rows (the inner loop vectorizes); D^-1 J_qR by kept column */
+  /* J_Rq = dF_R/dq is real for every cj, complex included: F_R holds no q' (the only q' is in
+     F_q), so J_Rq has no cj J_y' part. It is kept real (one double per value) and D^-1 is applied
+     to the complex b_q or coefficient instead: a real times a complex is half a complex product.
+     The real system keeps J_Rq D^-1 (schur_kernels.h) */
+  double* rq_val;
   /* values, nc doubles each */
   double* dinv;        /* 1 / J_ii of the last factorization */
   double* data;        /* S */
-  double *rq_val, *qr_val;
+  double* qr_val;
   double* acc;         /* dense column / vector scratch, nr, kept zero between uses */
   double* dq;
   klu_l_common common;
   klu_l_symbolic* symbolic;
   klu_l_numeric* numeric;
+  /* small, dense S (schur_use_dense): a dense LU instead of KLU; lu is S column-major (nr x nr,
+     nc doubles each), NULL when KLU is used */
+  double* lu;
+  int* ipiv;
+  int factored; /* lu holds a factorization */
 };
 
 #define SCHUR_CAT_(a, b) a##b
@@ -64,21 +74,29 @@ struct fmbSchur {
 #define SCHUR_FINITE(x) isfinite(x)
 #define SCHUR_FN(name) SCHUR_CAT(name, _real)
 #define SCHUR_KLU(name) SCHUR_CAT(klu_l_, name)
+#define SCHUR_ABS1(x) fabs(x)
+#define SCHUR_IS_COMPLEX 0
 #include "schur_kernels.h"
 #undef SCHUR_T
 #undef SCHUR_FINITE
 #undef SCHUR_FN
 #undef SCHUR_KLU
+#undef SCHUR_ABS1
+#undef SCHUR_IS_COMPLEX
 
 #define SCHUR_T double complex
 #define SCHUR_FINITE(x) (isfinite(creal(x)) && isfinite(cimag(x)))
 #define SCHUR_FN(name) SCHUR_CAT(name, _complex)
 #define SCHUR_KLU(name) SCHUR_CAT(klu_zl_, name)
+#define SCHUR_ABS1(x) (fabs(creal(x)) + fabs(cimag(x)))
+#define SCHUR_IS_COMPLEX 1
 #include "schur_kernels.h"
 #undef SCHUR_T
 #undef SCHUR_FINITE
 #undef SCHUR_FN
 #undef SCHUR_KLU
+#undef SCHUR_ABS1
+#undef SCHUR_IS_COMPLEX
 
 int fmb_schur_factor(fmbSchur* s, const double* J) {
   return s->nc == 2 ? schur_factor_complex(s, J) : schur_factor_real(s, J);
@@ -87,6 +105,7 @@ int fmb_schur_factor(fmbSchur* s, const double* J) {
 int fmb_schur_solve(fmbSchur* s, double* x) { return s->nc == 2 ? schur_solve_complex(s, x) : schur_solve_real(s, x); }
 
 void fmb_schur_forget(fmbSchur* s) {
+  s->factored = 0;
   if (!s->numeric) return;
   if (s->nc == 2)
     klu_zl_free_numeric(&s->numeric, &s->common);
@@ -114,6 +133,8 @@ void fmb_schur_free(fmbSchur* s) {
   free(s->qr_val);
   free(s->acc);
   free(s->dq);
+  free(s->lu);
+  free(s->ipiv);
   free(s);
 }
 
@@ -190,7 +211,7 @@ static int schur_blocks(fmbSchur* s) {
     n += m->colptr[i + 1] - s->first_kept[i];
   }
   s->rq_ptr[nq] = (int)n;
-  s->rq_val = malloc(sizeof(double) * (size_t)s->nc * (size_t)(n + 1));
+  s->rq_val = malloc(sizeof(double) * (size_t)(n + 1)); /* real, see fmbSchur */
   s->rq_run_ptr = malloc(sizeof(int) * (size_t)(nq + 1));
   s->run_row = malloc(sizeof(int) * (size_t)(n + 1));
   s->run_len = malloc(sizeof(int) * (size_t)(n + 1));
@@ -223,6 +244,27 @@ static int schur_blocks(fmbSchur* s) {
   return 0;
 }
 
+/* Dense LU (schur_kernels.h's dense_lu) or KLU for S. A beam's S is a dense core (its velocity
+   block couples every element to all inboard ones): 57 x 57 with 3,231 nonzeros (99 %) for 16 elements.
+   There KLU's left-looking sparse LU pays an indirect access per flop and a sparse triangular
+   solve per column, while a dense LU runs the same flops as contiguous column updates that
+   vectorize (instruction counts in docs/performance.md, "Integrators"; LAPACK's getrf/getrs on
+   Debian's reference BLAS gained only 3 % over KLU, its zgemm/ztrsm being unvectorized Fortran
+   loops, so the LU is written out). A dense LU costs nr^3/3 whatever the pattern, so it is
+   used only where that is near KLU's own work: S small (nr <= 200, lu at most 640 kB complex)
+   and at least 90 % full. Large or sparse S (banded beams, long chains, big mechanisms) keep
+   KLU, and so do the rigid mechanisms (the slider-crank's S is 51 x 51, 71 % full): at 30 % the
+   dense LU's fresh pivots changed where IDA gives up at singular passages (test_parallelogram,
+   failure_singular_fourbar), whose tests pin KLU's behaviour. FMB_SCHUR_LU=klu or =dense
+   overrides the rule (to compare the two). */
+static int schur_use_dense(const fmbSchur* s) {
+  const char* force = getenv("FMB_SCHUR_LU");
+  if (force && strcmp(force, "klu") == 0) return 0;
+  if (force && strcmp(force, "dense") == 0) return 1;
+  const double nr = s->nr;
+  return s->nr > 0 && s->nr <= 200 && (double)s->colptr[s->nr] >= 0.9 * nr * nr;
+}
+
 fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
   fmbSchur* s = calloc(1, sizeof *s);
   if (!s) return NULL;
@@ -249,6 +291,12 @@ fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
   for (int c = 0; c < m->nq; ++c)
     if (s->diag_pos[c] < 0) goto fail; /* pattern.c always holds F_q's diagonal */
   if (schur_pattern(s) || schur_blocks(s)) goto fail;
+  if (schur_use_dense(s)) {
+    s->lu = malloc(sizeof(double) * nc * (size_t)s->nr * (size_t)s->nr + sizeof(double));
+    s->ipiv = malloc(sizeof(int) * ((size_t)s->nr + 1));
+    if (!s->lu || !s->ipiv) goto fail;
+    return s;
+  }
   klu_l_defaults(&s->common);
   s->symbolic = klu_l_analyze(s->nr, s->colptr, s->rowind, &s->common);
   if (!s->symbolic) goto fail;

@@ -4,11 +4,13 @@
  * once. Complex values are interleaved (re, im) pairs, which is both C11's layout of double
  * complex (6.2.5) and what KLU's klu_zl_* routines take. Not a header for anyone else.
  *
- * Expects: SCHUR_T, SCHUR_FINITE(x), SCHUR_FN(name) (the name with the type's suffix) and
- * SCHUR_KLU(name) (klu_l_name or klu_zl_name). */
+ * Expects: SCHUR_T, SCHUR_FINITE(x), SCHUR_FN(name) (the name with the type's suffix),
+ * SCHUR_KLU(name) (klu_l_name or klu_zl_name), SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
+ * SCHUR_IS_COMPLEX (0 or 1). */
 
 /* S = J_RR - J_Rq D^-1 J_qR, column by column through a dense scratch column (schur.c's head
-   comment); also the compact J_Rq D^-1 and D^-1 J_qR copies the solves use. 0, or 1 when D has a
+   comment); also the compact J_Rq (complex: real, D^-1 applied in the solve; real: J_Rq D^-1)
+   and D^-1 J_qR copies the solves use. 0, or 1 when D has a
    zero or non-finite entry. */
 static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
   const fmbModel* m = s->m;
@@ -23,8 +25,13 @@ static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
     dinv[i] = 1.0 / d;
   }
   for (int i = 0; i < nq; ++i) {
-    SCHUR_T* val = (SCHUR_T*)s->rq_val + s->rq_ptr[i];
+    double* val = s->rq_val + s->rq_ptr[i];
+#if SCHUR_IS_COMPLEX /* J_Rq's real part: its imaginary part is zero (fmbSchur) */
+    for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = creal(J[k]);
+#else /* J_Rq D^-1, the product IDA's runs were made with: singular passages (the parallelogram's
+         flat points, tests/failures' singular four-bar) are sensitive to its last bit */
     for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = J[k] * dinv[i];
+#endif
   }
   for (int c = 0; c < s->nr; ++c) {
     SCHUR_T* val = (SCHUR_T*)s->qr_val + s->qr_ptr[c];
@@ -39,7 +46,17 @@ static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
         continue;
       }
       const SCHUR_T coef = J[k] * dinv[i]; /* (D^-1 J_qR)_ic */
-      for (long kk = s->first_kept[i]; kk < m->colptr[i + 1]; ++kk) acc[m->rowind[kk] - nq] -= J[kk] * coef;
+#if SCHUR_IS_COMPLEX
+      const double* rq = s->rq_val + s->rq_ptr[i] - s->first_kept[i]; /* J_Rq's column i, real */
+#else
+      const double* rq = J;
+#endif
+      for (long kk = s->first_kept[i]; kk < m->colptr[i + 1]; ++kk) acc[m->rowind[kk] - nq] -= rq[kk] * coef;
+    }
+    if (s->lu) { /* dense: the whole column, zeros included, then acc cleared */
+      memcpy((SCHUR_T*)s->lu + (size_t)c * (size_t)s->nr, acc, sizeof(SCHUR_T) * (size_t)s->nr);
+      memset(acc, 0, sizeof(SCHUR_T) * (size_t)s->nr);
+      continue;
     }
     for (SuiteSparse_long k = s->colptr[c]; k < s->colptr[c + 1]; ++k) {
       data[k] = acc[s->rowind[k]];
@@ -49,11 +66,74 @@ static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
   return 0;
 }
 
+/* Dense LU with partial pivoting of the n x n column-major a, in place (L unit lower, U upper),
+   LAPACK's getf2 written out: right-looking, so every inner loop runs down a contiguous column
+   and vectorizes (reference BLAS' zgemm/ztrsm spend ~20 instructions per complex multiply-add;
+   these loops about a third of that, schur.c's schur_use_dense). The pivot is the largest
+   |re| + |im| (izamax's measure). 0, or 1 when a pivot is zero or not finite (S singular). */
+static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restrict ipiv) {
+  for (int k = 0; k < n; ++k) {
+    SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
+    int p = k;
+    double best = -1.0;
+    for (int i = k; i < n; ++i) {
+      const double v = SCHUR_ABS1(ak[i]);
+      if (v > best) best = v, p = i;
+    }
+    ipiv[k] = p;
+    if (best == 0.0 || !isfinite(best)) return 1;
+    if (p != k)
+      for (int j = 0; j < n; ++j) {
+        SCHUR_T* col = a + (size_t)j * (size_t)n;
+        const SCHUR_T t = col[k];
+        col[k] = col[p];
+        col[p] = t;
+      }
+    const SCHUR_T r = 1.0 / ak[k];
+    for (int i = k + 1; i < n; ++i) ak[i] *= r;
+    for (int j = k + 1; j < n; ++j) {
+      SCHUR_T* restrict aj = a + (size_t)j * (size_t)n;
+      const SCHUR_T u = aj[k];
+      if (u == 0.0) continue; /* S's zeros outside the beam core stay zero */
+      for (int i = k + 1; i < n; ++i) aj[i] -= ak[i] * u;
+    }
+  }
+  return 0;
+}
+
+/* b = (P L U)^-1 b with dense_lu's factors: the row swaps, then L and U by columns (axpy form,
+   contiguous again) */
+static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* restrict ipiv, SCHUR_T* restrict b) {
+  for (int k = 0; k < n; ++k)
+    if (ipiv[k] != k) {
+      const SCHUR_T t = b[k];
+      b[k] = b[ipiv[k]];
+      b[ipiv[k]] = t;
+    }
+  for (int k = 0; k < n; ++k) {
+    const SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
+    const SCHUR_T bk = b[k];
+    if (bk == 0.0) continue;
+    for (int i = k + 1; i < n; ++i) b[i] -= ak[i] * bk;
+  }
+  for (int k = n - 1; k >= 0; --k) {
+    const SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
+    const SCHUR_T bk = b[k] / ak[k];
+    b[k] = bk;
+    if (bk == 0.0) continue;
+    for (int i = 0; i < k; ++i) b[i] -= ak[i] * bk;
+  }
+}
+
 /* S formed from J and factorized: a refactorization with the old pivot order, from scratch when a
    cheap estimate, then the accurate one, say the condition has degraded (as SUNDIALS' KLU module
    does). 0 ok, 1 recoverable (D or S singular), -1 KLU could not factorize at all. */
 static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
   if (SCHUR_FN(schur_form)(s, J)) return 1;
+  if (s->lu) { /* partial pivoting afresh each time: a dense LU has no refactorization to reuse */
+    s->factored = !SCHUR_FN(dense_lu)((SCHUR_T*)s->lu, s->nr, s->ipiv);
+    return s->factored ? 0 : 1;
+  }
   if (!s->numeric) {
     s->numeric = SCHUR_KLU(factor)(s->colptr, s->rowind, s->data, s->symbolic, &s->common);
     return s->numeric ? 0 : -1;
@@ -74,7 +154,7 @@ static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
 }
 
 /* x = J^-1 x in place with the last factorization: dR from S dR = b_R - J_Rq D^-1 b_q, then
-   dq = D^-1 (b_q - J_qR dR) (schur.c's head comment). 0 ok, 1 when KLU's solve failed. */
+   dq = D^-1 (b_q - J_qR dR) (schur.c's head comment). 0 ok, 1 when the LU's solve failed. */
 static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
   const int nq = s->nq, nr = s->nr;
   SCHUR_T* x = (SCHUR_T*)xd;
@@ -84,9 +164,14 @@ static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
   /* b_R - J_Rq D^-1 b_q */
   memcpy(rhs, x + nq, sizeof(SCHUR_T) * (size_t)nr);
   for (int i = 0; i < nq; ++i) {
-    const SCHUR_T bi = x[i];
+#if SCHUR_IS_COMPLEX
+    const SCHUR_T bi = x[i] * dinv[i]; /* (D^-1 b_q)_i, then J_Rq (real) times it */
+    dq[i] = bi;
+#else
+    const SCHUR_T bi = x[i]; /* rq_val holds J_Rq D^-1 */
     dq[i] = bi * dinv[i];
-    const SCHUR_T* val = (const SCHUR_T*)s->rq_val + s->rq_ptr[i];
+#endif
+    const double* val = s->rq_val + s->rq_ptr[i];
     for (int r = s->rq_run_ptr[i]; r < s->rq_run_ptr[i + 1]; ++r) {
       SCHUR_T* restrict dst = rhs + s->run_row[r];
       const int len = s->run_len[r];
@@ -94,7 +179,14 @@ static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
       val += len;
     }
   }
-  if (!SCHUR_KLU(solve)(s->symbolic, s->numeric, nr, 1, (double*)rhs, &s->common)) {
+  int ok = 1;
+  if (s->lu) {
+    ok = s->factored;
+    if (ok) SCHUR_FN(dense_solve)((const SCHUR_T*)s->lu, nr, s->ipiv, rhs);
+  } else {
+    ok = SCHUR_KLU(solve)(s->symbolic, s->numeric, nr, 1, (double*)rhs, &s->common) != 0;
+  }
+  if (!ok) {
     memset(rhs, 0, sizeof(SCHUR_T) * (size_t)nr);
     return 1;
   }
