@@ -11,8 +11,9 @@
  *
  * The matrix is sparse: the bodies' mass blocks and, per joint, its rows times the columns of its
  * bodies (fmb_joint_cols). KLU factors it (partial pivoting: the matrix is a saddle point, not
- * definite); the pattern and KLU's ordering are built once in fmb_augmented_new, so an evaluation
- * allocates nothing and costs what the mechanism's sparsity costs (a chain of linkages grows
+ * definite); the pattern and KLU's ordering are built once in fmb_augmented_new, and an evaluation
+ * refactorizes with the last pivot order (it allocates only when that order has to be renewed),
+ * so it costs what the mechanism's sparsity costs (a chain of linkages grows
  * linearly, where the dense matrix of earlier versions grew with the cube). */
 #include <math.h>
 #include <stdlib.h>
@@ -21,6 +22,10 @@
 
 #include "internal.h"
 
+/* the refactorization keeps its pivot order while KLU's cheap estimate 1/rcond, then condest,
+   stay below eps^(-2/3) (schur_kernels.h's rule) */
+#define AUG_RCOND_TINY 3.666852862501036e-11
+
 struct fmbAugmented {
   int nq, nc, n;
   SuiteSparse_long *Ap, *Ai;
@@ -28,6 +33,9 @@ struct fmbAugmented {
   /* per constraint row rr (of nc), entries k = rowptr[rr] .. rowptr[rr+1]-1: the q column col[k],
      the positions of Phi_q(rr, col) (column nq + rr) and of Phi_q^T (column col) in Ax */
   int *rowptr, *col;
+  /* per constraint row rr, per column c of its joint's fmb_joint_cols list (from eoff[rr] on):
+     the merged entry k that column adds to (two columns of one body pair may coincide) */
+  int *eoff, *entry;
   long *pos_phi, *pos_phit, *pos_diag;
   double *phi, *phit, *phitt, *phiq_v, *rhs, *Mb;
   klu_l_common common;
@@ -77,9 +85,11 @@ fmbAugmented* fmb_augmented_new(const fmbModel* m) {
   long nphi = 0;
   for (int j = 0; j < m->njoint; ++j) nphi += (long)m->joint[j].nrows * mc;
   g->col = calloc((size_t)nphi + 1, sizeof(int));
-  if (!cols || !g->rowptr || !g->col) goto fail;
+  g->eoff = calloc((size_t)nc + 1, sizeof(int));
+  g->entry = calloc((size_t)nphi + 1, sizeof(int));
+  if (!cols || !g->rowptr || !g->col || !g->eoff || !g->entry) goto fail;
   {
-    int k = 0;
+    int k = 0, e = 0;
     for (int j = 0; j < m->njoint; ++j) {
       const fmbJointInst* ji = &m->joint[j];
       if (ji->nrows == 0) continue;
@@ -87,16 +97,17 @@ fmbAugmented* fmb_augmented_new(const fmbModel* m) {
       for (int r = 0; r < ji->nrows; ++r) {
         const int rr = ji->rowadr + r;
         g->rowptr[rr] = k;
+        g->eoff[rr] = e;
         for (int c = 0; c < ncol; ++c) {
-          int dup = 0;
-          for (int e = g->rowptr[rr]; e < k && !dup; ++e) dup = g->col[e] == cols[c];
-          if (!dup) g->col[k++] = cols[c];
+          int at = g->rowptr[rr];
+          while (at < k && g->col[at] != cols[c]) ++at;
+          if (at == k) g->col[k++] = cols[c];
+          g->entry[e++] = at;
         }
       }
     }
-    for (int rr = 0; rr < nc; ++rr) /* rows are numbered joint by joint, so rowptr[nc] = k */
-      if (rr + 1 == nc) g->rowptr[nc] = k;
-    if (nc == 0) g->rowptr[0] = 0;
+    g->rowptr[nc] = k; /* rows are numbered joint by joint */
+    g->eoff[nc] = e;
   }
   const long nnz_phi = g->rowptr[nc];
   /* CSC pattern: mass blocks, Phi_q^T (rows < nq in the multiplier columns), Phi_q, diagonal */
@@ -174,6 +185,8 @@ void fmb_augmented_free(fmbAugmented* g) {
   free(g->Ax);
   free(g->rowptr);
   free(g->col);
+  free(g->eoff);
+  free(g->entry);
   free(g->pos_phi);
   free(g->pos_phit);
   free(g->pos_diag);
@@ -220,8 +233,7 @@ static int assemble(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double 
         pv += d * v[cols[c]];
         pmax = fmax(pmax, fabs(d));
         if (drop && drop[rr]) continue;
-        int k = g->rowptr[rr]; /* the merged entry of this column */
-        while (g->col[k] != cols[c]) ++k;
+        const int k = g->entry[g->eoff[rr] + c];
         g->Ax[g->pos_phi[k]] += d;
         g->Ax[g->pos_phit[k]] += d;
       }
@@ -232,10 +244,16 @@ static int assemble(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double 
   g->pmax = pmax;
   const double eps = tikhonov * pmax * pmax / fmax(mdiag, 1e-300);
   for (int rr = 0; rr < g->nc; ++rr) g->Ax[g->pos_diag[rr]] = (drop && drop[rr]) ? 1.0 : -eps;
-  /* a fresh factorization each time (not klu_refactor): the pivots must follow the matrix
-     through singular configurations, where the order of the last one can be a bad one */
-  if (g->num) klu_l_free_numeric(&g->num, &g->common);
-  g->num = klu_l_factor(g->Ap, g->Ai, g->Ax, g->sym, &g->common);
+  /* the pivot order of the last factorization, refreshed (KLU allocates then) only when the
+     condition estimates say it has degraded, as schur.c does: near a singular configuration the
+     order of the last one can become a bad one */
+  if (!g->num || !klu_l_refactor(g->Ap, g->Ai, g->Ax, g->sym, g->num, &g->common) ||
+      !klu_l_rcond(g->sym, g->num, &g->common) ||
+      (g->common.rcond < AUG_RCOND_TINY &&
+       (!klu_l_condest(g->Ap, g->Ax, g->sym, g->num, &g->common) || g->common.condest > 1.0 / AUG_RCOND_TINY))) {
+    if (g->num) klu_l_free_numeric(&g->num, &g->common);
+    g->num = klu_l_factor(g->Ap, g->Ai, g->Ax, g->sym, &g->common);
+  }
   if (!g->num || g->common.status != KLU_OK) return FMB_AUG_SINGULAR;
   return 0;
 }

@@ -67,7 +67,7 @@ typedef struct {
   SUNMatrix A;
   SUNLinearSolver LS;
   fmbAugmented* aug;
-  double *accel, *lambda; /* nq, nc */
+  double* lambda; /* nc */
   int nwork;              /* work integrals carried (njoint or 0) */
   char msg[512];
 } ProjRun;
@@ -129,7 +129,6 @@ static void proj_destroy(void* self) {
   if (c->y) N_VDestroy(c->y);
   if (c->atol) N_VDestroy(c->atol);
   fmb_augmented_free(c->aug);
-  free(c->accel);
   free(c->lambda);
   if (c->sun) SUNContext_Free(&c->sun);
   free(c);
@@ -148,9 +147,8 @@ static void* proj_create(const fmbIntegratorSetup* s, double t0, const double* y
   c->y = N_VNew_Serial(n, c->sun);
   c->atol = N_VNew_Serial(n, c->sun);
   c->aug = fmb_augmented_new(m);
-  c->accel = calloc((size_t)nq + 1, sizeof(double));
   c->lambda = calloc((size_t)m->nc + 1, sizeof(double));
-  if (!c->y || !c->atol || !c->aug || !c->accel || !c->lambda) goto oom;
+  if (!c->y || !c->atol || !c->aug || !c->lambda) goto oom;
   fmb_vector_use_fast_ops(c->y);
   double *y = N_VGetArrayPointer(c->y), *at = N_VGetArrayPointer(c->atol);
   memcpy(y, y0, sizeof(double) * 2 * (size_t)nq);
