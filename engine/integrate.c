@@ -20,7 +20,7 @@
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
   if (m->solver.formulation == FMB_FORM_PROJECTED) return &fmb_integrator_projected;
-  /* formulation: auto with radau5 stays on radau5 (the switch below is IDA's) */
+  /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
   return m->solver.integrator == FMB_INTEG_RADAU5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
 }
 
@@ -259,14 +259,14 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     const int flag = ops->advance(integ, tout, &tret, y, yp, &h, why, sizeof why);
     t = tret;
     if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && stop && *stop)) break;
-    if (flag == FMB_ADVANCE_FAILED && ops == &fmb_integrator_ida && may_switch &&
+    if (flag == FMB_ADVANCE_FAILED && ops != &fmb_integrator_projected && may_switch &&
         fmb_rank_deficient_at(m, w, tret, y, y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
-      /* a singular configuration: the GGL system's Newton matrix is singular here; the projected
-         formulation (minimum-norm multipliers) passes it, for the rest of the run. It starts from
-         the last output row, not from IDA's last good step: that one lies next to the singular
-         configuration, where a start with no step history failed (scenes/parallelogram.yaml at
-         rtol 1e-8: IDA gave up 2e-4 rad before the flat position, CVODE started there stopped at
-         it). The work integrals go on from the row's values. */
+      /* a singular configuration: the GGL system's Newton matrix (IDA's or radau5's) is singular
+         here; the projected formulation (minimum-norm multipliers) passes it, for the rest of the
+         run. It starts from the last output row, not from the last good step: that one lies next
+         to the singular configuration, where a start with no step history failed
+         (scenes/parallelogram.yaml at rtol 1e-8: IDA gave up 2e-4 rad before the flat position,
+         CVODE started there stopped at it). The work integrals go on from the row's values. */
       if (!opt || !opt->quiet)
         fprintf(stderr, "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
                 "the mechanism can change branch); continuing with the projected formulation (set solver.formulation: "
@@ -324,7 +324,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
       break;
     }
     st->rows_written++;
-    if (may_switch && ops == &fmb_integrator_ida) {
+    if (may_switch && ops != &fmb_integrator_projected) {
       row.t = t;
       memcpy(row.y, y, sizeof(double) * (size_t)ny);
       memcpy(row.yp, yp, sizeof(double) * (size_t)ny);
