@@ -31,11 +31,14 @@ static int name_taken(const fmbModel* m, const char* name) {
 /* solver.atol: a number, or `auto` (as if absent: derived from rtol, engine/tolerance.c), which
    lets `--set solver.atol=auto` compare a scene's own atol with the derived one */
 static int get_atol(fmbParser* p, fmbNode node, double* atol, int* is_auto) {
-  static const char* const words[] = {"auto", NULL};
-  const char* text = fmbp_scalar(p, fmb_find_key(p, node, "atol"));
-  int choice = 0;
+  const fmbNode key = fmb_find_key(p, node, "atol");
+  const char* text = fmbp_scalar(p, key);
   *is_auto = text && strcmp(text, "auto") == 0;
-  return *is_auto ? fmb_get_choice(p, node, "atol", 0, words, &choice) : fmb_get_double(p, node, "atol", FMB_POSITIVE, atol);
+  if (*is_auto) return 0;
+  char* end = NULL;
+  if (text && (strtod(text, &end), end == text || *end != '\0'))
+    return fmb_parse_error(p, key, "expected a number or auto for 'atol', got '%s'", text);
+  return fmb_get_double(p, node, "atol", FMB_POSITIVE, atol);
 }
 
 static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
