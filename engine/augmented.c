@@ -22,10 +22,6 @@
 
 #include "internal.h"
 
-/* the refactorization keeps its pivot order while KLU's cheap estimate 1/rcond, then condest,
-   stay below eps^(-2/3) (schur_kernels.h's rule) */
-#define AUG_RCOND_TINY 3.666852862501036e-11
-
 struct fmbAugmented {
   int nq, nc, n;
   SuiteSparse_long *Ap, *Ai;
@@ -249,8 +245,8 @@ static int assemble(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double 
      order of the last one can become a bad one */
   if (!g->num || !klu_l_refactor(g->Ap, g->Ai, g->Ax, g->sym, g->num, &g->common) ||
       !klu_l_rcond(g->sym, g->num, &g->common) ||
-      (g->common.rcond < AUG_RCOND_TINY &&
-       (!klu_l_condest(g->Ap, g->Ax, g->sym, g->num, &g->common) || g->common.condest > 1.0 / AUG_RCOND_TINY))) {
+      (g->common.rcond < FMB_KLU_RCOND_TINY &&
+       (!klu_l_condest(g->Ap, g->Ax, g->sym, g->num, &g->common) || g->common.condest > 1.0 / FMB_KLU_RCOND_TINY))) {
     if (g->num) klu_l_free_numeric(&g->num, &g->common);
     g->num = klu_l_factor(g->Ap, g->Ai, g->Ax, g->sym, &g->common);
   }

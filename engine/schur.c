@@ -77,12 +77,6 @@ struct fmbSchur {
 #define SCHUR_ABS1(x) fabs(x)
 #define SCHUR_IS_COMPLEX 0
 #include "schur_kernels.h"
-#undef SCHUR_T
-#undef SCHUR_FINITE
-#undef SCHUR_FN
-#undef SCHUR_KLU
-#undef SCHUR_ABS1
-#undef SCHUR_IS_COMPLEX
 
 #define SCHUR_T double complex
 #define SCHUR_FINITE(x) (isfinite(creal(x)) && isfinite(cimag(x)))
@@ -91,12 +85,6 @@ struct fmbSchur {
 #define SCHUR_ABS1(x) (fabs(creal(x)) + fabs(cimag(x)))
 #define SCHUR_IS_COMPLEX 1
 #include "schur_kernels.h"
-#undef SCHUR_T
-#undef SCHUR_FINITE
-#undef SCHUR_FN
-#undef SCHUR_KLU
-#undef SCHUR_ABS1
-#undef SCHUR_IS_COMPLEX
 
 int fmb_schur_factor(fmbSchur* s, const double* J) {
   return s->nc == 2 ? schur_factor_complex(s, J) : schur_factor_real(s, J);

@@ -6,7 +6,7 @@
  *
  * Expects: SCHUR_T, SCHUR_FINITE(x), SCHUR_FN(name) (the name with the type's suffix),
  * SCHUR_KLU(name) (klu_l_name or klu_zl_name), SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
- * SCHUR_IS_COMPLEX (0 or 1). */
+ * SCHUR_IS_COMPLEX (0 or 1); undefines them at its end. */
 
 /* S = J_RR - J_Rq D^-1 J_qR, column by column through a dense scratch column (schur.c's head
    comment); also the compact J_Rq (complex: real, D^-1 applied in the solve; real: J_Rq D^-1)
@@ -141,10 +141,9 @@ static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
   if (!SCHUR_KLU(refactor)(s->colptr, s->rowind, s->data, s->symbolic, s->numeric, &s->common) ||
       !SCHUR_KLU(rcond)(s->symbolic, s->numeric, &s->common))
     return 1;
-  const double tiny = pow(2.220446049250313e-16, 2.0 / 3.0);
-  if (s->common.rcond < tiny) {
+  if (s->common.rcond < FMB_KLU_RCOND_TINY) {
     if (!SCHUR_KLU(condest)(s->colptr, s->data, s->symbolic, s->numeric, &s->common)) return 1;
-    if (s->common.condest > 1.0 / tiny) {
+    if (s->common.condest > 1.0 / FMB_KLU_RCOND_TINY) {
       SCHUR_KLU(free_numeric)(&s->numeric, &s->common);
       s->numeric = SCHUR_KLU(factor)(s->colptr, s->rowind, s->data, s->symbolic, &s->common);
       if (!s->numeric) return -1;
@@ -202,3 +201,11 @@ static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
   memset(rhs, 0, sizeof(SCHUR_T) * (size_t)nr); /* the scratch column is kept zero between uses */
   return 0;
 }
+
+/* the parameters are this instantiation's only: the next one defines its own */
+#undef SCHUR_T
+#undef SCHUR_FINITE
+#undef SCHUR_FN
+#undef SCHUR_KLU
+#undef SCHUR_ABS1
+#undef SCHUR_IS_COMPLEX
