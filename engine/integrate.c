@@ -18,21 +18,6 @@
    at 0.3 mrad before the flat position in scenes/parallelogram.yaml) */
 #define FMB_AUTO_SWITCH_RANK_TOL 1e-2
 
-const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  if (m->solver.formulation == FMB_FORM_PROJECTED) return &fmb_integrator_projected;
-  /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
-  return m->solver.integrator == FMB_INTEG_RADAU5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
-}
-
-void fmb_print_stats(const fmbStats* s, FILE* f) {
-  if (!s || !f) return;
-  fprintf(f,
-          "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
-          "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
-          s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
-          s->error_test_fails, s->conv_fails, s->jacobians_reused, s->cpu_s);
-}
-
 static void add_stats(fmbStats* to, const fmbStats* from) {
   to->steps += from->steps;
   to->residuals += from->residuals;

@@ -1,0 +1,22 @@
+/* integrator_select.c — which integrator backend a model runs on, and the stats line that names
+ * what a run did. One place for the choice (docs/style.md: "a choice made in one place"), apart
+ * from the run driver (integrate.c), so that the backends' table and the rule that picks one can
+ * grow without touching the driver. */
+#include <stdio.h>
+
+#include "integrator.h"
+
+const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
+  if (m->solver.formulation == FMB_FORM_PROJECTED) return &fmb_integrator_projected;
+  /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
+  return m->solver.integrator == FMB_INTEG_RADAU5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
+}
+
+void fmb_print_stats(const fmbStats* s, FILE* f) {
+  if (!s || !f) return;
+  fprintf(f,
+          "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
+          "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
+          s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
+          s->error_test_fails, s->conv_fails, s->jacobians_reused, s->cpu_s);
+}
