@@ -391,6 +391,9 @@ typedef struct fmbStats {
   double ic_position_correction, ic_velocity_correction; /* norms of the initial projection */
   long rows_written;
   int interrupted; /* the run stopped because *fmbRunOptions.stop was set */
+  /* the integrator backend that ran last ("ida", "radau5", "projected"; solver.integrator: auto
+     picks one per model, formulation: auto may switch to projected mid-run); NULL if none ran */
+  const char* integrator;
 } fmbStats;
 
 typedef struct fmbRunOptions {

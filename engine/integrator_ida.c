@@ -403,6 +403,7 @@ static void ida_stats(const void* self, fmbStats* st) {
   st->error_test_fails = acc.error_test_fails;
   st->conv_fails = acc.conv_fails;
   st->jacobians_reused = c->reused;
+  st->integrator = fmb_integrator_ida.name;
 }
 
 static void ida_after_row(void* self, double t) {

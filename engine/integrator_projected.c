@@ -240,6 +240,7 @@ static void proj_stats(const void* self, fmbStats* st) {
   if (CVodeGetNumErrTestFails(cv, &v) == CV_SUCCESS) st->error_test_fails = v;
   if (CVodeGetNumNonlinSolvConvFails(cv, &v) == CV_SUCCESS) st->conv_fails = v;
   st->jacobians_reused = 0;
+  st->integrator = fmb_integrator_projected.name;
 }
 
 const fmbIntegratorOps fmb_integrator_projected = {

@@ -22,7 +22,11 @@
  * systems are solved with the position rows eliminated (schur.c: their q-blocks are (gamma/h) I
  * and ((alpha + i beta)/h) I up to O(|mu|), kept as their diagonals), so KLU factorizes two
  * matrices with nq fewer rows: a modified simplified Newton iteration, as IDA's; klu_full keeps
- * the whole matrices (the exact simplified Newton, for comparison and as a fallback by hand).
+ * the whole matrices (the exact simplified Newton). If a run on the reduced systems cannot go on
+ * (a factorization fails outright, or the step falls to min_step, or the Newton matrix stays
+ * singular), the cause may be the dropped O(|mu|) part rather than the model, so the run
+ * continues from the last accepted step with the whole matrices, once, and says so: IDA's
+ * fallback (integrator_ida.c).
  *
  * Error estimate (IV.8 (8.19)-(8.20), RADAU5's ESTRAD with the mass matrix J_y'):
  *   err = (J_y + gamma/h J_y')^-1 J_y' (y'_n + (1/h) sum_i d_i Z_i),
@@ -118,6 +122,7 @@ typedef struct {
   /* solver.linear_solver: klu (default): both systems with the position rows eliminated
      (schur.c); klu_full: KLU on the whole matrices above */
   fmbSchur *red1, *red2;
+  int fell_back;                 /* the reduced systems failed once: KLU on the whole matrices since */
   double h_lu;                   /* the step the factorizations are for (0: none) */
   int need_jac;                  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
   int caljac;                    /* the Jacobian was evaluated at this step's start (t, y) */
@@ -314,7 +319,8 @@ static int factor(RadauRun* c, klu_l_numeric** num, double* data, int complex_va
   return *num ? 0 : 1;
 }
 
-/* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized */
+/* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized: 0 ok, 1
+   singular, -1 a reduced factorization failed outright (KLU, or the tests' fault injection) */
 static int decompose(RadauRun* c) {
   const long nnz = c->m->nnz;
   const double g = GAMMA / c->h, a = ALPHA / c->h, b = BETA / c->h;
@@ -323,11 +329,16 @@ static int decompose(RadauRun* c) {
     c->e2[2 * k] = c->jy[k] + a * c->jyp[k];
     c->e2[2 * k + 1] = b * c->jyp[k];
   }
-  const int failed = c->red1 ? fmb_schur_factor(c->red1, c->e1) || fmb_schur_factor(c->red2, c->e2)
-                            : factor(c, &c->num1, c->e1, 0) || factor(c, &c->num2, c->e2, 1);
+  int failed = 0;
+  if (c->red1) {
+    failed = fmb_schur_factor(c->red1, c->e1);
+    if (!failed) failed = fmb_schur_factor(c->red2, c->e2);
+  } else {
+    failed = factor(c, &c->num1, c->e1, 0) || factor(c, &c->num2, c->e2, 1);
+  }
   if (failed) {
     c->h_lu = 0.0;
-    return 1;
+    return failed < 0 ? -1 : 1; /* -1: the reduced factorization failed outright */
   }
   c->h_lu = c->h;
   return 0;
@@ -625,7 +636,9 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       c->h_lu = 0.0;
     }
     if (c->h != c->h_lu) {
-      if (decompose(c)) {
+      const int dc = decompose(c);
+      if (dc < 0 && c->red1) return FAIL_SINGULAR; /* the reduced systems' own failure: the fallback */
+      if (dc) {
         if (++c->nsing >= FMB_RADAU_MAX_SINGULAR) return FAIL_SINGULAR;
         c->h *= 0.5;
         c->reject = 1;
@@ -711,6 +724,26 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
   }
 }
 
+/* the fallback (head comment): the whole matrices from here on, a fresh Jacobian, and the step
+   size of the last accepted step (the failed attempts drove h to where the reduced systems gave
+   up); 0 ok, 1 KLU could not analyze the whole pattern */
+static int fall_back_to_full(RadauRun* c) {
+  fmb_schur_free(c->red1);
+  fmb_schur_free(c->red2);
+  c->red1 = c->red2 = NULL;
+  c->fell_back = 1;
+  c->symbolic = klu_l_analyze(c->ny, c->colptr, c->rowind, &c->common);
+  if (!c->symbolic) return 1;
+  if (c->hold > 0.0) c->h = c->hold;
+  c->need_jac = 1;
+  c->h_lu = 0.0;
+  c->nsing = 0;
+  c->reject = 1;
+  fprintf(stderr, "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+          "from the last good step with klu_full (the whole matrices)\n", c->t);
+  return 0;
+}
+
 static int radau_advance(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
                          size_t why_len) {
   RadauRun* c = self;
@@ -724,6 +757,11 @@ static int radau_advance(void* self, double tout, double* t_reached, double* y, 
       break;
     }
     fail = radau_step(c, &interrupted);
+    if (!interrupted && c->red1 && (fail == FAIL_MIN_STEP || fail == FAIL_SINGULAR)) {
+      if (fall_back_to_full(c)) break;
+      fail = FAIL_NONE;
+      continue;
+    }
     if (fail != FAIL_NONE || interrupted) break;
     steps++;
   }
@@ -764,6 +802,7 @@ static void radau_stats(const void* self, fmbStats* st) {
   st->error_test_fails = c->st.error_test_fails;
   st->conv_fails = c->st.conv_fails;
   st->jacobians_reused = c->lu_reuses;
+  st->integrator = fmb_integrator_radau5.name;
 }
 
 const fmbIntegratorOps fmb_integrator_radau5 = {
