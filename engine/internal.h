@@ -84,9 +84,10 @@ typedef struct fmbSolverSettings {
      docs/mechanisms.md) */
   enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1, FMB_FORM_AUTO = 2 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */
-  /* the GGL system's integrator: IDA (BDF, default) or Radau IIA of order 5 (integrator_radau.c),
-     which keeps order 5 on undamped structural modes where BDF is capped at 2 */
-  enum { FMB_INTEG_IDA = 0, FMB_INTEG_RADAU5 = 1 } integrator;
+  /* the GGL system's integrator: IDA (BDF), Radau IIA of order 5 (integrator_radau.c), which
+     keeps order 5 on undamped structural modes where BDF is capped at 2, or auto (default): one
+     of the two per model by the rule of fmb_integrator_for (integrator_select.c) */
+  enum { FMB_INTEG_IDA = 0, FMB_INTEG_RADAU5 = 1, FMB_INTEG_AUTO = 2 } integrator;
   long max_steps_per_output;
 } fmbSolverSettings;
 

@@ -58,8 +58,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
-  static const char* const integrators[] = {"ida", "radau5", NULL}; /* order of FMB_INTEG_* */
-  int formulation = FMB_FORM_AUTO, integrator = FMB_INTEG_IDA;
+  static const char* const integrators[] = {"ida", "radau5", "auto", NULL}; /* order of FMB_INTEG_* */
+  int formulation = FMB_FORM_AUTO, integrator = FMB_INTEG_AUTO;
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
