@@ -10,10 +10,11 @@
    integrator x rtol (bench/auto.sh, docs/performance.md "Integrator auto"):
    - a model with a body that caps the BDF order below 5 (fmbBodyType.max_bdf_order: undamped
      structural modes, i.e. every beam model) runs radau5. BDF is held at order 2 there and buys
-     accuracy at the second-order rate, while Radau IIA is L-stable at order 5: at each shipped
-     beam scene's own rtol radau5 is 10-250x more accurate (the ω0 = 15 spin-up at 1e-6: 6.2e-7
-     against 1.8e-4 m), and at equal error it is the cheaper one on every beam scene from a tip
-     error of ~2e-5 m down (the exact beam: IDA is cheaper only above that).
+     accuracy at the second-order rate, while Radau IIA is L-stable at order 5: at each beam
+     scene's former settings radau5 was 15-1600x more accurate (the ω0 = 15 spin-up at rtol 1e-6:
+     6.2e-7 against 1.8e-4 m in 0.027 against 0.044 s; the flexible pendulum 4.4e-5 against
+     6.6e-4 m), and at equal error it is the cheaper one on every beam scene from an error of
+     ~1e-4 of the output's range down (the exact beam: IDA is cheaper only above that).
    - a model of rigid bodies runs IDA: BDF up to order 5 has no such cap, and on the four-bar it
      reaches 8e-11 rad at rtol 1e-10 where radau5 stays at 4e-8 (its output rows between large
      steps come from the order-3 collocation polynomial).
