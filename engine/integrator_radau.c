@@ -766,8 +766,25 @@ static void radau_stats(const void* self, fmbStats* st) {
   st->jacobians_reused = c->lu_reuses;
 }
 
+/* radau5's cross-key rules */
+static int radau_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
+  /* radau5 integrates the GGL system; the projected formulation has its own backend (CVODE) */
+  if (m->solver.formulation == FMB_FORM_PROJECTED)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "integrator"),
+                           "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
+                           "integrator (CVODE): drop one of the two keys");
+  /* radau5's systems are complex as well as real; SUNDIALS' dense LU is real only */
+  if (m->solver.linear_solver == FMB_LS_DENSE)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "linear_solver"),
+                           "integrator: radau5 solves with KLU: linear_solver klu (the position rows eliminated, "
+                           "default) or klu_full (the whole matrix); dense is IDA's only");
+  return 0;
+}
+
 const fmbIntegratorOps fmb_integrator_radau5 = {
     .name = "radau5",
+    .projected = 0,
+    .check = radau_check,
     .create = radau_create,
     .advance = radau_advance,
     .work = radau_work,

@@ -86,7 +86,7 @@ typedef struct fmbSolverSettings {
   int positions_only; /* error test on q only (error_control: positions) */
   /* the GGL system's integrator: IDA (BDF, default) or Radau IIA of order 5 (integrator_radau.c),
      which keeps order 5 on undamped structural modes where BDF is capped at 2 */
-  enum { FMB_INTEG_IDA = 0, FMB_INTEG_RADAU5 = 1 } integrator;
+  const struct fmbIntegratorOps* integrator; /* one of fmb_integrators[] (integrator.h), never projected */
   long max_steps_per_output;
 } fmbSolverSettings;
 
