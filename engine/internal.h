@@ -313,10 +313,6 @@ int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order
 /* constraint rows that depend on the others at the initial state and nearby (redundant, not a
    singular start); 0 when none or when the joints cannot be satisfied (the run says why) */
 int fmb_count_redundant(const fmbModel* m);
-/* KLU refactorizations keep their pivot order while the cheap estimate 1/rcond, then condest,
-   stay below eps^(-2/3) = 1 / FMB_KLU_RCOND_TINY (as SUNDIALS' KLU module; schur_kernels.h,
-   augmented.c) */
-#define FMB_KLU_RCOND_TINY 3.666852862501036e-11
 typedef struct fmbAugmented fmbAugmented; /* augmented.c: the index-1 system on a sparse matrix */
 enum { FMB_AUG_MASS_FAILED = 1, FMB_AUG_FORCES_FAILED, FMB_AUG_SINGULAR, FMB_AUG_NOT_FINITE };
 fmbAugmented* fmb_augmented_new(const fmbModel* m);

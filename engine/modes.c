@@ -25,9 +25,9 @@
 #include <string.h>
 
 #include "internal.h"
+#include "klu_policy.h"
 
 #include <arpack/arpack.h>
-#include <klu.h>
 
 /* coordinates from which `auto` takes the sparse path for a few modes: bench/modes.sh measured
    the crossover between 8 and 16 beam elements (27 and 51 coordinates) for 4 modes */
@@ -159,7 +159,7 @@ static int classify(const double* wr, const double* wi, int n2, int inverted, Ro
 
 typedef struct {
   int n, nnz;
-  int *p, *i;
+  SuiteSparse_long *p, *i; /* KLU's index type: the saddle-point matrix goes to klu.c */
   double* x;
 } Csc;
 
@@ -180,8 +180,8 @@ static int csc_build(Csc* a, int nt, const double* top, int ldt, int nc, const d
     for (int r = 0; r < nc; ++r) nnz += 2 * (J0[(size_t)j * ny + prow + r] != 0.0);
   }
   a->n = n;
-  a->p = malloc((size_t)(n + 1) * sizeof(int));
-  a->i = malloc((size_t)(nnz + 1) * sizeof(int));
+  a->p = malloc((size_t)(n + 1) * sizeof(SuiteSparse_long));
+  a->i = malloc((size_t)(nnz + 1) * sizeof(SuiteSparse_long));
   a->x = malloc((size_t)(nnz + 1) * sizeof(double));
   if (!a->p || !a->i || !a->x) return -1;
   int k = 0;
@@ -216,7 +216,7 @@ static void csc_matvec_add(const Csc* a, const double* x, double* y) {
   for (int j = 0; j < a->n; ++j) {
     const double xj = x[j];
     if (xj == 0.0) continue;
-    for (int k = a->p[j]; k < a->p[j + 1]; ++k) y[a->i[k]] += a->x[k] * xj;
+    for (SuiteSparse_long k = a->p[j]; k < a->p[j + 1]; ++k) y[a->i[k]] += a->x[k] * xj;
   }
 }
 
@@ -232,9 +232,7 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
   if (ncv > n2) ncv = n2;
   const int lworkl = 3 * ncv * ncv + 6 * ncv;
   Csc S = {0, 0, NULL, NULL, NULL}, Cs = S, Ms = S;
-  klu_common common;
-  klu_symbolic* sym = NULL;
-  klu_numeric* num = NULL;
+  fmbKlu* lu = NULL;
   double *resid = calloc((size_t)n2, sizeof(double)), *V = calloc((size_t)n2 * ncv, sizeof(double));
   double *workd = calloc((size_t)3 * n2, sizeof(double)), *workl = calloc((size_t)lworkl, sizeof(double));
   double *rhs = calloc((size_t)ns, sizeof(double)), *dr = calloc((size_t)nev + 1, sizeof(double));
@@ -247,10 +245,8 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
       csc_build(&Ms, nq, M, nq, 0, J0, ny, 0))
     goto done;
   rc = 1;
-  klu_defaults(&common);
-  sym = klu_analyze(ns, S.p, S.i, &common);
-  num = sym ? klu_factor(S.p, S.i, S.x, sym, &common) : NULL;
-  if (!num || common.status != KLU_OK) goto done;
+  lu = fmb_klu_new(ns, S.p, S.i, 0);
+  if (!lu || fmb_klu_factor(lu, S.x) != FMB_KLU_OK) goto done;
   int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
   iparam[0] = 1;    /* exact shifts */
   iparam[2] = 3000; /* restarts */
@@ -264,7 +260,7 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
     csc_matvec_add(&Cs, x, rhs);
     csc_matvec_add(&Ms, x + nq, rhs);
     for (int i = 0; i < nq; ++i) rhs[i] = -rhs[i];
-    klu_solve(sym, num, ns, 1, rhs, &common);
+    fmb_klu_solve(lu, rhs);
     memcpy(yv, rhs, (size_t)nq * sizeof(double));
     memcpy(yv + nq, x, (size_t)nq * sizeof(double));
   } while (1);
@@ -289,8 +285,7 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
   dr = di = Z = NULL;
   rc = 0;
 done:
-  if (num) klu_free_numeric(&num, &common);
-  if (sym) klu_free_symbolic(&sym, &common);
+  fmb_klu_free(lu);
   csc_free(&S);
   csc_free(&Cs);
   csc_free(&Ms);
