@@ -252,9 +252,6 @@ void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const do
                           double* vel);
 double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        const double* lambda);
-/* multipliers consistent with (q, v) at t (ic.c's augmented system; IDA's own between steps are
-   interpolated outside its error test), or y's when that system cannot be solved */
-const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y);
 /* force (global x, y) and torque (about the joint's point) that joint j's constraint forces exert
    on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
 int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
@@ -265,6 +262,9 @@ double* fmb_workspace_work(fmbWorkspace* w);
 /* per constraint row: 1 = redundant, out of the equations; *count (may be NULL) = how many */
 unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count);
 double* fmb_workspace_spring_energy0(fmbWorkspace* w);
+/* the slot of an object a layer above keeps with the workspace (output.c's multipliers), freed
+   with it by free_fn (set when not NULL): the workspace calls nothing above system.c */
+void** fmb_workspace_attached(fmbWorkspace* w, void (*free_fn)(void*));
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
 /* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1.
@@ -275,9 +275,6 @@ int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q
 /* ---- pattern.c ---- */
 int fmb_pattern_build(fmbModel* m);
 void fmb_pattern_free(fmbModel* m);
-void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals,
-                       int ld, double scale);
-void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v);
 
 /* ---- schur.c: KLU on the GGL Newton systems with the position rows eliminated ---- */
 /* One Newton matrix on the model's pattern, real or complex (values interleaved (re, im)), solved
@@ -378,16 +375,9 @@ double fmb_fd_increment(double y, double ewt);
 int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
                          const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
                          double* M, double* work, double* scratch);
-/* the same over a body's sparse pattern (b->pcolptr/prowind), one residual pair per colour:
-   K = d[R; Rz]/dq (and d/dz in the z columns), C = d/dv, M = d/da, each in pattern order
-   (pnnz). z: the body's auxiliary unknowns (NULL when nz = 0). scratch: fmb_fd_sparse_scratch. */
-size_t fmb_fd_sparse_scratch(const fmbBodyInst* b);
-int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                       const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                       double* work, double* scratch);
-/* ---- pattern.c: a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
-   pattern_jacobian when it has one, else by differences (fmb_fd_body_sparse); scratch doubles:
-   fmb_body_sparse_scratch ---- */
+/* a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
+   pattern_jacobian when it has one, else by differences over its pattern, one residual pair per
+   colour; scratch doubles: fmb_body_sparse_scratch */
 size_t fmb_body_sparse_scratch(const fmbBodyInst* b);
 int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                            const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
