@@ -201,10 +201,20 @@ fmbNode fmbp_seq_item(fmbParser* p, fmbNode seq, int i);
 const char* fmbp_scalar(fmbParser* p, fmbNode n); /* NULL if not a scalar */
 int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]);
 
-/* ---- diag ---- */
+/* ---- diag.c ---- */
 void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
+   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
+#define FMB_OVERRIDE_SHOWN 80
+const char* fmbp_shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]);
+/* a warning about a scene's node that does not stop the load: FILE:LINE:COL: warning: ... */
+void fmbp_warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
