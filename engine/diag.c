@@ -49,7 +49,8 @@ const char* fmbp_shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 
 
 /* where `node` is: file:line:column, or the override that made it */
 static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
-  yaml_node_t* nd = fmbp_node(p, node);
+  /* the node itself (libyaml's lookup, not yaml_get.c's, which calls into this file) */
+  yaml_node_t* nd = node > 0 ? yaml_document_get_node(&p->doc, node) : NULL;
   int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
   char shown[FMB_OVERRIDE_SHOWN + 32];
   if (ov >= 0)
