@@ -152,8 +152,13 @@ typedef struct fmbParam {
 
 /* type flags (fmbBodyType.flags, fmbJointType.flags) */
 enum {
-  FMB_TYPE_DOES_WORK = 1 << 0 /* feeds energy in (a prescribed motion, an applied load): conform
-                                 skips the energy-conservation run */
+  FMB_TYPE_DOES_WORK = 1 << 0, /* feeds energy in (a prescribed motion, an applied load): conform
+                                  skips the energy-conservation run */
+  /* conform's fixture (fmb_conform) is made of the first registered body type and joint type
+     with this flag, so that the engine names no type: the body must take mass, inertia,
+     position, velocity and angular_velocity (a rigid body with a frame), the joint body1, body2
+     and point2 (a pin joining two bodies' points) */
+  FMB_TYPE_CONFORM_FIXTURE = 1 << 1
 };
 
 /* ---------------------------------------------------------------------------------------------
@@ -373,7 +378,7 @@ FMB_API const fmbJointType* fmb_registry_joint(const fmbRegistry* reg, int i);
 /* where type i came from: "built-in" or the plugin's file */
 FMB_API const char* fmb_registry_body_origin(const fmbRegistry* reg, int i);
 FMB_API const char* fmb_registry_joint_origin(const fmbRegistry* reg, int i);
-/* the types shipped with flexmbd (tools/builtin.c), registered like any plugin */
+/* the types shipped with flexmbd (builtin/builtin.c), registered like any plugin */
 FMB_API const fmbPlugin* fmb_builtin_plugin(void);
 
 /* ---------------------------------------------------------------------------------------------
