@@ -118,7 +118,8 @@ int fmb_campbell_add(fmbCampbell* c, fmbModes* cur, fmbDiag* diag) {
   }
   const int count = c->count, i = c->done;
   if (cur->count < count) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "the scene has only %d modes; %d were asked for", cur->count, count);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "the scene has only %d modes; %d were asked for", cur->count,
+                 count);
     fmb_modes_free(cur);
     return FMB_EXIT_BAD_INPUT;
   }

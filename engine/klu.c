@@ -61,12 +61,14 @@ void fmb_klu_free(fmbKlu* k) {
 static int refactor_good(fmbKlu* k, double* x) {
   SuiteSparse_long *Ap = (SuiteSparse_long*)k->colptr, *Ai = (SuiteSparse_long*)k->rowind;
   if (k->is_complex) {
-    if (!klu_zl_refactor(Ap, Ai, x, k->symbolic, k->numeric, &k->common) || !klu_zl_rcond(k->symbolic, k->numeric, &k->common))
+    if (!klu_zl_refactor(Ap, Ai, x, k->symbolic, k->numeric, &k->common) ||
+        !klu_zl_rcond(k->symbolic, k->numeric, &k->common))
       return 0;
     if (k->common.rcond >= FMB_KLU_RCOND_TINY) return 1;
     return klu_zl_condest(Ap, x, k->symbolic, k->numeric, &k->common) && k->common.condest <= 1.0 / FMB_KLU_RCOND_TINY;
   }
-  if (!klu_l_refactor(Ap, Ai, x, k->symbolic, k->numeric, &k->common) || !klu_l_rcond(k->symbolic, k->numeric, &k->common))
+  if (!klu_l_refactor(Ap, Ai, x, k->symbolic, k->numeric, &k->common) ||
+      !klu_l_rcond(k->symbolic, k->numeric, &k->common))
     return 0;
   if (k->common.rcond >= FMB_KLU_RCOND_TINY) return 1;
   return klu_l_condest(Ap, x, k->symbolic, k->numeric, &k->common) && k->common.condest <= 1.0 / FMB_KLU_RCOND_TINY;
@@ -82,7 +84,8 @@ int fmb_klu_factor(fmbKlu* k, const double* values) {
   }
   k->was_full = 1;
   SuiteSparse_long *Ap = (SuiteSparse_long*)k->colptr, *Ai = (SuiteSparse_long*)k->rowind;
-  k->numeric = k->is_complex ? klu_zl_factor(Ap, Ai, x, k->symbolic, &k->common) : klu_l_factor(Ap, Ai, x, k->symbolic, &k->common);
+  k->numeric = k->is_complex ? klu_zl_factor(Ap, Ai, x, k->symbolic, &k->common)
+                             : klu_l_factor(Ap, Ai, x, k->symbolic, &k->common);
   if (k->numeric && k->common.status == KLU_OK) return FMB_KLU_OK;
   const int singular = k->common.status == KLU_SINGULAR;
   fmb_klu_forget(k);

@@ -102,6 +102,12 @@ static int merge(FILE* f, const Lines* part, const char* const* models, int nmod
   return ferror(f) ? -1 : 0;
 }
 
+/* the overrides that switch every named body to `model`, one per body (SET_MAX characters each) */
+static void set_model(char* sets, const char* const* bodies, int nbody, const char* model) {
+  for (int b = 0; b < nbody; ++b)
+    snprintf(sets + (size_t)b * SET_MAX, SET_MAX, "bodies.%.*s.model=%s", FMB_NAME_MAX, bodies[b], model);
+}
+
 int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int nbody, const char* const* models,
                    int nmodel, const fmbRunOptions* opt, fmbModelsResult* res, fmbDiag* diag) {
   fmbDiag local_diag;
@@ -111,13 +117,13 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
   memset(diag, 0, sizeof *diag);
   memset(res, 0, sizeof *res);
   const char* path = scene && scene->path ? scene->path : "";
-  const char* misuse = !scene || !scene->path || !scene->reg || scene->noverrides < 0 ||
-                               (scene->noverrides > 0 && !scene->overrides)
-                           ? "no scene (path, registry, overrides)"
-                       : !bodies || nbody < 1 ? "no body to switch"
-                       : !models || nmodel < 1 || nmodel > FMB_MODELS_MAX ? "from 1 to 8 models"
-                       : !opt || !opt->csv_path || strcmp(opt->csv_path, "-") == 0 ? "the merged CSV needs a file (opt->csv_path)"
-                                                                                  : NULL;
+  const char* misuse =
+      !scene || !scene->path || !scene->reg || scene->noverrides < 0 || (scene->noverrides > 0 && !scene->overrides)
+          ? "no scene (path, registry, overrides)"
+      : !bodies || nbody < 1                                      ? "no body to switch"
+      : !models || nmodel < 1 || nmodel > FMB_MODELS_MAX          ? "from 1 to 8 models"
+      : !opt || !opt->csv_path || strcmp(opt->csv_path, "-") == 0 ? "the merged CSV needs a file (opt->csv_path)"
+                                                                  : NULL;
   if (misuse) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "fmb_run_models: %s", misuse);
     return FMB_EXIT_BAD_INPUT;
@@ -142,12 +148,9 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
   }
   for (int i = 0; !rc && i < scene->noverrides; ++i) ov[i] = scene->overrides[i];
   for (int b = 0; b < nbody && !rc; ++b) ov[scene->noverrides + b] = sets + (size_t)b * SET_MAX;
-#define SET_MODEL(k)                                                                                     \
-  for (int b = 0; b < nbody; ++b)                                                                        \
-    snprintf(sets + (size_t)b * SET_MAX, SET_MAX, "bodies.%.*s.model=%s", FMB_NAME_MAX, bodies[b], models[k])
   /* every model must load before any runs */
   for (int k = 0; k < nmodel && !rc; ++k) {
-    SET_MODEL(k);
+    set_model(sets, bodies, nbody, models[k]);
     fmbModel* m = fmb_load(scene->path, ov, nov, scene->reg, diag);
     if (!m) rc = diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
     fmb_free(m);
@@ -165,7 +168,7 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
   int read = 0;
   for (int k = 0; k < nmodel && !rc; ++k) {
     snprintf(file, sizeof file, "%s/%s.csv", dir, models[k]);
-    SET_MODEL(k);
+    set_model(sets, bodies, nbody, models[k]);
     fmbModel* m = fmb_load(scene->path, ov, nov, scene->reg, &res->diag[k]);
     if (!m) {
       *diag = res->diag[k];
@@ -186,7 +189,6 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
     remove(file);
     if (!rc) read = k + 1;
   }
-#undef SET_MODEL
   int worst = 0;
   for (int k = 0; k < res->ran; ++k)
     if (res->code[k] > worst) worst = res->code[k];

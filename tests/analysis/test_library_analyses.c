@@ -13,7 +13,8 @@
 #include "analysis.h"
 
 static fmbSceneSource rotating(const char* const* ov, int nov, char* path, size_t len) {
-  const fmbSceneSource s = {fmbt_path("tests/analysis/scenes/rotating.yaml", path, len), ov, nov, fmb_builtin_registry()};
+  const fmbSceneSource s = {fmbt_path("tests/analysis/scenes/rotating.yaml", path, len), ov, nov,
+                            fmb_builtin_registry()};
   return s;
 }
 
@@ -135,7 +136,8 @@ static void models(void) {
   fmbDiag d;
   {
     const char* ov[] = {"solver.t_end=2"};
-    const fmbSceneSource scene = {fmbt_path("scenes/paper/spinup_w1.yaml", path, sizeof path), ov, 1, fmb_builtin_registry()};
+    const fmbSceneSource scene = {fmbt_path("scenes/paper/spinup_w1.yaml", path, sizeof path), ov, 1,
+                                  fmb_builtin_registry()};
     const char* list[] = {"complete", "exact"};
     const fmbRunOptions opt = {.csv_path = fmbt_out_path("models_w1.csv", out, sizeof out), .quiet = 1};
     ENSURE(fmb_run_models(&scene, bodies, 1, list, 2, &opt, &res, &d) == 0);
@@ -147,7 +149,8 @@ static void models(void) {
     fmbt_csv_free(&merged);
   }
   {
-    const fmbSceneSource scene = {fmbt_path("scenes/paper/spinup_w4.yaml", path, sizeof path), NULL, 0, fmb_builtin_registry()};
+    const fmbSceneSource scene = {fmbt_path("scenes/paper/spinup_w4.yaml", path, sizeof path), NULL, 0,
+                                  fmb_builtin_registry()};
     const char* list[] = {"zoac", "complete"};
     const fmbRunOptions opt = {.csv_path = fmbt_out_path("models_w4.csv", out, sizeof out), .quiet = 1};
     ENSURE(fmb_run_models(&scene, bodies, 1, list, 2, &opt, &res, &d) == FMB_EXIT_SOLVER);
@@ -161,7 +164,8 @@ static void models(void) {
     fmbt_csv_free(&merged);
   }
   {
-    const fmbSceneSource scene = {fmbt_path("scenes/paper/spinup_w1.yaml", path, sizeof path), NULL, 0, fmb_builtin_registry()};
+    const fmbSceneSource scene = {fmbt_path("scenes/paper/spinup_w1.yaml", path, sizeof path), NULL, 0,
+                                  fmb_builtin_registry()};
     const char* bad[] = {"complete", "cubic"};
     const fmbRunOptions opt = {.csv_path = fmbt_out_path("models_bad.csv", out, sizeof out), .quiet = 1};
     ENSURE(fmb_run_models(&scene, bodies, 1, bad, 2, &opt, &res, &d) == FMB_EXIT_BAD_INPUT);
