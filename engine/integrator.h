@@ -20,6 +20,7 @@
 #include <stddef.h>
 
 #include "internal.h"
+#include "schur.h"
 
 typedef struct {
   const fmbModel* m;

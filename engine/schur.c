@@ -34,6 +34,7 @@
 
 #include "internal.h"
 #include "klu_policy.h"
+#include "schur.h"
 
 struct fmbSchur {
   const fmbModel* m;
