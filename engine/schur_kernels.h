@@ -126,17 +126,18 @@ static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* r
 }
 
 /* S formed from J and factorized (klu.c's policy: the old pivot order while the condition
-   estimates allow). 0 ok, 1 recoverable (D or S singular), -1 KLU could not factorize at all. */
+   estimates allow). 0 ok, 1 recoverable (D singular, or a small dense S), -1 KLU could not
+   factorize S, not even from scratch with new pivots. */
 static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
   if (SCHUR_FN(schur_form)(s, J)) return 1;
   if (s->lu) { /* partial pivoting afresh each time: a dense LU has no refactorization to reuse */
     s->factored = !SCHUR_FN(dense_lu)((SCHUR_T*)s->lu, s->nr, s->ipiv);
     return s->factored ? 0 : 1;
   }
-  /* the one KLU policy (klu.c): a singular S is recoverable (IDA cuts the step), anything else not */
-  const int rc = fmb_klu_factor(s->klu, s->data);
-  if (rc != FMB_KLU_OK) return rc == FMB_KLU_SINGULAR ? 1 : -1;
-  return 0;
+  /* the one KLU policy (klu.c). No factorization at all, even from scratch, is a failure the step
+     size cannot mend (as SUNDIALS' KLU module says of a failed klu_factor): the caller falls back
+     to the whole matrix (klu_full) */
+  return fmb_klu_factor(s->klu, s->data) == FMB_KLU_OK ? 0 : -1;
 }
 
 /* x = J^-1 x in place with the last factorization: dR from S dR = b_R - J_Rq D^-1 b_q, then
