@@ -8,7 +8,12 @@
  * falls below eps^(2/3) and the accurate 1-norm estimate condest then exceeds eps^(-2/3): the old
  * order has become a bad one (near a singular configuration it can) and a factorization from
  * scratch picks new pivots. A refactorization that fails outright (a zero pivot in the old order)
- * is also retried from scratch: fresh partial pivoting may pass where the old order cannot. */
+ * is also retried from scratch: fresh partial pivoting may pass where the old order cannot.
+ * The rule's blind spot, kept on purpose: condest measures the matrix, not the factorization, so
+ * a bad old pivot in a well-conditioned matrix (rcond 1e-28, condest 4: tests/core/test_klu.c)
+ * keeps the old order. Factoring afresh on rcond alone would close it, but schur.c's S meets
+ * rcond < eps^(2/3) with condest 1e7..1e8 in shipped scenes (pendulum, parallelogram), whose
+ * numbers would then change; the Newton iterations that use S absorb a slightly worse solve. */
 #include <stdlib.h>
 
 #include "klu_policy.h"
