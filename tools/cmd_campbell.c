@@ -135,9 +135,19 @@ int fmb_cmd_campbell(int argc, char** argv) {
   }
   const fmbSceneSource scene = {s.scene, s.overrides, s.nover, fmb_cli_registry()};
   const fmbCampbellOptions opt = {path, count, an.method, an.opt};
-  fmbCampbell* c = NULL;
+  /* fmb_campbell in its steps: each speed's modes (computable anywhere, e.g. in other processes),
+     then followed in order */
+  fmbCampbell* c = fmb_campbell_new(speeds, nspeed, count);
   fmbDiag diag;
-  const int rc = fmb_campbell(&scene, &opt, speeds, nspeed, &c, &diag);
+  memset(&diag, 0, sizeof diag);
+  int rc = c ? 0 : FMB_EXIT_SOLVER;
+  if (!c) snprintf(diag.msg, sizeof diag.msg, "out of memory");
+  for (int i = 0; !rc && i < nspeed; ++i) {
+    fmbModes* modes = NULL;
+    rc = fmb_campbell_modes_at(&scene, &opt, speeds[i], &modes, &diag);
+    if (!rc && (rc = fmb_campbell_add(c, modes, &diag)) != 0)
+      snprintf(diag.file, sizeof diag.file, "%s", s.scene); /* too few modes: the scene's */
+  }
   const int done = c ? c->done : 0;
   for (int i = 1; i < done; ++i)
     for (int k = 0; k < count; ++k)

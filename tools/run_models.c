@@ -11,7 +11,6 @@
 
 #include "cli.h"
 
-#define MAX_BEAMS 32
 
 static void print_model_stats(const char* model, const fmbStats* st) {
   char* text = NULL;
@@ -59,26 +58,29 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
     fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
-  char beam[MAX_BEAMS][128];
-  const char* beams[MAX_BEAMS];
+  /* the beams' names point into m, kept until the runs are done */
+  const int nbody = fmb_model_nbody(m);
+  const char** beams = calloc((size_t)(nbody > 0 ? nbody : 1), sizeof *beams);
   int nbeam = 0;
-  for (int i = 0; i < fmb_model_nbody(m); ++i) {
+  for (int i = 0; beams && i < nbody; ++i) {
     const char *name, *type;
     fmb_model_body(m, i, &name, &type);
-    if (strcmp(type, "beam") == 0 && nbeam < MAX_BEAMS) {
-      snprintf(beam[nbeam], sizeof beam[0], "%s", name);
-      beams[nbeam] = beam[nbeam];
-      nbeam++;
-    }
+    if (strcmp(type, "beam") == 0) beams[nbeam++] = name;
   }
-  fmb_free(m);
-  if (nbeam == 0) {
-    fprintf(stderr, "%s: error: --models switches the model of the scene's beams, and it has no body of type beam\n",
-            s->scene);
-    return FMB_EXIT_BAD_INPUT;
+  if (!beams || nbeam == 0) {
+    if (beams)
+      fprintf(stderr, "%s: error: --models switches the model of the scene's beams, and it has no body of type beam\n",
+              s->scene);
+    else
+      fprintf(stderr, "flexmbd run: out of memory\n");
+    free(beams);
+    fmb_free(m);
+    return beams ? FMB_EXIT_BAD_INPUT : FMB_EXIT_SOLVER;
   }
   if (s->nover + nbeam > FMB_CLI_MAX_OVERRIDES) {
     fprintf(stderr, "flexmbd run: too many --set overrides with --models\n");
+    free(beams);
+    fmb_free(m);
     return FMB_EXIT_BAD_INPUT;
   }
   const fmbSceneSource scene = {s->scene, s->overrides, s->nover, fmb_cli_registry()};
@@ -86,6 +88,8 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
   fmbModelsResult* res = calloc(1, sizeof *res);
   if (!res) {
     fprintf(stderr, "flexmbd run: out of memory\n");
+    free(beams);
+    fmb_free(m);
     return FMB_EXIT_SOLVER;
   }
   const int rc = fmb_run_models(&scene, beams, nbeam, model, nmodel, &opt, res, &diag);
@@ -103,5 +107,7 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
     if (res->ran == 0) fmb_print_stats(&stats, stderr);
   }
   free(res);
+  free(beams);
+  fmb_free(m);
   return rc;
 }
