@@ -6,6 +6,27 @@
 
 #include "integrator.h"
 
+/* The one list of backends; solver.integrator names a GGL one or auto (the default, the rule below). */
+const fmbIntegratorOps* const fmb_integrators[] = {&fmb_integrator_ida, &fmb_integrator_radau5, &fmb_integrator_projected,
+                                                   NULL};
+
+static const fmbIntegratorOps* projected_backend(void) {
+  for (int i = 0; fmb_integrators[i]; ++i)
+    if (fmb_integrators[i]->projected) return fmb_integrators[i];
+  return NULL;
+}
+
+int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int cap) {
+  int n = 0;
+  for (int i = 0; fmb_integrators[i] && n + 1 < cap; ++i)
+    if (!fmb_integrators[i]->projected) {
+      if (ops) ops[n] = fmb_integrators[i];
+      names[n++] = fmb_integrators[i]->name;
+    }
+  names[n] = NULL;
+  return n;
+}
+
 /* solver.integrator: auto (the default). The rule, from the matrix of every shipped scene x
    integrator x rtol (bench/auto.sh, docs/performance.md "Integrator auto"):
    - a model with a body that caps the BDF order below 5 (fmbBodyType.max_bdf_order: undamped
@@ -25,13 +46,19 @@ static const fmbIntegratorOps* auto_integrator(const fmbModel* m) {
 }
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  if (m->solver.formulation == FMB_FORM_PROJECTED) return &fmb_integrator_projected;
+  if (m->solver.formulation == FMB_FORM_PROJECTED) return projected_backend();
   /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
-  switch (m->solver.integrator) {
-    case FMB_INTEG_RADAU5: return &fmb_integrator_radau5;
-    case FMB_INTEG_IDA: return &fmb_integrator_ida;
-    default: return auto_integrator(m);
-  }
+  return m->solver.integrator ? m->solver.integrator : auto_integrator(m);
+}
+
+/* solver.integrator: auto checks nothing here: it never picks radau5 with linear_solver: dense,
+   and formulation: projected runs the projected backend whatever the integrator */
+int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
+  const fmbIntegratorOps* ggl = m->solver.integrator;
+  if (ggl && ggl->check && ggl->check(m, p, solver)) return -1;
+  const fmbIntegratorOps* proj = projected_backend();
+  if (m->solver.formulation == FMB_FORM_PROJECTED && proj && proj->check && proj->check(m, p, solver)) return -1;
+  return 0;
 }
 
 void fmb_print_stats(const fmbStats* s, FILE* f) {
