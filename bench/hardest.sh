@@ -39,20 +39,9 @@ while [ $# -gt 0 ]; do
   shift
 done
 mkdir -p "$RES"
-. "$ROOT/bench/lib.sh" # median, stat_field
-
-build_old() { # commit: /tmp/fmb-COMMIT/build/flexmbd, built once from git archive
-  local dir=/tmp/fmb-$1
-  if [ ! -x "$dir/build/flexmbd" ]; then
-    echo "building $1 in $dir ..." >&2
-    mkdir -p "$dir"
-    git -C "$ROOT" archive "$1" | tar -x -C "$dir"
-    cmake -S "$dir" -B "$dir/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-    cmake --build "$dir/build" -j2 --target flexmbd >/dev/null
-  fi
-}
-build_old "$OLD_PEND"
-build_old "$OLD_SPIN"
+. "$ROOT/bench/lib.sh" # median, stat_field, build_landed
+build_landed "$OLD_PEND" "/tmp/fmb-$OLD_PEND"
+build_landed "$OLD_SPIN" "/tmp/fmb-$OLD_SPIN"
 
 PEND=scenes/paper/pendulum.yaml SPIN=scenes/paper/spinup_w15.yaml
 "$F" run "$PEND" -o "$WORK/pend_ref.csv" --quiet --set solver.integrator=radau5 --set solver.rtol=1e-11 --set solver.atol=1e-14
