@@ -1,6 +1,7 @@
-/* integrator_ida.c — the default backend: SUNDIALS IDA (BDF, variable order and step) on the GGL
- * system of system.c, with KLU (default; the position rows eliminated first, schur.c), KLU on the
- * whole matrix, or SUNDIALS' dense solver for the Newton systems.
+/* integrator_ida.c — SUNDIALS IDA (BDF, variable order and step) on the GGL system of system.c,
+ * the rigid mechanisms' backend under solver.integrator: auto (integrator_select.c), with KLU
+ * (default; the position rows eliminated first, schur.c), KLU on the whole matrix, or SUNDIALS'
+ * dense solver for the Newton systems.
  * The BDF order is capped by the bodies (fmbBodyType.max_bdf_order) or solver.max_order: BDF2 is
  * A-stable, while orders 3-5 have an instability wedge at the imaginary axis that amplifies
  * undamped structural modes (a 16-element beam has modes from 4 to 1e5 rad/s); the error test
