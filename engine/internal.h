@@ -351,6 +351,8 @@ int fmb_csv_close(fmbCsv* c);
 /* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */
 int fmb_csv_header_names(fmbCsv* c, int n, const char* const* names);
 int fmb_csv_values(fmbCsv* c, const double* values);
+/* v as printf's "%.12g" writes it, into out (>= 32 bytes); the length (format_g12.c) */
+int fmb_format_g12(double v, char* out);
 /* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row);
 

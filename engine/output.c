@@ -280,8 +280,9 @@ fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
 int fmb_csv_header_names(fmbCsv* c, int n, const char* const* names) {
   size_t need = 2;
   for (int i = 0; i < n; ++i) need += strlen(names[i]) + 1;
-  /* a row: at most 24 characters per %.12g value plus its comma */
-  if (need < (size_t)n * 26 + 2) need = (size_t)n * 26 + 2;
+  /* a row: at most 24 characters per %.12g value plus its comma, and the 32 bytes
+     fmb_format_g12 may be given for the last one */
+  if (need < (size_t)n * 26 + 34) need = (size_t)n * 26 + 34;
   free(c->line);
   free(c->row);
   c->line = malloc(need);
@@ -308,8 +309,10 @@ int fmb_csv_header(fmbCsv* c, const fmbModel* m) {
 /* one whole row of as many values as the header has columns; 0 ok, -1 a write failed */
 int fmb_csv_values(fmbCsv* c, const double* values) {
   size_t used = 0;
-  for (int i = 0; i < c->nrow; ++i)
-    used += (size_t)snprintf(c->line + used, c->cap - used, "%s%.12g", i ? "," : "", values[i]);
+  for (int i = 0; i < c->nrow; ++i) { /* %.12g's bytes (format_g12.c); the line holds 24 + 1 a value */
+    if (i) c->line[used++] = ',';
+    used += (size_t)fmb_format_g12(values[i], c->line + used);
+  }
   c->line[used++] = '\n';
   return write_line(c, c->line, used) ? -1 : 0;
 }
