@@ -155,6 +155,7 @@ static void int_weights(double le, double xi, double pw[5]) {
  * ------------------------------------------------------------------------------------------- */
 static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
 static const char* const assembly_names[] = {"auto", "dense", "banded", NULL};
+static const char* const integration_names[] = {"reduced", "full", NULL}; /* model: exact's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on: below it the dense blocks are small
    and the fewer unknowns win (docs/performance.md, "Scaling") */
@@ -212,6 +213,11 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_double(p, item, "damping", FMB_OPTIONAL | FMB_NONNEGATIVE, &b->beta);
   int assembly = ASSEMBLY_AUTO;
   err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, assembly_names, &assembly);
+  /* `integration` chooses the exact model's quadrature (bodies/beam_exact.c); these three models
+     have theirs in quadrature_points, so they check the word and ignore it: a scene written for
+     `model: exact` then runs under every model (`run --models`, docs/models.md) */
+  int integration = 0;
+  err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, integration_names, &integration);
   if (!err) {
     b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
     b->ng = default_points(b->model);
@@ -1402,7 +1408,6 @@ static int beam_velocity_error_test(const void* self) {
 
 /* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
 static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
-static const char* const exact_integrations[] = {"reduced", "full", NULL};
 
 static const fmbParam beam_params[] = {
     FMB_BEAM_SECTION_PARAMS(MAX_ELEMENTS),
@@ -1414,22 +1419,17 @@ static const fmbParam beam_params[] = {
      .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
     {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 4,
      .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
-    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
-     .doc = "model: exact only: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full)"},
+    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = integration_names,
+     .doc = "model: exact: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full); "
+            "the other models ignore it"},
     {.key = "assembly", .kind = FMB_PARAM_CHOICE, .fallback = "auto", .choices = assembly_names,
      .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
     {.key = NULL},
 };
 
-/* stations equally spaced from the clamped root to the tip; by default one per node */
 static int beam_centreline(const void* self, int n, double* local) {
   const Beam* b = self;
-  if (!local) return b->ne + 1;
-  for (int i = 0; i < n; ++i) {
-    local[2 * i] = n > 1 ? b->L * (double)i / (double)(n - 1) : 0.0;
-    local[2 * i + 1] = 0.0;
-  }
-  return n;
+  return fmb_beam_centreline(b->L, b->ne, n, local);
 }
 
 /* `model: exact` (the geometrically exact beam) is its own implementation behind the same type

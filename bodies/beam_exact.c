@@ -693,6 +693,12 @@ static const char* exact_invalid_state(const void* self, const double* q, const 
   return NULL;
 }
 
+/* the deformed centreline for `BODY.shape` and the VTK polyline, as the other models draw it */
+static int exact_centreline(const void* self, int n, double* local) {
+  const BeamExact* b = self;
+  return fmb_beam_centreline(b->L, b->ne, n, local);
+}
+
 /* what `flexmbd conform` needs to check this table on its own (tests/exact/test_exact_conform.c:
    beam.c's table, which the registry holds, declares the keys of type beam for users) */
 static const fmbParam exact_params[] = {
@@ -732,6 +738,7 @@ const fmbBodyType fmb_body_beam_exact = {
     .pattern = exact_pattern,
     .pattern_jacobian = exact_pattern_jacobian,
     .length_scale = exact_length_scale,
+    .centreline = exact_centreline,
     .params = exact_params,
     .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
                "model: exact\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",
