@@ -186,7 +186,7 @@ typedef struct fmbBodyType {
   void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
                  double* work);
   /* named outputs beyond the frame's x, y, theta, omega, vx, vy (which the engine provides for
-     every body with ncoord >= 3): lookup returns an id >= 0 or -1 (NULL: the id is the name's
+     every body with a frame: ncoord >= 3, or a marker that places the origin [0, 0]): lookup returns an id >= 0 or -1 (NULL: the id is the name's
      index in output_names); output evaluates one id. */
   const char* const* output_names; /* NULL-terminated, for listings */
   int (*output_lookup)(const void* self, const char* quantity);
@@ -446,6 +446,12 @@ FMB_API void fmb_describe(const fmbModel* m, FILE* f);
    joint name and row, and whether the start is a singular configuration. 0, or an exit code with
    *diag filled (joints that cannot be satisfied). */
 FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
+/* the outputs the engine itself gives, as NULL-terminated names (NULL for an unknown group):
+   "frame" (BODY.x y theta omega vx vy, for every body with a frame: one whose marker places its
+   origin), "power" (JOINT.power work, for a joint with constraint rows or a force), "reaction"
+   (JOINT.reaction_x ..., for a joint with constraint rows), "energy" (energy.*), "constraint"
+   (constraint.*). `flexmbd types` lists them from here, the loader resolves them from here. */
+FMB_API const char* const* fmb_engine_outputs(const char* group);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 

@@ -356,7 +356,8 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
 /* global position of a body's material point (its marker); 0 ok */
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle);
-void fmb_outputs_default(fmbModel* m);
+/* no `outputs:` list: x, y, theta, omega of every moving body with a frame; 0, or -1 out of memory */
+int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;
 /* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);

@@ -396,9 +396,15 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   if (m->solver.positions_only < 0) m->solver.positions_only = m->bodies_prefer_positions;
   if (outputs >= 0) {
     if (fmb_outputs_resolve(p, m, outputs)) return -1;
-  } else {
-    fmb_outputs_default(m);
+  } else if (fmb_outputs_default(p, m)) {
+    return fmb_parse_error(p, root, "out of memory");
   }
+  /* a CSV of times alone says nothing: refused rather than written silently */
+  if (m->noutput <= 1)
+    return fmb_parse_error(p, outputs >= 0 ? outputs : root,
+                           "the run would write only the time column t: %s; list what to write, e.g. "
+                           "outputs: [energy.total] (`flexmbd types` lists each type's outputs)",
+                           outputs >= 0 ? "'outputs' is empty" : "the scene has no 'outputs' and no body with a frame");
   /* the projected formulation works on q and v alone, with the bodies' mass matrices */
   if (m->solver.formulation == FMB_FORM_PROJECTED && m->nz > 0)
     return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
