@@ -58,7 +58,6 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
   fmbModel* m = fmb_load(s->scene, s->overrides, s->nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
-    fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   static char set[MAX_MODELS][MAX_BEAMS][224];
@@ -91,7 +90,6 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     fmbModel* mk = fmb_load(s->scene, ov[k], s->nover + nbeam, fmb_cli_registry(), &diag);
     if (!mk) {
       fmb_cli_print_diag(&diag);
-      fmb_print_stats(&stats, stderr);
       return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
     }
     fmb_free(mk);
@@ -119,7 +117,6 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     fmbModel* mk = fmb_load(s->scene, ov[k], s->nover + nbeam, fmb_cli_registry(), &diag);
     if (!mk) {
       fmb_cli_print_diag(&diag);
-      print_model_stats(model[k], &stats);
       rc = diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
       break;
     }
@@ -130,7 +127,7 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
       fmb_cli_print_diag(&diag);
       if (rk > rc) rc = rk;
     }
-    print_model_stats(model[k], &stats);
+    if (rk != FMB_EXIT_BAD_INPUT) print_model_stats(model[k], &stats); /* bad input ran nothing */
     fmb_free(mk);
     char err[512];
     if (fmb_table_load(part, &table[k], err, sizeof err)) {
