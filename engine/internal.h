@@ -186,6 +186,7 @@ struct fmbParser {
   const fmbParam* params;
   int expect_complete; /* valid and params name every key the mapping may have */
   const char* what;    /* the mapping for messages ("body 'bob' (type rigid)"), or NULL */
+  unsigned plausibility_warned; /* the plausibility rules (yaml_get.c) that have warned: once each */
   /* named materials and sections (top-level `materials:`/`sections:` maps): while a body or
      joint item is parsed, keys it does not have are looked up in the entries it names */
   fmbNode item;             /* the item being parsed, or -1 */

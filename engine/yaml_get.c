@@ -401,19 +401,60 @@ static int absent(fmbParser* p, fmbNode map, const char* key, unsigned flags, co
   return 0;
 }
 
-int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
-  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
-  fmbNode n = fmb_find_key(p, map, key);
-  if (n < 0) return absent(p, map, key, flags, "a number");
-  return number_at(p, n, key, flags, out);
-}
-
-/* a warning does not stop the load: FILE:LINE:COL: warning: ... on stderr (or the override) */
 static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
 #endif
     ;
+
+/* Values far outside what their unit means for any real material or part: most often a number
+   written in another unit (Young's modulus in GPa, a density in g/cm^3, a length in mm), which
+   runs (or fails much later, at t = 0.11 s with a generic solver message) without a word. Each
+   rule applies to a key by the SI unit its type declares (fmbParam.unit; `key` NULL = any key of
+   that unit) and warns once per scene. The bounds leave every structural solid inside: moduli from
+   soft rubber (~1e6 Pa) to diamond (1.2e12 Pa), densities from balsa (~100 kg/m^3) to osmium
+   (22,590 kg/m^3), beams from 0.1 mm to 100 m. The density's lower bound is 100, not 1 kg/m^3:
+   in g/cm^3 every metal lies between 1.7 and 22.6, so a bound of 1 would catch none of them;
+   a foam or an aerogel below 100 kg/m^3 still runs, with the warning. */
+static const struct {
+  const char* unit;
+  const char* key;
+  double lo, hi;
+  const char *below, *above; /* the likely mistake */
+} plausibility[] = {
+    {"Pa", NULL, 1e5, 1e13, "GPa or MPa given as Pa? 70 GPa is 70e9", "an exponent too large? diamond is 1.2e12 Pa"},
+    {"kg/m^3", NULL, 100.0, 1e5, "g/cm^3 or t/m^3 given as kg/m^3? aluminium is 2767 kg/m^3 = 2.767 g/cm^3",
+     "g/m^3 or an exponent too large? osmium, the densest element, is 22590 kg/m^3"},
+    {"m", "length", 1e-4, 100.0, "km given as m?", "mm given as m? 1000 mm is 1 m"},
+};
+
+static void check_plausible(fmbParser* p, fmbNode n, const char* key, double value) {
+  const fmbParam* par = NULL;
+  for (int i = 0; p->params && p->params[i].key && !par; ++i)
+    if (strcmp(p->params[i].key, key) == 0) par = &p->params[i];
+  if (!par || !par->unit) return;
+  for (unsigned r = 0; r < sizeof plausibility / sizeof plausibility[0]; ++r) {
+    if (strcmp(par->unit, plausibility[r].unit) != 0 || (plausibility[r].key && strcmp(plausibility[r].key, key) != 0))
+      continue;
+    const int low = value < plausibility[r].lo, high = value > plausibility[r].hi;
+    if ((!low && !high) || (p->plausibility_warned & (1u << r))) continue;
+    p->plausibility_warned |= 1u << r;
+    warning_at(p, n, "'%s: %g' %s %g %s, outside the range of real parts and materials (%g to %g %s): %s", key, value,
+               low ? "is below" : "is above", low ? plausibility[r].lo : plausibility[r].hi, par->unit,
+               plausibility[r].lo, plausibility[r].hi, par->unit, low ? plausibility[r].below : plausibility[r].above);
+  }
+}
+
+int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
+  if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
+  fmbNode n = fmb_find_key(p, map, key);
+  if (n < 0) return absent(p, map, key, flags, "a number");
+  const int rc = number_at(p, n, key, flags, out);
+  if (rc == 0) check_plausible(p, n, key, *out);
+  return rc;
+}
+
+/* a warning does not stop the load: FILE:LINE:COL: warning: ... on stderr (or the override) */
 static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
   char msg[600];
   va_list ap;
