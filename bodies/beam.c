@@ -1355,6 +1355,49 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   return 0;
 }
 
+/* The range where each model is accurate, from its measured error against the exact beam
+   (docs/models.md, "Each model's range"). Error = the largest |tip_v - exact| over a run relative
+   to the exact peak deflection; d = the model's own peak |tip_v| / L (what the run sees):
+     complete: 0.01 % at d = 1.0 % (paper spin-up w0 = 1), 0.14 % at 3.9 % (w0 = 4), 1.9 % at 10.9 %
+               (w0 = 15), 4.3 % at 17.0 % (the rotor starter, w0 = 6 over 5 s), 46 % at 43 % (the
+               same at w0 = 15): error ~ d^2.5;
+     FOAC:     0.05 % at 3.9 %, 0.31 % at 10.9 %, 4.3 % at 36.6 % (starter at w0 = 15), 6.3 % at
+               45.7 % (w0 = 20).
+   The limit is the deflection where the error reaches 5 % of the deflection, interpolated between
+   the two measured points around it: 18 % of L for complete (and ZOAC, whose kinematics are the
+   same), 40 % for FOAC. The paper's cases (at most 10.9 %) and the starter (17.0 %) lie inside.
+   ZOAC has no centrifugal stiffening: 4 % off at w0 = 1, a quarter of its first clamped bending
+   frequency w1; with the stiffening it lacks growing like w^2 the error reaches ~5 % near 0.3 w1,
+   and the beam diverges at w1. */
+static double beam_first_frequency(const Beam* b) {
+  return 1.8751040687119611 * 1.8751040687119611 * sqrt(b->Emod * b->Izz / (b->rho * b->A)) / (b->L * b->L);
+}
+static double beam_deflection_limit(const Beam* b) { return b->model == BEAM_FOAC ? 0.40 : 0.18; }
+enum { ZOAC_SPIN_LIMIT_PERCENT = 30 };
+
+static const char* beam_model_range(const void* self, const double* q, const double* v, char* msg, size_t len) {
+  const Beam* b = self;
+  double tip = 0.0;
+  beam_output(b, OUT_TIP_V, q, v, &tip, NULL);
+  const double limit = beam_deflection_limit(b), w1 = beam_first_frequency(b);
+  if (fabs(tip) > limit * b->L) {
+    snprintf(msg, len,
+             "its tip deflects %.3g m, %.1f %% of its length, beyond the %.0f %% up to which the %s model stays within "
+             "about 5 %% of the geometrically exact beam (docs/models.md); use `model: exact`",
+             fabs(tip), 100.0 * fabs(tip) / b->L, 100.0 * limit, model_names[b->model]);
+    return msg;
+  }
+  if (b->model == BEAM_ZOAC && fabs(v[2]) > 0.01 * ZOAC_SPIN_LIMIT_PERCENT * w1) {
+    snprintf(msg, len,
+             "it turns at %.3g rad/s, %.0f %% of its first bending frequency %.3g rad/s: ZOAC has no centrifugal "
+             "stiffening, is off by more than about 5 %% beyond %d %% and diverges at 100 %% (docs/models.md); use "
+             "`model: complete` or `model: exact`",
+             fabs(v[2]), 100.0 * fabs(v[2]) / w1, w1, ZOAC_SPIN_LIMIT_PERCENT);
+    return msg;
+  }
+  return NULL;
+}
+
 static void beam_describe(const void* self, FILE* f) {
   const Beam* b = self;
   static const char* const terms[] = {"w_c dropped (no coupling deformation)",
@@ -1363,6 +1406,13 @@ static void beam_describe(const void* self, FILE* f) {
   fprintf(f, "%s model, %d elements, %d Gauss points/element, %s%s, %s assembly", model_names[b->model], b->ne, b->ng,
           terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "",
           b->banded ? "banded (coupling sums as auxiliary unknowns)" : "dense");
+  /* its range (beam_model_range): the run warns when it is left */
+  fprintf(f, "; accurate while the tip deflects less than %.0f %% of the length (%.3g m)", 100.0 * beam_deflection_limit(b),
+          beam_deflection_limit(b) * b->L);
+  if (b->model == BEAM_ZOAC)
+    fprintf(f, " and it turns slower than %d %% of its first bending frequency (%.3g rad/s)", ZOAC_SPIN_LIMIT_PERCENT,
+            0.01 * ZOAC_SPIN_LIMIT_PERCENT * beam_first_frequency(b));
+  if (b->model == BEAM_FOAC) fprintf(f, ", under prescribed rotation only");
   fputc('\n', f);
 }
 
@@ -1477,7 +1527,8 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
     .naux = beam_naux, \
     .residual_aux = beam_residual_aux, \
     .aux_initial = beam_aux_initial, \
-    .pattern = beam_pattern
+    .pattern = beam_pattern, \
+    .model_range = beam_model_range
 
 const fmbBodyType fmb_body_beam = {BEAM_OPS, .jacobian = beam_jacobian, .pattern_jacobian = beam_pattern_jacobian};
 static const fmbBodyType beam_fd = {BEAM_OPS};

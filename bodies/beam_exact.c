@@ -642,7 +642,8 @@ static int exact_output(const void* self, int id, const double* q, const double*
 
 static void exact_describe(const void* self, FILE* f) {
   const BeamExact* b = self;
-  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly\n",
+  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly; "
+          "no range limit (its accuracy is the mesh's and the tolerance's, docs/models.md)\n",
           b->ne, b->integration == INTEGRATION_FULL ? "full" : "reduced",
           b->integration == INTEGRATION_FULL ? "axial at 5, bending at 3 Gauss points"
                                              : "axial at 3 Lobatto, bending at 2 Gauss points",

@@ -25,7 +25,7 @@ extern "C" {
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
    the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
-   pattern_jacobian and length_scale ops (added to 2 before any release of it). */
+   pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). */
 #define FMB_ABI_VERSION 2
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
@@ -266,6 +266,12 @@ typedef struct fmbBodyType {
      coordinate and its velocity (engine/integrate.c), so one atol in metres controls slopes and
      displacements alike at any size of the body. NULL = atol as given for every coordinate. */
   void (*length_scale)(const void* self, double* metres_per_unit);
+  /* The range where the body's model is accurate (ABI 2, added before any release of it): NULL
+     while the state (q, v) is inside it; otherwise the body writes into msg[len] what left the
+     range, by how much, and what to use instead, and returns msg. The run warns once per body,
+     at the first output time it happens, with the time (beam: the tip deflection beyond the
+     model's measured limit, "use model: exact"). NULL op = no range stated. */
+  const char* (*model_range)(const void* self, const double* q, const double* v, char* msg, size_t len);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
