@@ -276,6 +276,13 @@ int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
     if (pr->key <= p->nnodes_cap && p->known[pr->key]) continue;
     const char* k = fmbp_scalar(p, pr->key);
     if (!k) return fmb_parse_error(p, pr->key, "keys must be plain words in %s", what);
+    if (p->expect_complete && key_expected(p, k)) { /* a key of the type that these settings do not read */
+      char read[600] = "";
+      for (int i = 0, used = 0; i < p->nlooked && used + 40 < (int)sizeof read; ++i)
+        used += snprintf(read + used, sizeof read - used, "%s%s", i ? ", " : "", p->looked[i]);
+      return fmb_parse_error(p, pr->key, "key '%s' does not apply to %s as written: it is read only with other "
+                             "settings (keys read here: %s)", k, what, read);
+    }
     return unknown_key_error(p, pr->key, k, what);
   }
   return 0;

@@ -2,7 +2,7 @@
 # run.sh FLEXMBD CATALOGUE_DIR WORK_DIR — check every bad scene of expected.txt.
 #
 # For each line FILE EXIT WHERE FRAGMENT [OVERRIDE] of the manifest, `flexmbd run FILE -o OUT`
-# must: exit with EXIT; print exactly one "error:" line, first on stderr, starting with
+# must: exit with EXIT; print exactly one "error:" line, first on stderr (after any warnings), starting with
 # "FILE:WHERE: error: " (or "--set: error: OVERRIDE: ") and containing FRAGMENT; print no
 # "stats:" line (nothing ran: the error is the last word); print nothing on stdout; and leave no
 # OUT behind (nothing is written before the scene is valid). `flexmbd check FILE` must give the
@@ -50,7 +50,7 @@ while IFS=$tab read -r file code where frag override; do
     "$bin" run "$scene" -o "$out" >"$work/stdout" 2>"$work/stderr"
   fi
   rc=$?
-  first=$(sed -n 1p "$work/stderr")
+  first=$(grep -v "warning: " "$work/stderr" | sed -n 1p) # warnings (plausibility) may come first
   last=$(sed -n '$p' "$work/stderr")
   case $where in
     --set) prefix="--set: error: $override: " ;;
@@ -80,7 +80,7 @@ while IFS=$tab read -r file code where frag override; do
     "$bin" check "$scene" >"$work/stdout" 2>"$work/stderr"
   fi
   crc=$?
-  cfirst=$(sed -n 1p "$work/stderr")
+  cfirst=$(grep -v "warning: " "$work/stderr" | sed -n 1p)
   [ "$crc" = "$code" ] || fail "$file" "check: exit code $crc, expected $code"
   [ "$cfirst" = "$first" ] || fail "$file" "check says '$cfirst', run says '$first'"
 done <"$manifest"
