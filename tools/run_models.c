@@ -13,7 +13,6 @@
 #include "csv_table.h"
 
 #define MAX_MODELS 8
-#define MAX_BEAMS 32
 
 static void print_model_stats(const char* model, const fmbStats* st) {
   char* text = NULL;
@@ -60,50 +59,69 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     fmb_cli_print_diag(&diag);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
-  static char set[MAX_MODELS][MAX_BEAMS][224];
-  char beam[MAX_BEAMS][128];
+  /* one `bodies.NAME.model=M` override per beam and model, however many beams (a fixed 32 once
+     switched only the first 32, and the 33rd beam's @zoac column held the complete model's run) */
+  const int nbody = fmb_model_nbody(m);
+  char* set = calloc((size_t)MAX_MODELS * (size_t)(nbody > 0 ? nbody : 1), 224);
+  const char** ov[MAX_MODELS] = {NULL};
+  for (int k = 0; k < nmodel && set; ++k)
+    if (!(ov[k] = calloc((size_t)(s->nover + nbody + 1), sizeof *ov[k]))) {
+      free(set);
+      set = NULL;
+    }
+  if (!set) {
+    for (int k = 0; k < nmodel; ++k) free(ov[k]);
+    fmb_free(m);
+    fprintf(stderr, "flexmbd run: out of memory\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
   int nbeam = 0;
-  for (int i = 0; i < fmb_model_nbody(m); ++i) {
+  for (int i = 0; i < nbody; ++i) {
     const char *name, *type;
     fmb_model_body(m, i, &name, &type);
-    if (strcmp(type, "beam") == 0 && nbeam < MAX_BEAMS) snprintf(beam[nbeam++], sizeof beam[0], "%s", name);
+    if (strcmp(type, "beam") != 0) continue;
+    for (int k = 0; k < nmodel; ++k) {
+      char* one = set + ((size_t)k * (size_t)nbody + (size_t)nbeam) * 224;
+      snprintf(one, 224, "bodies.%.127s.model=%.63s", name, model[k]);
+      ov[k][s->nover + nbeam] = one;
+    }
+    ++nbeam;
   }
   fmb_free(m);
+  int rc = 0;
   if (nbeam == 0) {
     fprintf(stderr, "%s: error: --models switches the model of the scene's beams, and it has no body of type beam\n",
             s->scene);
-    return FMB_EXIT_BAD_INPUT;
-  }
-  if (s->nover + nbeam > FMB_CLI_MAX_OVERRIDES) {
-    fprintf(stderr, "flexmbd run: too many --set overrides with --models\n");
-    return FMB_EXIT_BAD_INPUT;
+    rc = FMB_EXIT_BAD_INPUT;
   }
 
   /* every model must load before any runs (a misspelt model is bad input, not a late failure) */
-  const char* ov[MAX_MODELS][FMB_CLI_MAX_OVERRIDES];
-  for (int k = 0; k < nmodel; ++k) {
+  for (int k = 0; k < nmodel && !rc; ++k) {
     memcpy(ov[k], s->overrides, sizeof(ov[k][0]) * (size_t)s->nover);
-    for (int b = 0; b < nbeam; ++b) {
-      snprintf(set[k][b], sizeof set[k][b], "bodies.%.127s.model=%.63s", beam[b], model[k]);
-      ov[k][s->nover + b] = set[k][b];
-    }
     fmbModel* mk = fmb_load(s->scene, ov[k], s->nover + nbeam, fmb_cli_registry(), &diag);
     if (!mk) {
       fmb_cli_print_diag(&diag);
-      return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
+      rc = diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
     }
     fmb_free(mk);
+  }
+  if (rc) {
+    for (int k = 0; k < nmodel; ++k) free(ov[k]);
+    free(set);
+    return rc;
   }
 
   fmbTable table[MAX_MODELS];
   memset(table, 0, sizeof table);
-  int rc = 0, loaded = 0;
+  int loaded = 0;
   /* each model's own CSV, in a folder of this run's (nothing of the user's is touched) */
   char partdir[600];
   const char* tmp = getenv("TMPDIR");
   snprintf(partdir, sizeof partdir, "%s/flexmbd-models-XXXXXX", tmp && *tmp ? tmp : "/tmp");
   if (!mkdtemp(partdir)) {
     fprintf(stderr, "flexmbd run: cannot make a temporary folder %s: %s\n", partdir, strerror(errno));
+    for (int k = 0; k < nmodel; ++k) free(ov[k]);
+    free(set);
     return FMB_EXIT_BAD_INPUT;
   }
   for (int k = 0; k < nmodel; ++k) {
@@ -174,7 +192,11 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
       }
     }
   }
-  for (int k = 0; k < nmodel; ++k) fmb_table_free(&table[k]);
+  for (int k = 0; k < nmodel; ++k) {
+    fmb_table_free(&table[k]);
+    free(ov[k]);
+  }
+  free(set);
   rmdir(partdir);
   return rc;
 }
