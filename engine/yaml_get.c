@@ -603,13 +603,26 @@ static int table_rows(fmbParser* p, fmbNode n, const char* key, double* x, doubl
     return 0;
   }
   const char* name = fmbp_scalar(p, n);
-  char path[1024], line[512];
+  char path[1024], line[4096];
   sibling_path(p->path, name, path, sizeof path);
   FILE* f = fopen(path, "r");
   if (!f) return fmb_parse_error(p, n, "cannot read the table file '%s' for '%s': %s", path, key, strerror(errno));
   int lineno = 0, header_ok = 1;
   while (fgets(line, sizeof line, f)) {
     ++lineno;
+    /* a line longer than the buffer must not become two rows (its tail read as the next line):
+       a long comment is skipped whole, a long row refused */
+    const size_t len = strlen(line);
+    if (len == sizeof line - 1 && line[len - 1] != '\n') {
+      const int comment = line[strspn(line, " \t")] == '#';
+      int c;
+      while ((c = getc(f)) != EOF && c != '\n') {
+      }
+      if (comment) continue;
+      fclose(f);
+      return fmb_parse_error(p, n, "table file '%s' line %d: longer than %d characters; a row is 't,value'", path,
+                             lineno, (int)sizeof line - 2);
+    }
     double v[2];
     int r = table_file_row(line, v);
     if (r == 1) continue;

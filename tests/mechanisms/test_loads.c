@@ -113,6 +113,10 @@ int main(void) {
   law_case("table", tab, 2, S_table);
   const char* file[] = {"joints.push.law=table", "joints.push.table=load_table.csv"};
   law_case("tablefile", file, 2, S_table);
+  /* the same rows, one padded to 700 characters and a 7000-character comment: one row each (a
+     512-byte line buffer once split them into two rows) */
+  const char* longfile[] = {"joints.push.law=table", "joints.push.table=load_table_long.csv"};
+  law_case("tablelong", longfile, 2, S_table);
   follower(1);
   follower(0);
   return fmbt_finish("test_loads");
