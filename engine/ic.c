@@ -237,6 +237,64 @@ static void unsatisfiable_error(const fmbModel* m, fmbWorkspace* w, double t0, c
               rest);
 }
 
+/* The projection's change dq of the poses given: beyond FMB_ASSEMBLY_TOL on some body, and
+   unless the scene says `initial: assemble`, the poses do not satisfy the joints: named at the
+   joint furthest from holding in them (pose_joint, its residual). 1 with *diag filled, or 0. */
+static int pose_moved_error(const fmbModel* m, const double* dq, int pose_joint, double pose_residual, fmbDiag* diag) {
+  int worst = 0;
+  double moved = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const double d = max_abs(dq + m->body[b].qadr, m->body[b].nq);
+    if (d > moved) {
+      moved = d;
+      worst = b;
+    }
+  }
+  if (!(moved > FMB_ASSEMBLY_TOL) || m->assemble) return 0;
+  char rest[500];
+  snprintf(rest, sizeof rest,
+           " (off by %.3g m or rad): the joints move body '%s' by %.3g (the largest change of one of its coordinates, "
+           "m or rad; tolerance %g). Give poses that satisfy the joints, or write `initial: assemble` at the top level "
+           "to let flexmbd move the bodies onto them",
+           pose_residual, m->body[worst].name, moved, FMB_ASSEMBLY_TOL);
+  joint_error(m, pose_joint, diag, "is not satisfied by the poses given", rest);
+  return 1;
+}
+
+int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  double* v = calloc((size_t)nq + 1, sizeof(double));
+  double* dq = calloc((size_t)nq + 1, sizeof(double));
+  double* PhiQ = calloc((size_t)nc * nq + 1, sizeof(double));
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* phit = calloc((size_t)nc + 1, sizeof(double));
+  double* phitt = calloc((size_t)nc + 1, sizeof(double));
+  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
+  double* rhs = calloc((size_t)nq + nc + 1, sizeof(double));
+  int* piv = calloc((size_t)nq + nc + 1, sizeof(int));
+  unsigned char* drop = calloc((size_t)nc + 1, 1);
+  int rc = 0;
+  if (!v || !dq || !PhiQ || !phi || !phit || !phitt || !G || !rhs || !piv || !drop) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory checking the initial poses");
+    rc = FMB_EXIT_SOLVER;
+  } else {
+    double pose_residual = 0.0, res = 0.0;
+    const int pose_joint = worst_joint(m, w, t, q, v, phi, PhiQ, phit, phitt, &pose_residual);
+    int rank = nc, it = 0;
+    memcpy(dq, q, (size_t)nq * sizeof(double));
+    if (!settle_positions(m, w, t, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it)) {
+      unsatisfiable_error(m, w, t, q, v, phi, PhiQ, phit, phitt, res, it, diag);
+      rc = FMB_EXIT_BAD_INPUT;
+    } else {
+      for (int i = 0; i < nq; ++i) dq[i] = q[i] - dq[i];
+      if (pose_moved_error(m, dq, pose_joint, pose_residual, diag)) rc = FMB_EXIT_BAD_INPUT;
+    }
+  }
+  free(v), free(dq), free(PhiQ), free(phi), free(phit), free(phitt), free(G), free(rhs), free(piv), free(drop);
+  return rc;
+}
+
 /* The constraints at the scene's initial state, projected: what fmb_count_redundant and
    fmb_check_constraints both report. */
 typedef struct {
@@ -643,24 +701,7 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }
-  /* the body the projection moved most: beyond FMB_ASSEMBLY_TOL only if the scene asks */
-  int worst = 0;
-  double moved = 0.0;
-  for (int b = 1; b < m->nbody; ++b) {
-    const double d = max_abs(q0 + m->body[b].qadr, m->body[b].nq);
-    if (d > moved) {
-      moved = d;
-      worst = b;
-    }
-  }
-  if (moved > FMB_ASSEMBLY_TOL && !m->assemble) {
-    char rest[500];
-    snprintf(rest, sizeof rest,
-             " (off by %.3g m or rad): the joints move body '%s' by %.3g (the largest change of one of its coordinates, "
-             "m or rad; tolerance %g). Give poses that satisfy the joints, or write `initial: assemble` at the top level "
-             "to let flexmbd move the bodies onto them",
-             pose_residual, m->body[worst].name, moved, FMB_ASSEMBLY_TOL);
-    joint_error(m, pose_joint, diag, "is not satisfied by the poses given", rest);
+  if (pose_moved_error(m, q0, pose_joint, pose_residual, diag)) {
     rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }

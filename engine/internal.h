@@ -357,6 +357,10 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
                            fmbDiag* diag);
 
 /* ---- static.c ---- */
+/* the poses q at time t against the joints, as a run checks them (ic.c): joints that cannot be
+   satisfied, or poses they would move by more than FMB_ASSEMBLY_TOL without `initial: assemble`,
+   are bad input (FMB_EXIT_BAD_INPUT, named at the joint); q is left projected onto them */
+int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag);
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
 /* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
