@@ -324,7 +324,8 @@ FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], dou
                double* dpos_dq, int ld, double* dangle_dq);
 /* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
 FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
-/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1) */
+/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
+   context or another k (0 would be body 0's column: a wrong place, silently) */
 FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 
 /* ---------------------------------------------------------------------------------------------
@@ -526,11 +527,13 @@ enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
 /* Linearize the DAE about the state (y, yp) at time t (from fmb_static: the rotating-frame
    terms of a steady rotation are included), eliminate the constraints and solve the
    eigenproblem (`method`). Returns 0 with *out (the caller frees it with fmb_modes_free)
-   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag. */
+   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag
+   (FMB_EXIT_BAD_INPUT for a `method` other than FMB_EIGEN_* or a time that is not finite). */
 FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
               fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
-/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1] */
+/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
+   NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);
 /* the scene's outputs at state (y, yp), one CSV row (header first) */
 FMB_API int fmb_write_state_row(const fmbModel* m, const char* path, double t, const double* y, const double* yp,
@@ -541,10 +544,11 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
                           const char* path, fmbDiag* diag);
 /* mode k (0-based) as a ParaView animation in dir (created; DIR/SCENE.pvd and one .vtu per frame,
    the run's VTK writer): `frames` states over one period, the largest coordinate moving by
-   `amplitude` (its units: m or rad) */
+   `amplitude` (its units: m or rad; positive and finite, else FMB_EXIT_BAD_INPUT) */
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
-/* a table of named numeric columns (row-major values), through the one CSV writer */
+/* a table of named numeric columns (row-major values), through the one CSV writer; nrow >= 0
+   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table) */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
 
