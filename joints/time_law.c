@@ -74,6 +74,19 @@ void fmbj_law_free(fmbTimeLaw* law) {
 
 const char* fmbj_law_name(const fmbTimeLaw* law) { return fmbj_law_names[law->kind]; }
 
+/* the row lo with t[lo] <= t < t[lo + 1], for t[0] < t < t[n - 1] (bisection) */
+static int table_segment(const fmbTimeLaw* law, double t) {
+  int lo = 0, hi = law->n - 1;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    if (law->t[mid] <= t)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
 /* a position table: the cubic Hermite through the rows with their slopes, straight on along the
    end slopes outside (s, rate, accel; no integral: a position law is not integrated) */
 static fmbLawValue smooth_table_eval(const fmbTimeLaw* law, double t) {
@@ -85,14 +98,7 @@ static fmbLawValue smooth_table_eval(const fmbTimeLaw* law, double t) {
     v.s = law->s[e] + v.rate * (t - law->t[e]);
     return v;
   }
-  int lo = 0, hi = n - 1; /* bisection: t[lo] <= t < t[hi] */
-  while (hi - lo > 1) {
-    const int mid = (lo + hi) / 2;
-    if (law->t[mid] <= t)
-      lo = mid;
-    else
-      hi = mid;
-  }
+  const int lo = table_segment(law, t), hi = lo + 1;
   const double h = law->t[hi] - law->t[lo], x = (t - law->t[lo]) / h;
   const double s0 = law->s[lo], s1 = law->s[hi], d0 = law->slope[lo] * h, d1 = law->slope[hi] * h;
   /* Hermite basis on x in [0, 1]; d/dt = (d/dx) / h */
@@ -115,14 +121,7 @@ static fmbLawValue table_eval(const fmbTimeLaw* law, double t) {
     v.s = law->s[n - 1];
     v.integral = law->integral[n - 1] + law->s[n - 1] * (t - law->t[n - 1]);
   } else {
-    int lo = 0, hi = n - 1; /* bisection: t[lo] <= t < t[hi] */
-    while (hi - lo > 1) {
-      const int mid = (lo + hi) / 2;
-      if (law->t[mid] <= t)
-        lo = mid;
-      else
-        hi = mid;
-    }
+    const int lo = table_segment(law, t), hi = lo + 1;
     const double h = t - law->t[lo];
     v.rate = (law->s[hi] - law->s[lo]) / (law->t[hi] - law->t[lo]);
     v.s = law->s[lo] + v.rate * h;

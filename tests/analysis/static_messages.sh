@@ -9,13 +9,7 @@
 #  - joints that cannot all hold: exit 2 naming one at its line (before: exit 3 "singular");
 #  - nan or inf in an option: exit 2 naming the option (before: exit 3 "not finite at t = nan");
 #  - bad input ends with the error line, no stats line.
-set -u
-F=$1
-SRC=$2
-OUT=$3
-mkdir -p "$OUT" && cd "$SRC" || exit 1
-fail=0
-check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
+. "$(dirname "$0")/../exact/cli_lib.sh" # F, SRC, OUT, check; in SRC
 last() { tail -1 "$OUT/$1.err"; }
 
 for s in pendulum double_pendulum; do

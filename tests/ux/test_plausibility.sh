@@ -3,13 +3,8 @@
 # draw one warning each at load, naming the key and the likely unit (engine/yaml_get.c,
 # check_plausible): Young's modulus in GPa (68.95 for 68.95e9 Pa), a density in g/cm^3, a length in
 # mm, and an exponent too large; none on any shipped scene or starter.
-set -u
-F=$1
-SRC=$2
-OUT=$3
-mkdir -p "$OUT" && cd "$OUT" || exit 1
-fail=0
-check() { if eval "$2"; then echo "ok: $1"; else echo "FAIL: $1"; fail=1; fi; }
+. "$(dirname "$0")/../exact/cli_lib.sh" # F, SRC, OUT, check
+cd "$OUT" || exit 1
 
 # the rotor's three blades, each with its modulus in GPa: one warning, not three
 sed 's/youngs_modulus: 68.95e9/youngs_modulus: 68.95/' "$SRC/scenes/rotor.yaml" >gpa.yaml
