@@ -685,6 +685,7 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
                     fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (ncol <= 0 || !names || nrow < 0 || (nrow > 0 && !values)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns, no values or a negative row count");
     return FMB_EXIT_BAD_INPUT;
@@ -706,6 +707,7 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
                         fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_state_row: NULL model or state");
     return FMB_EXIT_BAD_INPUT;
@@ -733,6 +735,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
                           const char* path, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp || !md || md->nq != m->nq) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
@@ -788,6 +791,7 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
                              double amplitude, int frames, const char* dir, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2 || !(amplitude > 0.0) ||
       !isfinite(amplitude)) { /* an amplitude of 0, -1 or nan drew a still or inverted mode */
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_animation: NULL or mismatched arguments");

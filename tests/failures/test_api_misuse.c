@@ -38,9 +38,10 @@ static void write_file(const char* path, const char* text) {
    MAC of modes out of range (0.0, "orthogonal"), a table of -1 rows (an empty table, exit 0), a
    mode animation of amplitude 0, -1 or nan (a still or inverted mode), an unknown eigen-solver
    (the dense one, silently), a time of nan for the linearization; and fmb_eval_col0 of body 2
-   (0: body 0's column; see parser_misuse). */
+   (0: body 0's column; see parser_misuse). The writers also left a caller's earlier error in
+   *diag (the first error wins) instead of their own. */
 static void wrong_results(const fmbModel* m, const char* csv) {
-  fmbDiag d;
+  fmbDiag d = {.code = FMB_EXIT_SOLVER, .msg = "an earlier error"}; /* each call reports its own */
   double shape[2] = {1.0, 0.0}, freq = 1.0, zeta = 0.0;
   fmbModes one = {.count = 1, .nq = 1, .frequency = &freq, .damping_ratio = &zeta, .shape_re = shape,
                   .shape_im = shape + 1};
