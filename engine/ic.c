@@ -650,7 +650,12 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
       char rows[600];
       fmb_name_rows(m, drop, rows, sizeof rows);
       if (singular_here(m, w, t0, q, v, drop, rank)) {
-        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+        int first = -1; /* located at the first joint named */
+        for (int j = 0; j < m->njoint && first < 0; ++j)
+          for (int r = 0; r < m->joint[j].nrows; ++r)
+            if (drop[m->joint[j].rowadr + r]) first = j;
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, first >= 0 ? m->joint[first].line : 0,
+                     first >= 0 ? m->joint[first].col : 0,
                      "the mechanism starts in a singular configuration at t = %g: %s depend%s on the other joints' "
                      "equations here but not nearby (a dead point or a flat linkage); start it away from that position",
                      t0, rows, rank == nc - 1 ? "s" : "");
