@@ -1297,7 +1297,7 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
  * ------------------------------------------------------------------------------------------- */
 enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
        OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
-       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_NTIP = FMB_BEAM_NTIP };
+       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE, OUT_NTIP = FMB_BEAM_NTIP };
 enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 
 static int beam_output_lookup(const void* self, const char* quantity) {
@@ -1325,7 +1325,6 @@ static void deformation_at(const Beam* b, const double* p, const double* pd, dou
 }
 
 static int beam_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
-  (void)work;
   const Beam* b = self;
   double x = b->L;
   int comp = id;
@@ -1339,6 +1338,12 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   } else if (id == OUT_ANG_MOMENTUM) {
     fmbEnergy en;
     beam_integrals(b, NULL, q, v, &en, value);
+    return 0;
+  } else if (id == OUT_TIP_ANGLE) {
+    const double tip[2] = {b->L, 0.0};
+    double pos[2], angle;
+    if (beam_marker(b, q, tip, pos, &angle, NULL, NULL, work)) return -1;
+    *value = angle - q[2];
     return 0;
   }
   double u[2], ud[2];

@@ -601,18 +601,24 @@ static void exact_energy(const void* self, const fmbEnv* env, const double* q, c
    transverse displacement in the frame (the complete model's u(L) and w2(L)) */
 enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
        OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
-       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_NTIP = FMB_BEAM_NTIP };
+       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE, OUT_NTIP = FMB_BEAM_NTIP };
 enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 static int exact_output_lookup(const void* self, const char* quantity) {
   return fmb_beam_output_lookup(((const BeamExact*)self)->ne, quantity);
 }
 
 static int exact_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
-  (void)work;
   const BeamExact* b = self;
   if (id == OUT_ANG_MOMENTUM) {
     fmbEnergy en;
     exact_integrals(b, NULL, q, v, &en, value);
+    return 0;
+  }
+  if (id == OUT_TIP_ANGLE) {
+    const double tip[2] = {b->L, 0.0};
+    double pos[2], angle;
+    if (exact_marker(b, q, tip, pos, &angle, NULL, NULL, work)) return -1;
+    *value = angle - q[2];
     return 0;
   }
   int node = b->ne, comp = id;

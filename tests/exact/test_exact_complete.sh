@@ -6,6 +6,7 @@
 #    (about 1e-5 m against the exact beam, docs/models.md; measured 1.6e-6 m), at every station and row.
 #    A straight (rigid) outline would be 0.018 m off, a mirrored one 0.036 m;
 #  - `--vtk` draws it as a polyline through its nodes, like the complete model's;
+#  - `tip_angle` of every model under a static tip load P = 1e-3 N: P L^2 / (2 E I) = 1.8045535e-4 rad;
 #  - `run --models complete,exact` on every shipped scene with a beam and on the starters, exit 0,
 #    except where a scene keeps a key the exact beam refuses (`damping`: exit 2 naming the key).
 . "$(dirname "$0")/cli_lib.sh"
@@ -36,6 +37,13 @@ npts() { grep -o 'NumberOfPoints="[0-9]*"' "$1" | tr -dc 0-9; }
 check "--vtk: the exact beam is a polyline through its 17 nodes and the joint point, as the complete model's" \
   "[ \"\$(npts '$OUT/vtk_exact/spinup_w15_000002.vtu')\" = 18 ] &&
    [ \"\$(npts '$OUT/vtk_exact/spinup_w15_000002.vtu')\" = \"\$(npts '$OUT/vtk_complete/spinup_w15_000002.vtu')\" ]"
+
+for model in zoac foac complete exact; do
+  "$F" static tests/analysis/scenes/cantilever.yaml --set 'joints.load.force=[0, 1e-3]' --set bodies.beam.model=$model \
+    --set "outputs=[beam.tip_angle]" -o "$OUT/angle_$model.csv" -q 2>/dev/null
+  a=$(tail -1 "$OUT/angle_$model.csv" | cut -d, -f2)
+  check "$model: static tip_angle $a = P L^2/(2EI) to 1e-6" "[ -n '$a' ] && near '$a' 1.8045534899730322e-4 1.8e-10"
+done
 
 # every shipped scene with a beam, and the starters, under both models (a short stretch of each)
 "$F" new rotor >"$OUT/rotor.yaml" && "$F" new beam >"$OUT/beam.yaml" && "$F" new slider-crank >"$OUT/slider-crank.yaml"
