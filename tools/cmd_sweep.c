@@ -114,7 +114,7 @@ static int make_ids(fmbSweep* sw) {
     qsort(sets, (size_t)n, sizeof *sets, by_text);
     uint64_t h = base;
     for (int k = 0; k < n; ++k) h = fmb_fnv1a(h, sets[k], strlen(sets[k]) + 1);
-    sw->id[i] = h;
+    sw->id[i] = fmb_mix64(h); /* FNV-1a alone leaves ids of runs that differ in a last digit alike */
     sw->digest = fmb_fnv1a(sw->digest, &h, sizeof h);
   }
   free(sets), free(text);
@@ -144,13 +144,15 @@ static int check_run(fmbSweep* sw, long index, int verbose) {
   for (int k = 0; k < sw->nplugins; ++k) argv[n++] = "--plugin", argv[n++] = (char*)sw->plugins[k];
   argv[n] = NULL;
   fmbPool* pool = fmb_pool_new(1);
-  fmbChildSpec spec = {.argv = argv, .stderr_path = err, .timeout_s = 60.0, .mem_limit_mb = sw->mem_limit_mb};
+  /* a check that crashes or hangs is left to the runs to record; only refused input stops the sweep */
+  fmbChildSpec spec = {.argv = argv, .stderr_path = err, .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,
+                       .mem_limit_mb = sw->mem_limit_mb};
   fmbChildResult r = {.status = FMB_CHILD_CRASHED};
   if (pool && fmb_pool_start(pool, &spec) == 0)
     while (fmb_pool_wait(pool, 1.0, &r) == 0) {
     }
   fmb_pool_free(pool);
-  const int rc = r.status == FMB_CHILD_OK ? 0 : r.exit_code == 2 ? 2 : 3;
+  const int rc = r.status == FMB_CHILD_OK ? 0 : r.status == FMB_CHILD_BAD_INPUT ? 2 : 3;
   if (verbose || rc) {
     fprintf(stderr, "check of run %ld:", index);
     for (int k = 0; k < sw->plan.npath; ++k) fprintf(stderr, " %s", sets[k]);
@@ -393,6 +395,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
              sw->plan.npath);
       for (int k = 0; k < sw->plan.npath; ++k) printf(" %s", sw->plan.path[k]);
       printf("\n");
+      if (fmb_journal_write_plan(sw) == 0) printf("sweep plan: written to %s/plan.csv\n", sw->dir);
       fflush(stdout);
       long pick[3] = {0, sw->nrun - 1, (long)(fmb_plan_uniform(sw->plan.seed, 0, 1u << 20) * (double)sw->nrun)};
       for (int k = 0; k < 3 && !rc; ++k)
@@ -401,7 +404,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
       ext->mpi_finalize(0);
       return rc ? FMB_EXIT_BAD_INPUT : 0;
     }
-    if (!rc) rc = check_run(sw, 0, 0) ? FMB_EXIT_BAD_INPUT : 0; /* an unknown path: refused before anything runs */
+    if (!rc) rc = check_run(sw, 0, 0) == 2 ? FMB_EXIT_BAD_INPUT : 0; /* an unknown path: refused before anything runs */
     if (!rc) rc = fmb_journal_open(sw, resume, fresh);
     if (!rc) rc = fmb_journal_write_plan(sw) ? FMB_EXIT_BAD_INPUT : 0;
   }

@@ -171,9 +171,13 @@ char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
     char m[sizeof msg];
     snprintf(m, sizeof m, "killed by signal %d (%s)%s%.1800s", r->signal, strsignal(r->signal), msg[0] ? ": " : "", msg);
     memcpy(msg, m, sizeof msg);
+  } else if (r->status == FMB_CHILD_CRASHED && !msg[0]) {
+    snprintf(msg, sizeof msg, "exit code %d (flexmbd ends with 0, 2, 3 or 4)%s", r->exit_code,
+             r->exit_code == 127 ? ": the program could not be started" : "");
   } else if (r->status == FMB_CHILD_TIMEOUT) {
     char m[sizeof msg];
-    snprintf(m, sizeof m, "no result after %.3g s: killed%s%.1800s", r->wall_s, msg[0] ? ": " : "", msg);
+    snprintf(m, sizeof m, "no result within the time limit (--timeout): killed after %.3g s%s%.1800s", r->wall_s,
+             msg[0] ? ": " : "", msg);
     memcpy(msg, m, sizeof msg);
   } else if (r->status == FMB_CHILD_OK) {
     msg[0] = '\0';

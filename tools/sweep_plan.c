@@ -24,15 +24,15 @@ uint64_t fmb_fnv1a(uint64_t h, const void* data, size_t n) {
 }
 
 /* splitmix64's output function (Steele, Lea, Flood 2014): a bijection that scatters counters */
-static uint64_t mix64(uint64_t z) {
+uint64_t fmb_mix64(uint64_t z) {
   z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
   z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
   return z ^ (z >> 31);
 }
 
 double fmb_plan_uniform(uint64_t seed, uint64_t sample, uint64_t stream) {
-  uint64_t z = mix64(seed) + 0x9e3779b97f4a7c15ULL * (sample + 1) + 0xd1b54a32d192ed03ULL * (stream + 1);
-  z = mix64(z);
+  uint64_t z = fmb_mix64(seed) + 0x9e3779b97f4a7c15ULL * (sample + 1) + 0xd1b54a32d192ed03ULL * (stream + 1);
+  z = fmb_mix64(z);
   return ((double)(z >> 11) + 0.5) * 0x1.0p-53; /* 53 bits, never 0 or 1 */
 }
 
@@ -314,10 +314,10 @@ int fmb_plan_add_random(fmbSweepPlan* p, const char* spec, char* err, size_t len
   const int k = add_path(p, spec, &rest, err, len);
   if (k < 0) return -1;
   static const char* const kinds[3] = {"uniform", "normal", "lognormal"};
-  char name[16], tail;
+  char name[16];
   double a, b;
-  int kind = -1;
-  if (sscanf(rest, "%15[a-z](%lf,%lf)%c", name, &a, &b, &tail) == 4 && tail == ')')
+  int kind = -1, used = 0;
+  if (sscanf(rest, "%15[a-z](%lf,%lf)%n", name, &a, &b, &used) == 3 && used > 0 && rest[used] == '\0')
     for (int i = 0; i < 3; ++i)
       if (strcmp(name, kinds[i]) == 0) kind = i;
   if (kind < 0 || !isfinite(a) || !isfinite(b)) {

@@ -50,6 +50,8 @@ double fmb_plan_uniform(uint64_t seed, uint64_t sample, uint64_t stream);
 /* the standard normal quantile (bisection on erfc: slow, exact to the last bits, reproducible) */
 double fmb_plan_normal_quantile(double u);
 
+/* splitmix64's output function: a bijection of 64-bit words that scatters every input bit */
+uint64_t fmb_mix64(uint64_t z);
 /* FNV-1a 64 over bytes, continuing from h (start with FMB_FNV_OFFSET) */
 #define FMB_FNV_OFFSET 0xcbf29ce484222325ULL
 uint64_t fmb_fnv1a(uint64_t h, const void* data, size_t n);

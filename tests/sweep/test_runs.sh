@@ -1,0 +1,105 @@
+#!/bin/sh
+# `flexmbd sweep` runs (docs/sweep.md):
+#  1. bit for bit: every row's stats (but cpu_s) equal the stats line of the same `flexmbd run`
+#     typed by hand, its --metric values equal max/min/end/rms computed here by awk from that
+#     run's CSV, and the kept series (--keep series) is that CSV byte for byte;
+#  2. injected faults (tests/sweep/faulty.c): segfault, abort, hang, endless allocation under
+#     --mem-limit, an unknown exit code -> rows crashed/timeout, and the sweep itself ends with 0;
+#  3. the table is the same for -j 1 and -j 2 (but timings); sweep.h5 is readable by h5dump (and
+#     h5py when installed) and holds the table; --status counts the statuses.
+#   usage: test_runs.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
+set -eu
+F=$1
+SRC=$2
+D=$3
+PLUGIN=$4
+rm -rf "$D"
+mkdir -p "$D"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+SCENE=$SRC/scenes/fourbar.yaml
+
+# 1. bit for bit against runs typed by hand
+"$F" sweep "$SCENE" -o "$D/s1" -j 2 --quiet --keep series --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
+  --grid bodies.crank.mass=1,2 --metric crank.theta:max,end --metric motor.power:min,rms,max 2> "$D/s1.err" ||
+  { cat "$D/s1.err"; fail "sweep s1 failed"; }
+[ "$(tail -n +2 "$D/s1/table.csv" | wc -l)" = 4 ] || fail "s1: expected 4 rows"
+# column numbers by name
+col() { head -1 "$D/s1/table.csv" | tr ',' '\n' | grep -n -x "$1" | cut -d: -f1; }
+tail -n +2 "$D/s1/table.csv" | while IFS= read -r row; do
+  get() { echo "$row" | cut -d, -f"$(col "$1")"; }
+  rtol=$(get solver.rtol)
+  mass=$(get bodies.crank.mass)
+  id=$(get run_id)
+  [ "$(get status)" = ok ] || fail "s1: status $(get status) for rtol=$rtol mass=$mass"
+  "$F" run "$SCENE" -o "$D/direct.csv" --quiet --set solver.t_end=1 --set "solver.rtol=$rtol" --set "bodies.crank.mass=$mass" \
+    2> "$D/direct.err" || fail "direct run failed"
+  cmp -s "$D/direct.csv" "$D/s1/series/$id.csv" || fail "s1: kept series of $id differs from the direct run"
+  stats=$(tail -1 "$D/direct.err")
+  for k in t_reached steps residuals jacobians newton_iters error_test_fails conv_fails jacobians_reused; do
+    want=$(echo "$stats" | tr ' ' '\n' | grep "^$k=" | cut -d= -f2)
+    [ "$(get $k)" = "$want" ] || fail "s1: $k = $(get $k) in the sweep, $want in the direct run (rtol=$rtol mass=$mass)"
+  done
+  # metrics by awk from the direct CSV: max, min, end (exact) and rms = sqrt(sum v^2 / n) in row order
+  for m in crank.theta:max crank.theta:end motor.power:min motor.power:rms motor.power:max; do
+    c=${m%%:*}
+    s=${m##*:}
+    k=$(head -1 "$D/direct.csv" | tr ',' '\n' | grep -n -x "$c" | cut -d: -f1)
+    want=$(awk -F, -v k="$k" -v s="$s" 'NR > 1 { v = $k + 0; if (NR == 2 || v > mx) mx = v; if (NR == 2 || v < mn) mn = v;
+           sq += v * v; n++; e = v } END { r = s == "max" ? mx : s == "min" ? mn : s == "end" ? e : sqrt(sq / n);
+           printf "%.17g", r }' "$D/direct.csv")
+    [ "$(get "$c.$s")" = "$want" ] || fail "s1: $c.$s = $(get "$c.$s") in the sweep, $want from the direct run"
+  done
+done
+
+# 3. -j 1 gives the same table but timings (wall_s, rank, cpu_s)
+"$F" sweep "$SCENE" -o "$D/s1j1" -j 1 --quiet --keep series --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
+  --grid bodies.crank.mass=1,2 --metric crank.theta:max,end --metric motor.power:min,rms,max 2> /dev/null || fail "s1j1"
+strip() { cut -d, -f1-6,9-18,20- "$1"; }
+strip "$D/s1/table.csv" | cmp -s - "$(strip "$D/s1j1/table.csv" > "$D/t1"; echo "$D/t1")" || fail "-j 1 and -j 2 tables differ"
+
+# HDF5: the table in /runs, readable by h5dump (and h5py)
+if [ -f "$D/s1/sweep.h5" ]; then
+  h5dump -d /runs/steps "$D/s1/sweep.h5" > "$D/h5.txt" || fail "h5dump cannot read sweep.h5"
+  steps=$(tail -n +2 "$D/s1/table.csv" | cut -d, -f"$(col steps)" | tr '\n' ' ')
+  for s in $steps; do grep -q "$s" "$D/h5.txt" || fail "sweep.h5 /runs/steps lacks $s"; done
+  h5dump -H -g /series "$D/s1/sweep.h5" | grep -q 'DATASET "3"' || fail "sweep.h5: no /series/3 with --keep series"
+  if python3 -c "import h5py" 2> /dev/null; then
+    python3 - "$D/s1/sweep.h5" "$D/s1/table.csv" << 'EOF' || fail "h5py reads another table"
+import csv, sys, h5py
+f = h5py.File(sys.argv[1], "r")
+rows = list(csv.DictReader(open(sys.argv[2])))
+assert [int(v) for v in f["runs/steps"][:]] == [int(r["steps"]) for r in rows]
+assert list(f["series/0"].attrs["columns"].decode().split(","))[0] == "t"
+EOF
+  else
+    echo "h5py not installed: skipped its check"
+  fi
+else
+  [ -f "$(dirname "$F")/libflexmbd_sweep.so" ] && fail "no sweep.h5 although the sweep module was built"
+  echo "built without HDF5: no sweep.h5 to check"
+fi
+
+# 2. faults: each costs one row, the sweep goes on and ends with 0
+rc=0
+"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 1 --mem-limit 256 \
+  --grid bodies.f.fault=0,1,2,3,4,5 2> "$D/faults.err" || rc=$?
+[ "$rc" = 0 ] || { cat "$D/faults.err"; fail "the sweep with faults ended with $rc"; }
+expect() { # fault status signal
+  line=$(awk -F, -v f="$1" 'NR > 1 && $9 == f' "$D/faults/table.csv")
+  [ "$(echo "$line" | cut -d, -f4)" = "$2" ] || fail "fault $1: status $(echo "$line" | cut -d, -f4), expected $2: $line"
+  [ -z "$3" ] || [ "$(echo "$line" | cut -d, -f6)" = "$3" ] || fail "fault $1: signal $(echo "$line" | cut -d, -f6), expected $3"
+}
+expect 0 ok 0
+expect 1 crashed 11
+expect 2 crashed 6
+expect 3 timeout ""
+expect 4 crashed ""
+expect 5 crashed 0
+grep -q "timeout" "$D/faults/table.csv" && grep -q 'exit code 7' "$D/faults/table.csv" || fail "fault messages"
+"$F" sweep --status "$D/faults" > "$D/status.txt" || fail "--status"
+grep -q "6 planned (6 distinct), 6 with a row, 0 to do" "$D/status.txt" && grep -q "crashed  *4" "$D/status.txt" ||
+  { cat "$D/status.txt"; fail "--status counts"; }
+# no child left behind
+sleep 0.2
+pgrep -f "$D/faults" > /dev/null && fail "a child of the fault sweep still runs"
+echo "test_runs: ok"
