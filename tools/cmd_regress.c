@@ -55,7 +55,7 @@ static void remove_tmpdir(const char* dir) {
     struct dirent* e;
     char p[1200];
     while ((e = readdir(d)) != NULL) {
-      if (e->d_name[0] == '.') continue;
+      if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue; /* a killed run leaves .NAME.XXXXXX */
       snprintf(p, sizeof p, "%s/%s", dir, e->d_name);
       remove(p);
     }
