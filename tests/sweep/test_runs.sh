@@ -99,6 +99,28 @@ grep -q "timeout" "$D/faults/table.csv" && grep -q 'exit code 7' "$D/faults/tabl
 "$F" sweep --status "$D/faults" > "$D/status.txt" || fail "--status"
 grep -q "6 planned (6 distinct), 6 with a row, 0 to do" "$D/status.txt" && grep -q "crashed  *4" "$D/status.txt" ||
   { cat "$D/status.txt"; fail "--status counts"; }
+# --retry crashed: the crashed runs again (attempt 2), the others kept
+"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 1 --mem-limit 256 \
+  --grid bodies.f.fault=0,1,2,3,4,5 --retry crashed 2> "$D/retry.err" || fail "--retry crashed"
+grep -q "sweep: 4 runs" "$D/retry.err" || { cat "$D/retry.err"; fail "--retry crashed should rerun 4 runs"; }
+awk -F, 'NR > 1 && $4 == "crashed" && $3 != 2 { exit 1 }' "$D/faults/table.csv" || fail "--retry: attempt 2 expected"
+
+# --timeout Nx: N times the median of the ok runs so far (one child: the 6 ok runs end first)
+"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/rel" -j 1 --quiet --timeout 5x \
+  --zip bodies.f.fault=0,0,0,0,0,0,3 --zip solver.t_end=0.1,0.11,0.12,0.13,0.14,0.15,0.16 2> "$D/rel.err" || fail "--timeout 5x"
+awk -F, 'NR == 8 && $4 == "timeout" && $7 < 3.5 { found = 1 } END { exit !found }' "$D/rel/table.csv" ||
+  { cat "$D/rel/table.csv"; fail "--timeout 5x: the hanging run should be killed within 5 x the median + 2 s"; }
+
+# a refined grid with --resume runs only the new points (ids are content, not positions)
+"$F" sweep "$SCENE" -o "$D/refine" --quiet --set solver.t_end=0.5 --grid solver.rtol=1e-4:1e-8:5:log 2> /dev/null
+"$F" sweep "$SCENE" -o "$D/refine" --quiet --set solver.t_end=0.5 --grid solver.rtol=1e-4:1e-8:9:log 2> "$D/refine.err" &&
+  fail "another plan in the same folder must be refused without --resume"
+grep -q "journal of another plan" "$D/refine.err" || fail "no word about another plan"
+"$F" sweep "$SCENE" -o "$D/refine" --quiet --resume --set solver.t_end=0.5 --grid solver.rtol=1e-4:1e-8:9:log \
+  2> "$D/refine.err" || fail "--resume of a refined grid"
+grep -q "sweep: 4 runs" "$D/refine.err" || { cat "$D/refine.err"; fail "the refined grid should run only its 4 new points"; }
+[ "$(tail -n +2 "$D/refine/table.csv" | wc -l)" = 9 ] || fail "the refined table should have 9 rows"
+
 # no child left behind
 sleep 0.2
 pgrep -f "$D/faults" > /dev/null && fail "a child of the fault sweep still runs"
