@@ -24,13 +24,6 @@
 #include "cli.h"
 #include "sweep.h"
 
-#ifndef FLEXMBD_VERSION
-#define FLEXMBD_VERSION "unknown"
-#endif
-#ifndef FLEXMBD_COMMIT
-#define FLEXMBD_COMMIT "unknown"
-#endif
-
 #define YES_LIMIT 1e6 /* a larger plan needs --yes */
 #define MAX_PLAN 1e9  /* a larger plan is refused */
 
@@ -132,17 +125,9 @@ static int make_ids(fmbSweep* sw) {
 static int check_run(fmbSweep* sw, long index, int verbose) {
   char err[4300];
   snprintf(err, sizeof err, "%s/logs/check.err", sw->dir);
-  char* argv[8 + 2 * (FMB_SWEEP_MAX_FIXED + FMB_SWEEP_MAX_PATHS + 16)];
-  char sets[FMB_SWEEP_MAX_PATHS][600];
-  int n = 0;
-  argv[n++] = sw->exe, argv[n++] = "check", argv[n++] = (char*)sw->scene;
-  for (int k = 0; k < sw->nfixed; ++k) argv[n++] = "--set", argv[n++] = (char*)sw->fixed[k];
-  for (int k = 0; k < sw->plan.npath; ++k) {
-    snprintf(sets[k], sizeof sets[k], "%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
-    argv[n++] = "--set", argv[n++] = sets[k];
-  }
-  for (int k = 0; k < sw->nplugins; ++k) argv[n++] = "--plugin", argv[n++] = (char*)sw->plugins[k];
-  argv[n] = NULL;
+  char* argv[FMB_SWEEP_MAX_ARGS];
+  char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
+  fmb_sweep_argv(sw, index, "check", NULL, argv, sets);
   fmbPool* pool = fmb_pool_new(1);
   /* a check that crashes or hangs is left to the runs to record; only refused input stops the sweep */
   fmbChildSpec spec = {.argv = argv, .stderr_path = err, .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,

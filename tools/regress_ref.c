@@ -14,13 +14,6 @@
 
 #include "regress.h"
 
-#ifndef FLEXMBD_VERSION
-#define FLEXMBD_VERSION "unknown"
-#endif
-#ifndef FLEXMBD_COMMIT
-#define FLEXMBD_COMMIT "unknown"
-#endif
-
 const double regress_companion_rtol[REGRESS_NCOMPANION] = {0.97, 1.03};
 
 void regress_say(char* buf, size_t len, const char* fmt, ...) {

@@ -96,6 +96,14 @@ void fmb_journal_close(fmbSweep* sw);
 int fmb_journal_status(const char* dir);
 
 /* sweep_exec.c */
+#define FMB_SWEEP_SET_LEN 600 /* one "--set PATH=VALUE" of a swept path */
+#define FMB_SWEEP_MAX_ARGS (8 + 2 * (FMB_SWEEP_MAX_FIXED + FMB_SWEEP_MAX_PATHS + 16))
+/* argv of `flexmbd VERB SCENE [-o OUT --quiet] --set ... --plugin ...` for run `index` (sets: the
+   swept paths' texts, FMB_SWEEP_MAX_PATHS of them); argv has FMB_SWEEP_MAX_ARGS places; argc */
+int fmb_sweep_argv(const fmbSweep* sw, long index, const char* verb, const char* out, char** argv,
+                   char (*sets)[FMB_SWEEP_SET_LEN]);
+/* kills the pool's children on an interrupt and takes their starts back (they are not lost) */
+void fmb_sweep_cancel(fmbSweep* sw, fmbPool* pool);
 /* the child for run `index` (attempt `attempt`) started in the pool; 0 or -1 */
 int fmb_sweep_start(fmbSweep* sw, fmbPool* pool, long index, double timeout_s);
 /* the journal row of a finished child (metrics, stats, message), '\n'-terminated, malloc'd */

@@ -20,27 +20,30 @@ static void run_file(const fmbSweep* sw, long index, const char* sub, const char
   snprintf(out, len, "%s/%s/%016" PRIx64 "%s", sw->dir, sub, sw->id[index], ext);
 }
 
-int fmb_sweep_start(fmbSweep* sw, fmbPool* pool, long index, double timeout_s) {
-  char series[4300], err[4300];
-  run_file(sw, index, "series", ".csv", series, sizeof series);
-  run_file(sw, index, "logs", ".err", err, sizeof err);
-  enum { MAXARG = 8 + 2 * (FMB_SWEEP_MAX_FIXED + FMB_SWEEP_MAX_PATHS + 16) };
-  char* argv[MAXARG];
-  char sets[FMB_SWEEP_MAX_PATHS][600];
+int fmb_sweep_argv(const fmbSweep* sw, long index, const char* verb, const char* out, char** argv,
+                   char (*sets)[FMB_SWEEP_SET_LEN]) {
   int n = 0;
-  argv[n++] = sw->exe;
-  argv[n++] = (char*)sw->verb;
+  argv[n++] = (char*)sw->exe;
+  argv[n++] = (char*)verb;
   argv[n++] = (char*)sw->scene;
-  argv[n++] = "-o";
-  argv[n++] = series;
-  argv[n++] = "--quiet";
+  if (out) argv[n++] = "-o", argv[n++] = (char*)out, argv[n++] = "--quiet";
   for (int k = 0; k < sw->nfixed; ++k) argv[n++] = "--set", argv[n++] = (char*)sw->fixed[k];
   for (int k = 0; k < sw->plan.npath; ++k) {
-    snprintf(sets[k], sizeof sets[k], "%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
+    snprintf(sets[k], FMB_SWEEP_SET_LEN, "%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
     argv[n++] = "--set", argv[n++] = sets[k];
   }
   for (int k = 0; k < sw->nplugins; ++k) argv[n++] = "--plugin", argv[n++] = (char*)sw->plugins[k];
   argv[n] = NULL;
+  return n;
+}
+
+int fmb_sweep_start(fmbSweep* sw, fmbPool* pool, long index, double timeout_s) {
+  char series[4300], err[4300];
+  run_file(sw, index, "series", ".csv", series, sizeof series);
+  run_file(sw, index, "logs", ".err", err, sizeof err);
+  char* argv[FMB_SWEEP_MAX_ARGS];
+  char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
+  fmb_sweep_argv(sw, index, sw->verb, series, argv, sets);
   fmbChildSpec spec = {.argv = argv,
                        .stdout_path = NULL,
                        .stderr_path = err,
@@ -296,8 +299,7 @@ static void finish(fmbSweep* sw, const fmbChildResult* r) {
   free(row);
 }
 
-/* the pool's children killed on an interrupt: their starts taken back (they are not lost) */
-static void cancel_running(fmbSweep* sw, fmbPool* pool) {
+void fmb_sweep_cancel(fmbSweep* sw, fmbPool* pool) {
   long tags[1024];
   const int n = fmb_pool_running(pool) <= 1024 ? fmb_pool_tags(pool, tags) : 0;
   fmb_pool_kill_all(pool, 2.0);
@@ -318,7 +320,7 @@ int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n) {
     sw->running = 0;
     if (got == 1) finish(sw, &r);
   }
-  if (*sw->stop) cancel_running(sw, pool);
+  if (*sw->stop) fmb_sweep_cancel(sw, pool);
   fmb_pool_free(pool);
   return *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
 }
@@ -346,7 +348,7 @@ int fmb_sweep_local(fmbSweep* sw) {
     sw->running = fmb_pool_running(pool);
     fmb_sweep_progress(sw, 0);
   }
-  if (pool && *sw->stop) cancel_running(sw, pool);
+  if (pool && *sw->stop) fmb_sweep_cancel(sw, pool);
   fmb_pool_free(pool);
   free(todo);
   return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;

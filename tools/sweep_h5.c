@@ -15,14 +15,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "cli.h"
 #include "sweep.h"
 
 #ifdef FLEXMBD_HAVE_HDF5
 #include <hdf5.h>
-
-#ifndef FLEXMBD_VERSION
-#define FLEXMBD_VERSION "unknown"
-#endif
 
 typedef struct {
   int ncol;

@@ -53,7 +53,19 @@ void fmb_sweep_mpi_finalize(int rc) {
   MPI_Finalize();
 }
 
-static void backoff(double* wait, int active) { *wait = active ? 2e-4 : (*wait * 2 < 0.02 ? *wait * 2 : 0.02); }
+/* a finished child into *r (1), or 0 after waiting up to *wait; the wait backs off from 0.2 ms to
+   20 ms while nothing happens (`active`: something did this round) */
+static int wait_child(fmbPool* pool, double* wait, int active, fmbChildResult* r) {
+  int got = 0;
+  if (fmb_pool_running(pool)) {
+    got = fmb_pool_wait(pool, *wait, r) == 1;
+  } else if (!active) {
+    struct timespec ts = {0, (long)(*wait * 1e9)};
+    nanosleep(&ts, NULL);
+  }
+  *wait = active || got ? 2e-4 : (*wait * 2 < 0.02 ? *wait * 2 : 0.02);
+  return got;
+}
 
 static int manager(fmbSweep* sw) {
   long n = 0, ninf = 0;
@@ -130,28 +142,25 @@ static int manager(fmbSweep* sw) {
         stops == worker_slots)
       break;
     fmbChildResult r;
-    if (fmb_pool_running(pool) && fmb_pool_wait(pool, wait, &r) == 1) {
+    if (wait_child(pool, &wait, active, &r)) {
       char* row = fmb_sweep_row(sw, &r, sw->starts[sw->first[r.tag]]);
       if (row && fmb_journal_append(sw, r.tag, row) == 0) fmb_sweep_account(sw, (int)r.status, r.wall_s);
       free(row);
-      active = 1;
-    } else if (!fmb_pool_running(pool) && !active) {
-      struct timespec ts = {0, (long)(wait * 1e9)};
-      nanosleep(&ts, NULL);
     }
-    backoff(&wait, active);
     fmb_sweep_progress(sw, 0);
   }
-  if (pool && *sw->stop) {
-    long tags[1024];
-    const int k = fmb_pool_running(pool) <= 1024 ? fmb_pool_tags(pool, tags) : 0;
-    fmb_pool_kill_all(pool, 2.0);
-    for (int t = 0; t < k; ++t) fmb_journal_cancelled(sw, tags[t]);
-  }
+  if (pool && *sw->stop) fmb_sweep_cancel(sw, pool);
   fmb_pool_free(pool);
   free(todo);
   free(buf);
   return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
+}
+
+/* a finished run's row to rank 0 (which takes it as a request for the next run too) */
+static void send_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
+  char* row = fmb_sweep_row(sw, r, attempt);
+  MPI_Send(row, row ? (int)strlen(row) : 0, MPI_CHAR, 0, TAG_ROW, MPI_COMM_WORLD);
+  free(row);
 }
 
 static int worker(fmbSweep* sw) {
@@ -180,22 +189,11 @@ static int worker(fmbSweep* sw) {
       attempt[i] = (int)msg[1];
       if (fmb_sweep_start(sw, pool, i, msg[2]) != 0) {
         fmbChildResult r = {.tag = i, .status = FMB_CHILD_CRASHED, .exit_code = -1};
-        char* row = fmb_sweep_row(sw, &r, attempt[i]);
-        MPI_Send(row, row ? (int)strlen(row) : 0, MPI_CHAR, 0, TAG_ROW, MPI_COMM_WORLD);
-        free(row);
+        send_row(sw, &r, attempt[i]);
       }
     }
     fmbChildResult r;
-    if (fmb_pool_running(pool) && fmb_pool_wait(pool, wait, &r) == 1) {
-      char* row = fmb_sweep_row(sw, &r, attempt[r.tag]);
-      MPI_Send(row, row ? (int)strlen(row) : 0, MPI_CHAR, 0, TAG_ROW, MPI_COMM_WORLD);
-      free(row);
-      active = 1;
-    } else if (!fmb_pool_running(pool) && !active) {
-      struct timespec ts = {0, (long)(wait * 1e9)};
-      nanosleep(&ts, NULL);
-    }
-    backoff(&wait, active);
+    if (wait_child(pool, &wait, active, &r)) send_row(sw, &r, attempt[r.tag]);
   }
   fmb_pool_free(pool); /* kills what still runs (an interrupt) */
   free(attempt);

@@ -11,14 +11,8 @@
 #    links and scenes without a reference are reported;
 #  misleading: a crashed run's message quotes its last stderr line, not a file already deleted.
 #   usage: test_regress_hostile.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
-set -eu
-F=$1
-SRC=$2
-D=$3
-PLUGIN=$(realpath "$4")
-rm -rf "$D"
+. "$(dirname "$0")/../sweep/lib.sh" # F SRC D PLUGIN, fail()
 mkdir -p "$D/s"
-fail() { echo "FAIL: $*" >&2; exit 1; }
 reg() { rc=0; "$F" regress "$@" > "$D/out.txt" 2> "$D/err.txt" || rc=$?; echo "$rc"; }
 S=$D/s
 cp "$SRC/scenes/fourbar.yaml" "$SRC/scenes/fourbar.ref.csv" "$S/"

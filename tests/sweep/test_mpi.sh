@@ -5,15 +5,8 @@
 #     rows from more than one rank;
 #  2. SIGTERM to mpirun while every rank's children hang: no child is left running.
 #   usage: test_mpi.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN MPIRUN
-set -eu
-F=$1
-SRC=$2
-D=$3
-PLUGIN=$4
+. "$(dirname "$0")/lib.sh"
 MPIRUN=$5
-rm -rf "$D"
-mkdir -p "$D"
-fail() { echo "FAIL: $*" >&2; exit 1; }
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 MPI="$MPIRUN --oversubscribe --bind-to none"
 

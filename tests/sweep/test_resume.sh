@@ -6,14 +6,7 @@
 #  3. SIGINT: every child killed (a hanging one too), exit 4, the journal whole; --status says what
 #     is left; the next start resumes and ends with 0.
 #   usage: test_resume.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
-set -eu
-F=$1
-SRC=$2
-D=$3
-PLUGIN=$4
-rm -rf "$D"
-mkdir -p "$D"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "$0")/lib.sh"
 children_of() { pgrep -f -- "-o $1/series" || true; }
 
 # 1. 20 kills at random moments, then to the end

@@ -8,14 +8,7 @@
 #  3. the table is the same for -j 1 and -j 2 (but timings); sweep.h5 is readable by h5dump (and
 #     h5py when installed) and holds the table; --status counts the statuses.
 #   usage: test_runs.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
-set -eu
-F=$1
-SRC=$2
-D=$3
-PLUGIN=$4
-rm -rf "$D"
-mkdir -p "$D"
-fail() { echo "FAIL: $*" >&2; exit 1; }
+. "$(dirname "$0")/lib.sh"
 SCENE=$SRC/scenes/fourbar.yaml
 
 # 1. bit for bit against runs typed by hand
