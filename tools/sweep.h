@@ -17,6 +17,7 @@
 #define FMB_SWEEP_MAX_METRICS 64
 #define FMB_SWEEP_MAX_FIXED 256
 #define FMB_SWEEP_MAX_RETRIES 3 /* starts without a row before a run is marked lost */
+#define FMB_SWEEP_SYNC_S 1.0    /* the journal goes to the disk at most this often (sweep_journal.c) */
 /* the stats fields every row carries, in the order of the stats line */
 #define FMB_SWEEP_NSTATS 9
 extern const char* const fmb_sweep_stat_names[FMB_SWEEP_NSTATS];
@@ -64,6 +65,7 @@ typedef struct fmbSweep {
   int* status;    /* per index: its latest status, -1 none */
   int* starts;    /* per index: dispatches recorded in DIR/inflight.log */
   int inflight_fd;
+  double last_sync; /* when the journal last went to the disk */
   long count[FMB_CHILD_NSTATUS];
   long done, failed, running, total_todo;
   double t_start, last_progress;
@@ -81,7 +83,7 @@ int fmb_sweep_header(const fmbSweep* sw, char* buf, size_t len);
 /* opens DIR/runs.csv and DIR/inflight.log: resumes (the same plan, or `resume` given), sets aside
    (`fresh`) or refuses another plan (2); fills row_at/status/starts. 0 or an exit code. */
 int fmb_journal_open(fmbSweep* sw, int resume, int fresh);
-/* appends one row (ending in '\n') to runs.csv with one write, flushed to disk; 0 or -1 */
+/* appends one row (ending in '\n') to runs.csv with one write (to the disk once a second); 0 or -1 */
 int fmb_journal_append(fmbSweep* sw, long index, const char* row);
 /* records the dispatch of run `index` in inflight.log before it starts */
 void fmb_journal_started(fmbSweep* sw, long index);
