@@ -68,12 +68,12 @@ run_cases() {
   [ "$ec" != - ] && sets+=(--set "solver.error_control=$ec")
   [ "$ord" != - ] && sets+=(--set "solver.max_order=$ord")
   local rl="" al="" nl="" a
-  local -A as_given # the sweep prints numbers %.17g; the table keeps them as written here
+  local -A given_r given_a # the sweep prints numbers %.17g; the table keeps them as written here
   for r in $rtols; do
     a=$(awk -v r="$r" 'BEGIN { printf "%.3g", r / 100 }')
     rl+=${rl:+,}$r; al+=${al:+,}$a
-    as_given[$(awk -v r="$r" 'BEGIN { printf "%.17g", r }')]=$r
-    as_given[$(awk -v r="$a" 'BEGIN { printf "%.17g", r }')]=$a
+    given_r[$(awk -v r="$r" 'BEGIN { printf "%.17g", r }')]=$r
+    given_a[$(awk -v r="$a" 'BEGIN { printf "%.17g", r }')]=$a
   done
   for n in $nes; do [ "$n" != - ] && nl+=${nl:+,}$n; done
   plan=(--zip "solver.rtol=$rl" --zip "solver.atol=$al")
@@ -97,7 +97,7 @@ run_cases() {
   tail -n +2 "$d1/table.csv" | while IFS= read -r line; do
     local f; f() { cut -d, -f"$(col "$1")" <<< "$line"; }
     local rid status ne rtol atol csv cpu reps
-    rid=$(f run_id); rtol=${as_given[$(f solver.rtol)]}; atol=${as_given[$(f solver.atol)]}
+    rid=$(f run_id); rtol=${given_r[$(f solver.rtol)]}; atol=${given_a[$(f solver.atol)]}
     ne=$nes; [ -n "$nl" ] && ne=$(f bodies.beam.elements)
     case $(f status) in ok) status=ok ;; timeout) status=timeout ;; *) status=failed ;; esac
     cpu=$(for t in "$WORK"/sw_"${tag}"_[0-9]*/table.csv; do awk -F, -v id="$rid" -v c="$(col cpu_s)" '$2 == id && $4 == "ok" { print $c }' "$t"; done |
