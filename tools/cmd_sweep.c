@@ -363,8 +363,11 @@ int fmb_cmd_sweep(int argc, char** argv) {
     sw->jobs = n > 0 ? (int)n : 1;
   }
   if (make_ids(sw)) return bad("out of memory for %s runs", "the");
-  const fmbSweepExtension* ext = fmb_sweep_extension_load();
-  if (!ext->mpi_wanted() || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
+  /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
+     libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
+  const int launched = fmb_sweep_launched_by_mpi();
+  const fmbSweepExtension* ext = fmb_sweep_extension_load(launched);
+  if (!launched || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
 
   int rc = 0;
   if (sw->rank != 0 && dry) { /* rank 0 alone checks the plan */
@@ -408,6 +411,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (sw->rank == 0 && sw->journal_fd >= 0) {
     fmb_sweep_progress(sw, 1);
     if (fmb_journal_write_table(sw)) fprintf(stderr, "flexmbd sweep: cannot write %s/table.csv\n", sw->dir);
+    ext = fmb_sweep_extension_load(1);
     if (rc == 0 && ext->write_h5(sw) < 0) fprintf(stderr, "flexmbd sweep: cannot write %s/sweep.h5\n", sw->dir);
     if (rc == FMB_EXIT_INTERRUPTED)
       fprintf(stderr, "sweep: interrupted; every child stopped, %s/runs.csv is complete: run the same command to resume\n", sw->dir);

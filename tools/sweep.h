@@ -131,8 +131,6 @@ int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n);
    LIBDIR/flexmbd (installed); without it the sweep is the local pool and writes no sweep.h5. */
 typedef struct fmbSweepExtension {
   int has_mpi, has_hdf5;
-  /* started by mpirun/srun (their environment variables) */
-  int (*mpi_wanted)(void);
   int (*mpi_init)(fmbSweep* sw); /* MPI_Init, rank and size; 0 or -1 */
   /* the sweep over the ranks; rc0: rank 0's verdict on the spec and journal (0 go, else every
      rank returns it); rank 0 returns what fmb_sweep_local would */
@@ -141,10 +139,12 @@ typedef struct fmbSweepExtension {
   /* DIR/sweep.h5 from DIR/plan.csv, DIR/table.csv and (--keep series) the series; 0 or -1 */
   int (*write_h5)(const fmbSweep* sw);
 } fmbSweepExtension;
-/* the module's table, or one of fallbacks (local pool, no HDF5) when it cannot be loaded */
-const fmbSweepExtension* fmb_sweep_extension_load(void);
+/* started by mpirun or srun (their environment variables: OMPI_COMM_WORLD_SIZE, PMIX_RANK, ...) */
+int fmb_sweep_launched_by_mpi(void);
+/* with `load`, the module's table (loaded once), or fallbacks (local pool, no HDF5) when it cannot
+   be loaded; without, the fallbacks until it is */
+const fmbSweepExtension* fmb_sweep_extension_load(int load);
 /* in the module (sweep_mpi.c, sweep_h5.c) */
-int fmb_sweep_mpi_wanted(void);
 int fmb_sweep_mpi_init(fmbSweep* sw);
 int fmb_sweep_mpi(fmbSweep* sw, int rc0);
 void fmb_sweep_mpi_finalize(int rc);

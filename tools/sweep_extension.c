@@ -7,7 +7,6 @@ const fmbSweepExtension* fmb_sweep_extension(void) {
   static const fmbSweepExtension ext = {
 #ifdef FLEXMBD_HAVE_MPI
       .has_mpi = 1,
-      .mpi_wanted = fmb_sweep_mpi_wanted,
       .mpi_init = fmb_sweep_mpi_init,
       .mpi_run = fmb_sweep_mpi,
       .mpi_finalize = fmb_sweep_mpi_finalize,

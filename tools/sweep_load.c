@@ -4,6 +4,7 @@
 #include <dlfcn.h>
 #include <libgen.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -13,7 +14,14 @@
 #define FLEXMBD_LIBDIR "lib"
 #endif
 
-static int no_mpi_wanted(void) { return 0; }
+int fmb_sweep_launched_by_mpi(void) {
+  /* set by Open MPI's mpirun, by PMI/PMIx launchers (srun) */
+  static const char* const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"};
+  for (size_t k = 0; k < sizeof vars / sizeof vars[0]; ++k)
+    if (getenv(vars[k])) return 1;
+  return 0;
+}
+
 static int no_mpi_init(fmbSweep* sw) {
   sw->rank = 0, sw->nranks = 1;
   return 0;
@@ -25,12 +33,11 @@ static int no_h5(const fmbSweep* sw) {
   return 1;
 }
 
-const fmbSweepExtension* fmb_sweep_extension_load(void) {
-  static fmbSweepExtension ext;
+const fmbSweepExtension* fmb_sweep_extension_load(int load) {
+  static fmbSweepExtension ext = {0, 0, no_mpi_init, no_mpi_run, no_mpi_finalize, no_h5};
   static int loaded;
-  if (loaded) return &ext;
+  if (loaded || !load) return &ext;
   loaded = 1;
-  ext = (fmbSweepExtension){0, 0, no_mpi_wanted, no_mpi_init, no_mpi_run, no_mpi_finalize, no_h5};
   char exe[4096], path[4400];
   ssize_t n = readlink("/proc/self/exe", exe, sizeof exe - 1);
   if (n <= 0) return &ext;
@@ -51,7 +58,7 @@ const fmbSweepExtension* fmb_sweep_extension_load(void) {
   const fmbSweepExtension* m = entry();
   if (m->has_mpi) {
     ext.has_mpi = 1;
-    ext.mpi_wanted = m->mpi_wanted, ext.mpi_init = m->mpi_init, ext.mpi_run = m->mpi_run;
+    ext.mpi_init = m->mpi_init, ext.mpi_run = m->mpi_run;
     ext.mpi_finalize = m->mpi_finalize;
   }
   if (m->has_hdf5) ext.has_hdf5 = 1, ext.write_h5 = m->write_h5;

@@ -26,14 +26,6 @@
 enum { TAG_HELLO = 1, TAG_ASK, TAG_ROW, TAG_RUN };
 static int mpi_up;
 
-int fmb_sweep_mpi_wanted(void) {
-  /* set by Open MPI's mpirun, by PMI/PMIx launchers (srun) */
-  static const char* const vars[] = {"OMPI_COMM_WORLD_SIZE", "PMIX_RANK", "PMI_RANK", "PMI_SIZE"};
-  for (size_t k = 0; k < sizeof vars / sizeof vars[0]; ++k)
-    if (getenv(vars[k])) return 1;
-  return 0;
-}
-
 int fmb_sweep_mpi_init(fmbSweep* sw) {
   if (MPI_Init(NULL, NULL) != MPI_SUCCESS) {
     fprintf(stderr, "flexmbd sweep: MPI_Init failed\n");
