@@ -73,4 +73,10 @@ int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fm
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
                          double** yp, fmbStaticResult* res, fmbDiag* diag);
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
+/* the modes at one speed (steady state, then modes): 0 with *out, or an exit code with *diag */
+typedef int (*fmbCliModesAt)(void* ctx, double speed, fmbModes** out, fmbDiag* diag);
+/* at(ctx, speeds[i]) for every i in child processes, `jobs` at once (tools/modes_pool.c): out[i]
+   for i < *done (the speeds before the first that failed, whose code and *diag are returned) */
+int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx, fmbModes** out,
+                              int* done, fmbDiag* diag);
 #endif

@@ -1,4 +1,4 @@
-/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K]
+/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j J]
  *                    [--at T] [-o campbell.csv] [--plot campbell.png] [--eigen dense|sparse|auto]
  *                    [--set PATH=VALUE]...`
  * For each hub speed (PATH: the scene key that sets it, e.g. joints.spin.speed): the steady state,
@@ -17,6 +17,39 @@
 #define MAX_TRACKED 64
 #define EXTRA_MODES 6 /* computed beyond K so that a mode crossing from above can be followed */
 
+
+/* what one speed's modes need (modes_at) */
+typedef struct {
+  fmbCliScene* s; /* its overrides[nover] is the speed's */
+  const fmbCliAnalysis* an;
+  const char* path; /* --speed PATH */
+  int count;
+} Speed;
+
+/* the steady state at `speed`, then its modes (count + EXTRA_MODES of them, so that a mode
+   crossing from above can be followed) */
+static int modes_at(void* ctx, double speed, fmbModes** out, fmbDiag* diag) {
+  const Speed* c = ctx;
+  char override[600];
+  snprintf(override, sizeof override, "%s=%.17g", c->path, speed);
+  c->s->overrides[c->s->nover] = override;
+  fmbModel* m;
+  double *y, *yp;
+  fmbStaticResult res;
+  *out = NULL;
+  int rc = fmb_cli_steady_state(c->s, c->s->nover + 1, &c->an->opt, &m, &y, &yp, &res, diag);
+  if (!rc) rc = fmb_modes(m, res.t, y, yp, c->count + EXTRA_MODES, c->an->method, out, diag);
+  if (!rc && (*out)->count < c->count) {
+    snprintf(diag->msg, sizeof diag->msg, "the scene has only %d modes; --count %d asks for more", (*out)->count,
+             c->count);
+    diag->file[0] = '\0', diag->line = 0;
+    rc = FMB_EXIT_BAD_INPUT;
+  }
+  free(y);
+  free(yp);
+  fmb_free(m);
+  return rc;
+}
 
 /* "A:B:N" (N values from A to B) or "S1,S2,..."; returns the count or -1 */
 static int parse_speeds(const char* text, double* out) {
@@ -71,6 +104,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
   an.count_max = MAX_TRACKED;
   an.opt.quiet = 1;
   const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
+  int jobs = 1; /* -j K: the speeds computed in K child processes (tools/modes_pool.c) */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("campbell", argc, argv, &i, &s);
@@ -83,6 +117,14 @@ int fmb_cmd_campbell(int argc, char** argv) {
       if (!(png = fmb_cli_value("campbell", argc, argv, &i, "a PNG file name"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--speed") == 0) {
       if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
+      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of processes");
+      char* end;
+      jobs = v ? (int)strtol(v, &end, 10) : 0;
+      if (!v || *end || jobs < 1 || jobs > 1024) {
+        fprintf(stderr, "flexmbd campbell: -j expects 1 to 1024 processes\n");
+        return FMB_EXIT_BAD_INPUT;
+      }
     } else if (strcmp(a, "--speeds") == 0) {
       if (!(speeds_text = fmb_cli_value("campbell", argc, argv, &i, "A:B:N or S1,S2,..."))) return FMB_EXIT_BAD_INPUT;
     } else {
@@ -110,24 +152,25 @@ int fmb_cmd_campbell(int argc, char** argv) {
   const int ncol = count + 1;
   double* rows = calloc((size_t)nspeed * ncol, sizeof(double));
   char** names = calloc((size_t)ncol, sizeof(char*));
-  char override[600];
   int rc = rows && names ? 0 : FMB_EXIT_SOLVER, done = 0;
   fmbDiag diag;
   memset(&diag, 0, sizeof diag);
   fmbModes* prev = NULL;
   int track[MAX_TRACKED]; /* tracked mode k is mode track[k] of prev */
+  Speed ctx = {&s, &an, path, count};
+  /* -j K: every speed's modes at once in child processes, then followed in order as below */
+  fmbModes** pre = jobs > 1 && !rc ? calloc((size_t)nspeed, sizeof *pre) : NULL;
+  int pre_done = 0, pre_rc = 0;
+  if (pre) pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, pre, &pre_done, &diag);
   for (int i = 0; rc == 0 && i < nspeed; ++i) {
-    snprintf(override, sizeof override, "%s=%.17g", path, speeds[i]);
-    s.overrides[s.nover] = override;
-    fmbModel* m;
-    double *y, *yp;
-    fmbStaticResult res;
     fmbModes* cur = NULL;
-    rc = fmb_cli_steady_state(&s, s.nover + 1, &an.opt, &m, &y, &yp, &res, &diag);
-    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, an.method, &cur, &diag);
-    if (!rc && cur->count < count) {
-      fprintf(stderr, "flexmbd campbell: the scene has only %d modes; --count %d asks for more\n", cur->count, count);
-      rc = FMB_EXIT_BAD_INPUT;
+    if (!pre) {
+      rc = modes_at(&ctx, speeds[i], &cur, &diag);
+    } else if (i < pre_done) {
+      cur = pre[i];
+      pre[i] = NULL;
+    } else {
+      rc = pre_rc;
     }
     if (!rc) {
       /* follow the modes: greedy assignment by the largest MAC with the previous speed's shapes */
@@ -167,10 +210,9 @@ int fmb_cmd_campbell(int argc, char** argv) {
       done = i + 1;
     }
     fmb_modes_free(cur);
-    free(y);
-    free(yp);
-    fmb_free(m);
   }
+  for (int i = 0; pre && i < nspeed; ++i) fmb_modes_free(pre[i]);
+  free(pre);
   fmb_modes_free(prev);
   if (rc) fmb_cli_print_diag(&diag);
   int wrc = 0;
