@@ -193,7 +193,8 @@ char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
   const int usable = (r->status == FMB_CHILD_OK || r->status == FMB_CHILD_SOLVER_STOPPED) &&
                      (sw->nmetric + sw->nrefcol) > 0;
   char why[600] = "";
-  const int have = usable && fmb_table_load(series, &t, why, sizeof why) == 0;
+  /* run and static write t first, modes writes mode first: any first column for the metrics */
+  const int have = usable && fmb_table_load_keyed(series, &t, NULL, why, sizeof why) == 0;
   for (int k = 0; k < sw->nmetric; ++k) {
     const int c = have ? fmb_table_col(&t, sw->metric[k].column) : -1;
     if (c < 0 && have && !msg[0]) snprintf(msg, sizeof msg, "no column '%s' in the run's CSV", sw->metric[k].column);

@@ -114,6 +114,20 @@ grep -q "journal of another plan" "$D/refine.err" || fail "no word about another
 grep -q "sweep: 4 runs" "$D/refine.err" || { cat "$D/refine.err"; fail "the refined grid should run only its 4 new points"; }
 [ "$(tail -n +2 "$D/refine/table.csv" | wc -l)" = 9 ] || fail "the refined table should have 9 rows"
 
+# --verb modes and static: the metric is that of the command typed by hand (modes: first column 'mode')
+B=$SRC/scenes/campbell_beam.yaml
+"$F" sweep "$B" -o "$D/modes" --quiet --verb modes --grid joints.spin.speed=0,5 --metric frequency:min 2> /dev/null ||
+  fail "--verb modes"
+"$F" modes "$B" --set joints.spin.speed=5 -o "$D/m5.csv" 2> /dev/null || fail "flexmbd modes"
+want=$(awk -F, 'NR == 2 { printf "%.17g", $2 + 0 }' "$D/m5.csv")
+[ "$(awk -F, 'NR == 3 { print $19 }' "$D/modes/table.csv")" = "$want" ] || fail "--verb modes: frequency.min is not $want"
+"$F" sweep "$B" -o "$D/static" --quiet --verb static --grid joints.spin.speed=5 --metric beam.tip_u:end 2> /dev/null ||
+  fail "--verb static"
+"$F" static "$B" --set joints.spin.speed=5 -o "$D/s5.csv" 2> /dev/null || fail "flexmbd static"
+k=$(head -1 "$D/s5.csv" | tr ',' '\n' | grep -n -x beam.tip_u | cut -d: -f1)
+want=$(awk -F, -v k="$k" 'END { printf "%.17g", $k + 0 }' "$D/s5.csv")
+[ "$(awk -F, 'NR == 2 { print $19 }' "$D/static/table.csv")" = "$want" ] || fail "--verb static: beam.tip_u.end is not $want"
+
 # no child left behind
 sleep 0.2
 pgrep -f "$D/faults" > /dev/null && fail "a child of the fault sweep still runs"
