@@ -11,6 +11,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/resource.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -262,6 +263,14 @@ void fmb_sweep_progress(fmbSweep* sw, int final) {
     fprintf(stderr, "sweep: %ld runs in %.2f s:", sw->done, now - sw->t_start);
     for (int s = 0; s < FMB_CHILD_NSTATUS; ++s)
       if (sw->count[s]) fprintf(stderr, " %s %ld", fmb_child_status_name((fmbChildStatus)s), sw->count[s]);
+    /* the sweep's own CPU (plan, dispatch, journal, rows; its children not counted): what one
+       manager spends per run, the serial part of a sweep over many ranks (docs/performance.md) */
+    struct rusage ru;
+    if (sw->done > 0 && getrusage(RUSAGE_SELF, &ru) == 0) {
+      const double cpu = (double)ru.ru_utime.tv_sec + 1e-6 * (double)ru.ru_utime.tv_usec + (double)ru.ru_stime.tv_sec +
+                         1e-6 * (double)ru.ru_stime.tv_usec;
+      fprintf(stderr, " (this process: %.3f ms of CPU per run)", 1e3 * cpu / (double)sw->done);
+    }
     fprintf(stderr, "\n");
   }
 }
