@@ -79,6 +79,11 @@ void fmb_pool_free(fmbPool* p) {
 
 int fmb_pool_running(const fmbPool* p) { return p->running; }
 int fmb_pool_free_slots(const fmbPool* p) { return p->nslot - p->running; }
+void fmb_pool_kill(fmbPool* p, long tag) {
+  for (int i = 0; i < p->nslot; ++i)
+    if (p->slot[i].pid && p->slot[i].tag == tag) kill(-p->slot[i].pid, SIGKILL);
+}
+
 int fmb_pool_tags(const fmbPool* p, long* tags) {
   int n = 0;
   for (int i = 0; i < p->nslot; ++i)
@@ -96,11 +101,12 @@ static void child_setup(const fmbChildSpec* s, pid_t parent) {
     rl.rlim_cur = rl.rlim_max = (rlim_t)(s->mem_limit_mb * 1048576.0);
     setrlimit(RLIMIT_AS, &rl);
   }
-  int in = open("/dev/null", O_RDONLY);
+  int in = s->use_fds ? s->stdin_fd : open("/dev/null", O_RDONLY | O_CLOEXEC);
   if (in >= 0) dup2(in, 0);
   const char* paths[2] = {s->stdout_path, s->stderr_path};
   for (int k = 0; k < 2; ++k) {
-    int fd = open(paths[k] ? paths[k] : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    int fd = k == 0 && s->use_fds ? s->stdout_fd
+                                  : open(paths[k] ? paths[k] : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd >= 0) dup2(fd, k + 1);
   }
   struct sigaction dfl;

@@ -32,6 +32,7 @@ typedef struct fmbChildSpec {
   void (*fn)(void* arg); /* ... or a function run in the forked child; it must _exit */
   void* arg;
   const char* stdout_path, *stderr_path; /* NULL: /dev/null */
+  int use_fds, stdin_fd, stdout_fd;      /* use_fds: stdin and stdout are these (pipes) instead */
   double timeout_s;                      /* wall time allowed; <= 0: none */
   double mem_limit_mb;                   /* RLIMIT_AS of the child; <= 0: none */
   long tag;                              /* the caller's name for the child, handed back */
@@ -53,6 +54,9 @@ fmbPool* fmb_pool_new(int slots);
 void fmb_pool_free(fmbPool* p);
 int fmb_pool_running(const fmbPool* p);
 int fmb_pool_free_slots(const fmbPool* p);
+/* SIGKILL to the process group of the running child tagged `tag` (its result: status as if it
+   had died on its own, signal 9) */
+void fmb_pool_kill(fmbPool* p, long tag);
 /* the tags of the running children into tags[0..running); their number */
 int fmb_pool_tags(const fmbPool* p, long* tags);
 /* starts a child in a free slot: 0, or -1 (no free slot, or fork failed: errno) */

@@ -31,8 +31,11 @@ typedef struct fmbCliScene {
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
 /* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
-/* file:line:col: error: msg (or the shorter forms when no location is known) */
+/* file:line:col: error: msg (or the shorter forms when no location is known), on stderr or in buf */
 void fmb_cli_print_diag(const fmbDiag* d);
+void fmb_cli_format_diag(const fmbDiag* d, char* buf, size_t len);
+/* `run SCENE --serve`: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
+int fmb_run_serve(const fmbCliScene* s);
 /* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
    else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
 int fmb_cli_check_input(const char* path, const char* what);

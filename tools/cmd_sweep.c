@@ -3,7 +3,7 @@
  *                 lognormal(m,s)]... [--count N] [--seed S] [--design mc|lhs] [--set PATH=VALUE]...
  *                 [--verb run|static|modes] [--metric COL:max,min,end,rms]... [--reference REF.csv
  *                 [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...] [--keep summary|series]
- *                 [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...`
+ *                 [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...`
  *               `flexmbd sweep --status DIR`
  * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
  * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
@@ -171,7 +171,8 @@ static void usage(FILE* f) {
           "         [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)]... --count N [--seed S]\n"
           "         [--design mc|lhs] [--set PATH=VALUE]... [--verb run|static|modes] [--metric COL:max,min,end,rms]...\n"
           "         [--reference REF.csv [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...]\n"
-          "         [--keep summary|series] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...\n"
+          "         [--keep summary|series] [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes]\n"
+          "         [--quiet] [--plugin x.so]...\n"
           "       flexmbd sweep --status DIR\n"
           "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
           "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
@@ -290,6 +291,10 @@ int fmb_cmd_sweep(int argc, char** argv) {
       if (!(v = VALUE("summary or series"))) return FMB_EXIT_BAD_INPUT;
       if (strcmp(v, "summary") && strcmp(v, "series")) return bad("--keep expects summary or series, got '%s'", v);
       sw->keep_series = strcmp(v, "series") == 0;
+    } else if (strcmp(a, "--runner") == 0) {
+      if (!(v = VALUE("spawn or serve"))) return FMB_EXIT_BAD_INPUT;
+      if (strcmp(v, "spawn") && strcmp(v, "serve")) return bad("--runner expects spawn or serve, got '%s'", v);
+      sw->serve = strcmp(v, "serve") == 0;
     } else if (strcmp(a, "--mem-limit") == 0) {
       char* end;
       if (!(v = VALUE("megabytes"))) return FMB_EXIT_BAD_INPUT;
@@ -320,6 +325,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (!sw->dir) return bad("no output folder given (-o DIR)%s", "");
   if (resume && fresh) return bad("--resume and --fresh exclude each other%s", "");
   if (fmb_cli_check_input(sw->scene, "scene")) return FMB_EXIT_BAD_INPUT;
+  if (sw->serve && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
   if (design_lhs >= 0 && !sw->plan.nrandom) return bad("--design goes with --random%s", "");
   if (seed_given && !sw->plan.nrandom) return bad("--seed goes with --random%s", "");
   sw->plan.count = count;
@@ -407,7 +413,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (sw->nranks > 1)
     rc = ext->mpi_run(sw, rc);
   else if (!rc)
-    rc = fmb_sweep_local(sw);
+    rc = sw->serve ? fmb_sweep_serve(sw) : fmb_sweep_local(sw);
   if (sw->rank == 0 && sw->journal_fd >= 0) {
     fmb_sweep_progress(sw, 1);
     if (fmb_journal_write_table(sw)) fprintf(stderr, "flexmbd sweep: cannot write %s/table.csv\n", sw->dir);

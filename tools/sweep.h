@@ -50,6 +50,7 @@ typedef struct fmbSweep {
   double mem_limit_mb;
   unsigned retry_mask; /* bit per fmbChildStatus re-run on resume */
   int keep_series, quiet, progress;
+  int serve; /* --runner serve: one `flexmbd run --serve` per slot instead of a process per run */
   char exe[4096]; /* this program, for the children */
   /* the plan and its identities */
   fmbSweepPlan plan;
@@ -110,6 +111,9 @@ void fmb_sweep_cancel(fmbSweep* sw, fmbPool* pool);
 int fmb_sweep_start(fmbSweep* sw, fmbPool* pool, long index, double timeout_s);
 /* the journal row of a finished child (metrics, stats, message), '\n'-terminated, malloc'd */
 char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt);
+/* the same from a runner's answer (sweep_serve.c): its stats line and message */
+char* fmb_sweep_row_served(fmbSweep* sw, const fmbChildResult* r, int attempt, const char* stats_line,
+                           const char* message);
 /* a row for a run that never ran to a result (lost after three starts) */
 char* fmb_sweep_row_lost(fmbSweep* sw, long index, int attempt);
 /* the deadline of the next run (absolute, or N x median) */
@@ -121,6 +125,8 @@ void fmb_sweep_progress(fmbSweep* sw, int final);
 long* fmb_sweep_todo(fmbSweep* sw, long* n, long* n_inflight);
 /* the whole sweep in this process; 0, or FMB_EXIT_INTERRUPTED (resumable) */
 int fmb_sweep_local(fmbSweep* sw);
+/* the same with persistent runners (`--runner serve`, sweep_serve.c) */
+int fmb_sweep_serve(fmbSweep* sw);
 /* runs the in-flight runs of a crash one at a time (each alone: one may be what crashed) */
 int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n);
 

@@ -75,8 +75,20 @@ double fmb_sweep_timeout(fmbSweep* sw) {
   return sw->timeout_s;
 }
 
-/* the stats line's value of each field (text as printed, so rows equal `flexmbd run`'s line) and
-   the first error line; from the child's stderr file */
+/* the stats line's value of each field (text as printed, so rows equal `flexmbd run`'s line) */
+static void parse_stats(const char* line, char stats[FMB_SWEEP_NSTATS][40]) {
+  for (int k = 0; k < FMB_SWEEP_NSTATS; ++k) {
+    char key[40];
+    snprintf(key, sizeof key, " %s=", fmb_sweep_stat_names[k]);
+    const char* v = strstr(line, key);
+    if (v) {
+      v += strlen(key);
+      snprintf(stats[k], 40, "%.*s", (int)strcspn(v, " \t"), v);
+    }
+  }
+}
+
+/* the stats and the first error line from a child's stderr file */
 static void read_stderr(const char* path, char stats[FMB_SWEEP_NSTATS][40], char* msg, size_t msglen) {
   for (int k = 0; k < FMB_SWEEP_NSTATS; ++k) stats[k][0] = '\0';
   msg[0] = '\0';
@@ -86,15 +98,7 @@ static void read_stderr(const char* path, char stats[FMB_SWEEP_NSTATS][40], char
   while (fgets(line, sizeof line, f)) {
     line[strcspn(line, "\n")] = '\0';
     if (strncmp(line, "stats:", 6) == 0) {
-      for (int k = 0; k < FMB_SWEEP_NSTATS; ++k) {
-        char key[40];
-        snprintf(key, sizeof key, " %s=", fmb_sweep_stat_names[k]);
-        const char* v = strstr(line, key);
-        if (v) {
-          v += strlen(key);
-          snprintf(stats[k], sizeof stats[k], "%.*s", (int)strcspn(v, " "), v);
-        }
-      }
+      parse_stats(line, stats);
     } else if (!msg[0] && strstr(line, "error")) {
       snprintf(msg, msglen, "%s", line);
     } else if (!first[0] && line[0]) {
@@ -165,24 +169,25 @@ static void put_lead(const fmbSweep* sw, Buf* b, long index, int attempt, const 
   for (int k = 0; k < sw->plan.npath; ++k) put(b, ",%s", fmb_plan_value(&sw->plan, index, k));
 }
 
-char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
+/* the row from what the run's end told: status, its stats fields, its message */
+static char* build_row(fmbSweep* sw, const fmbChildResult* r, int attempt, char stats[FMB_SWEEP_NSTATS][40],
+                       char* msg) {
+  enum { msglen = 2048 };
   const long index = r->tag;
-  char series[4300], err[4300], stats[FMB_SWEEP_NSTATS][40], msg[2048];
+  char series[4300];
   run_file(sw, index, "series", ".csv", series, sizeof series);
-  run_file(sw, index, "logs", ".err", err, sizeof err);
-  read_stderr(err, stats, msg, sizeof msg);
   if (r->status == FMB_CHILD_CRASHED && r->signal) {
-    char m[sizeof msg];
+    char m[msglen];
     snprintf(m, sizeof m, "killed by signal %d (%s)%s%.1800s", r->signal, strsignal(r->signal), msg[0] ? ": " : "", msg);
-    memcpy(msg, m, sizeof msg);
+    memcpy(msg, m, msglen);
   } else if (r->status == FMB_CHILD_CRASHED && !msg[0]) {
-    snprintf(msg, sizeof msg, "exit code %d (flexmbd ends with 0, 2, 3 or 4)%s", r->exit_code,
+    snprintf(msg, msglen, "exit code %d (flexmbd ends with 0, 2, 3 or 4)%s", r->exit_code,
              r->exit_code == 127 ? ": the program could not be started" : "");
   } else if (r->status == FMB_CHILD_TIMEOUT) {
-    char m[sizeof msg];
+    char m[msglen];
     snprintf(m, sizeof m, "no result within the time limit (--timeout): killed after %.3g s%s%.1800s", r->wall_s,
              msg[0] ? ": " : "", msg);
-    memcpy(msg, m, sizeof msg);
+    memcpy(msg, m, msglen);
   } else if (r->status == FMB_CHILD_OK) {
     msg[0] = '\0';
   }
@@ -198,7 +203,7 @@ char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
   const int have = usable && fmb_table_load_keyed(series, &t, NULL, why, sizeof why) == 0;
   for (int k = 0; k < sw->nmetric; ++k) {
     const int c = have ? fmb_table_col(&t, sw->metric[k].column) : -1;
-    if (c < 0 && have && !msg[0]) snprintf(msg, sizeof msg, "no column '%s' in the run's CSV", sw->metric[k].column);
+    if (c < 0 && have && !msg[0]) snprintf(msg, msglen, "no column '%s' in the run's CSV", sw->metric[k].column);
     if (c < 0)
       put(&b, ",");
     else
@@ -215,12 +220,29 @@ char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
       put_double(&b, e.end_abs);
     }
   }
-  if (usable && !have && !msg[0]) snprintf(msg, sizeof msg, "%s", why);
+  if (usable && !have && !msg[0]) snprintf(msg, msglen, "%s", why);
   if (have) fmb_table_free(&t);
   put_message(&b, msg);
   if (!sw->keep_series) unlink(series);
-  if (r->status == FMB_CHILD_OK) unlink(err); /* kept for the runs that need a look */
   return b.s;
+}
+
+char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
+  char err[4300], stats[FMB_SWEEP_NSTATS][40], msg[2048];
+  run_file(sw, r->tag, "logs", ".err", err, sizeof err);
+  read_stderr(err, stats, msg, sizeof msg);
+  char* row = build_row(sw, r, attempt, stats, msg);
+  if (r->status == FMB_CHILD_OK) unlink(err); /* kept for the runs that need a look */
+  return row;
+}
+
+char* fmb_sweep_row_served(fmbSweep* sw, const fmbChildResult* r, int attempt, const char* stats_line,
+                           const char* message) {
+  char stats[FMB_SWEEP_NSTATS][40], msg[2048];
+  for (int k = 0; k < FMB_SWEEP_NSTATS; ++k) stats[k][0] = '\0';
+  parse_stats(stats_line, stats);
+  snprintf(msg, sizeof msg, "%s", message);
+  return build_row(sw, r, attempt, stats, msg);
 }
 
 char* fmb_sweep_row_lost(fmbSweep* sw, long index, int attempt) {

@@ -4,7 +4,9 @@
 #     typed by hand, its --metric values equal max/min/end/rms computed here by awk from that
 #     run's CSV, and the kept series (--keep series) is that CSV byte for byte;
 #  2. injected faults (tests/sweep/faulty.c): segfault, abort, hang, endless allocation under
-#     --mem-limit, an unknown exit code -> rows crashed/timeout, and the sweep itself ends with 0;
+#     --mem-limit, an unknown exit code -> rows crashed/timeout, and the sweep itself ends with 0,
+#     with a process per run and with persistent runners (--runner serve), whose table also equals
+#     the spawned runs' table;
 #  3. the table is the same for -j 1 and -j 2 (but timings); sweep.h5 is readable by h5dump (and
 #     h5py when installed) and holds the table; --status counts the statuses.
 #   usage: test_runs.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
@@ -50,6 +52,12 @@ done
 strip() { cut -d, -f1-6,9-18,20- "$1"; }
 strip "$D/s1/table.csv" | cmp -s - "$(strip "$D/s1j1/table.csv" > "$D/t1"; echo "$D/t1")" || fail "-j 1 and -j 2 tables differ"
 
+# --runner serve (persistent runners): the same table but timings
+"$F" sweep "$SCENE" -o "$D/s1serve" -j 2 --quiet --runner serve --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
+  --grid bodies.crank.mass=1,2 --metric crank.theta:max,end --metric motor.power:min,rms,max 2> /dev/null || fail "s1serve"
+strip "$D/s1serve/table.csv" > "$D/t3"
+strip "$D/s1/table.csv" | cmp -s - "$D/t3" || fail "--runner serve gives another table than spawned runs"
+
 # HDF5: the table in /runs, readable by h5dump (and h5py)
 if [ -f "$D/s1/sweep.h5" ]; then
   h5dump -d /runs/steps "$D/s1/sweep.h5" > "$D/h5.txt" || fail "h5dump cannot read sweep.h5"
@@ -72,28 +80,33 @@ else
   echo "built without HDF5: no sweep.h5 to check"
 fi
 
-# 2. faults: each costs one row, the sweep goes on and ends with 0
-rc=0
-"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 1 --mem-limit 256 \
-  --grid bodies.f.fault=0,1,2,3,4,5 2> "$D/faults.err" || rc=$?
-[ "$rc" = 0 ] || { cat "$D/faults.err"; fail "the sweep with faults ended with $rc"; }
+# 2. faults: each costs one row, the sweep goes on and ends with 0 (spawned runs, then runners)
 expect() { # fault status signal
-  line=$(awk -F, -v f="$1" 'NR > 1 && $9 == f' "$D/faults/table.csv")
+  line=$(awk -F, -v f="$1" 'NR > 1 && $9 == f' "$D/$FAULTS/table.csv")
   [ "$(echo "$line" | cut -d, -f4)" = "$2" ] || fail "fault $1: status $(echo "$line" | cut -d, -f4), expected $2: $line"
   [ -z "$3" ] || [ "$(echo "$line" | cut -d, -f6)" = "$3" ] || fail "fault $1: signal $(echo "$line" | cut -d, -f6), expected $3"
 }
-expect 0 ok 0
-expect 1 crashed 11
-expect 2 crashed 6
-expect 3 timeout ""
-expect 4 crashed ""
-expect 5 crashed 0
-grep -q "timeout" "$D/faults/table.csv" && grep -q 'exit code 7' "$D/faults/table.csv" || fail "fault messages"
+for runner in serve spawn; do
+  FAULTS=faults_$runner
+  [ $runner = spawn ] && FAULTS=faults
+  rc=0
+  "$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/$FAULTS" -j 2 --quiet --timeout 2 --mem-limit 256 \
+    --runner $runner --grid bodies.f.fault=0,1,2,3,4,5 2> "$D/faults.err" || rc=$?
+  [ "$rc" = 0 ] || { cat "$D/faults.err"; fail "the sweep with faults ($runner) ended with $rc"; }
+  expect 0 ok 0
+  expect 1 crashed 11
+  expect 2 crashed 6
+  expect 3 timeout ""
+  expect 4 crashed ""
+  expect 5 crashed 0
+  grep -q "time limit" "$D/$FAULTS/table.csv" && grep -q 'exit code 7' "$D/$FAULTS/table.csv" ||
+    { cat "$D/$FAULTS/table.csv"; fail "fault messages ($runner)"; }
+done
 "$F" sweep --status "$D/faults" > "$D/status.txt" || fail "--status"
 grep -q "6 planned (6 distinct), 6 with a row, 0 to do" "$D/status.txt" && grep -q "crashed  *4" "$D/status.txt" ||
   { cat "$D/status.txt"; fail "--status counts"; }
 # --retry crashed: the crashed runs again (attempt 2), the others kept
-"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 1 --mem-limit 256 \
+"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 2 --mem-limit 256 \
   --grid bodies.f.fault=0,1,2,3,4,5 --retry crashed 2> "$D/retry.err" || fail "--retry crashed"
 grep -q "sweep: 4 runs" "$D/retry.err" || { cat "$D/retry.err"; fail "--retry crashed should rerun 4 runs"; }
 awk -F, 'NR > 1 && $4 == "crashed" && $3 != 2 { exit 1 }' "$D/faults/table.csv" || fail "--retry: attempt 2 expected"
