@@ -141,6 +141,14 @@ k=$(head -1 "$D/s5.csv" | tr ',' '\n' | grep -n -x beam.tip_u | cut -d: -f1)
 want=$(awk -F, -v k="$k" 'END { printf "%.17g", $k + 0 }' "$D/s5.csv")
 [ "$(awk -F, 'NR == 2 { print $19 }' "$D/static/table.csv")" = "$want" ] || fail "--verb static: beam.tip_u.end is not $want"
 
+# on a terminal: a progress line (done/failed/running, rate, ETA), then the summary of statuses
+if command -v script > /dev/null; then
+  script -qec "$F sweep $SRC/tests/sweep/faulty.yaml --plugin $PLUGIN -o $D/tty -j 2 --grid bodies.f.fault=0,1 --grid solver.t_end=0.2,0.3" \
+    "$D/tty.log" > /dev/null 2>&1 || fail "sweep on a terminal"
+  grep -q "sweep: 4/4 done, 2 not ok, 0 running, .* runs/s, ETA" "$D/tty.log" || { cat "$D/tty.log"; fail "no progress line"; }
+  grep -q "sweep: 4 runs in .* ok 2 crashed 2" "$D/tty.log" || fail "no summary of statuses"
+fi
+
 # no child left behind
 sleep 0.2
 pgrep -f "$D/faults" > /dev/null && fail "a child of the fault sweep still runs"
