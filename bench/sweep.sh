@@ -22,7 +22,7 @@ F=$ROOT/$B/flexmbd
 W=$(mktemp -d "${TMPDIR:-/tmp}/flexmbd-bench-sweep-XXXXXX")
 trap 'rm -rf "$W"' EXIT
 mkdir -p "$RES"
-cc -std=c11 -O3 -DNDEBUG -D_DEFAULT_SOURCE -Wall -Wextra -Iengine -Itools bench/sweep_serial.c -o "$W/serial" \
+cc -std=c11 -O3 -DNDEBUG -D_DEFAULT_SOURCE -Wall -Wextra -Iengine -Ibuiltin bench/sweep_serial.c -o "$W/serial" \
   -L"$B" -lflexmbd -Wl,-rpath,"$ROOT/$B" -lm
 now() { date +%s.%N; }
 # timed LABEL CMD...: wall time and CPU time (user + system, children included) of CMD as
