@@ -7,7 +7,9 @@
 #include "integrator.h"
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  if (m->solver.formulation == FMB_FORM_PROJECTED) return &fmb_integrator_projected;
+  if (m->solver.formulation == FMB_FORM_PROJECTED ||
+      (m->solver.formulation == FMB_FORM_AUTO && fmb_needs_singular_method(m)))
+    return &fmb_integrator_projected;
   /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
   return m->solver.integrator == FMB_INTEG_RADAU5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
 }
