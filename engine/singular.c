@@ -10,7 +10,8 @@
  * formulation a stretch of the run that passes a flat commits no more error than one that does not
  * (max over 0.05 s stretches: 8.3e-9 and 1.1e-8 rad).
  *
- * How: from the assembled initial configuration, walk along the constraint manifold (time frozen at
+ * How: only a model whose constraining joints close a loop of bodies can lose rank (an open chain
+ * never does). From the assembled initial configuration, walk along the constraint manifold (time frozen at
  * t0) in the direction of the initial velocity (a generic direction if the model starts at rest),
  * in tangent steps that move no coordinate by more than SCAN_STEP, each projected back onto Phi = 0
  * by the mass-orthogonal Newton steps of augmented.c, and look at the rank of Phi_q after each step.
@@ -62,8 +63,31 @@ static int walk(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t0, 
   return singular;
 }
 
+static int root(int* parent, int b) {
+  while (parent[b] != b) b = parent[b] = parent[parent[b]];
+  return b;
+}
+
+/* 1 when the joints that constrain close a loop of bodies (the ground counts as one body): only
+   then can Phi_q lose rank on the motion; an open chain (a pendulum, a rotor) is never scanned */
+static int has_closed_loop(const fmbModel* m) {
+  int* parent = malloc(sizeof(int) * (size_t)(m->nbody + 1));
+  int loop = 0;
+  if (!parent) return 0;
+  for (int b = 0; b < m->nbody; ++b) parent[b] = b;
+  for (int j = 0; j < m->njoint && !loop; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (ji->nrows == 0) continue;
+    const int a = root(parent, ji->body[0] > 0 ? ji->body[0] : 0), b = root(parent, ji->body[1] > 0 ? ji->body[1] : 0);
+    if (a == b) loop = 1;
+    else parent[a] = b;
+  }
+  free(parent);
+  return loop;
+}
+
 int fmb_needs_singular_method(const fmbModel* m) {
-  if (!m || m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS) return 0;
+  if (!m || m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS || !has_closed_loop(m)) return 0;
   const int nq = m->nq, nc = m->nc;
   fmbWorkspace* w = fmb_workspace_new(m);
   fmbAugmented* g = fmb_augmented_new(m);
