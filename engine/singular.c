@@ -11,7 +11,7 @@
  * (max over 0.05 s stretches: 8.3e-9 and 1.1e-8 rad).
  *
  * How: only a model whose constraining joints close a loop of bodies can lose rank (an open chain
- * never does). From the assembled initial configuration, walk along the constraint manifold (time frozen at
+ * never does); only rigid bodies are walked (see rigid_bodies_only). From the assembled initial configuration, walk along the constraint manifold (time frozen at
  * t0) in the direction of the initial velocity (a generic direction if the model starts at rest),
  * in tangent steps that move no coordinate by more than SCAN_STEP, each projected back onto Phi = 0
  * by the mass-orthogonal Newton steps of augmented.c, and look at the rank of Phi_q after each step.
@@ -86,8 +86,18 @@ static int has_closed_loop(const fmbModel* m) {
   return loop;
 }
 
+/* every body moves rigidly in the plane (3 coordinates): the walk steps every coordinate by up to
+   SCAN_STEP, which for a deformation coordinate is no motion the body makes; flexible loops (the
+   slider-crank's rod) stay on the GGL path and its switch at a failure */
+static int rigid_bodies_only(const fmbModel* m) {
+  for (int b = 1; b < m->nbody; ++b)
+    if (m->body[b].nq != 3) return 0;
+  return 1;
+}
+
 int fmb_needs_singular_method(const fmbModel* m) {
-  if (!m || m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS || !has_closed_loop(m)) return 0;
+  if (!m || m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS || !rigid_bodies_only(m) || !has_closed_loop(m))
+    return 0;
   const int nq = m->nq, nc = m->nc;
   fmbWorkspace* w = fmb_workspace_new(m);
   fmbAugmented* g = fmb_augmented_new(m);
