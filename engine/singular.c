@@ -39,7 +39,18 @@
 /* the projected formulation's dense-Newton limit (integrator_projected.c, PROJ_DENSE_MAX) */
 #define SCAN_MAX_UNKNOWNS 256
 
-static int walk(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t0, double* q, double* v, double* dir) {
+/* the potential energy at q (gravity, strain, springs) */
+static double potential(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* zero_v) {
+  fmbEnergy e;
+  fmb_energy(m, w, t, q, zero_v, &e);
+  return e.strain + e.gravity + e.spring;
+}
+
+/* Walk from q along dir (both updated). energy_cap: the model's total energy when nothing but
+   conservative forces act (a configuration whose potential exceeds it is out of the motion's
+   reach: the walk stops there), or INFINITY. */
+static int walk(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t0, double* q, const double* v, double* dir,
+                double energy_cap) {
   const int nq = m->nq;
   double* zero_v = calloc((size_t)nq, sizeof(double));
   int singular = 0;
@@ -57,6 +68,8 @@ static int walk(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double t0, 
     }
     memset(zero_v, 0, sizeof(double) * (size_t)nq);
     if (fmb_project_state(m, w, g, t0, q, zero_v)) break;
+    memset(zero_v, 0, sizeof(double) * (size_t)nq);
+    if (potential(m, w, t0, q, zero_v) > energy_cap) break;
     singular = fmb_rank_deficient_at(m, w, t0, q, v, SCAN_RANK_TOL);
   }
   free(zero_v);
@@ -104,6 +117,8 @@ int fmb_needs_singular_method(const fmbModel* m) {
   double* y = calloc((size_t)m->ny + 1, sizeof(double));
   double* yp = calloc((size_t)m->ny + 1, sizeof(double));
   double* dir = calloc((size_t)nq, sizeof(double));
+  double* dir_start = calloc((size_t)nq, sizeof(double));
+  double* q_start = calloc((size_t)nq, sizeof(double));
   double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
   double* work = calloc((size_t)nc * nq + nc, sizeof(double));
   int* order = calloc((size_t)nc, sizeof(int));
@@ -112,7 +127,7 @@ int fmb_needs_singular_method(const fmbModel* m) {
   fmbDiag diag;
   memset(&st, 0, sizeof st);
   memset(&diag, 0, sizeof diag);
-  if (w && g && y && yp && dir && PhiQ && work && order && !fmb_initial_conditions(m, w, y, yp, &st, &diag)) {
+  if (w && g && y && yp && dir && dir_start && q_start && PhiQ && work && order && !fmb_initial_conditions(m, w, y, yp, &st, &diag)) {
     const double t0 = m->solver.t0;
     double* q = y;
     double* v = y + nq;
@@ -121,16 +136,38 @@ int fmb_needs_singular_method(const fmbModel* m) {
                          ? nq
                          : fmb_independent_rows(nc, nq, PhiQ, 1e-9, order, work);
     if (rank < nq) {
+      /* gravity, springs and constraints only (no joint applies forces: nothing feeds energy in)
+         bound the configurations the motion can reach by its total energy */
+      int conservative = 1;
+      for (int j = 0; j < m->njoint; ++j)
+        if (m->joint[j].type->force) conservative = 0;
+      double cap = INFINITY;
+      if (conservative) {
+        fmbEnergy e0;
+        fmb_energy(m, w, t0, q, v, &e0);
+        const double total = e0.kinetic + e0.strain + e0.gravity + e0.spring;
+        cap = total + 1e-9 * (fabs(total) + fabs(e0.kinetic)); /* the start's own rounding */
+      }
       double vn = 0.0;
       for (int i = 0; i < nq; ++i) vn += v[i] * v[i];
       for (int i = 0; i < nq; ++i) dir[i] = vn > 0.0 ? v[i] : sin(1.7 * i + 0.3);
-      singular = walk(m, w, g, t0, q, v, dir);
+      /* the way it moves first, then the other way (a swing turns back) */
+      memcpy(q_start, q, sizeof(double) * (size_t)nq);
+      memcpy(dir_start, dir, sizeof(double) * (size_t)nq);
+      singular = walk(m, w, g, t0, q, v, dir, cap);
+      if (!singular) {
+        memcpy(q, q_start, sizeof(double) * (size_t)nq);
+        for (int i = 0; i < nq; ++i) dir[i] = -dir_start[i];
+        singular = walk(m, w, g, t0, q, v, dir, cap);
+      }
     }
   }
   free(order);
   free(work);
   free(PhiQ);
   free(dir);
+  free(dir_start);
+  free(q_start);
   free(yp);
   free(y);
   fmb_augmented_free(g);
