@@ -18,6 +18,7 @@
 #include <string.h>
 #include <klu.h>
 
+#include "integrator.h"
 #include "internal.h"
 
 #define FMB_IC_PHI_TOL 1e-10   /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
@@ -266,6 +267,12 @@ int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
     else
       fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n"
               "singular configuration at t = %g: no\n", rows, t0);
+    /* what formulation: auto decides from the walk along the manifold (singular.c) */
+    if (!s.singular && nc > 0)
+      fprintf(f, "singular configuration within the motion's reach: %s\n",
+              fmb_needs_singular_method(m) ? "yes (formulation: auto runs the projected formulation from the start)"
+                                           : "none found (looked for in closed loops of rigid bodies left free to move, up to 128 "
+                                             "coordinates)");
   }
   start_free(&s);
   return rc;
