@@ -33,9 +33,9 @@
 
 #include "integrator.h"
 
-/* CVODE runs at this fraction of solver.rtol and of the absolute tolerances, so that an rtol means
-   at least the accuracy it means with the default formulation (IDA on the GGL system), also when
-   `auto` switches mid-run. Measured on regular motions both formulations can integrate, error
+/* CVODE runs at this fraction of solver.rtol (the absolute tolerances at PROJ_ATOL_FACTOR), so
+   that an rtol means at least the accuracy it means with the default formulation (IDA on the GGL
+   system), also when `auto` switches mid-run. Measured on regular motions both formulations can integrate, error
    against an independent reference at rtol r (GGL) and r x factor (projected):
      rotating crank, 10 s, r = 1e-8:        GGL 6.7e-6 rad | x1 3.9e-5  x1/3 2.4e-5  x1/10 8.7e-6
      rotating crank, 10 s, r = 1e-6:        GGL 1.4e-3     | x1 3.2e-3  x1/3 9.5e-4  x1/10 6.6e-5
@@ -257,8 +257,19 @@ static void proj_stats(const void* self, fmbStats* st) {
   st->jacobians_reused = 0;
 }
 
+/* the projected formulation works on q and v alone, with the bodies' mass matrices */
+static int proj_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
+  if (m->nz > 0)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
+                           "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
+                           "its assembly: dense, or use formulation: ggl)");
+  return 0;
+}
+
 const fmbIntegratorOps fmb_integrator_projected = {
     .name = "projected",
+    .projected = 1,
+    .check = proj_check,
     .create = proj_create,
     .advance = proj_advance,
     .work = proj_work,

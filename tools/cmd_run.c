@@ -72,7 +72,7 @@ int fmb_cmd_run(int argc, char** argv) {
     fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
     return FMB_EXIT_BAD_INPUT;
   }
-  if (models) return fmb_run_models(&s, models, out, quiet);
+  if (models) return fmb_cli_run_models(&s, models, out, quiet);
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);
@@ -108,13 +108,8 @@ int fmb_cmd_run(int argc, char** argv) {
     /* one line per column on stdout: the error against the reference and what the run cost */
     char tag[160];
     snprintf(tag, sizeof tag, "status=%s cpu_s=%.4f steps=%ld", rc ? "failed" : "ok", stats.cpu_s, stats.steps);
-    char* cargv[10] = {argv[0], "compare", (char*)out, (char*)reference, "--tag", tag, "--common", NULL, NULL};
-    int cargc = 7;
-    if (columns) {
-      cargv[cargc++] = "--columns";
-      cargv[cargc++] = (char*)columns;
-    }
-    int crc = fmb_cmd_compare(cargc, cargv);
+    const fmbCliCompare c = {.out = out, .ref = reference, .columns = columns, .tag = tag, .common = 1};
+    int crc = fmb_cli_compare(&c);
     if (crc && !rc) rc = crc;
   }
   fmb_print_stats(&stats, stderr);
