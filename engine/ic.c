@@ -18,7 +18,6 @@
 #include <string.h>
 #include <klu.h>
 
-#include "integrator.h"
 #include "internal.h"
 #include "klu_policy.h"
 
@@ -268,12 +267,6 @@ int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
     else
       fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n"
               "singular configuration at t = %g: no\n", rows, t0);
-    /* what formulation: auto decides from the walk along the manifold (singular.c) */
-    if (!s.singular && nc > 0)
-      fprintf(f, "singular configuration within the motion's reach: %s\n",
-              fmb_needs_singular_method(m) ? "yes (formulation: auto runs the projected formulation from the start)"
-                                           : "none found (looked for in closed loops of rigid bodies left free to move, up to 128 "
-                                             "coordinates)");
   }
   start_free(&s);
   return rc;
