@@ -96,8 +96,10 @@ static int has_closed_loop(const fmbModel* m) {
     const fmbJointInst* ji = &m->joint[j];
     if (ji->nrows == 0) continue;
     const int a = root(parent, ji->body[0] > 0 ? ji->body[0] : 0), b = root(parent, ji->body[1] > 0 ? ji->body[1] : 0);
-    if (a == b) loop = 1;
-    else parent[a] = b;
+    if (a == b)
+      loop = 1;
+    else
+      parent[a] = b;
   }
   free(parent);
   return loop;
@@ -134,7 +136,8 @@ int fmb_needs_singular_method(const fmbModel* m) {
   fmbDiag diag;
   memset(&st, 0, sizeof st);
   memset(&diag, 0, sizeof diag);
-  if (w && g && y && yp && dir && dir_start && q_start && PhiQ && work && order && !fmb_initial_conditions(m, w, y, yp, &st, &diag)) {
+  if (w && g && y && yp && dir && dir_start && q_start && PhiQ && work && order &&
+      !fmb_initial_conditions(m, w, y, yp, &st, &diag)) {
     const double t0 = m->solver.t0;
     double* q = y;
     double* v = y + nq;

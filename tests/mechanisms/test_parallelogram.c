@@ -40,8 +40,8 @@ static void exact(double* y, double* yd, double T) {
   const long n = lround(ceil(T / 1e-4 - 1e-9));
   const double h = n > 0 ? T / (double)n : 0.0;
   for (long i = 0; i < n; ++i) {
-    const double k1 = *yd, l1 = accel(*y), k2 = *yd + 0.5 * h * l1, l2 = accel(*y + 0.5 * h * k1), k3 = *yd + 0.5 * h * l2,
-                 l3 = accel(*y + 0.5 * h * k2), k4 = *yd + h * l3, l4 = accel(*y + h * k3);
+    const double k1 = *yd, l1 = accel(*y), k2 = *yd + 0.5 * h * l1, l2 = accel(*y + 0.5 * h * k1);
+    const double k3 = *yd + 0.5 * h * l2, l3 = accel(*y + 0.5 * h * k2), k4 = *yd + h * l3, l4 = accel(*y + h * k3);
     *y += h / 6 * (k1 + 2 * k2 + 2 * k3 + k4);
     *yd += h / 6 * (l1 + 2 * l2 + 2 * l3 + l4);
   }
