@@ -46,7 +46,9 @@ static const fmbIntegratorOps* auto_integrator(const fmbModel* m) {
 }
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  if (m->solver.formulation == FMB_FORM_PROJECTED) return projected_backend();
+  if (m->solver.formulation == FMB_FORM_PROJECTED ||
+      (m->solver.formulation == FMB_FORM_AUTO && fmb_needs_singular_method(m)))
+    return projected_backend();
   /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
   return m->solver.integrator ? m->solver.integrator : auto_integrator(m);
 }
