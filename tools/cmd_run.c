@@ -36,6 +36,7 @@ int fmb_cmd_run(int argc, char** argv) {
   int quiet = 0, progress = 0;
   const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
   const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
+  int serve = 0;             /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("run", argc, argv, &i, &s);
@@ -51,6 +52,8 @@ int fmb_cmd_run(int argc, char** argv) {
       if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = 1;
+    } else if (strcmp(a, "--serve") == 0) {
+      serve = 1;
     } else if (strcmp(a, "--progress") == 0) {
       progress = 1;
     } else if (strcmp(a, "--vtk") == 0) {
@@ -73,6 +76,7 @@ int fmb_cmd_run(int argc, char** argv) {
     return FMB_EXIT_BAD_INPUT;
   }
   if (models) return fmb_cli_run_models(&s, models, out, quiet);
+  if (serve) return fmb_run_serve(&s);
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);
