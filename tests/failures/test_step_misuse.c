@@ -13,9 +13,7 @@
 #include <stdio.h>
 #include <string.h>
 
-#include "builtin.h"
-#include "check.h"
-#include "flexmbd.h"
+#include "testlib.h"
 
 static int warnings;
 static void count_warning(void* user, const char* message) {
@@ -24,8 +22,8 @@ static void count_warning(void* user, const char* message) {
 }
 
 static fmbModel* load_text(const char* name, const char* text) {
-  char path[256];
-  snprintf(path, sizeof path, "%s/%s", FLEXMBD_TEST_OUT, name);
+  char path[1024];
+  fmbt_out_path(name, path, sizeof path);
   FILE* f = fopen(path, "w");
   if (!f) return NULL;
   fputs(text, f);
