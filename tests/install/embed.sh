@@ -4,16 +4,7 @@
 # built with find_package(flexmbd) and again with pkg-config, then run: a PD controller stepping a
 # flexible rotor through fmb_set_input/fmb_advance must agree with the same law as a spring-damper
 # scene (pd_rotor.c says how: first order in the control step, Richardson to 1e-1 of it).
-set -u
-src=$1
-build=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work" || exit 1
-T=$work/prefix
-cmake --install "$build" --prefix "$T" >/dev/null || { echo "FAIL: cmake --install" >&2; exit 1; }
-libdir=$(ls -d "$T"/lib*/ | head -n 1)
-libdir=${libdir%/}
+. "$(dirname "$0")/prefix.sh"
 ex=$work/embed
 mkdir -p "$ex"
 cp "$src"/examples/embed/*.c "$src"/examples/embed/*.yaml "$src"/examples/embed/CMakeLists.txt "$ex"/
