@@ -47,5 +47,7 @@ struct fmbData {
 
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
+/* free a data object that never left the engine (fmb_run's) at once, without the quarantine */
+void fmb_data_destroy(fmbData* d);
 
 #endif
