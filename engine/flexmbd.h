@@ -613,7 +613,8 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
    `amplitude` (its units: m or rad) */
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
-/* a table of named numeric columns (row-major values), through the one CSV writer */
+/* a table of named numeric columns (row-major values), through the one CSV writer: with the names
+   "t" and fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
 
