@@ -490,7 +490,8 @@ FMB_API fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag);
 FMB_API void fmb_data_free(fmbData* d);
 #define FMB_DATA_QUARANTINE 64
 /* the consistent state at the scene's t0 (initial conditions; inputs back to their `value:`);
-   again = restart from t0. 0 or an exit code with *diag */
+   again = restart from t0. The integrator itself is set up by the first fmb_advance from the
+   state then (after any fmb_set_input). 0 or an exit code with *diag */
 FMB_API int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag);
 /* integrate from time() to t_out, time() <= t_out <= t_end (t_out == time(): nothing to do). A
    changed input (fmb_set_input) or a run interrupted or failed before restarts the integrator
