@@ -523,7 +523,7 @@ FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
 FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
 /* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
    a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
-   unknown name, NaN or infinity, misuse); the value holds from time() on, as a step (piecewise
+   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from time() on, as a step (piecewise
    constant) that the next advance starts from. */
 FMB_API int fmb_ninput(const fmbModel* m);
 FMB_API const char* fmb_input_name(const fmbModel* m, int i);
