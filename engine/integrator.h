@@ -26,6 +26,24 @@ typedef struct {
   const double* atol;                /* ny absolute tolerances, one per unknown (tolerance.c) */
 } fmbIntegratorSetup;
 
+/* A stop request (fmbIntegratorSetup.stop; NULL: none): set by a signal handler in the same thread
+   (fmb_run's SIGINT) or by another thread (fmb_data_cancel), so read and written atomically:
+   a lock-free atomic int is what both may touch (C11 7.14.1.1, 7.17.5). */
+static inline int fmb_stop_requested(const volatile sig_atomic_t* stop) {
+#if defined(__GNUC__)
+  return stop && __atomic_load_n(stop, __ATOMIC_RELAXED);
+#else
+  return stop && *stop;
+#endif
+}
+static inline void fmb_stop_set(volatile sig_atomic_t* stop, int value) {
+#if defined(__GNUC__)
+  __atomic_store_n(stop, value, __ATOMIC_RELAXED);
+#else
+  *stop = value;
+#endif
+}
+
 /* fmbIntegratorOps.advance's results */
 enum { FMB_ADVANCE_OK = 0, FMB_ADVANCE_FAILED = -1, FMB_ADVANCE_INTERRUPTED = -2 };
 

@@ -111,7 +111,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
                "share of the reactions by the minimum-norm rule", rows, nredundant == 1 ? "s" : "");
     }
   }
-  if (rc || (stop && *stop)) goto done;
+  if (rc || fmb_stop_requested(stop)) goto done;
   if (fmb_csv_header(csv, m)) {
     row_failed(m, -1, d->t, diag);
     rc = FMB_EXIT_SOLVER;
@@ -134,11 +134,11 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     }
     st->rows_written++;
     progress_update(&progress, m, d);
-    if (stop && *stop) break;
+    if (fmb_stop_requested(stop)) break;
   }
 
 done:
-  if (rc == FMB_EXIT_INTERRUPTED || (stop && *stop && !rc)) {
+  if (rc == FMB_EXIT_INTERRUPTED || (fmb_stop_requested(stop) && !rc)) {
     rc = FMB_EXIT_INTERRUPTED;
     memset(diag, 0, sizeof *diag);
     fmb_diag_set(diag, rc, m->path, 0, 0, "interrupted at t = %.6g (SIGINT or SIGTERM): the %ld rows written so far are kept",

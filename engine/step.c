@@ -169,7 +169,7 @@ void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop) {
 }
 
 void fmb_data_cancel(fmbData* d) {
-  if (d) d->cancel = 1; /* only a store: a signal handler may call it */
+  if (d) fmb_stop_set(&d->cancel, 1); /* one atomic store: another thread or a signal handler may call it */
 }
 
 void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user) {
@@ -219,7 +219,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   d->ops = fmb_integrator_for(m);
   d->restart = 0;
   d->initialised = d->ic_done = d->interrupted = 0;
-  d->cancel = 0;
+  fmb_stop_set(&d->cancel, 0);
   d->cpu_s = 0.0;
   memset(&d->before, 0, sizeof d->before);
   memset(&d->ic, 0, sizeof d->ic);
@@ -314,7 +314,7 @@ static void update_work(const fmbModel* m, fmbData* d) {
 static int interrupted(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   update_work(m, d); /* up to where it stopped: a run that goes on keeps its energy balance */
   d->interrupted = 1;
-  if (d->stop == &d->cancel) d->cancel = 0; /* used up; fmb_run's own flag stays as its signal set it */
+  if (d->stop == &d->cancel) fmb_stop_set(&d->cancel, 0); /* used up; fmb_run's flag stays as its signal set it */
   retire_backend(d, 1);
   fmb_diag_set(diag, FMB_EXIT_INTERRUPTED, m->path, 0, 0, "interrupted at t = %.6g", d->t);
   return FMB_EXIT_INTERRUPTED;
@@ -335,7 +335,8 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
     char why[1200] = "";
     const int flag = d->ops->advance(d->integ, t_out, &tret, d->y, d->yp, &h, why, sizeof why);
     d->t = tret;
-    if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && *d->stop)) return interrupted(m, d, diag);
+    if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && fmb_stop_requested(d->stop)))
+      return interrupted(m, d, diag);
     if (flag == FMB_ADVANCE_FAILED && d->ops != &fmb_integrator_projected && d->may_switch &&
         fmb_rank_deficient_at(m, w, tret, d->y, d->y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
       /* a singular configuration: the GGL system's Newton matrix (IDA's or radau5's) is singular
@@ -411,7 +412,7 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
                  t_out, m->solver.t_end);
     return FMB_EXIT_BAD_INPUT;
   }
-  if (*d->stop) { /* cancelled between two advances */
+  if (fmb_stop_requested(d->stop)) { /* cancelled between two advances */
     d->failed = 1;
     return interrupted(m, d, diag);
   }
