@@ -41,6 +41,7 @@ struct fmbData {
   const volatile sig_atomic_t* stop; /* what the backends watch: &cancel, or fmb_run's flag */
   int quiet;                         /* fmb_run --quiet: no notes (warnings still go out) */
   fmbStats ic;                       /* the initial projection's corrections */
+  unsigned char* range_warned; /* nbody: the body's model_range warning was given (once per run) */
   int interrupted;
   int failed;   /* the last init or advance failed (fmb_data_stats' status) */
   double cpu_s; /* CPU time of this thread in init and advance */

@@ -80,6 +80,7 @@ static void release(fmbData* d) {
   d->integ = NULL;
   double* bufs[] = {d->y, d->yp, d->atol, d->row, d->work_before, d->redundant_phi, d->start.y, d->start.yp};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(d->range_warned);
   fmb_workspace_free(d->w);
   d->w = NULL;
 }
@@ -106,12 +107,13 @@ fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
   d->row = calloc((size_t)m->noutput + 1, sizeof(double));
   d->work_before = calloc((size_t)m->njoint + 1, sizeof(double));
   d->redundant_phi = calloc((size_t)m->nc + 1, sizeof(double));
+  d->range_warned = calloc((size_t)m->nbody + 1, 1);
   d->may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
   if (d->may_switch) {
     d->start.y = calloc(ny, sizeof(double));
     d->start.yp = calloc(ny, sizeof(double));
   }
-  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi ||
+  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi || !d->range_warned ||
       (d->may_switch && (!d->start.y || !d->start.yp))) {
     release(d);
     free(d);
@@ -119,7 +121,6 @@ fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
     return NULL;
   }
   fmb_absolute_tolerances(m, d->atol);
-  d->ops = fmb_integrator_for(m);
   d->stop = &d->cancel;
   d->t = NAN;
   d->magic = FMB_DATA_LIVE;
@@ -239,6 +240,8 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
       rc = FMB_EXIT_SOLVER;
     }
   }
+  memset(d->range_warned, 0, (size_t)m->nbody + 1);
+  if (!rc) fmb_warn_model_range(m, d->w, d->t, d->y, d->range_warned);
   if (!rc && m->need_work) { /* the force elements' potential at t0 enters energy.balance */
     fmbEnergy e0;
     fmb_energy(m, w, d->t, d->y, d->y + m->nq, &e0);
@@ -325,7 +328,7 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   const size_t ny = (size_t)m->ny;
   int rc = ensure_backend(m, d, diag);
   if (rc) return rc;
-  if (d->may_switch && d->ops != &fmb_integrator_projected) {
+  if (d->may_switch && !d->ops->projected) {
     d->start.t = d->t;
     memcpy(d->start.y, d->y, sizeof(double) * ny);
     memcpy(d->start.yp, d->yp, sizeof(double) * ny);
@@ -337,7 +340,7 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
     d->t = tret;
     if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && fmb_stop_requested(d->stop)))
       return interrupted(m, d, diag);
-    if (flag == FMB_ADVANCE_FAILED && d->ops != &fmb_integrator_projected && d->may_switch &&
+    if (flag == FMB_ADVANCE_FAILED && !d->ops->projected && d->may_switch &&
         fmb_rank_deficient_at(m, w, tret, d->y, d->y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
       /* a singular configuration: the GGL system's Newton matrix (IDA's or radau5's) is singular
          here; the projected formulation (minimum-norm multipliers) passes it, for the rest of the
@@ -385,6 +388,7 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
       mass_failure(m, bad, d->t, diag);
       return FMB_EXIT_SOLVER;
     }
+    fmb_warn_model_range(m, d->w, d->t, d->y, d->range_warned);
     if (d->ops->after_row) d->ops->after_row(d->integ, d->t);
     return 0;
   }
