@@ -42,8 +42,10 @@ static int live(const fmbData* d) { return d && d->magic == FMB_DATA_LIVE; }
 /* the misuse every call on (m, d) refuses; 0 when usable */
 static int misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDiag* diag) {
   const char* path = m ? m->path : "";
-  if (!m) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no model (NULL)", fn);
-  else if (!d) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no data object (NULL)", fn);
+  if (!m)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no model (NULL)", fn);
+  else if (!d)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no data object (NULL)", fn);
   else if (d->magic == FMB_DATA_FREED)
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: the data object was freed (fmb_data_free)", fn);
   else if (d->magic != FMB_DATA_LIVE)
@@ -149,7 +151,8 @@ void fmb_data_free(fmbData* d) {
 #if defined(__GNUC__)
 __attribute__((destructor))
 #endif
-static void quarantine_release(void) {
+static void
+quarantine_release(void) {
   pthread_mutex_lock(&quarantine_lock);
   for (int i = 0; i < FMB_DATA_QUARANTINE; ++i) {
     free(quarantine[i]);
@@ -256,7 +259,8 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
 /* A row left out as redundant must keep holding: if it stops (the joints were dependent only at
    t0, or only on part of the motion) the run would silently lose a joint. Checked after every
    advance. */
-static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, const double* y, double* phi, fmbDiag* diag) {
+static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, const double* y, double* phi,
+                                fmbDiag* diag) {
   int count = 0;
   const unsigned char* drop = fmb_workspace_redundant(w, &count);
   if (!count || fmb_constraints_all(m, w, t, y, y + m->nq, phi, NULL, NULL, NULL)) return 0;
@@ -272,7 +276,8 @@ static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, co
       }
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                    "stopped at t = %.6g: %s, left out as redundant at the start, no longer holds (residual %.3g): the "
-                   "joints repeat each other only on part of the motion; remove the repeated joint", t, name, phi[r]);
+                   "joints repeat each other only on part of the motion; remove the repeated joint",
+                   t, name, phi[r]);
       return 1;
     }
   return 0;
@@ -350,9 +355,11 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
          before the flat position, CVODE started there stopped at it). The work integrals go on
          from their values there. */
       if (!d->quiet)
-        fmb_warn(w, "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
+        fmb_warn(w,
+                 "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
                  "the mechanism can change branch); continuing with the projected formulation (set solver.formulation: "
-                 "ggl to stop instead)", tret);
+                 "ggl to stop instead)",
+                 tret);
       retire_backend(d, 0);
       d->ops = &fmb_integrator_projected;
       d->t = d->start.t;
@@ -369,11 +376,13 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
       if (bad)
         mass_failure(m, bad, tret, diag);
       else if (d->switched.t >= 0 && tret - d->switched.t < m->solver.output_step) /* no further: IDA's reason */
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s (the projected "
-                     "formulation, tried from t = %.6g, did not get further)", tret, d->switched.h, d->switched.why,
-                     d->switched.t);
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                     "solver failed at t = %.6g (step size %.3g): %s (the projected "
+                     "formulation, tried from t = %.6g, did not get further)",
+                     tret, d->switched.h, d->switched.why, d->switched.t);
       else
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h, why);
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h,
+                     why);
       update_work(m, d);
       retire_backend(d, 1);
       return FMB_EXIT_SOLVER;
@@ -405,9 +414,10 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
     return FMB_EXIT_BAD_INPUT;
   }
   if (isnan(t_out) || t_out < d->t) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "fmb_advance: t_out = %g is before the run's time %.17g: a run goes forward (fmb_init starts it again)",
-                 t_out, d->t);
+    fmb_diag_set(
+        diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+        "fmb_advance: t_out = %g is before the run's time %.17g: a run goes forward (fmb_init starts it again)", t_out,
+        d->t);
     return FMB_EXIT_BAD_INPUT;
   }
   if (t_out > m->solver.t_end) {
@@ -488,8 +498,10 @@ int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value)
   const int i = input_index(m, name);
   if (i < 0 || !isfinite(value)) {
     if (i < 0)
-      fmb_warn(d->w, "fmb_set_input: no input named '%s' (%d inputs: a drive with `profile: input` or a load with "
-               "`law: input` is one, named by its joint)", name ? name : "(NULL)", m->ninput);
+      fmb_warn(d->w,
+               "fmb_set_input: no input named '%s' (%d inputs: a drive with `profile: input` or a load with "
+               "`law: input` is one, named by its joint)",
+               name ? name : "(NULL)", m->ninput);
     else
       fmb_warn(d->w, "fmb_set_input: input '%s' = %g: not a finite number", name, value);
     return FMB_EXIT_BAD_INPUT;

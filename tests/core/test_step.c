@@ -180,7 +180,8 @@ static void messages(void) {
   fmbDiag diag;
   fmbModel* m = fmb_load(path, NULL, 0, fmb_builtin_registry(), &diag); /* angle 10: radians, or degrees? */
   ENSURE(m != NULL);
-  ENSURE(by_default.count == 1 && strstr(by_default.last, "step-warning.yaml:2:") && strstr(by_default.last, "warning:"));
+  ENSURE(by_default.count == 1 && strstr(by_default.last, "step-warning.yaml:2:") &&
+         strstr(by_default.last, "warning:"));
   ENSURE(by_default.last[strlen(by_default.last) - 1] != '\n'); /* one message, no newline */
   printf("load-time warning to the thread's handler: %s\n", by_default.last);
   fmb_free(m);
@@ -239,7 +240,7 @@ int main(void) {
   fmbt_path("scenes/parallelogram.yaml", scene, sizeof scene);
   const char* auto_set[] = {"solver.formulation=auto"};
   compare(scene, auto_set, 1, "parallelogram-auto", 0); /* the scan finds the flat: projected from t0 */
-  setenv("FMB_TEST_NO_SINGULAR_WALK", "1", 1); /* no scan: IDA's failure at the flat, the switch */
+  setenv("FMB_TEST_NO_SINGULAR_WALK", "1", 1);          /* no scan: IDA's failure at the flat, the switch */
   compare(scene, auto_set, 1, "parallelogram-auto-switch", 0);
   unsetenv("FMB_TEST_NO_SINGULAR_WALK");
   const char* ggl_set[] = {"solver.formulation=ggl"};
@@ -269,7 +270,8 @@ int main(void) {
       ENSURE(ref->tab.rc == 0 && ref->tab.nrow > 10 && together[k].tab.time_wrong == 0);
       ENSURE(same_table(&ref->tab, &together[k].tab));
       printf("thread %d (%s): %d rows x %d columns, %s alone\n", k, k < 2 ? "own model" : "shared model",
-             together[k].tab.nrow, together[k].tab.ncol, same_table(&ref->tab, &together[k].tab) ? "identical to" : "DIFFERENT from");
+             together[k].tab.nrow, together[k].tab.ncol,
+             same_table(&ref->tab, &together[k].tab) ? "identical to" : "DIFFERENT from");
       free(together[k].tab.values);
     }
     free(alone[0].tab.values);
