@@ -32,7 +32,7 @@ static int parse_speeds(const char* text, double* out) {
   int n;
   char tail;
   if (sscanf(text, "%lf:%lf:%d%c", &a, &b, &n, &tail) == 3) {
-    if (n < 1 || n > MAX_SPEEDS) return -1;
+    if (n < 1 || n > MAX_SPEEDS || !isfinite(a) || !isfinite(b)) return -1; /* nan, inf: bad input */
     for (int i = 0; i < n; ++i) out[i] = n == 1 ? a : a + (b - a) * i / (n - 1);
     return n;
   }
@@ -41,7 +41,7 @@ static int parse_speeds(const char* text, double* out) {
   while (*p && n < MAX_SPEEDS) {
     char* end;
     out[n++] = strtod(p, &end);
-    if (end == p || (*end != ',' && *end != '\0')) return -1;
+    if (end == p || (*end != ',' && *end != '\0') || !isfinite(out[n - 1])) return -1;
     p = *end ? end + 1 : end;
   }
   return *p ? -1 : n;
@@ -147,7 +147,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
   double* speeds = malloc(MAX_SPEEDS * sizeof(double));
   const int nspeed = speeds ? parse_speeds(speeds_text, speeds) : -1;
   if (nspeed < 1) {
-    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,..., got '%s'\n",
+    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,... of finite speeds, got '%s'\n",
             MAX_SPEEDS, speeds_text);
     free(speeds);
     return FMB_EXIT_BAD_INPUT;

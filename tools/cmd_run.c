@@ -87,15 +87,11 @@ int fmb_cmd_run(int argc, char** argv) {
   for (int k = 0; k < s.nplugins; ++k) inputs[ninputs++] = s.plugins[k];
   int bad = reference ? fmb_cli_check_input(reference, "reference") : 0;
   if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
-  if (bad) {
-    fmb_print_stats(&stats, stderr);
-    return bad;
-  }
+  if (bad) return bad; /* nothing ran: no stats line */
   catch_stop_signals();
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
-    fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   /* the progress line: on a terminal once a run has taken 2 s; --progress asks for it anywhere
@@ -116,7 +112,9 @@ int fmb_cmd_run(int argc, char** argv) {
     int crc = fmb_cli_compare(&c);
     if (crc && !rc) rc = crc;
   }
-  fmb_print_stats(&stats, stderr);
+  /* the stats line tells what a run did; bad input (found in the initial pose, or an output that
+     cannot be written) ran nothing, and the error line is the last word */
+  if (rc != FMB_EXIT_BAD_INPUT) fmb_print_stats(&stats, stderr);
   fmb_free(m);
   return rc;
 }
