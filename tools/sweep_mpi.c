@@ -192,10 +192,56 @@ static int worker(fmbSweep* sw) {
   return *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
 }
 
+/* a worker with persistent runners (--runner serve): runs from rank 0's RUN messages, rows back */
+typedef struct {
+  fmbSweep* sw;
+  double* queue; /* [jobs][3]: index, attempt, timeout; at most one request per slot is out */
+  int head, count, stops;
+} Remote;
+static int remote_pump(void* ctx) {
+  Remote* q = ctx;
+  int flag = 1, got = 0;
+  while (MPI_Iprobe(0, TAG_RUN, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE) == MPI_SUCCESS && flag) {
+    double msg[3];
+    MPI_Recv(msg, 3, MPI_DOUBLE, 0, TAG_RUN, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    got = 1;
+    if (msg[0] < 0) {
+      ++q->stops;
+    } else if (q->count < q->sw->jobs) {
+      memcpy(q->queue + 3 * ((q->head + q->count++) % q->sw->jobs), msg, sizeof msg);
+    }
+  }
+  return got;
+}
+static int remote_next(void* ctx, long* index, int* attempt, double* timeout) {
+  Remote* q = ctx;
+  if (!q->count) return q->stops >= q->sw->jobs ? -1 : 0;
+  const double* m = q->queue + 3 * q->head;
+  *index = (long)m[0], *attempt = (int)m[1], *timeout = m[2];
+  q->head = (q->head + 1) % q->sw->jobs;
+  --q->count;
+  return 1;
+}
+static void remote_done(void* ctx, const fmbChildResult* res, char* row) {
+  (void)ctx, (void)res;
+  MPI_Send(row, row ? (int)strlen(row) : 0, MPI_CHAR, 0, TAG_ROW, MPI_COMM_WORLD);
+  free(row);
+}
+static int worker_serve(fmbSweep* sw) {
+  Remote q = {sw, calloc((size_t)sw->jobs * 3, sizeof(double)), 0, 0, 0};
+  if (!q.queue) return FMB_EXIT_BAD_INPUT;
+  MPI_Send(&sw->jobs, (int)sizeof sw->jobs, MPI_CHAR, 0, TAG_HELLO, MPI_COMM_WORLD);
+  for (int s = 0; s < sw->jobs; ++s) MPI_Send(NULL, 0, MPI_CHAR, 0, TAG_ASK, MPI_COMM_WORLD);
+  const fmbRunFeed feed = {remote_next, remote_done, remote_pump, NULL, &q};
+  const int rc = fmb_sweep_serve_feed(sw, &feed);
+  free(q.queue);
+  return rc;
+}
+
 int fmb_sweep_mpi(fmbSweep* sw, int rc0) {
   MPI_Bcast(&rc0, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (rc0) return rc0;
-  return sw->rank == 0 ? manager(sw) : worker(sw);
+  return sw->rank == 0 ? manager(sw) : sw->serve ? worker_serve(sw) : worker(sw);
 }
 
 #endif
