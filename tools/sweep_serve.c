@@ -141,12 +141,22 @@ int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed) {
   struct pollfd* pfd = calloc((size_t)sw->jobs, sizeof *pfd);
   signal(SIGPIPE, SIG_IGN); /* a runner that died: its pipe says so by EPIPE */
   int more = 1;           /* the feed may still hand out runs */
+  int failed = 0;         /* no runner could be started */
   double wait = 2e-4;     /* with a pump (MPI): how long poll waits, backing off to 20 ms */
   while (pool && runners && pfd && !*sw->stop) {
     int busy = 0, active = feed->pump ? feed->pump(feed->ctx) : 0;
     for (int k = 0; k < sw->jobs; ++k) {
       Runner* r = &runners[k];
-      if (!r->alive && more && start_runner(sw, pool, r, k) != 0) break;
+      if (!r->alive && more && start_runner(sw, pool, r, k) != 0) {
+        int alive = 0;
+        for (int j = 0; j < sw->jobs; ++j) alive += runners[j].alive;
+        if (!alive) { /* no runner at all: the runs left stay without a row, for a resume */
+          fprintf(stderr, "flexmbd sweep: cannot start a runner (%s): stopping; run the command again to resume\n",
+                  strerror(errno));
+          more = 0, failed = 1;
+        }
+        break;
+      }
       if (r->alive && r->index < 0 && more) {
         long index;
         int attempt;
@@ -211,7 +221,7 @@ int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed) {
     if (runners[k].alive) close(runners[k].in), close(runners[k].out); /* EOF: the runner ends */
   fmb_pool_free(pool);
   free(runners), free(pfd);
-  return *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
+  return *sw->stop ? FMB_EXIT_INTERRUPTED : failed ? FMB_EXIT_SOLVER : 0;
 }
 
 /* the local feed: the runs still to do, rows into the journal */
