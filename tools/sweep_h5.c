@@ -104,7 +104,7 @@ static int write_columns(hid_t file, const char* group, const Text* t) {
   int rc = num && str ? 0 : -1;
   for (int c = 0; c < t->ncol && !rc; ++c) {
     int numeric = 1;
-    for (hsize_t r = 0; r < n && numeric; ++r) {
+    for (hsize_t r = 0; r < n; ++r) { /* every row: a word in the last row makes it a string column */
       const char* v = t->cell[(r + 1) * (hsize_t)t->ncol + (hsize_t)c];
       char* end;
       num[r] = *v ? strtod(v, &end) : NAN;
