@@ -734,6 +734,16 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     return FMB_EXIT_BAD_INPUT;
   }
   *out = NULL;
+  /* an unknown method once ran the dense path silently; a time of nan linearized at nan */
+  if (method != FMB_EIGEN_AUTO && method != FMB_EIGEN_DENSE && method != FMB_EIGEN_SPARSE) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: method %d is not FMB_EIGEN_AUTO, _DENSE or _SPARSE",
+                 method);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (!isfinite(t)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the time %g is not finite", t);
+    return FMB_EXIT_BAD_INPUT;
+  }
   Linearized L;
   Reduced R;
   Eigen E;
@@ -758,7 +768,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
 }
 
 double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k) {
-  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return 0.0;
+  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return NAN; /* not 0: "orthogonal" */
   const double *ar = a->shape_re + (size_t)i * a->nq, *ai = a->shape_im + (size_t)i * a->nq;
   const double *br = b->shape_re + (size_t)k * b->nq, *bi = b->shape_im + (size_t)k * b->nq;
   double re = 0.0, im = 0.0, na = 0.0, nb = 0.0;
@@ -778,8 +788,9 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
                     fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (ncol <= 0 || !names || (nrow > 0 && !values)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns or no values");
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
+  if (ncol <= 0 || !names || nrow < 0 || (nrow > 0 && !values)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns, no values or a negative row count");
     return FMB_EXIT_BAD_INPUT;
   }
   fmbCsv* c = fmb_csv_open(path, diag);
@@ -799,6 +810,7 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
                         fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_state_row: NULL model or state");
     return FMB_EXIT_BAD_INPUT;
@@ -826,6 +838,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
                           const char* path, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp || !md || md->nq != m->nq) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
@@ -881,7 +894,9 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
                              double amplitude, int frames, const char* dir, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2) {
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
+  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2 || !(amplitude > 0.0) ||
+      !isfinite(amplitude)) { /* an amplitude of 0, -1 or nan drew a still or inverted mode */
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_animation: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
   }
