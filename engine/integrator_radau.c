@@ -384,7 +384,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }
-    if (c->stop && *c->stop) return NEWTON_FATAL;
+    if (fmb_stop_requested(c->stop)) return NEWTON_FATAL;
     for (int i = 0; i < 3; ++i) {
       for (int k = 0; k < ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
       stage_derivative(c, i, h, c->yps);
@@ -639,7 +639,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
   int zero_start = c->first;
   c->caljac = 0;
   for (;;) {
-    if (c->stop && *c->stop) {
+    if (fmb_stop_requested(c->stop)) {
       *interrupted = 1;
       return FAIL_NONE;
     }
@@ -677,7 +677,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     double hfac = 0.5;
     const int nr = newton(c, &newt, &hfac);
     if (nr == NEWTON_FATAL) {
-      if (c->stop && *c->stop) {
+      if (fmb_stop_requested(c->stop)) {
         *interrupted = 1;
         return FAIL_NONE;
       }
@@ -770,8 +770,8 @@ static int fall_back_to_full(RadauRun* c) {
   c->h_lu = 0.0;
   c->nsing = 0;
   c->reject = 1;
-  fprintf(stderr, "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
-          "from the last good step with klu_full (the whole matrices)\n", c->t);
+  fmb_warn(c->w, "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+           "from the last good step with klu_full (the whole matrices)", c->t);
   return 0;
 }
 

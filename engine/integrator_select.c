@@ -1,6 +1,6 @@
 /* integrator_select.c — which integrator backend a model runs on, and the stats line that names
  * what a run did. One place for the choice (docs/style.md: "a choice made in one place"), apart
- * from the run driver (integrate.c), so that the backends' table and the rule that picks one can
+ * from the run driver (run.c), so that the backends' table and the rule that picks one can
  * grow without touching the driver. */
 #include <stdio.h>
 
