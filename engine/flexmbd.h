@@ -440,6 +440,35 @@ FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
    (0 <= i < count; 0, or -1 when out of range). Lets a program address them with --set. */
 FMB_API int fmb_model_nbody(const fmbModel* m);
 FMB_API int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type);
+/* the scene's joints: their count, and joint i's name and `type:` (0 <= i < count; 0, or -1) */
+FMB_API int fmb_model_njoint(const fmbModel* m);
+FMB_API int fmb_model_joint(const fmbModel* m, int i, const char** name, const char** type);
+/* What a mechanism looks like (engine/drawing.c), fixed at load: the points and cells that the
+   ParaView animation (--vtk) and `flexmbd view` draw, from the types' ops alone: a body with a
+   `centreline` is a polyline through its stations; any other body with a frame (ncoord >= 3) is the
+   outline through the points its joints attach to (closed from three points) and its frame's x and
+   y axes; a joint with constraint rows is a vertex at its first point; a force element with two
+   points (a spring) is the line between them. */
+enum { FMB_DRAW_CENTRELINE = 0, FMB_DRAW_OUTLINE = 1, FMB_DRAW_FRAME_AXIS = 2, FMB_DRAW_JOINT = 3, FMB_DRAW_FORCE_ELEMENT = 4 };
+typedef struct fmbDrawPoint {
+  int body;        /* 0 = the world frame (local is then global); k >= 1 = fmb_model_body(m, k - 1) */
+  double local[2]; /* the material point in the body frame, as joints and `marker` take it */
+  int station;     /* a centreline station: K of the columns BODY.shapeK_x, BODY.shapeK_y; else -1 */
+} fmbDrawPoint;
+typedef struct fmbDrawCell {
+  int first, count; /* its points: conn[first .. first + count) */
+  int part;         /* FMB_DRAW_* */
+  int owner;        /* the body (numbered as fmbDrawPoint.body) or the joint (from 0) it draws */
+} fmbDrawCell;
+typedef struct fmbDrawing {
+  int npoint, ncell, nconn;
+  fmbDrawPoint* point;
+  fmbDrawCell* cell;
+  int* conn;
+} fmbDrawing;
+/* NULL when m is NULL or out of memory; free with fmb_drawing_free (NULL allowed) */
+FMB_API fmbDrawing* fmb_drawing_new(const fmbModel* m);
+FMB_API void fmb_drawing_free(fmbDrawing* d);
 /* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
 /* the constraints at t0 after the initial projection: degrees of freedom, redundant equations by

@@ -476,6 +476,15 @@ int fmb_model_body(const fmbModel* m, int i, const char** name, const char** typ
   return 0;
 }
 
+int fmb_model_njoint(const fmbModel* m) { return m ? m->njoint : 0; }
+
+int fmb_model_joint(const fmbModel* m, int i, const char** name, const char** type) {
+  if (!m || i < 0 || i >= m->njoint) return -1;
+  if (name) *name = m->joint[i].name;
+  if (type) *type = m->joint[i].type->name;
+  return 0;
+}
+
 void fmb_describe(const fmbModel* m, FILE* f) {
   if (!m || !f) return;
   fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
