@@ -48,6 +48,7 @@ int fmb_cmd_new(int argc, char** argv);
 int fmb_cmd_static(int argc, char** argv);
 int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
+int fmb_cmd_view(int argc, char** argv);
 /* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
 typedef struct fmbCliAnalysis {
   fmbStaticOptions opt; /* --at T, --quiet */

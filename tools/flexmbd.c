@@ -30,6 +30,9 @@ static const Command commands[] = {
      "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
      "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)", 0},
+    {"view", fmb_cmd_view,
+     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--set PATH=VALUE]... [--plugin x.so]...\n"
+     "      one self-contained HTML page animating the run (mechanism, beam shapes, traces, a plot)", 0},
     {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene", 0},
     {"static", fmb_cmd_static,
      "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive", 0},

@@ -2,7 +2,8 @@
 # Install what flexmbd needs on Debian 12, only if something is missing.
 #   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; and
 #         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
-#         VTK itself (skipped without it)
+#         VTK itself (skipped without it); chromium, in which the test view_page loads the page of
+#         `flexmbd view` headless (skipped without it)
 # python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux.
 set -euo pipefail
 # liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
@@ -10,7 +11,7 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
       liblapack-dev libblas-dev libarpack2-dev)
 if [ "${1:-}" = "--ci" ]; then
-  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9)
+  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9 chromium)
 fi
 missing=()
 for p in "${pkgs[@]}"; do
