@@ -573,6 +573,14 @@ FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names
  * ------------------------------------------------------------------------------------------- */
 typedef struct fmbSafeFile fmbSafeFile;
 /* NULL with the reason (e.g. strerror's) in err on failure */
+/* The files this process reads (the scene and its table files, noted by fmb_load; plugins, noted
+   when loaded; whatever a program notes): fmb_safe_open refuses to replace one, whatever name or
+   link leads to it (same device and inode), until the process ends. Notes are counted: each
+   note is undone by one forget. note: 0, or -1 (not a regular file, or out of memory). input_at: the
+   noted path of the input that `path` is, or NULL. Not thread-safe: note from one thread. */
+FMB_API int fmb_safe_note_input(const char* path);
+FMB_API void fmb_safe_forget_input(const char* path);
+FMB_API const char* fmb_safe_input_at(const char* path);
 FMB_API fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen);
 FMB_API FILE* fmb_safe_stream(fmbSafeFile* f); /* a stdio stream over it (closed by fmb_safe_close) */
 FMB_API int fmb_safe_fd(const fmbSafeFile* f);

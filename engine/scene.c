@@ -436,6 +436,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
   p.model = m;
   p.reg = reg;
   int rc = fmbp_open(&p, path, overrides, noverrides, diag);
+  if (rc == 0) fmb_safe_note_input(path); /* no output of this process may replace it */
   if (rc == 0) rc = parse_scene(&p, m);
   fmbp_close(&p);
   fmb_registry_free(p.own_reg); /* the types stay: their code is never unloaded */
@@ -449,6 +450,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
 
 void fmb_free(fmbModel* m) {
   if (!m) return;
+
   for (int b = 0; b < m->nbody; ++b)
     if (m->body[b].type && m->body[b].self) m->body[b].type->destroy(m->body[b].self);
   for (int j = 0; j < m->njoint; ++j)

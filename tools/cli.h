@@ -3,6 +3,9 @@
  * command's name), listed once in the table of tools/flexmbd.c. */
 #ifndef FLEXMBD_CLI_H
 #define FLEXMBD_CLI_H
+#include <signal.h>
+#include <stdio.h>
+
 #include "flexmbd.h"
 
 #define FMB_CLI_MAX_OVERRIDES 256
@@ -27,14 +30,22 @@ void fmb_cli_print_diag(const fmbDiag* d);
 /* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
    else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
 int fmb_cli_check_input(const char* path, const char* what);
-/* FMB_EXIT_BAD_INPUT after saying so when `out` is the same file (device and inode, whatever
-   the names) as one of the n inputs, else 0; "-" and a file that does not exist are never inputs */
+/* Notes the n inputs for the whole process (engine/safe_file.c: no later write, by any writer,
+   may replace one; the library notes scenes, their table files and plugins itself), then
+   FMB_EXIT_BAD_INPUT after saying so when `out` is one of the noted inputs (device and inode,
+   whatever the names), else 0. "-", non-regular files and files that do not exist are never inputs. */
 int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n);
+/* catch SIGINT/SIGTERM: the flag they set (work stops after the step in progress, keeps what
+   it has and exits FMB_EXIT_INTERRUPTED) */
+volatile sig_atomic_t* fmb_cli_catch_stop_signals(void);
+/* `s` as a gnuplot string that gnuplot never expands (single-quoted; no command substitution);
+   -1 and nothing written when s holds a control character (a line break would end the command) */
+int fmb_cli_gnuplot_string(FILE* g, const char* s);
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
 
 /* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c) */
-int fmb_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet);
+int fmb_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet, volatile sig_atomic_t* stop);
 
 /* the commands */
 int fmb_cmd_run(int argc, char** argv);

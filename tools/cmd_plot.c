@@ -8,7 +8,9 @@
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
 
 #include "cli.h"
 #include "csv_table.h"
@@ -49,14 +51,14 @@ static void column_list(const fmbTable* tb, char* out, size_t len) {
     used += (size_t)snprintf(out + used, len - used, "%s%s", i ? ", " : "", tb->name[i]);
 }
 
-/* a gnuplot double-quoted string */
+/* every string reaches gnuplot through fmb_cli_gnuplot_string (single quotes: a column named
+   `touch PWNED` is a name, never a command); a name it refuses (a control character) is refused */
+static int bad_string;
 static void quoted(FILE* g, const char* s) {
-  fputc('"', g);
-  for (; *s; ++s) {
-    if (*s == '"' || *s == '\\') fputc('\\', g);
-    fputc(*s, g);
+  if (fmb_cli_gnuplot_string(g, s) != 0) {
+    bad_string = 1;
+    fputs("''", g);
   }
-  fputc('"', g);
 }
 
 /* the legend label of CSV i: the i-th item of --legend a,b,c, else the file name */
@@ -139,6 +141,8 @@ int fmb_cmd_plot(int argc, char** argv) {
       fprintf(stderr, "flexmbd plot: %s\n", err);
       rc = FMB_EXIT_BAD_INPUT;
     }
+  /* the CSVs are inputs: the figure may not replace one (engine/safe_file.c) */
+  if (!rc && fmb_cli_check_output_not_input(a.out, a.csv, a.ncsv)) rc = FMB_EXIT_BAD_INPUT;
   /* the x column: --x, else the first column (t) */
   const char* xcol = rc ? NULL : a.x ? a.x : table[0].name[0];
   for (int i = 0; i < a.ncsv && !rc; ++i)
@@ -190,7 +194,10 @@ int fmb_cmd_plot(int argc, char** argv) {
     }
   }
   if (!rc) {
-    /* gnuplot reads the script from its stdin; its own messages go to our stderr */
+    /* gnuplot reads the script from its stdin; its own messages go to our stderr. A gnuplot that
+       is missing or ends early must not kill us with SIGPIPE: writes then fail, and its exit
+       status says why. */
+    signal(SIGPIPE, SIG_IGN);
     g = popen("gnuplot", "w");
     if (!g) {
       fprintf(stderr, "flexmbd plot: cannot start gnuplot (Debian: apt-get install gnuplot-nox)\n");
@@ -241,12 +248,18 @@ int fmb_cmd_plot(int argc, char** argv) {
       }
     }
     fprintf(g, "\n");
+    if (bad_string) fprintf(g, "\nexit status 1\n"); /* nothing drawn with a name it could not take */
     int status = pclose(g);
     struct stat st;
     /* success is judged by the file gnuplot leaves */
     const int made = status == 0 && stat(fig_path, &st) == 0 && st.st_size > 0;
     if (fmb_safe_close(fig, made) != 0 || !made) {
-      fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out, status);
+      if (bad_string)
+        fprintf(stderr, "flexmbd plot: a column or file name holds a control character (a line break): not plotted\n");
+      else if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 127)
+        fprintf(stderr, "flexmbd plot: gnuplot is not installed (Debian: apt-get install gnuplot-nox)\n");
+      else
+        fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out, status);
       rc = FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(stderr, "flexmbd plot: wrote %s\n", a.out);

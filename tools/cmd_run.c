@@ -2,30 +2,11 @@
  *                [--vtk DIR] [--reference REF.csv [--columns a,b]]
  *                [--models zoac,foac,complete,exact]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
-#include <signal.h>
 #include <stdio.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "cli.h"
-
-/* SIGINT/SIGTERM end the run after the step in progress (fmbRunOptions.stop): the rows so far
-   stay, the stats line says status=interrupted and the exit code is FMB_EXIT_INTERRUPTED. The
-   handler is one-shot (SA_RESETHAND): a second signal ends the program at once. */
-static volatile sig_atomic_t stop_requested;
-static void on_stop_signal(int sig) {
-  (void)sig;
-  stop_requested = 1;
-}
-static void catch_stop_signals(void) {
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_stop_signal;
-  sa.sa_flags = SA_RESETHAND | SA_RESTART;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
-}
 
 int fmb_cmd_run(int argc, char** argv) {
   fmbCliScene s;
@@ -72,7 +53,6 @@ int fmb_cmd_run(int argc, char** argv) {
     fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
     return FMB_EXIT_BAD_INPUT;
   }
-  if (models) return fmb_run_models(&s, models, out, quiet);
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);
@@ -87,7 +67,8 @@ int fmb_cmd_run(int argc, char** argv) {
     fmb_print_stats(&stats, stderr);
     return bad;
   }
-  catch_stop_signals();
+  volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
+  if (models) return fmb_run_models(&s, models, out, quiet, stop);
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
@@ -101,7 +82,7 @@ int fmb_cmd_run(int argc, char** argv) {
                        .progress = !quiet && (progress || isatty(STDERR_FILENO)),
                        .progress_after_s = progress ? 0.0 : 2.0,
                        .vtk_dir = vtk,
-                       .stop = &stop_requested};
+                       .stop = stop};
   int rc = fmb_run(m, &opt, &stats, &diag);
   if (rc) fmb_cli_print_diag(&diag);
   if (reference) {

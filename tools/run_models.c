@@ -27,7 +27,7 @@ static void print_model_stats(const char* model, const fmbStats* st) {
   free(text);
 }
 
-int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet) {
+int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet, volatile sig_atomic_t* stop) {
   if (!out || strcmp(out, "-") == 0) {
     fprintf(stderr, "flexmbd run: --models needs the CSV in a file (-o OUT.csv)\n");
     return FMB_EXIT_BAD_INPUT;
@@ -60,6 +60,12 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     fmb_cli_print_diag(&diag);
     fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
+  }
+  /* the scene's table files are inputs now too: refuse before any run, not after all of them */
+  const char* scene_input[1] = {s->scene};
+  if (fmb_cli_check_output_not_input(out, scene_input, 1)) {
+    fmb_free(m);
+    return FMB_EXIT_BAD_INPUT;
   }
   static char set[MAX_MODELS][MAX_BEAMS][224];
   char beam[MAX_BEAMS][128];
@@ -123,7 +129,7 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
       rc = diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
       break;
     }
-    fmbRunOptions opt = {.csv_path = part, .quiet = quiet};
+    fmbRunOptions opt = {.csv_path = part, .quiet = quiet, .stop = stop};
     int rk = fmb_run(mk, &opt, &stats, &diag);
     if (rk) {
       fprintf(stderr, "model %s: ", model[k]);
@@ -141,12 +147,13 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
     }
     remove(part);
     loaded = k + 1;
+    if (rk == FMB_EXIT_INTERRUPTED) break; /* the models run so far are written, the rest not run */
   }
-  if (loaded == nmodel) {
+  if (loaded > 0 && (loaded == nmodel || rc == FMB_EXIT_INTERRUPTED)) {
     /* one table: t from the longest run, then each model's columns in turn */
     long nrow = 0;
     int longest = 0;
-    for (int k = 0; k < nmodel; ++k)
+    for (int k = 0; k < loaded; ++k)
       if (table[k].nrow > nrow) nrow = table[k].nrow, longest = k;
     char err[300] = "";
     fmbSafeFile* sf = fmb_safe_open(out, err, sizeof err); /* beside it, renamed into place */
@@ -157,12 +164,12 @@ int fmb_run_models(const fmbCliScene* s, const char* list, const char* out, int 
       rc = FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(f, "t");
-      for (int k = 0; k < nmodel; ++k)
+      for (int k = 0; k < loaded; ++k)
         for (int c = 1; c < table[k].ncol; ++c) fprintf(f, ",%s@%s", table[k].name[c], model[k]);
       fprintf(f, "\n");
       for (long r = 0; r < nrow; ++r) {
         fprintf(f, "%.12g", fmb_table_at(&table[longest], r, 0));
-        for (int k = 0; k < nmodel; ++k)
+        for (int k = 0; k < loaded; ++k)
           for (int c = 1; c < table[k].ncol; ++c) {
             if (r < table[k].nrow)
               fprintf(f, ",%.12g", fmb_table_at(&table[k], r, c));
