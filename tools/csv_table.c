@@ -15,6 +15,7 @@ void fmb_table_free(fmbTable* tb) {
   for (int i = 0; i < tb->nmeta; ++i) free(tb->meta[i]);
   free(tb->name);
   free(tb->meta);
+  free(tb->index);
   free(tb->v);
   memset(tb, 0, sizeof *tb);
 }
@@ -52,10 +53,20 @@ static long read_line(FILE* f, char** buf, size_t* cap) {
   return (long)n;
 }
 
+/* FNV-1a, for the column-name index */
+static unsigned name_hash(const char* s) {
+  unsigned h = 2166136261u;
+  for (; *s; ++s) h = (h ^ (unsigned char)*s) * 16777619u;
+  return h;
+}
+
 static int push_string(char*** list, int* n, const char* s) {
-  char** nl = realloc(*list, (size_t)(*n + 1) * sizeof *nl);
-  if (!nl) return -1;
-  *list = nl;
+  if ((*n & (*n - 1)) == 0) { /* at 0, 1, 2, 4, ...: capacity doubles, appending stays linear */
+    char** nl = realloc(*list, (size_t)(*n ? 2 * *n : 1) * sizeof *nl);
+    if (!nl) return -1;
+    *list = nl;
+  }
+  char** nl = *list;
   if (!(nl[*n] = strdup(s))) return -1;
   ++*n;
   return 0;
@@ -107,12 +118,20 @@ int fmb_table_load(const char* path, fmbTable* tb, char* err, size_t errlen) {
     say(err, errlen, "%s:%ld: the first column must be 't' (a flexmbd CSV), got '%.40s'", path, lineno, tb->name[0]);
     goto out;
   }
-  for (int i = 1; i < tb->ncol; ++i)
-    for (int j = 0; j < i; ++j)
-      if (strcmp(tb->name[i], tb->name[j]) == 0) {
-        say(err, errlen, "%s:%ld: column '%.80s' appears twice in the header", path, lineno, tb->name[i]);
-        goto out;
-      }
+  /* the name index: a duplicate is found as it is entered */
+  tb->nindex = 2;
+  while (tb->nindex < 2 * tb->ncol) tb->nindex *= 2;
+  if (!(tb->index = malloc((size_t)tb->nindex * sizeof *tb->index))) goto nomem;
+  for (int i = 0; i < tb->nindex; ++i) tb->index[i] = -1;
+  for (int i = 0; i < tb->ncol; ++i) {
+    unsigned h = name_hash(tb->name[i]) & (unsigned)(tb->nindex - 1);
+    while (tb->index[h] >= 0 && strcmp(tb->name[tb->index[h]], tb->name[i]) != 0) h = (h + 1) & (unsigned)(tb->nindex - 1);
+    if (tb->index[h] >= 0) {
+      say(err, errlen, "%s:%ld: column '%.80s' appears twice in the header", path, lineno, tb->name[i]);
+      goto out;
+    }
+    tb->index[h] = i;
+  }
   while ((n = read_line(f, &line, &cap)) >= 0) {
     ++lineno;
     if (line[0] == '\0') continue;
@@ -162,9 +181,16 @@ out:
 }
 
 int fmb_table_col(const fmbTable* tb, const char* name) {
-  for (int i = 1; i < tb->ncol; ++i)
-    if (strcmp(tb->name[i], name) == 0) return i;
-  return -1;
+  if (!tb->index) { /* a table built by hand */
+    for (int i = 1; i < tb->ncol; ++i)
+      if (strcmp(tb->name[i], name) == 0) return i;
+    return -1;
+  }
+  for (unsigned h = name_hash(name) & (unsigned)(tb->nindex - 1);; h = (h + 1) & (unsigned)(tb->nindex - 1)) {
+    const int i = tb->index[h];
+    if (i < 0) return -1;
+    if (strcmp(tb->name[i], name) == 0) return i >= 1 ? i : -1;
+  }
 }
 
 double fmb_table_t_end(const fmbTable* tb) { return fmb_table_at(tb, tb->nrow - 1, 0); }

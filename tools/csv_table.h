@@ -15,6 +15,9 @@ typedef struct fmbTable {
   double* v; /* row-major nrow x ncol */
   int nmeta;
   char** meta; /* the '#' lines before the header, without the '#' and the newline */
+  int* index;  /* open-addressing hash of the column names (nindex slots, -1 empty): a name is
+                  found in O(1), so 60 000 columns are not 60 000^2 string compares */
+  int nindex;
 } fmbTable;
 
 /* 0, or -1 with a message "PATH:LINE: what was expected" in err. Refuses non-regular files. */
