@@ -316,6 +316,17 @@ void fmb_modes_free(fmbModes* md) {
   free(md);
 }
 
+/* LAPACK reports a bad argument through xerbla, whose reference version prints a line and STOPs:
+   the calling program would end with exit status 0. The library never ends its caller, so this
+   definition (found before liblapack's, which the library links) only returns: the routine then
+   returns with info < 0, which every call here checks. */
+FMB_API void xerbla_(const char* name, const int* info, int len);
+void xerbla_(const char* name, const int* info, int len) {
+  (void)name;
+  (void)info;
+  (void)len;
+}
+
 int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
               fmbModes** out, fmbDiag* diag) {
   fmbDiag local;
@@ -326,6 +337,21 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     return FMB_EXIT_BAD_INPUT;
   }
   *out = NULL;
+  if (method < FMB_EIGEN_AUTO || method > FMB_EIGEN_SPARSE) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: method %d is none of FMB_EIGEN_AUTO, _DENSE, _SPARSE",
+                 method);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  /* a state that is not finite is refused here: LAPACK would be handed NaN workspace sizes and
+     its error handler (xerbla, below) would end the calling program */
+  int bad = isfinite(t) ? -1 : 0;
+  for (int i = 0; i < m->ny && bad < 0; ++i)
+    if (!isfinite(y[i]) || !isfinite(yp[i])) bad = i + 1;
+  if (bad >= 0) {
+    if (bad == 0) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the time t is not finite");
+    else fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the state is not finite (y or yp [%d])", bad - 1);
+    return FMB_EXIT_BAD_INPUT;
+  }
   const int nq = m->nq, nc = m->nc, ny = m->ny;
   const double speed = state_speed(m, y, y + nq);
   int rc = 0, info = 0, rank = 0, nr = nq, nvec = 0, nroot = 0, symmetric = 0, inverted = 0, sparse_used = 0;
@@ -675,8 +701,10 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
                     fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (ncol <= 0 || !names || (nrow > 0 && !values)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns or no values");
+  int named = names != NULL;
+  for (int i = 0; named && i < ncol; ++i) named = names[i] != NULL;
+  if (ncol <= 0 || !named || nrow < 0 || (nrow > 0 && !values)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns, a NULL name, or no values");
     return FMB_EXIT_BAD_INPUT;
   }
   fmbCsv* c = fmb_csv_open(path, diag);
@@ -723,7 +751,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
                           const char* path, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (!m || !y || !yp || !md || md->nq != m->nq) {
+  if (!m || !y || !yp || !md || md->nq != m->nq || md->count < 0 || (md->count > 0 && !md->shape_re)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
   }
@@ -778,8 +806,10 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
                              double amplitude, int frames, const char* dir, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_animation: NULL or mismatched arguments");
+  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || !md->shape_re || !md->frequency ||
+      frames < 2 || frames > 100000 || !isfinite(amplitude) || !isfinite(t)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0,
+                 "fmb_write_mode_animation: NULL or mismatched arguments (frames 2..100000, amplitude and t finite)");
     return FMB_EXIT_BAD_INPUT;
   }
   const int nq = m->nq;

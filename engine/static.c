@@ -511,6 +511,11 @@ int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_static: NULL model, state or result");
     return FMB_EXIT_BAD_INPUT;
   }
+  if (opt && ((opt->has_t && !isfinite(opt->t)) || !(opt->tol >= 0.0) || opt->max_iter < 0 || opt->max_halvings < 0)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_static: options out of range (t not finite, or a negative tol, max_iter or max_halvings)");
+    return FMB_EXIT_BAD_INPUT;
+  }
   fmbWorkspace* w = fmb_workspace_new(m);
   if (!w) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");

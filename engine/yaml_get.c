@@ -518,6 +518,7 @@ static int table_file(fmbParser* p, fmbNode n, const char* key, double** x, doub
 }
 
 int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, double** x, double** y, int* n) {
+  if (!p || !key || !x || !y || !n) return -1; /* a plugin bug: no parser to report it through */
   fmbNode node = fmb_find_key(p, map, key);
   *x = *y = NULL;
   *n = 0;
