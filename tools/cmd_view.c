@@ -287,6 +287,12 @@ int fmb_cmd_view(int argc, char** argv) {
     fmb_table_free(&tb);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
+  /* the scene's table files are inputs too, known now that it is loaded */
+  if (fmb_cli_check_output_not_input(out, NULL, 0)) {
+    fmb_free(m);
+    fmb_table_free(&tb);
+    return FMB_EXIT_BAD_INPUT;
+  }
   fmbDrawing* d = fmb_drawing_new(m);
   const int nb = fmb_model_nbody(m);
   ViewBody* vb = calloc((size_t)nb + 1, sizeof *vb);
