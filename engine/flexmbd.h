@@ -466,6 +466,10 @@ typedef struct fmbDrawing {
   fmbDrawCell* cell;
   int* conn;
 } fmbDrawing;
+/* the SI unit of a CSV column the engine itself defines ("t": s; BODY.x: m; BODY.omega: rad/s;
+   JOINT.power: W; JOINT.work and energy.*: J; JOINT.reaction_x: N; reaction_torque: N m;
+   BODY.shapeK_x: m), or NULL (a type's own output, whose unit is not declared; unknown names) */
+FMB_API const char* fmb_output_unit(const char* column);
 /* NULL when m is NULL or out of memory; free with fmb_drawing_free (NULL allowed) */
 FMB_API fmbDrawing* fmb_drawing_new(const fmbModel* m);
 FMB_API void fmb_drawing_free(fmbDrawing* d);

@@ -195,24 +195,31 @@ int fmb_table_col(const fmbTable* tb, const char* name) {
 
 double fmb_table_t_end(const fmbTable* tb) { return fmb_table_at(tb, tb->nrow - 1, 0); }
 
-void fmb_table_column_error(const fmbTable* a, int ca, const fmbTable* b, int cb, fmbColumnError* e) {
-  memset(e, 0, sizeof *e);
+int fmb_table_at_time(const fmbTable* b, int cb, double t, long* j, double* value) {
+  if (b->nrow == 0) return -1;
   const double t_lo = fmb_table_at(b, 0, 0), t_hi = fmb_table_t_end(b);
   const double tol_t = 1e-9 * fmax(1.0, fmax(fabs(t_lo), fabs(t_hi)));
+  if (t < t_lo - tol_t || t > t_hi + tol_t) return -1;
+  if (*j < 0 || *j >= b->nrow || fmb_table_at(b, *j, 0) > t + tol_t) *j = 0;
+  while (*j + 1 < b->nrow && fmb_table_at(b, *j + 1, 0) <= t + tol_t) ++*j;
+  const double t0 = fmb_table_at(b, *j, 0);
+  if (fabs(t0 - t) <= tol_t || *j + 1 >= b->nrow) {
+    *value = fmb_table_at(b, *j, cb);
+  } else {
+    const double s = (t - t0) / (fmb_table_at(b, *j + 1, 0) - t0);
+    *value = (1.0 - s) * fmb_table_at(b, *j, cb) + s * fmb_table_at(b, *j + 1, cb);
+  }
+  return 0;
+}
+
+void fmb_table_column_error(const fmbTable* a, int ca, const fmbTable* b, int cb, fmbColumnError* e) {
+  memset(e, 0, sizeof *e);
   int nonfinite = 0;
   long j = 0; /* b's interval start */
   for (long k = 0; k < a->nrow; ++k) {
     const double t = fmb_table_at(a, k, 0);
-    if (t < t_lo - tol_t || t > t_hi + tol_t) continue;
-    while (j + 1 < b->nrow && fmb_table_at(b, j + 1, 0) <= t + tol_t) ++j;
-    const double t0 = fmb_table_at(b, j, 0);
     double bv;
-    if (fabs(t0 - t) <= tol_t || j + 1 >= b->nrow) {
-      bv = fmb_table_at(b, j, cb);
-    } else {
-      const double s = (t - t0) / (fmb_table_at(b, j + 1, 0) - t0);
-      bv = (1.0 - s) * fmb_table_at(b, j, cb) + s * fmb_table_at(b, j + 1, cb);
-    }
+    if (fmb_table_at_time(b, cb, t, &j, &bv)) continue;
     const double err = fabs(fmb_table_at(a, k, ca) - bv);
     if (!isfinite(err)) nonfinite = 1;
     if (err > e->max_abs || e->rows == 0) {

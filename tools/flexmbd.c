@@ -6,6 +6,14 @@
 
 #include "cli.h"
 
+/* set by CMakeLists.txt from project() and `git rev-parse` (as in regression references) */
+#ifndef FLEXMBD_VERSION
+#define FLEXMBD_VERSION "unknown"
+#endif
+#ifndef FLEXMBD_COMMIT
+#define FLEXMBD_COMMIT "unknown"
+#endif
+
 typedef struct {
   const char* name;
   int (*main)(int argc, char** argv);
@@ -47,6 +55,7 @@ static const Command commands[] = {
 
 static void usage(FILE* f) {
   for (int i = 0; i < NCOMMANDS; ++i) fprintf(f, "%s flexmbd %s\n", i ? "      " : "usage:", commands[i].usage);
+  fprintf(f, "       flexmbd --version\n");
   fprintf(f, "PATH addresses any scene value, bodies and joints by name: solver.rtol=1e-8, bodies.beam.elements=32\n"
              "exit codes: 0 ok, 1 beyond tolerance (compare, regress), 2 bad input, 3 solver failure, 4 interrupted\n");
 }
@@ -57,6 +66,10 @@ int main(int argc, char** argv) {
     return FMB_EXIT_BAD_INPUT;
   }
   const char* cmd = argv[1];
+  if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "version") == 0) {
+    printf("flexmbd %s (commit %s, plugin ABI %d)\n", FLEXMBD_VERSION, FLEXMBD_COMMIT, FMB_ABI_VERSION);
+    return 0;
+  }
   if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
     for (int i = 0; argc == 3 && i < NCOMMANDS; ++i)
       if (strcmp(argv[2], commands[i].name) == 0) {
