@@ -401,6 +401,7 @@ typedef struct fmbRunOptions {
   int progress;
   double progress_after_s;
   const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
+  int vtk_every;       /* the animation takes every Nth output row, from the first (0, 1: each) */
   /* may be NULL; when *stop becomes non-zero (e.g. set by a SIGINT handler) the run ends after
      the step in progress, keeps its rows and returns FMB_EXIT_INTERRUPTED */
   const volatile sig_atomic_t* stop;

@@ -3,6 +3,7 @@
  *                [--models zoac,foac,complete,exact]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
@@ -16,6 +17,7 @@ int fmb_cmd_run(int argc, char** argv) {
   const char* columns = NULL;
   int quiet = 0, progress = 0;
   const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
+  int vtk_every = 1;      /* --vtk-every N: of every Nth row */
   const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
@@ -36,6 +38,15 @@ int fmb_cmd_run(int argc, char** argv) {
       progress = 1;
     } else if (strcmp(a, "--vtk") == 0) {
       if (!(vtk = fmb_cli_value("run", argc, argv, &i, "a directory"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--vtk-every") == 0) {
+      const char* v = fmb_cli_value("run", argc, argv, &i, "a whole number N >= 1");
+      char* end = NULL;
+      const long n = v ? strtol(v, &end, 10) : 0;
+      if (!v || end == v || *end || n < 1 || n > 1000000000L) {
+        if (v) fprintf(stderr, "flexmbd run: --vtk-every expects a whole number N >= 1 (every Nth row), got '%s'\n", v);
+        return FMB_EXIT_BAD_INPUT;
+      }
+      vtk_every = (int)n;
     } else {
       fprintf(stderr, "flexmbd run: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -82,6 +93,7 @@ int fmb_cmd_run(int argc, char** argv) {
                        .progress = !quiet && (progress || isatty(STDERR_FILENO)),
                        .progress_after_s = progress ? 0.0 : 2.0,
                        .vtk_dir = vtk,
+                       .vtk_every = vtk_every,
                        .stop = stop};
   int rc = fmb_run(m, &opt, &stats, &diag);
   if (rc) fmb_cli_print_diag(&diag);

@@ -23,7 +23,7 @@ typedef struct {
 
 static const Command commands[] = {
     {"run", fmb_cmd_run,
-     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR]\n"
+     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR [--vtk-every N]]\n"
      "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
      "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each", 0},
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run", 0},
