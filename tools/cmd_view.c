@@ -107,8 +107,12 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
     if (c > 1) fputc(',', f);
     json_string(f, tb->name[c]);
   }
-  fputs("],\"units\":[", f);
-  for (int c = 1; c < tb->ncol; ++c) fputs(c > 1 ? ",\"\"" : "\"\"", f);
+  fputs("],\"units\":[", f); /* the units the library knows (fmb_output_unit), "" otherwise */
+  for (int c = 1; c < tb->ncol; ++c) {
+    if (c > 1) fputc(',', f);
+    const char* unit = fmb_output_unit(tb->name[c]);
+    json_string(f, unit ? unit : "");
+  }
   fputs("],\"data\":[", f);
   for (int c = 1; c < tb->ncol; ++c) {
     fputs(c > 1 ? ",\n[" : "\n[", f);
