@@ -471,6 +471,9 @@ typedef struct fmbDrawing {
    JOINT.power: W; JOINT.work and energy.*: J; JOINT.reaction_x: N; reaction_torque: N m;
    BODY.shapeK_x: m), or NULL (a type's own output, whose unit is not declared; unknown names) */
 FMB_API const char* fmb_output_unit(const char* column);
+/* s as XML text or attribute value (& < > " ' escaped, control characters other than \n \t
+   dropped): the VTK collection, JUnit reports */
+FMB_API void fmb_write_xml_text(FILE* f, const char* s);
 /* NULL when m is NULL or out of memory; free with fmb_drawing_free (NULL allowed) */
 FMB_API fmbDrawing* fmb_drawing_new(const fmbModel* m);
 FMB_API void fmb_drawing_free(fmbDrawing* d);

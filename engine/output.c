@@ -33,6 +33,21 @@ static int lookup(const char* const* names, const char* s) {
   return -1;
 }
 
+void fmb_write_xml_text(FILE* f, const char* s) {
+  if (!f || !s) return;
+  for (; *s; ++s) {
+    switch (*s) {
+      case '&': fputs("&amp;", f); break;
+      case '<': fputs("&lt;", f); break;
+      case '>': fputs("&gt;", f); break;
+      case '"': fputs("&quot;", f); break;
+      case '\'': fputs("&apos;", f); break;
+      default: /* XML 1.0 has no other control characters */
+        if ((unsigned char)*s >= 0x20 || *s == '\n' || *s == '\t') fputc(*s, f);
+    }
+  }
+}
+
 const char* fmb_output_unit(const char* column) {
   if (!column) return NULL;
   if (strcmp(column, "t") == 0) return "s";

@@ -50,19 +50,6 @@ struct fmbVtk {
   uint8_t* u8;
 };
 
-/* s in an XML attribute value (the scene's file name in the collection) */
-static void xml_text(FILE* f, const char* s) {
-  for (; *s; ++s) {
-    switch (*s) {
-      case '&': fputs("&amp;", f); break;
-      case '<': fputs("&lt;", f); break;
-      case '>': fputs("&gt;", f); break;
-      case '"': fputs("&quot;", f); break;
-      case '\'': fputs("&apos;", f); break;
-      default: fputc(*s, f);
-    }
-  }
-}
 
 static const char pvd_tail[] = "  </Collection>\n</VTKFile>\n";
 
@@ -245,7 +232,7 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   /* the new entry replaces the collection's closing tags, which follow it again */
   if (fseek(v->pvd, -(long)(sizeof pvd_tail - 1), SEEK_END) != 0) return -1;
   fprintf(v->pvd, "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"", t);
-  xml_text(v->pvd, name);
+  fmb_write_xml_text(v->pvd, name);
   fprintf(v->pvd, "\"/>\n%s", pvd_tail);
   if (fflush(v->pvd) != 0 || ferror(v->pvd)) return -1;
   v->step++;

@@ -8,6 +8,15 @@
 
 #include "flexmbd.h"
 
+/* the version and commit the build records (CMakeLists.txt passes them to the files that print
+   them: `flexmbd --version`, regression references) */
+#ifndef FLEXMBD_VERSION
+#define FLEXMBD_VERSION "unknown"
+#endif
+#ifndef FLEXMBD_COMMIT
+#define FLEXMBD_COMMIT "unknown"
+#endif
+
 #define FMB_CLI_MAX_OVERRIDES 256
 
 /* a scene and its --set overrides, as `run`, `check` and the analysis commands take them */

@@ -28,13 +28,6 @@
 #include "cli.h"
 #include "csv_table.h"
 
-#ifndef FLEXMBD_VERSION
-#define FLEXMBD_VERSION "unknown"
-#endif
-#ifndef FLEXMBD_COMMIT
-#define FLEXMBD_COMMIT "unknown"
-#endif
-
 /* Default column tolerance (docs/regression.md): --bless also runs the scene at rtol x 0.97 and
    x 1.03. Those companions take other, equally valid step sequences, as another compiler or a fused
    multiply-add does; their largest difference from the run, per column, is the column's noise:
@@ -702,19 +695,6 @@ static int bless_job(Job* job, const Options* o) {
  * Reporting
  * ---------------------------------------------------------------------------------------------- */
 
-static void xml_escaped(FILE* f, const char* s) {
-  for (; *s; ++s) {
-    switch (*s) {
-      case '&': fputs("&amp;", f); break;
-      case '<': fputs("&lt;", f); break;
-      case '>': fputs("&gt;", f); break;
-      case '"': fputs("&quot;", f); break;
-      default:
-        if ((unsigned char)*s >= 0x20 || *s == '\n' || *s == '\t') fputc(*s, f);
-    }
-  }
-}
-
 static int write_junit(const char* path, Job* const* jobs, int n) {
   char err[300] = "";
   fmbSafeFile* sf = fmb_safe_open(path, err, sizeof err);
@@ -737,20 +717,20 @@ static int write_junit(const char* path, Job* const* jobs, int n) {
   for (int i = 0; i < n; ++i) {
     const Job* j = jobs[i];
     fprintf(f, "  <testcase classname=\"regress\" name=\"");
-    xml_escaped(f, j->scene);
+    fmb_write_xml_text(f, j->scene);
     fprintf(f, "\" time=\"%.4f\"", j->run.cpu_s);
     if (!j->failed && !j->bad_input) {
       fprintf(f, "/>\n");
       continue;
     }
     fprintf(f, ">\n    <%s message=\"", j->bad_input ? "error" : "failure");
-    xml_escaped(f, j->why);
+    fmb_write_xml_text(f, j->why);
     fprintf(f, "\">");
     if (j->worst[0]) {
       char detail[400];
       snprintf(detail, sizeof detail, "worst column %s: max error %.3g, tolerance %.3g, at t = %.6g", j->worst,
                j->worst_err, j->worst_tol, j->worst_t);
-      xml_escaped(f, detail);
+      fmb_write_xml_text(f, detail);
     }
     fprintf(f, "</%s>\n  </testcase>\n", j->bad_input ? "error" : "failure");
   }

@@ -6,14 +6,6 @@
 
 #include "cli.h"
 
-/* set by CMakeLists.txt from project() and `git rev-parse` (as in regression references) */
-#ifndef FLEXMBD_VERSION
-#define FLEXMBD_VERSION "unknown"
-#endif
-#ifndef FLEXMBD_COMMIT
-#define FLEXMBD_COMMIT "unknown"
-#endif
-
 typedef struct {
   const char* name;
   int (*main)(int argc, char** argv);

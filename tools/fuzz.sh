@@ -44,22 +44,17 @@ run() { # NAME CORPUS... : one harness, SECONDS, log in $build/fuzz-NAME.log
     "$@" >"$build/fuzz-$name.log" 2>&1
 }
 status=0
-run load "$corpus/load" "$corpus/seeds-load" "$src/tests/fuzz/regressions/load" &
-p1=$!
-run override "$corpus/override" "$src/tests/fuzz/override_seeds" "$src/tests/fuzz/regressions/override" &
-p2=$!
-run compare "$corpus/compare" "$src/tests/fuzz/compare_seeds" "$src/tests/fuzz/regressions/compare" &
-p3=$!
-wait $p1 || status=1
-wait $p2 || status=1
-wait $p3 || status=1
-# the second pair after the first: at most 3 harnesses at once (JOBS cores)
-run table "$corpus/table" "$src/tests/fuzz/table_seeds" "$src/tests/fuzz/regressions/table" &
-p4=$!
-run reference "$corpus/reference" "$src/tests/fuzz/reference_seeds" "$src/tests/fuzz/regressions/reference" &
-p5=$!
-wait $p4 || status=1
-wait $p5 || status=1
+# three harnesses at a time: load, override, compare; then table, reference
+for group in "load override compare" "table reference"; do
+  pids=
+  for name in $group; do
+    seeds=$src/tests/fuzz/${name}_seeds
+    [ "$name" = load ] && seeds=$corpus/seeds-load
+    run "$name" "$corpus/$name" "$seeds" "$src/tests/fuzz/regressions/$name" &
+    pids="$pids $!"
+  done
+  for p in $pids; do wait "$p" || status=1; done
+done
 
 for name in load override compare table reference; do
   log=$build/fuzz-$name.log
