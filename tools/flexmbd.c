@@ -29,6 +29,8 @@ static const Command commands[] = {
     {"plot", fmb_cmd_plot,
      "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
+     "      [--diff REF.csv]   each column minus REF's (with --abs --logy: an error plot)\n"
+     "      [--shape BEAM --at t1,t2,...]   the beam's centreline at those times (BEAM.shape columns)\n"
      "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)", 0},
     {"view", fmb_cmd_view,
      "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--set PATH=VALUE]... [--plugin x.so]...\n"
