@@ -1,8 +1,9 @@
 #!/bin/sh
 # code_from_data.sh FLEXMBD SOURCE_DIR WORK_DIR — data never reaches a shell (issue 27): gnuplot
 # runs `backquotes` in double-quoted strings, so a CSV column, a file name or a scene name holding
-# one once ran a command through `plot` and `campbell`. They are passed single-quoted now (and a
-# name with a line break is refused): no command runs, and the plot is still made. POSIX sh.
+# one once ran a command through `plot` and `campbell`. The numbers now go to gnuplot as a data
+# file and every string single-quoted (a title with a line break is refused): no command runs,
+# and the plot is still made. POSIX sh.
 set -u
 . "$(dirname "$0")/../file_test_lib.sh" "$@"
 command -v gnuplot >/dev/null 2>&1 || {
@@ -26,15 +27,19 @@ cp "$src/scenes/campbell_beam.yaml" "c\`touch PWNED5\`.yaml"
 "$bin" campbell "c\`touch PWNED5\`.yaml" --speed joints.spin.speed --speeds 0:2:2 --count 1 -o c.csv 2>err.txt ||
   fail "campbell on a scene named with backquotes" "exit $?: $(tail -n 1 err.txt)"
 [ -s c.png ] || fail "campbell on a scene named with backquotes" "no figure"
-# a line break in a name is refused, not passed on
+# a line break: in a file name it never reaches gnuplot (the data go as a file of numbers); in a
+# title it is refused, not passed on
 printf 't,a\n0,1\n1,2\n' >"nl
 !touch PWNED6
 .csv"
 "$bin" plot "nl
 !touch PWNED6
-.csv" -o nl.png 2>err.txt
-[ $? = 2 ] || fail "plot of a file named with a line break" "not refused"
-for k in 1 2 3 4 5 6; do
+.csv" -o nl.png 2>err.txt || fail "plot of a file named with a line break" "exit $?: $(tail -n 1 err.txt)"
+"$bin" plot evil.csv -o nl2.png --title "a
+!touch PWNED7" 2>err.txt
+[ $? = 2 ] || fail "plot with a line break in the title" "not refused"
+grep -q "control character" err.txt || fail "plot with a line break in the title" "$(tail -n 1 err.txt)"
+for k in 1 2 3 4 5 6 7; do
   [ -e "PWNED$k" ] && fail "code from data" "PWNED$k was created: a command ran"
 done
 file_test_done code_from_data
