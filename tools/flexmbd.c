@@ -25,7 +25,7 @@ static const Command commands[] = {
      "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references", 1},
     {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs", 0},
     {"conform", fmb_cmd_conform,
-     "conform [--plugin x.so]... [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure", 0},
+     "conform [--plugin x.so]... [--work DIR] [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure", 0},
     {"plot", fmb_cmd_plot,
      "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
