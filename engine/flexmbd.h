@@ -152,8 +152,13 @@ typedef struct fmbParam {
 
 /* type flags (fmbBodyType.flags, fmbJointType.flags) */
 enum {
-  FMB_TYPE_DOES_WORK = 1 << 0 /* feeds energy in (a prescribed motion, an applied load): conform
-                                 skips the energy-conservation run */
+  FMB_TYPE_DOES_WORK = 1 << 0, /* feeds energy in (a prescribed motion, an applied load): conform
+                                  skips the energy-conservation run */
+  /* conform's fixture (fmb_conform) is made of the first registered body type and joint type
+     with this flag, so that the engine names no type: the body must take mass, inertia,
+     position, velocity and angular_velocity (a rigid body with a frame), the joint body1, body2
+     and point2 (a pin joining two bodies' points) */
+  FMB_TYPE_CONFORM_FIXTURE = 1 << 1
 };
 
 /* ---------------------------------------------------------------------------------------------
@@ -373,7 +378,7 @@ FMB_API const fmbJointType* fmb_registry_joint(const fmbRegistry* reg, int i);
 /* where type i came from: "built-in" or the plugin's file */
 FMB_API const char* fmb_registry_body_origin(const fmbRegistry* reg, int i);
 FMB_API const char* fmb_registry_joint_origin(const fmbRegistry* reg, int i);
-/* the types shipped with flexmbd (tools/builtin.c), registered like any plugin */
+/* the types shipped with flexmbd (builtin/builtin.c), registered like any plugin */
 FMB_API const fmbPlugin* fmb_builtin_plugin(void);
 
 /* ---------------------------------------------------------------------------------------------
@@ -572,6 +577,85 @@ FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* 
 /* a table of named numeric columns (row-major values), through the one CSV writer */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
+
+/* A scene as fmb_load takes it, for the analyses that load it again with an override of their own
+   (one per hub speed, one per beam model): path, the caller's overrides and the registry, read
+   only during the call. */
+typedef struct fmbSceneSource {
+  const char* path;
+  const char* const* overrides;
+  int noverrides;
+  const fmbRegistry* reg;
+} fmbSceneSource;
+
+/* Load the scene with `extra` (may be NULL) after its overrides, and solve its static or steady
+   state (fmb_static): *m, *y, *yp are the caller's (fmb_free, free) also on failure (NULL when
+   not made). Returns 0 or an exit code with *diag. */
+FMB_API int fmb_load_steady(const fmbSceneSource* scene, const char* extra, const fmbStaticOptions* opt, fmbModel** m,
+                            double** y, double** yp, fmbStaticResult* res, fmbDiag* diag);
+
+/* ---------------------------------------------------------------------------------------------
+ * Campbell diagram (engine/campbell.c; docs/analysis.md): for each hub speed the steady state
+ * (fmb_load_steady with `speed_key=SPEED`), then its modes, each mode followed from speed to
+ * speed by its shape (the largest modal assurance criterion with its shape at the speed before,
+ * assigned greedily), not by its rank in frequency.
+ * ------------------------------------------------------------------------------------------- */
+#define FMB_CAMPBELL_MAX_MODES 64
+typedef struct fmbCampbellOptions {
+  const char* speed_key;   /* the scene key that sets the hub speed, e.g. joints.spin.speed */
+  int count;               /* modes followed, 1 .. FMB_CAMPBELL_MAX_MODES (0 = 4) */
+  int method;              /* FMB_EIGEN_* */
+  fmbStaticOptions steady; /* for fmb_static at each speed */
+} fmbCampbellOptions;
+
+typedef struct fmbCampbell {
+  int nspeed;        /* speeds asked for */
+  int done;          /* speeds computed, from the first on (rows filled) */
+  int count;         /* modes followed */
+  double* speed;     /* nspeed, rad/s */
+  double* frequency; /* nspeed x count, row i at i * count: mode k at speed i (rad/s; negative = divergent) */
+  double* mac;       /* nspeed x count: MAC of mode k with its own shape at speed i - 1 (1 at the first
+                        speed); below 0.5 the speeds are too far apart to follow it reliably */
+  /* internal: the last speed's modes and which of them each followed mode is */
+  fmbModes* last;
+  int* track;
+} fmbCampbell;
+
+/* The diagram at speeds[0 .. nspeed). Returns 0, or an exit code with *diag (the scene, a speed
+   whose steady state or modes fail, fewer modes than opt->count); *out (free it with
+   fmb_campbell_free) holds the speeds done before a failure as well. */
+FMB_API int fmb_campbell(const fmbSceneSource* scene, const fmbCampbellOptions* opt, const double* speeds, int nspeed,
+                         fmbCampbell** out, fmbDiag* diag);
+/* The same in steps, for a caller that computes the speeds' modes itself (in other processes):
+   an empty diagram; the modes at one speed (at least opt->count + FMB_CAMPBELL_EXTRA_MODES of
+   them when the system has that many, so that a mode crossing from above can be followed); and
+   the modes at speeds[c->done] added in order (c takes `modes` over, also on failure). */
+#define FMB_CAMPBELL_EXTRA_MODES 6
+FMB_API fmbCampbell* fmb_campbell_new(const double* speeds, int nspeed, int count);
+FMB_API int fmb_campbell_modes_at(const fmbSceneSource* scene, const fmbCampbellOptions* opt, double speed,
+                                  fmbModes** modes, fmbDiag* diag);
+FMB_API int fmb_campbell_add(fmbCampbell* c, fmbModes* modes, fmbDiag* diag);
+FMB_API void fmb_campbell_free(fmbCampbell* c);
+
+/* ---------------------------------------------------------------------------------------------
+ * One scene, several models (engine/models.c; docs/models.md): the scene run once per model,
+ * the named bodies' `model` key set to it (`bodies.NAME.model=M`, as --set would), the outputs
+ * side by side in one CSV: t (from the longest run), then each model's columns as NAME@MODEL. A
+ * model whose run stops keeps its rows; its later cells are `nan`.
+ * ------------------------------------------------------------------------------------------- */
+#define FMB_MODELS_MAX 8
+typedef struct fmbModelsResult {
+  int ran;                        /* models run, in order (their entries below are filled) */
+  int code[FMB_MODELS_MAX];       /* fmb_run's result for each */
+  fmbStats stats[FMB_MODELS_MAX];
+  fmbDiag diag[FMB_MODELS_MAX];   /* why a model's run stopped (code 0: it did not) */
+} fmbModelsResult;
+/* opt->csv_path (required, a file: not "-") receives the merged table; each run takes quiet and
+   stop from opt. Every model is loaded before any runs (a misspelt model is bad input, not a late
+   failure). Returns 0, or the largest exit code of the runs, or an exit code for the scene, the
+   models or the merged file with *diag saying why; *res (may be NULL) says what each run did. */
+FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int nbody, const char* const* models,
+                           int nmodel, const fmbRunOptions* opt, fmbModelsResult* res, fmbDiag* diag);
 
 /* ---------------------------------------------------------------------------------------------
  * Writing a file without losing one (engine/safe_file.c): the content goes to a temporary file

@@ -19,6 +19,7 @@
 #include <klu.h>
 
 #include "internal.h"
+#include "klu_policy.h"
 
 #define FMB_IC_PHI_TOL 1e-10   /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
 #define FMB_ASSEMBLY_TOL 1e-6  /* m or rad: a larger initial correction changes the mechanism */
@@ -348,10 +349,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   Triplets t = {0, 0, NULL, NULL, NULL};
   SuiteSparse_long *Ap = calloc((size_t)N + 1, sizeof(SuiteSparse_long)), *Ai = NULL;
   double* Ax = NULL;
-  klu_l_common common;
-  klu_l_defaults(&common);
-  klu_l_symbolic* sym = NULL;
-  klu_l_numeric* num = NULL;
+  fmbKlu* lu = NULL; /* klu.c; G_x keeps its pattern from one iteration to the next */
   int rc = (!x || !G || !Qj || !ewt || !blk || !Ap || !Rb || !scratch) ? FMB_EXIT_SOLVER : 0;
   const char* why = "out of memory computing initial accelerations";
   /* the joints' forces: all forces less the bodies' own (-R at a = 0) */
@@ -457,16 +455,14 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
         Ai[j + 1] = r;
         Ax[j + 1] = vv;
       }
-    if (!sym) sym = klu_l_analyze(N, Ap, Ai, &common);
-    if (num) klu_l_free_numeric(&num, &common);
-    num = sym ? klu_l_factor(Ap, Ai, Ax, sym, &common) : NULL;
-    if (!num) {
+    if (!lu) lu = fmb_klu_new(N, Ap, Ai, 0);
+    if (!lu || fmb_klu_factor(lu, Ax) != FMB_KLU_OK) {
       rc = FMB_EXIT_BAD_INPUT;
       why = "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
             "with redundant joints): cannot compute initial accelerations";
       break;
     }
-    if (!klu_l_solve(sym, num, N, 1, G, &common)) {
+    if (fmb_klu_solve(lu, G)) {
       rc = FMB_EXIT_SOLVER;
       break;
     }
@@ -491,8 +487,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
     memcpy(y + 2 * nq, lam, (size_t)nc * sizeof(double));
     memcpy(y + m->zoff, z, (size_t)nz * sizeof(double));
   }
-  if (num) klu_l_free_numeric(&num, &common);
-  if (sym) klu_l_free_symbolic(&sym, &common);
+  fmb_klu_free(lu);
   free(x), free(G), free(Qj), free(ewt), free(blk), free(Rb), free(scratch), free(Ap), free(Ai), free(Ax);
   free(t.row), free(t.col), free(t.val);
   return rc;

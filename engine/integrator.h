@@ -4,12 +4,15 @@
  * interrupts and the failure message's frame. A backend owns how the state advances from one
  * output time to the next and what it needs for that (its own vectors, matrices, solver).
  *
- * Built-in backends (integrator_*.c), chosen by fmb_integrator_for():
+ * Built-in backends (integrator_*.c), listed once in fmb_integrators[] (integrator_select.c) and
+ * chosen by fmb_integrator_for():
  *   ida        IDA (BDF, variable order and step) on the GGL index-2 system of system.c, KLU
  *   radau5     Radau IIA of order 5 (3 stages, after Hairer & Wanner's RADAU5) on the same GGL
  *              system, KLU real and complex (solver.integrator: radau5)
  *   projected  the index-1 form with minimum-norm multipliers and projections onto the
- *              constraints (solver.formulation: projected; passes singular configurations) */
+ *              constraints (solver.formulation: projected; passes singular configurations)
+ * A backend's name is its ops' .name: solver.integrator's words are the names of the GGL
+ * backends in the table, and the messages take the name from there. */
 #ifndef FMB_INTEGRATOR_H
 #define FMB_INTEGRATOR_H
 
@@ -17,6 +20,7 @@
 #include <stddef.h>
 
 #include "internal.h"
+#include "schur.h"
 
 typedef struct {
   const fmbModel* m;
@@ -29,7 +33,14 @@ typedef struct {
 enum { FMB_ADVANCE_OK = 0, FMB_ADVANCE_FAILED = -1, FMB_ADVANCE_INTERRUPTED = -2 };
 
 typedef struct fmbIntegratorOps {
-  const char* name;
+  const char* name; /* the word solver.integrator takes (GGL backends), and the one messages use */
+  /* 1: integrates the projected formulation (solver.formulation: projected, or auto after a
+     singular configuration); 0: a GGL backend, named by solver.integrator */
+  int projected;
+  /* optional: the backend's cross-key rules, checked at load once the bodies are parsed (e.g.
+     radau5 refuses formulation: projected). 0 when the model suits the backend, else -1 with the
+     error reported through fmb_parse_error at the offending key of the scene's `solver` node. */
+  int (*check)(const fmbModel* m, fmbParser* p, fmbNode solver);
   /* Set up from the consistent initial state y, yp (all ny unknowns: q, v, multipliers, a body's
      auxiliary unknowns) at t0. NULL with *diag set on failure. When m->need_work, the joints'
      powers (fmb_joint_power) are integrated from t0 into m->njoint work integrals. */
@@ -53,7 +64,17 @@ extern const fmbIntegratorOps fmb_integrator_ida;
 extern const fmbIntegratorOps fmb_integrator_projected;
 extern const fmbIntegratorOps fmb_integrator_radau5;
 
+/* every backend, NULL-terminated; the first GGL one is the default of solver.integrator */
+extern const fmbIntegratorOps* const fmb_integrators[];
+
 /* the backend the model's solver settings ask for */
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m);
+
+/* solver.integrator's words: the GGL backends' names, NULL-terminated, into names[cap] and their
+   ops into ops[cap] (same order); returns how many */
+int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int cap);
+
+/* the cross-key rules of every backend the model may run on: 0, or -1 with the parse error set */
+int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver);
 
 #endif

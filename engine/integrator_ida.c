@@ -412,6 +412,8 @@ static void ida_after_row(void* self, double t) {
 
 const fmbIntegratorOps fmb_integrator_ida = {
     .name = "ida",
+    .projected = 0,
+    .check = NULL,
     .create = ida_create,
     .advance = ida_advance,
     .work = ida_work,

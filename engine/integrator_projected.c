@@ -242,8 +242,19 @@ static void proj_stats(const void* self, fmbStats* st) {
   st->jacobians_reused = 0;
 }
 
+/* the projected formulation works on q and v alone, with the bodies' mass matrices */
+static int proj_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
+  if (m->nz > 0)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
+                           "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
+                           "its assembly: dense, or use formulation: ggl)");
+  return 0;
+}
+
 const fmbIntegratorOps fmb_integrator_projected = {
     .name = "projected",
+    .projected = 1,
+    .check = proj_check,
     .create = proj_create,
     .advance = proj_advance,
     .work = proj_work,

@@ -86,7 +86,7 @@ typedef struct fmbSolverSettings {
   int positions_only; /* error test on q only (error_control: positions) */
   /* the GGL system's integrator: IDA (BDF, default) or Radau IIA of order 5 (integrator_radau.c),
      which keeps order 5 on undamped structural modes where BDF is capped at 2 */
-  enum { FMB_INTEG_IDA = 0, FMB_INTEG_RADAU5 = 1 } integrator;
+  const struct fmbIntegratorOps* integrator; /* one of fmb_integrators[] (integrator.h), never projected */
   long max_steps_per_output;
 } fmbSolverSettings;
 
@@ -201,10 +201,20 @@ fmbNode fmbp_seq_item(fmbParser* p, fmbNode seq, int i);
 const char* fmbp_scalar(fmbParser* p, fmbNode n); /* NULL if not a scalar */
 int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]);
 
-/* ---- diag ---- */
+/* ---- diag.c ---- */
 void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
+   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
+#define FMB_OVERRIDE_SHOWN 80
+const char* fmbp_shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]);
+/* a warning about a scene's node that does not stop the load: FILE:LINE:COL: warning: ... */
+void fmbp_warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
@@ -252,9 +262,6 @@ void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const do
                           double* vel);
 double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        const double* lambda);
-/* multipliers consistent with (q, v) at t (ic.c's augmented system; IDA's own between steps are
-   interpolated outside its error test), or y's when that system cannot be solved */
-const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y);
 /* force (global x, y) and torque (about the joint's point) that joint j's constraint forces exert
    on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
 int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
@@ -265,6 +272,9 @@ double* fmb_workspace_work(fmbWorkspace* w);
 /* per constraint row: 1 = redundant, out of the equations; *count (may be NULL) = how many */
 unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count);
 double* fmb_workspace_spring_energy0(fmbWorkspace* w);
+/* the slot of an object a layer above keeps with the workspace (output.c's multipliers), freed
+   with it by free_fn (set when not NULL): the workspace calls nothing above system.c */
+void** fmb_workspace_attached(fmbWorkspace* w, void (*free_fn)(void*));
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
 /* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1.
@@ -275,25 +285,6 @@ int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q
 /* ---- pattern.c ---- */
 int fmb_pattern_build(fmbModel* m);
 void fmb_pattern_free(fmbModel* m);
-void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals,
-                       int ld, double scale);
-void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v);
-
-/* ---- schur.c: KLU on the GGL Newton systems with the position rows eliminated ---- */
-/* One Newton matrix on the model's pattern, real or complex (values interleaved (re, im)), solved
-   through the Schur complement of its position rows. Factor: 0 ok, 1 recoverable (singular),
-   -1 KLU failed outright; solve in place: 0 ok, 1 failed. Allocates in new only (and when KLU
-   picks a new pivot order). */
-typedef struct fmbSchur fmbSchur;
-fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values);
-int fmb_schur_factor(fmbSchur* s, const double* J);
-int fmb_schur_solve(fmbSchur* s, double* x);
-void fmb_schur_forget(fmbSchur* s); /* drop the factorization: the next one chooses pivots afresh */
-void fmb_schur_free(fmbSchur* s);
-/* the real one as IDA's SUNLinearSolver */
-struct _generic_SUNLinearSolver;
-struct _SUNContext;
-struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
 
 /* ---- integrator_ida.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
 struct _generic_SUNMatrix;
@@ -313,10 +304,6 @@ int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order
 /* constraint rows that depend on the others at the initial state and nearby (redundant, not a
    singular start); 0 when none or when the joints cannot be satisfied (the run says why) */
 int fmb_count_redundant(const fmbModel* m);
-/* KLU refactorizations keep their pivot order while the cheap estimate 1/rcond, then condest,
-   stay below eps^(-2/3) = 1 / FMB_KLU_RCOND_TINY (as SUNDIALS' KLU module; schur_kernels.h,
-   augmented.c) */
-#define FMB_KLU_RCOND_TINY 3.666852862501036e-11
 typedef struct fmbAugmented fmbAugmented; /* augmented.c: the index-1 system on a sparse matrix */
 enum { FMB_AUG_MASS_FAILED = 1, FMB_AUG_FORCES_FAILED, FMB_AUG_SINGULAR, FMB_AUG_NOT_FINITE };
 fmbAugmented* fmb_augmented_new(const fmbModel* m);
@@ -383,16 +370,9 @@ double fmb_fd_increment(double y, double ewt);
 int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
                          const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
                          double* M, double* work, double* scratch);
-/* the same over a body's sparse pattern (b->pcolptr/prowind), one residual pair per colour:
-   K = d[R; Rz]/dq (and d/dz in the z columns), C = d/dv, M = d/da, each in pattern order
-   (pnnz). z: the body's auxiliary unknowns (NULL when nz = 0). scratch: fmb_fd_sparse_scratch. */
-size_t fmb_fd_sparse_scratch(const fmbBodyInst* b);
-int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                       const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                       double* work, double* scratch);
-/* ---- pattern.c: a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
-   pattern_jacobian when it has one, else by differences (fmb_fd_body_sparse); scratch doubles:
-   fmb_body_sparse_scratch ---- */
+/* a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
+   pattern_jacobian when it has one, else by differences over its pattern, one residual pair per
+   colour; scratch doubles: fmb_body_sparse_scratch */
 size_t fmb_body_sparse_scratch(const fmbBodyInst* b);
 int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                            const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,

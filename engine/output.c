@@ -357,6 +357,44 @@ int fmb_csv_values(fmbCsv* c, const double* values) {
   return write_line(c, c->line, used) ? -1 : 0;
 }
 
+/* The multipliers the reaction outputs show: consistent with (q, v) at t from the augmented
+   system (augmented.c; IDA's own between steps are interpolated outside its error test), or y's
+   when that system cannot be solved. Made at the first row that needs them and kept with the
+   workspace, which frees it. */
+typedef struct {
+  fmbAugmented* aug; /* NULL with a body that declared a sparse pattern (a banded beam: the
+                        augmented system takes (nq + nc)^2 memory there), where IDA's own are used */
+  double* lambda;
+} OutputMultipliers;
+
+static void output_multipliers_free(void* p) {
+  OutputMultipliers* om = p;
+  if (!om) return;
+  fmb_augmented_free(om->aug);
+  free(om->lambda);
+  free(om);
+}
+
+static const double* output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y) {
+  void** slot = fmb_workspace_attached(w, output_multipliers_free);
+  OutputMultipliers* om = *slot;
+  if (!om && (om = calloc(1, sizeof *om)) != NULL) {
+    *slot = om;
+    if (!fmb_model_has_sparse_body(m)) {
+      om->aug = fmb_augmented_new(m);
+      om->lambda = calloc((size_t)m->nc + 1, sizeof(double));
+    }
+  }
+  if (!om || !om->aug || !om->lambda) return y + 2 * m->nq;
+  int nred = 0;
+  fmb_workspace_redundant(w, &nred);
+  /* with redundant rows the multipliers are not unique: the minimum-norm ones, the limit of the
+     Tikhonov-regularized system as its shift -> 0 */
+  if (fmb_augmented_solve(m, w, om->aug, t, y, y + m->nq, NULL, nred ? FMB_MIN_NORM_SHIFT : 0.0, NULL, om->lambda))
+    return y + 2 * m->nq;
+  return om->lambda;
+}
+
 /* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row) {
   const double *q = y, *v = y + m->nq;
@@ -365,7 +403,7 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
   double cpos = 0.0, cvel = 0.0;
   if (m->need_energy) fmb_energy(m, w, t, q, v, &e);
   if (m->need_constraint) fmb_constraint_norms(m, w, t, q, v, &cpos, &cvel);
-  const double* lam = m->need_multipliers ? fmb_output_multipliers(m, w, t, y) : y + 2 * m->nq;
+  const double* lam = m->need_multipliers ? output_multipliers(m, w, t, y) : y + 2 * m->nq;
   double* work = fmb_workspace_plugin(w);
   for (int i = 0; i < m->noutput; ++i) {
     const fmbOutput* o = &m->output[i];

@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "integrator.h"
 #include "internal.h"
 
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
@@ -58,8 +59,11 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
-  static const char* const integrators[] = {"ida", "radau5", NULL}; /* order of FMB_INTEG_* */
-  int formulation = FMB_FORM_AUTO, integrator = FMB_INTEG_IDA;
+  /* the GGL backends' names, from the one table of integrators (integrator_select.c) */
+  const char* integrators[8];
+  const fmbIntegratorOps* integrator_ops[8];
+  fmb_integrator_choices(integrators, integrator_ops, 8);
+  int formulation = FMB_FORM_AUTO, integrator = 0;
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
@@ -78,17 +82,7 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_choice(p, node, "integrator", 0, integrators, &integrator))
     return -1;
   s->formulation = formulation;
-  s->integrator = integrator;
-  /* radau5 integrates the GGL system; the projected formulation has its own backend (CVODE) */
-  if (integrator == FMB_INTEG_RADAU5 && formulation == FMB_FORM_PROJECTED)
-    return fmb_parse_error(p, fmb_find_key(p, node, "integrator"),
-                           "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
-                           "integrator (CVODE): drop one of the two keys");
-  /* radau5's systems are complex as well as real; SUNDIALS' dense LU is real only */
-  if (integrator == FMB_INTEG_RADAU5 && linear_solver == FMB_LS_DENSE)
-    return fmb_parse_error(p, fmb_find_key(p, node, "linear_solver"),
-                           "integrator: radau5 solves with KLU: linear_solver klu (the position rows eliminated, "
-                           "default) or klu_full (the whole matrix); dense is IDA's only");
+  s->integrator = integrator_ops[integrator];
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->atol_given = !atol_is_auto && fmb_find_key(p, node, "atol") >= 0;
   if (!s->atol_given) s->atol = FMB_ATOL_PER_RTOL * s->rtol; /* a metre of a 1 m body (tolerance.c) */
@@ -399,11 +393,8 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   } else {
     fmb_outputs_default(m);
   }
-  /* the projected formulation works on q and v alone, with the bodies' mass matrices */
-  if (m->solver.formulation == FMB_FORM_PROJECTED && m->nz > 0)
-    return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
-                           "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
-                           "its assembly: dense, or use formulation: ggl)");
+  /* each backend's cross-key rules (e.g. radau5 refuses formulation: projected) */
+  if (fmb_integrator_check(m, p, solver)) return -1;
   m->nredundant = fmb_count_redundant(m);
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
   return check_resources(p, m);

@@ -9,7 +9,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,18 +22,6 @@
    bounds what libyaml is asked to hold (its document takes ~20x the text) */
 #define FMB_SCENE_BYTES_MAX (64 * 1024 * 1024)
 
-void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...) {
-  if (!d || d->code) return; /* the first error wins */
-  d->code = code;
-  snprintf(d->file, sizeof d->file, "%s", file ? file : "");
-  d->line = line;
-  d->col = col;
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(d->msg, sizeof d->msg, fmt, ap);
-  va_end(ap);
-}
-
 yaml_node_t* fmbp_node(fmbParser* p, fmbNode n) {
   if (n <= 0) return NULL;
   return yaml_document_get_node(&p->doc, n);
@@ -46,65 +33,6 @@ fmbNode fmbp_root(fmbParser* p) {
 }
 
 static int node_count(fmbParser* p) { return (int)(p->doc.nodes.top - p->doc.nodes.start); }
-
-/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
-   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
-#define FMB_OVERRIDE_SHOWN 80
-static const char* shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]) {
-  size_t used = 0, i = 0;
-  const size_t len = strlen(text);
-  for (; text[i] && used < FMB_OVERRIDE_SHOWN - 20; ++i) {
-    const unsigned char ch = (unsigned char)text[i];
-    if (ch == '\n' || ch == '\t')
-      used += (size_t)snprintf(buf + used, 8, "\\%c", ch == '\n' ? 'n' : 't');
-    else if (ch < 0x20 || ch == 0x7f)
-      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
-    else
-      buf[used++] = (char)ch;
-  }
-  if (text[i] && len > FMB_OVERRIDE_SHOWN) {
-    snprintf(buf + used, FMB_OVERRIDE_SHOWN + 32 - used, "...(%zu characters)", len);
-    return buf;
-  }
-  for (; text[i] && used < FMB_OVERRIDE_SHOWN + 24; ++i) {
-    const unsigned char ch = (unsigned char)text[i];
-    if (ch < 0x20 || ch == 0x7f)
-      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
-    else
-      buf[used++] = (char)ch;
-  }
-  buf[used] = '\0';
-  return buf;
-}
-
-/* where `node` is: file:line:column, or the override that made it */
-static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
-  yaml_node_t* nd = fmbp_node(p, node);
-  int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
-  char shown[FMB_OVERRIDE_SHOWN + 32];
-  if (ov >= 0)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", shown_override(p->overrides[ov], shown), msg);
-  else if (nd)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s", msg);
-  else
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "%s", msg);
-}
-
-static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
-  char msg[900];
-  vsnprintf(msg, sizeof msg, fmt, ap);
-  diag_at(p, node, p->diag, msg);
-  return -1;
-}
-
-int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
-  if (!p || !fmt) return -1;
-  va_list ap;
-  va_start(ap, fmt);
-  verror_at(p, node, fmt, ap);
-  va_end(ap);
-  return -1;
-}
 
 int fmbp_is_map(fmbParser* p, fmbNode n) {
   yaml_node_t* nd = fmbp_node(p, n);
@@ -298,27 +226,6 @@ int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, d
   return number_at(p, n, key, flags, out);
 }
 
-/* a warning does not stop the load: FILE:LINE:COL: warning: ... on stderr (or the override) */
-static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
-  char msg[600];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(msg, sizeof msg, fmt, ap);
-  va_end(ap);
-  fmbDiag w;
-  memset(&w, 0, sizeof w);
-  diag_at(p, node, &w, msg);
-  if (w.line > 0)
-    fprintf(stderr, "%s:%d:%d: warning: %s\n", w.file, w.line, w.col, w.msg);
-  else
-    fprintf(stderr, "%s: warning: %s\n", w.file, w.msg);
-}
-
 /* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */
 int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
   if (!p || !key || !out) return -1;
@@ -350,7 +257,7 @@ int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
   if ((flags & FMB_NONNEGATIVE) && !(v >= 0))
     return fmb_parse_error(p, n, "expected a non-negative angle for '%s', got %s", key, s);
   if ((flags & FMB_POSE) && !*unit && fabs(v) > two_pi)
-    warning_at(p, n, "'%s: %s' is taken as radians (%.3g turns); write '%s deg' if degrees were meant", key, s,
+    fmbp_warning_at(p, n, "'%s: %s' is taken as radians (%.3g turns); write '%s deg' if degrees were meant", key, s,
                fabs(v) / two_pi, s);
   *out = v * scale;
   return 0;
@@ -701,7 +608,7 @@ static void mark_override(fmbParser* p, int first_new, int ov) {
 static int apply_override(fmbParser* p, int ov) {
   const char* full = p->overrides[ov];
   char shown[FMB_OVERRIDE_SHOWN + 32];
-  const char* text = shown_override(full, shown);
+  const char* text = fmbp_shown_override(full, shown);
   const char* eq = strchr(full, '=');
   if (!eq || eq == full) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected PATH=VALUE, e.g. solver.rtol=1e-8", text);

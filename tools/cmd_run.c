@@ -79,7 +79,7 @@ int fmb_cmd_run(int argc, char** argv) {
     return bad;
   }
   volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
-  if (models) return fmb_run_models(&s, models, out, quiet, stop);
+  if (models) return fmb_cli_run_models(&s, models, out, quiet, stop);
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
@@ -101,13 +101,8 @@ int fmb_cmd_run(int argc, char** argv) {
     /* one line per column on stdout: the error against the reference and what the run cost */
     char tag[160];
     snprintf(tag, sizeof tag, "status=%s cpu_s=%.4f steps=%ld", rc ? "failed" : "ok", stats.cpu_s, stats.steps);
-    char* cargv[10] = {argv[0], "compare", (char*)out, (char*)reference, "--tag", tag, "--common", NULL, NULL};
-    int cargc = 7;
-    if (columns) {
-      cargv[cargc++] = "--columns";
-      cargv[cargc++] = (char*)columns;
-    }
-    int crc = fmb_cmd_compare(cargc, cargv);
+    const fmbCliCompare c = {.out = out, .ref = reference, .columns = columns, .tag = tag, .common = 1};
+    int crc = fmb_cli_compare(&c);
     if (crc && !rc) rc = crc;
   }
   fmb_print_stats(&stats, stderr);

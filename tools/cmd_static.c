@@ -56,14 +56,8 @@ int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fm
 
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
                          double** yp, fmbStaticResult* res, fmbDiag* diag) {
-  memset(res, 0, sizeof *res);
-  *y = *yp = NULL;
-  *m = fmb_load(s->scene, s->overrides, nover, fmb_cli_registry(), diag);
-  if (!*m) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
-  const int ny = fmb_state_size(*m);
-  *y = calloc((size_t)ny, sizeof(double));
-  *yp = calloc((size_t)ny, sizeof(double));
-  return *y && *yp ? fmb_static(*m, opt, *y, *yp, res, diag) : FMB_EXIT_SOLVER;
+  const fmbSceneSource scene = {s->scene, s->overrides, nover, fmb_cli_registry()};
+  return fmb_load_steady(&scene, NULL, opt, m, y, yp, res, diag);
 }
 
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f) {

@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Install what flexmbd needs on Debian 12, only if something is missing.
-#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; and
+#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; clang-format-14
+#         (tools/format.sh: the committed .clang-format); and
 #         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
 #         VTK itself (skipped without it); chromium, in which the test view_page loads the page of
 #         `flexmbd view` headless (skipped without it)
@@ -11,7 +12,7 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
       liblapack-dev libblas-dev libarpack2-dev)
 if [ "${1:-}" = "--ci" ]; then
-  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9 chromium)
+  pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 chromium)
 fi
 missing=()
 for p in "${pkgs[@]}"; do
