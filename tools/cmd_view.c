@@ -26,28 +26,33 @@
 
 typedef struct {
   const char* name;
-  int frame[3]; /* table columns of x, y, theta; 0 = absent */
-  int nshape;   /* stations found in the CSV (BODY.shapeK_x/_y, K = 0 .. nshape - 1) */
-  int* shape;   /* 2 table columns per station */
-  int drawn;    /* has a point in the drawing */
-  int centreline; /* its drawing has centreline stations */
-  int nstation;   /* how many (the drawing's) */
+  int frame[3];    /* table columns of x, y, theta; 0 = absent */
+  int nshape;      /* stations found in the CSV (BODY.shapeK_x/_y, K = 0 .. nshape - 1) */
+  int* shape;      /* 2 table columns per station */
+  int drawn;       /* has a point in the drawing */
+  int centreline;  /* its drawing has centreline stations */
+  int nstation;    /* how many (the drawing's) */
   double* station; /* their body-frame coordinates, 2 each: the drawing's, or resampled to nshape */
 } ViewBody;
 
 static void json_string(FILE* f, const char* s) {
   fputc('"', f);
   for (const unsigned char* c = (const unsigned char*)s; *c; ++c) {
-    if (*c == '"' || *c == '\\') fprintf(f, "\\%c", *c);
-    else if (*c < 0x20 || *c == '<' || *c == '>' || *c == '&') fprintf(f, "\\u%04x", *c); /* never ends the <script> */
-    else fputc(*c, f);
+    if (*c == '"' || *c == '\\')
+      fprintf(f, "\\%c", *c);
+    else if (*c < 0x20 || *c == '<' || *c == '>' || *c == '&')
+      fprintf(f, "\\u%04x", *c); /* never ends the <script> */
+    else
+      fputc(*c, f);
   }
   fputc('"', f);
 }
 
 static void json_number(FILE* f, double v) {
-  if (isfinite(v)) fprintf(f, "%.12g", v); /* the CSV's own digits, so the page draws its numbers */
-  else fputs("null", f);
+  if (isfinite(v))
+    fprintf(f, "%.12g", v); /* the CSV's own digits, so the page draws its numbers */
+  else
+    fputs("null", f);
 }
 
 /* the table column of "BODY.quantity", or 0 */
@@ -87,7 +92,8 @@ static int parse_columns(const char* list, const fmbTable* tb, int* cols, int ca
 
 /* the page: the template with the data where its placeholder stands */
 static int write_page(FILE* f, const char* title, const fmbTable* tb, const ViewBody* vb, int nb, const fmbDrawing* d,
-                      const fmbModel* m, const int* plot, int nplot, double scale, const char* const* notes, int nnotes) {
+                      const fmbModel* m, const int* plot, int nplot, double scale, const char* const* notes,
+                      int nnotes) {
   static const char placeholder[] = "/*FMB_VIEW_DATA*/null";
   const char* page = (const char*)fmb_view_html;
   const char* at = strstr(page, placeholder);
@@ -127,11 +133,14 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
     const ViewBody* v = &vb[b];
     fputs(b ? ",\n{\"name\":" : "\n{\"name\":", f);
     json_string(f, v->name);
-    if (v->frame[0]) fprintf(f, ",\"frame\":[%d,%d,%d]", v->frame[0] - 1, v->frame[1] - 1, v->frame[2] - 1);
-    else fputs(",\"frame\":null", f);
+    if (v->frame[0])
+      fprintf(f, ",\"frame\":[%d,%d,%d]", v->frame[0] - 1, v->frame[1] - 1, v->frame[2] - 1);
+    else
+      fputs(",\"frame\":null", f);
     if (v->centreline && v->nshape >= 2) {
       fputs(",\"shape\":[", f);
-      for (int k = 0; k < v->nshape; ++k) fprintf(f, "%s[%d,%d]", k ? "," : "", v->shape[2 * k] - 1, v->shape[2 * k + 1] - 1);
+      for (int k = 0; k < v->nshape; ++k)
+        fprintf(f, "%s[%d,%d]", k ? "," : "", v->shape[2 * k] - 1, v->shape[2 * k + 1] - 1);
       fputs("],\"stations\":[", f);
       for (int k = 0; k < v->nshape; ++k) {
         fputs(k ? ",[" : "[", f);
@@ -184,8 +193,10 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
     fputc(',', f);
     json_number(f, p->local[1]);
     fprintf(f, "],\"station\":%d,\"joint\":", v && v->centreline && v->nshape >= 2 ? p->station : -1);
-    if (joint) json_string(f, joint);
-    else fputs("null", f);
+    if (joint)
+      json_string(f, joint);
+    else
+      fputs("null", f);
     fputc('}', f);
     index[i] = npoint++;
   }
@@ -202,7 +213,8 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
     } else {
       for (int k = 0; k < cell->count; ++k) fprintf(f, "%s%d", k ? "," : "", index[d->conn[cell->first + k]]);
       const int p0 = d->conn[cell->first];
-      if (cell->part == FMB_DRAW_JOINT && d->point[p0].body > 0 && ntrace < VIEW_MAX_TRACES) trace[ntrace++] = index[p0];
+      if (cell->part == FMB_DRAW_JOINT && d->point[p0].body > 0 && ntrace < VIEW_MAX_TRACES)
+        trace[ntrace++] = index[p0];
     }
     fputs("]}", f);
   }
@@ -239,7 +251,8 @@ int fmb_cmd_view(int argc, char** argv) {
     if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
       if (!(out = fmb_cli_value("view", argc, argv, &i, "a file name (.html)"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--columns") == 0) {
-      if (!(columns = fmb_cli_value("view", argc, argv, &i, "a comma-separated list of columns"))) return FMB_EXIT_BAD_INPUT;
+      if (!(columns = fmb_cli_value("view", argc, argv, &i, "a comma-separated list of columns")))
+        return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--scale") == 0) {
       const char* v = fmb_cli_value("view", argc, argv, &i, "a deformation scale (a number >= 0)");
       char* end = NULL;
@@ -368,11 +381,12 @@ int fmb_cmd_view(int argc, char** argv) {
     for (int k = 0; k < 3 && !v->frame[0]; ++k)
       if (!column_of(&tb, v->name, q[k]))
         used += (size_t)snprintf(lack + used, sizeof lack - used, ", %s.%s", v->name, q[k]);
-    if (v->centreline && !has_shape && used < sizeof lack) snprintf(lack + used, sizeof lack - used, ", %s.shape", v->name);
+    if (v->centreline && !has_shape && used < sizeof lack)
+      snprintf(lack + used, sizeof lack - used, ", %s.shape", v->name);
     if (!lack[0]) continue;
     const char* cost = !v->centreline || (!has_shape && !v->frame[0]) ? "not drawn"
-                       : !has_shape ? "its centreline is drawn straight, undeformed"
-                                    : "its deformation is drawn at scale 1 only";
+                       : !has_shape                                   ? "its centreline is drawn straight, undeformed"
+                                                                      : "its deformation is drawn at scale 1 only";
     char note[1024];
     snprintf(note, sizeof note, "%s: no %s: %s", v->name, lack + 2, cost);
     notes[nnotes++] = strdup(note);
@@ -395,9 +409,13 @@ int fmb_cmd_view(int argc, char** argv) {
         if (strcmp(dot + 1, "shape0_x") != 0) continue;
         int b = -1;
         for (int k = 0; k < nb; ++k)
-          if ((size_t)(dot - tb.name[c]) == strlen(vb[k].name) && strncmp(tb.name[c], vb[k].name, dot - tb.name[c]) == 0) b = k;
-        if (b >= 0 && vb[b].nshape != vb[b].nstation) fprintf(stderr, "%s%.*s.shape_%d", first ? "" : ", ", (int)(dot - tb.name[c]), tb.name[c], vb[b].nshape);
-        else fprintf(stderr, "%s%.*s.shape", first ? "" : ", ", (int)(dot - tb.name[c]), tb.name[c]);
+          if ((size_t)(dot - tb.name[c]) == strlen(vb[k].name) &&
+              strncmp(tb.name[c], vb[k].name, dot - tb.name[c]) == 0)
+            b = k;
+        if (b >= 0 && vb[b].nshape != vb[b].nstation)
+          fprintf(stderr, "%s%.*s.shape_%d", first ? "" : ", ", (int)(dot - tb.name[c]), tb.name[c], vb[b].nshape);
+        else
+          fprintf(stderr, "%s%.*s.shape", first ? "" : ", ", (int)(dot - tb.name[c]), tb.name[c]);
       } else {
         fprintf(stderr, "%s%s", first ? "" : ", ", tb.name[c]);
       }
@@ -431,7 +449,8 @@ int fmb_cmd_view(int argc, char** argv) {
     }
     fmbSafeFile* sf = fmb_safe_open(out, ferr, sizeof ferr);
     FILE* f = fmb_safe_stream(sf);
-    const int ok = f && write_page(f, title, &tb, vb, nb, d, m, plot, nplot, scale, (const char* const*)notes, nnotes) == 0;
+    const int ok =
+        f && write_page(f, title, &tb, vb, nb, d, m, plot, nplot, scale, (const char* const*)notes, nnotes) == 0;
     if (fmb_safe_close(sf, ok) != 0 || !ok) {
       fprintf(stderr, "flexmbd view: cannot write '%s': %s\n", out, ferr[0] ? ferr : "write failed");
       rc = FMB_EXIT_BAD_INPUT;
