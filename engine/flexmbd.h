@@ -667,8 +667,9 @@ typedef struct fmbSafeFile fmbSafeFile;
 /* NULL with the reason (e.g. strerror's) in err on failure */
 /* The files this process reads (the scene and its table files, noted by fmb_load; plugins, noted
    when loaded; whatever a program notes): fmb_safe_open refuses to replace one, whatever name or
-   link leads to it (same device and inode), until the process ends. Notes are counted: each
-   note is undone by one forget. note: 0, or -1 (not a regular file, or out of memory). input_at: the
+   link leads to it (same device and inode), until the process ends or the noted name no longer
+   leads to that file (deleted or replaced since: its inode may be reused). Notes are counted:
+   each note is undone by one forget. note: 0, or -1 (not a regular file, or out of memory). input_at: the
    noted path of the input that `path` is, or NULL. Not thread-safe: note from one thread. */
 FMB_API int fmb_safe_note_input(const char* path);
 FMB_API void fmb_safe_forget_input(const char* path);

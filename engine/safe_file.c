@@ -37,7 +37,8 @@ typedef struct {
   dev_t dev;
   ino_t ino;
   int refs;
-  char* path;
+  char* path; /* as the program named it, for messages */
+  char* real; /* its absolute name when noted (realpath), to tell a stale note */
 } InputFile;
 static InputFile* input_file;
 static int ninput_file, cap_input_file;
@@ -49,7 +50,10 @@ static InputFile* input_same_as(const struct stat* st) {
 }
 
 static void forget_all_inputs(void) { /* at exit: valgrind counts what is still reachable */
-  for (int i = 0; i < ninput_file; ++i) free(input_file[i].path);
+  for (int i = 0; i < ninput_file; ++i) {
+    free(input_file[i].path);
+    free(input_file[i].real);
+  }
   free(input_file);
   input_file = NULL;
   ninput_file = cap_input_file = 0;
@@ -72,8 +76,13 @@ int fmb_safe_note_input(const char* path) {
     cap_input_file = cap;
   }
   char* copy = strdup(path);
-  if (!copy) return -1;
-  input_file[ninput_file++] = (InputFile){st.st_dev, st.st_ino, 1, copy};
+  char* real = realpath(path, NULL);
+  if (!copy || !real) {
+    free(copy);
+    free(real);
+    return -1;
+  }
+  input_file[ninput_file++] = (InputFile){st.st_dev, st.st_ino, 1, copy, real};
   return 0;
 }
 
@@ -85,6 +94,7 @@ void fmb_safe_forget_input(const char* path) {
     if (strcmp(input_file[i].path, path) == 0) in = &input_file[i];
   if (!in || --in->refs > 0) return;
   free(in->path);
+  free(in->real);
   *in = input_file[--ninput_file];
   if (ninput_file == 0) { /* nothing noted: nothing held (valgrind counts what is still reachable) */
     free(input_file);
@@ -94,10 +104,13 @@ void fmb_safe_forget_input(const char* path) {
 }
 
 const char* fmb_safe_input_at(const char* path) {
-  struct stat st;
+  struct stat st, noted;
   if (!path || strcmp(path, "-") == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) return NULL;
   const InputFile* in = input_same_as(&st);
-  return in ? in->path : NULL;
+  /* a note whose own name no longer leads to that file is stale: the input was deleted or
+     replaced since, and its inode may now belong to an unrelated file */
+  if (!in || stat(in->real, &noted) != 0 || noted.st_dev != st.st_dev || noted.st_ino != st.st_ino) return NULL;
+  return in->path;
 }
 
 static fmbSafeFile* fail(fmbSafeFile* f, char* err, size_t errlen, const char* path, const char* what) {
