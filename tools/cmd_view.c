@@ -1,9 +1,10 @@
-/* cmd_view.c — `flexmbd view RUN.csv SCENE.yaml [-o run.html] [--columns a,b] [--scale S]
+/* cmd_view.c — `flexmbd view RUN.csv SCENE.yaml [-o run.html] [--columns a,b] [--scale S] [--model M]
  *                [--set PATH=VALUE]... [--plugin x.so]...`
  * One self-contained HTML file (no network, no external script: tools/view.html, embedded at
  * build time) that animates the run: the mechanism drawn row by row, play/pause, a time slider,
  * speed, a deformation scale for beams, traces, and a plot of chosen columns with a time cursor.
  *
+ * `--model M` draws the run of model M in a `run --models` CSV (its NAME@M columns).
  * What is drawn is the library's drawing of the scene (fmb_drawing_new, the same points and cells
  * as --vtk); where each point is comes from the run's own columns, never from a second run:
  *   - a point of a body with a frame: BODY.x, BODY.y, BODY.theta and the point's body-frame
@@ -55,10 +56,13 @@ static void json_number(FILE* f, double v) {
     fputs("null", f);
 }
 
-/* the table column of "BODY.quantity", or 0 */
+/* `run --models` CSVs: the columns of one model, NAME@MODEL (--model MODEL), else NULL */
+static const char* view_model;
+
+/* the table column of "BODY.quantity" (of --model's run), or 0 */
 static int column_of(const fmbTable* tb, const char* body, const char* quantity) {
   char name[512];
-  snprintf(name, sizeof name, "%s.%s", body, quantity);
+  snprintf(name, sizeof name, "%s.%s%s%s", body, quantity, view_model ? "@" : "", view_model ? view_model : "");
   const int c = fmb_table_col(tb, name);
   return c > 0 ? c : 0;
 }
@@ -67,6 +71,13 @@ static int column_of(const fmbTable* tb, const char* body, const char* quantity)
 static int is_shape_column(const char* name) {
   const char* dot = strrchr(name, '.');
   return dot && strncmp(dot + 1, "shape", 5) == 0 && strchr(dot, '_');
+}
+
+/* the length of a column's output name: without "@MODEL" (--model), or 0 for another model's */
+static int output_name_length(const char* name) {
+  const char* at = strrchr(name, '@');
+  if (!view_model) return (int)strlen(name);
+  return at && strcmp(at + 1, view_model) == 0 ? (int)(at - name) : 0;
 }
 
 /* "a,b,c": the table columns named, into cols (0-based data indices); -1 after a message */
@@ -253,6 +264,9 @@ int fmb_cmd_view(int argc, char** argv) {
     } else if (strcmp(a, "--columns") == 0) {
       if (!(columns = fmb_cli_value("view", argc, argv, &i, "a comma-separated list of columns")))
         return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--model") == 0) {
+      if (!(view_model = fmb_cli_value("view", argc, argv, &i, "a model name (the CSV's NAME@MODEL columns)")))
+        return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--scale") == 0) {
       const char* v = fmb_cli_value("view", argc, argv, &i, "a deformation scale (a number >= 0)");
       char* end = NULL;
@@ -404,9 +418,11 @@ int fmb_cmd_view(int argc, char** argv) {
     fprintf(stderr, "  to draw everything, run again with: --set 'outputs=[");
     int first = 1;
     for (int c = 1; c < tb.ncol; ++c) {
+      const int len = output_name_length(tb.name[c]);
+      if (len == 0) continue; /* another model's column */
       if (is_shape_column(tb.name[c])) {
         const char* dot = strrchr(tb.name[c], '.');
-        if (strcmp(dot + 1, "shape0_x") != 0) continue;
+        if (strncmp(dot + 1, "shape0_x", 8) != 0 || (dot[9] != '\0' && dot[9] != '@')) continue;
         int b = -1;
         for (int k = 0; k < nb; ++k)
           if ((size_t)(dot - tb.name[c]) == strlen(vb[k].name) &&
@@ -417,7 +433,7 @@ int fmb_cmd_view(int argc, char** argv) {
         else
           fprintf(stderr, "%s%.*s.shape", first ? "" : ", ", (int)(dot - tb.name[c]), tb.name[c]);
       } else {
-        fprintf(stderr, "%s%s", first ? "" : ", ", tb.name[c]);
+        fprintf(stderr, "%s%.*s", first ? "" : ", ", len, tb.name[c]);
       }
       first = 0;
     }

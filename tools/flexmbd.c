@@ -33,7 +33,7 @@ static const Command commands[] = {
      "      [--shape BEAM --at t1,t2,...]   the beam's centreline at those times (BEAM.shape columns)\n"
      "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)", 0},
     {"view", fmb_cmd_view,
-     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--set PATH=VALUE]... [--plugin x.so]...\n"
+     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--model M] [--set PATH=VALUE]... [--plugin x.so]...\n"
      "      one self-contained HTML page animating the run (mechanism, beam shapes, traces, a plot)", 0},
     {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene", 0},
     {"static", fmb_cmd_static,

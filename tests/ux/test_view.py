@@ -13,6 +13,7 @@ test is skipped, exit 77, without it) loads it:
     tolerance, 1e-6 m); with ?scale=10 the tip station is u + 10 (r - u), u the undeformed
     station from rod.x, rod.y, rod.theta;
   - a screenshot's drawing area is not blank (non-white pixels), and differs between two times;
+  - a `run --models` CSV drawn with --model zoac shows the zoac run's stations;
   - a CSV without the columns says which are missing and the --set that adds them (exit 2 when
     nothing can be drawn); an output onto the CSV is refused (exit 2)."""
 import csv
@@ -177,6 +178,26 @@ a, b = drawing_pixels(times[0]), drawing_pixels(times[-1])
 print(f"screenshot: {len(a)} and {len(b)} non-white pixels in the drawing, {len(a ^ b)} differ")
 check(len(a) > 500 and len(b) > 500, f"the drawing is not blank ({len(a)}, {len(b)} non-white pixels)")
 check(len(a ^ b) > 100, f"the drawing moves between t = {times[0]} and {times[-1]} ({len(a ^ b)} pixels differ)")
+
+# a `run --models` CSV: --model picks one model's columns (NAME@MODEL)
+models_csv = os.path.join(out, "models.csv")
+run(["run", scene, "-o", models_csv, "--quiet", "--models", "zoac,complete", "--set", outputs, "--set",
+     "solver.t_end=0.01"], 0)
+models_page = os.path.join(out, "models.html")
+run(["view", models_csv, scene, "-o", models_page, "--model", "zoac"], 0)
+mrows = list(csv.DictReader(open(models_csv)))
+# the page's drawn stations at the last row equal the zoac columns (and differ from complete's)
+page, saved_page = models_page, page
+d = drawn(float(mrows[-1]["t"]))
+page = saved_page
+if d is not None:
+    last = {k: float(v) for k, v in mrows[-1].items()}
+    st = [p for p in d["points"] if p["body"] == "rod" and p["station"] >= 0]
+    check(len(st) == nstation and all(near(p["x"], last[f"rod.shape{p['station']}_x@zoac"], 1e-12) and
+                                      near(p["y"], last[f"rod.shape{p['station']}_y@zoac"], 1e-12) for p in st),
+          "view --model zoac draws the zoac run's stations")
+    check(any(abs(last[f"rod.shape{k}_y@zoac"] - last[f"rod.shape{k}_y@complete"]) > 1e-9 for k in range(nstation)),
+          "the two models' shapes differ (the check above can tell them apart)")
 
 # what the CSV lacks is said, with the --set that adds it
 bare = os.path.join(out, "bare.csv")
