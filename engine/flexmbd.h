@@ -25,7 +25,7 @@ extern "C" {
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
    the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
-   pattern_jacobian and length_scale ops (added to 2 before any release of it). */
+   pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). */
 #define FMB_ABI_VERSION 2
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
@@ -191,7 +191,7 @@ typedef struct fmbBodyType {
   void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
                  double* work);
   /* named outputs beyond the frame's x, y, theta, omega, vx, vy (which the engine provides for
-     every body with ncoord >= 3): lookup returns an id >= 0 or -1 (NULL: the id is the name's
+     every body with a frame: ncoord >= 3, or a marker that places the origin [0, 0]): lookup returns an id >= 0 or -1 (NULL: the id is the name's
      index in output_names); output evaluates one id. */
   const char* const* output_names; /* NULL-terminated, for listings */
   int (*output_lookup)(const void* self, const char* quantity);
@@ -271,6 +271,12 @@ typedef struct fmbBodyType {
      coordinate and its velocity (engine/integrate.c), so one atol in metres controls slopes and
      displacements alike at any size of the body. NULL = atol as given for every coordinate. */
   void (*length_scale)(const void* self, double* metres_per_unit);
+  /* The range where the body's model is accurate (ABI 2, added before any release of it): NULL
+     while the state (q, v) is inside it; otherwise the body writes into msg[len] what left the
+     range, by how much, and what to use instead, and returns msg. The run warns once per body,
+     at the first output time it happens, with the time (beam: the tip deflection beyond the
+     model's measured limit, "use model: exact"). NULL op = no range stated. */
+  const char* (*model_range)(const void* self, const double* q, const double* v, char* msg, size_t len);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -323,7 +329,8 @@ FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], dou
                double* dpos_dq, int ld, double* dangle_dq);
 /* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
 FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
-/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1) */
+/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
+   context or another k (0 would be body 0's column: a wrong place, silently) */
 FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 
 /* ---------------------------------------------------------------------------------------------
@@ -488,6 +495,12 @@ FMB_API void fmb_describe(const fmbModel* m, FILE* f);
    joint name and row, and whether the start is a singular configuration. 0, or an exit code with
    *diag filled (joints that cannot be satisfied). */
 FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
+/* the outputs the engine itself gives, as NULL-terminated names (NULL for an unknown group):
+   "frame" (BODY.x y theta omega vx vy, for every body with a frame: one whose marker places its
+   origin), "power" (JOINT.power work, for a joint with constraint rows or a force), "reaction"
+   (JOINT.reaction_x ..., for a joint with constraint rows), "energy" (energy.*), "constraint"
+   (constraint.*). `flexmbd types` lists them from here, the loader resolves them from here. */
+FMB_API const char* const* fmb_engine_outputs(const char* group);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 
@@ -556,11 +569,13 @@ enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
 /* Linearize the DAE about the state (y, yp) at time t (from fmb_static: the rotating-frame
    terms of a steady rotation are included), eliminate the constraints and solve the
    eigenproblem (`method`). Returns 0 with *out (the caller frees it with fmb_modes_free)
-   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag. */
+   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag
+   (FMB_EXIT_BAD_INPUT for a `method` other than FMB_EIGEN_* or a time that is not finite). */
 FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
               fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
-/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1] */
+/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
+   NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);
 /* the scene's outputs at state (y, yp), one CSV row (header first) */
 FMB_API int fmb_write_state_row(const fmbModel* m, const char* path, double t, const double* y, const double* yp,
@@ -571,10 +586,11 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
                           const char* path, fmbDiag* diag);
 /* mode k (0-based) as a ParaView animation in dir (created; DIR/SCENE.pvd and one .vtu per frame,
    the run's VTK writer): `frames` states over one period, the largest coordinate moving by
-   `amplitude` (its units: m or rad) */
+   `amplitude` (its units: m or rad; positive and finite, else FMB_EXIT_BAD_INPUT) */
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
-/* a table of named numeric columns (row-major values), through the one CSV writer */
+/* a table of named numeric columns (row-major values), through the one CSV writer; nrow >= 0
+   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table) */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
 

@@ -67,6 +67,11 @@ extern const fmbIntegratorOps fmb_integrator_radau5;
 /* every backend, NULL-terminated; the first GGL one is the default of solver.integrator */
 extern const fmbIntegratorOps* const fmb_integrators[];
 
+/* 1 when the model's constraint manifold holds a singular configuration near its motion (a
+   scan along the manifold from the initial state, engine/singular.c): `formulation: auto` then
+   starts on the projected formulation */
+int fmb_needs_singular_method(const fmbModel* m);
+
 /* the backend the model's solver settings ask for */
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m);
 

@@ -28,7 +28,9 @@ int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int
 }
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  if (m->solver.formulation == FMB_FORM_PROJECTED) return projected_backend();
+  if (m->solver.formulation == FMB_FORM_PROJECTED ||
+      (m->solver.formulation == FMB_FORM_AUTO && fmb_needs_singular_method(m)))
+    return projected_backend();
   /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
   return m->solver.integrator;
 }

@@ -36,6 +36,7 @@ typedef struct fmbJointInst {
   const fmbJointType* type;
   void* self;
   int body[2];   /* body indices, -1 = none */
+  int line, col; /* its item in the scene (1-based), for messages after parsing (initial pose) */
   int ncol;      /* nq(body0) + nq(body1) */
   int rowadr, nrows;
   /* the columns (of the ncol) its constraint or force can depend on, found by evaluating it at
@@ -177,6 +178,15 @@ struct fmbParser {
   const char* const* overrides;
   const char* looked[64];   /* keys looked up in the current item, for "expected one of" */
   int nlooked;
+  /* every key the current mapping may have, when known before its keys are read (fmbp_expect):
+     the loader's own list (top level, solver, an item's name and type) and the item's type's
+     declared params. They make "expected one of" complete, and let a missing required key be
+     reported after an unknown key beside it (the typo that explains it, with did you mean). */
+  const char* const* valid;
+  const fmbParam* params;
+  int expect_complete; /* valid and params name every key the mapping may have */
+  const char* what;    /* the mapping for messages ("body 'bob' (type rigid)"), or NULL */
+  unsigned plausibility_warned; /* the plausibility rules (yaml_get.c) that have warned: once each */
   /* named materials and sections (top-level `materials:`/`sections:` maps): while a body or
      joint item is parsed, keys it does not have are looked up in the entries it names */
   fmbNode item;             /* the item being parsed, or -1 */
@@ -193,6 +203,12 @@ fmbNode fmbp_root(fmbParser* p);
 yaml_node_t* fmbp_node(fmbParser* p, fmbNode n);
 /* start a new item (resets the looked-up key list); check that every key of `map` was looked up */
 void fmbp_begin_item(fmbParser* p);
+/* the scene's top-level keys, the two required ones (solver, bodies) first (engine/scene.c) */
+extern const char* const fmb_scene_keys[];
+/* the keys the current mapping may have: `keys` (NULL-terminated) and a type's `params`, either
+   NULL; `complete` when together they name every key it may have; `what` names the mapping in
+   messages (kept as a pointer: it must live while the mapping is read). Reset by fmbp_begin_item. */
+void fmbp_expect(fmbParser* p, const char* what, const char* const* keys, const fmbParam* params, int complete);
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what);
 int fmbp_is_map(fmbParser* p, fmbNode n);
 int fmbp_is_seq(fmbParser* p, fmbNode n);
@@ -328,6 +344,10 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
                            fmbDiag* diag);
 
 /* ---- static.c ---- */
+/* the poses q at time t against the joints, as a run checks them (ic.c): joints that cannot be
+   satisfied, or poses they would move by more than FMB_ASSEMBLY_TOL without `initial: assemble`,
+   are bad input (FMB_EXIT_BAD_INPUT, named at the joint); q is left projected onto them */
+int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag);
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
 /* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
@@ -343,7 +363,8 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
 /* global position of a body's material point (its marker); 0 ok */
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle);
-void fmb_outputs_default(fmbModel* m);
+/* no `outputs:` list: x, y, theta, omega of every moving body with a frame; 0, or -1 out of memory */
+int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;
 /* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);

@@ -745,19 +745,23 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     return FMB_EXIT_BAD_INPUT;
   }
   *out = NULL;
-  if (method < FMB_EIGEN_AUTO || method > FMB_EIGEN_SPARSE) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: method %d is none of FMB_EIGEN_AUTO, _DENSE, _SPARSE",
+  /* an unknown method once ran the dense path silently; a time of nan linearized at nan */
+  if (method != FMB_EIGEN_AUTO && method != FMB_EIGEN_DENSE && method != FMB_EIGEN_SPARSE) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: method %d is not FMB_EIGEN_AUTO, _DENSE or _SPARSE",
                  method);
     return FMB_EXIT_BAD_INPUT;
   }
-  /* a state that is not finite is refused here: LAPACK would be handed NaN workspace sizes and
-     its error handler (xerbla, above) would end the calling program */
-  int bad = isfinite(t) ? -1 : 0;
+  if (!isfinite(t)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the time %g is not finite", t);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  /* a state that is not finite is refused too: LAPACK would be handed NaN workspace sizes and its
+     error handler (xerbla, above) would end the calling program */
+  int bad = -1;
   for (int i = 0; i < m->ny && bad < 0; ++i)
-    if (!isfinite(y[i]) || !isfinite(yp[i])) bad = i + 1;
+    if (!isfinite(y[i]) || !isfinite(yp[i])) bad = i;
   if (bad >= 0) {
-    if (bad == 0) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the time t is not finite");
-    else fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the state is not finite (y or yp [%d])", bad - 1);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the state is not finite (y or yp [%d])", bad);
     return FMB_EXIT_BAD_INPUT;
   }
   Linearized L;
@@ -784,7 +788,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
 }
 
 double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k) {
-  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return 0.0;
+  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return NAN; /* not 0: "orthogonal" */
   const double *ar = a->shape_re + (size_t)i * a->nq, *ai = a->shape_im + (size_t)i * a->nq;
   const double *br = b->shape_re + (size_t)k * b->nq, *bi = b->shape_im + (size_t)k * b->nq;
   double re = 0.0, im = 0.0, na = 0.0, nb = 0.0;
@@ -804,10 +808,12 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
                     fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   int named = names != NULL;
   for (int i = 0; named && i < ncol; ++i) named = names[i] != NULL;
   if (ncol <= 0 || !named || nrow < 0 || (nrow > 0 && !values)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns, a NULL name, or no values");
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0,
+                 "fmb_write_table: no columns, a NULL name, no values or a negative row count");
     return FMB_EXIT_BAD_INPUT;
   }
   fmbCsv* c = fmb_csv_open(path, diag);
@@ -827,6 +833,7 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
                         fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_state_row: NULL model or state");
     return FMB_EXIT_BAD_INPUT;
@@ -854,6 +861,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
                           const char* path, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp || !md || md->nq != m->nq || md->count < 0 || (md->count > 0 && !md->shape_re)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
@@ -909,10 +917,12 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
                              double amplitude, int frames, const char* dir, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || !md->shape_re || !md->frequency ||
-      frames < 2 || frames > 100000 || !isfinite(amplitude) || !isfinite(t)) {
+      frames < 2 || frames > 100000 || !(amplitude > 0.0) || !isfinite(amplitude) || !isfinite(t)) {
+    /* an amplitude of 0, -1 or nan drew a still or inverted mode; 1 << 30 frames, as many files */
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0,
-                 "fmb_write_mode_animation: NULL or mismatched arguments (frames 2..100000, amplitude and t finite)");
+                 "fmb_write_mode_animation: NULL or mismatched arguments (frames 2..100000, amplitude > 0, t finite)");
     return FMB_EXIT_BAD_INPUT;
   }
   const int nq = m->nq;

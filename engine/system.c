@@ -203,7 +203,10 @@ const double* fmb_eval_v(const fmbJointEval* ev, int k) {
 
 double* fmb_eval_scratch(const fmbJointEval* ev) { return ev ? ev->js : NULL; }
 
-int fmb_eval_col0(const fmbJointEval* ev, int k) { return k == 1 ? fmb_eval_ncoord(ev, 0) : 0; }
+int fmb_eval_col0(const fmbJointEval* ev, int k) {
+  if (!ev || (k != 0 && k != 1)) return -1; /* 0 would send a plugin to body 0's columns */
+  return k == 1 ? fmb_eval_ncoord(ev, 0) : 0;
+}
 
 int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle, double* dpos_dq,
                int ld, double* dangle_dq) {

@@ -8,16 +8,16 @@
 
 #include "flexmbd.h"
 
-/* the version and commit the build records (CMakeLists.txt passes them to the files that print
-   them: `flexmbd --version`, regression references) */
+#define FMB_CLI_MAX_OVERRIDES 256
+
+/* what a result records as the build that made it (CMakeLists.txt defines both for the files
+   that write them: regression references, sweep run ids, sweep.h5, `flexmbd --version`) */
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "unknown"
 #endif
 #ifndef FLEXMBD_COMMIT
 #define FLEXMBD_COMMIT "unknown"
 #endif
-
-#define FMB_CLI_MAX_OVERRIDES 256
 
 /* a scene and its --set overrides, as `run`, `check` and the analysis commands take them */
 typedef struct fmbCliScene {
@@ -34,8 +34,11 @@ typedef struct fmbCliScene {
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
 /* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
-/* file:line:col: error: msg (or the shorter forms when no location is known) */
+/* file:line:col: error: msg (or the shorter forms when no location is known), on stderr or in buf */
 void fmb_cli_print_diag(const fmbDiag* d);
+void fmb_cli_format_diag(const fmbDiag* d, char* buf, size_t len);
+/* `run SCENE --serve`: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
+int fmb_run_serve(const fmbCliScene* s);
 /* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
    else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
 int fmb_cli_check_input(const char* path, const char* what);
@@ -83,6 +86,7 @@ int fmb_cmd_static(int argc, char** argv);
 int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
 int fmb_cmd_view(int argc, char** argv);
+int fmb_cmd_sweep(int argc, char** argv);
 /* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
 typedef struct fmbCliAnalysis {
   fmbStaticOptions opt; /* --at T, --quiet */
@@ -98,4 +102,10 @@ int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fm
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
                          double** yp, fmbStaticResult* res, fmbDiag* diag);
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
+/* the modes at one speed (steady state, then modes): 0 with *out, or an exit code with *diag */
+typedef int (*fmbCliModesAt)(void* ctx, double speed, fmbModes** out, fmbDiag* diag);
+/* at(ctx, speeds[i]) for every i in child processes, `jobs` at once (tools/modes_pool.c): out[i]
+   for i < *done (the speeds before the first that failed, whose code and *diag are returned) */
+int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx, fmbModes** out,
+                              int* done, fmbDiag* diag);
 #endif

@@ -1,4 +1,4 @@
-/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K]
+/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j J]
  *                    [--at T] [-o campbell.csv] [--plot campbell.png] [--eigen dense|sparse|auto]
  *                    [--set PATH=VALUE]...`
  * For each hub speed (PATH: the scene key that sets it, e.g. joints.spin.speed): the steady state,
@@ -16,13 +16,23 @@
 
 #define MAX_SPEEDS 10000
 
+/* one speed's modes, for the child processes of -j J (tools/modes_pool.c) */
+typedef struct {
+  const fmbSceneSource* scene;
+  const fmbCampbellOptions* opt;
+} Speed;
+static int modes_at(void* ctx, double speed, fmbModes** out, fmbDiag* diag) {
+  const Speed* c = ctx;
+  return fmb_campbell_modes_at(c->scene, c->opt, speed, out, diag);
+}
+
 /* "A:B:N" (N values from A to B) or "S1,S2,..."; returns the count or -1 */
 static int parse_speeds(const char* text, double* out) {
   double a, b;
   int n;
   char tail;
   if (sscanf(text, "%lf:%lf:%d%c", &a, &b, &n, &tail) == 3) {
-    if (n < 1 || n > MAX_SPEEDS) return -1;
+    if (n < 1 || n > MAX_SPEEDS || !isfinite(a) || !isfinite(b)) return -1; /* nan, inf: bad input */
     for (int i = 0; i < n; ++i) out[i] = n == 1 ? a : a + (b - a) * i / (n - 1);
     return n;
   }
@@ -31,7 +41,7 @@ static int parse_speeds(const char* text, double* out) {
   while (*p && n < MAX_SPEEDS) {
     char* end;
     out[n++] = strtod(p, &end);
-    if (end == p || (*end != ',' && *end != '\0')) return -1;
+    if (end == p || (*end != ',' && *end != '\0') || !isfinite(out[n - 1])) return -1;
     p = *end ? end + 1 : end;
   }
   return *p ? -1 : n;
@@ -104,6 +114,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
   an.count_max = FMB_CAMPBELL_MAX_MODES;
   an.opt.quiet = 1;
   const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
+  int jobs = 1; /* -j J: the speeds' modes computed in J child processes (tools/modes_pool.c) */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("campbell", argc, argv, &i, &s);
@@ -116,6 +127,14 @@ int fmb_cmd_campbell(int argc, char** argv) {
       if (!(png = fmb_cli_value("campbell", argc, argv, &i, "a PNG file name"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--speed") == 0) {
       if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
+      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of processes");
+      char* end;
+      jobs = v ? (int)strtol(v, &end, 10) : 0;
+      if (!v || *end || jobs < 1 || jobs > 1024) {
+        fprintf(stderr, "flexmbd campbell: -j expects 1 to 1024 processes\n");
+        return FMB_EXIT_BAD_INPUT;
+      }
     } else if (strcmp(a, "--speeds") == 0) {
       if (!(speeds_text = fmb_cli_value("campbell", argc, argv, &i, "A:B:N or S1,S2,..."))) return FMB_EXIT_BAD_INPUT;
     } else {
@@ -138,7 +157,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
   double* speeds = malloc(MAX_SPEEDS * sizeof(double));
   const int nspeed = speeds ? parse_speeds(speeds_text, speeds) : -1;
   if (nspeed < 1) {
-    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,..., got '%s'\n",
+    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,... of finite speeds, got '%s'\n",
             MAX_SPEEDS, speeds_text);
     free(speeds);
     return FMB_EXIT_BAD_INPUT;
@@ -153,8 +172,15 @@ int fmb_cmd_campbell(int argc, char** argv) {
   int rc = c ? 0 : FMB_EXIT_SOLVER;
   if (!c) snprintf(diag.msg, sizeof diag.msg, "out of memory");
   volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
+  /* -j J: every speed's modes at once in child processes, then followed in order as below */
+  Speed ctx = {&scene, &opt};
+  fmbModes** pre = jobs > 1 && !rc ? calloc((size_t)nspeed, sizeof *pre) : NULL;
+  int pre_done = 0, pre_rc = 0;
+  fmbDiag pre_diag;
+  memset(&pre_diag, 0, sizeof pre_diag);
+  if (pre) pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, pre, &pre_done, &pre_diag);
   for (int i = 0; !rc && i < nspeed; ++i) {
-    if (*stop) { /* SIGINT/SIGTERM: the speeds done so far are written below */
+    if (*stop && (!pre || i >= pre_done)) { /* SIGINT/SIGTERM: the speeds done so far are written below */
       memset(&diag, 0, sizeof diag);
       diag.code = FMB_EXIT_INTERRUPTED;
       snprintf(diag.msg, sizeof diag.msg, "interrupted (SIGINT/SIGTERM) before speed %g: the %d of %d speeds done are kept",
@@ -163,10 +189,20 @@ int fmb_cmd_campbell(int argc, char** argv) {
       break;
     }
     fmbModes* modes = NULL;
-    rc = fmb_campbell_modes_at(&scene, &opt, speeds[i], &modes, &diag);
+    if (!pre) {
+      rc = modes_at(&ctx, speeds[i], &modes, &diag);
+    } else if (i < pre_done) {
+      modes = pre[i];
+      pre[i] = NULL;
+    } else {
+      rc = pre_rc;
+      diag = pre_diag;
+    }
     if (!rc && (rc = fmb_campbell_add(c, modes, &diag)) != 0)
       snprintf(diag.file, sizeof diag.file, "%s", s.scene); /* too few modes: the scene's */
   }
+  for (int i = 0; pre && i < nspeed; ++i) fmb_modes_free(pre[i]);
+  free(pre);
   const int done = c ? c->done : 0;
   for (int i = 1; i < done; ++i)
     for (int k = 0; k < count; ++k)

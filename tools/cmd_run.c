@@ -19,6 +19,7 @@ int fmb_cmd_run(int argc, char** argv) {
   const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
   int vtk_every = 1;      /* --vtk-every N: of every Nth row */
   const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
+  int serve = 0;             /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("run", argc, argv, &i, &s);
@@ -34,6 +35,8 @@ int fmb_cmd_run(int argc, char** argv) {
       if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = 1;
+    } else if (strcmp(a, "--serve") == 0) {
+      serve = 1;
     } else if (strcmp(a, "--progress") == 0) {
       progress = 1;
     } else if (strcmp(a, "--vtk") == 0) {
@@ -64,6 +67,7 @@ int fmb_cmd_run(int argc, char** argv) {
     fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
     return FMB_EXIT_BAD_INPUT;
   }
+  if (serve) return fmb_run_serve(&s);
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);
@@ -74,16 +78,12 @@ int fmb_cmd_run(int argc, char** argv) {
   for (int k = 0; k < s.nplugins; ++k) inputs[ninputs++] = s.plugins[k];
   int bad = reference ? fmb_cli_check_input(reference, "reference") : 0;
   if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
-  if (bad) {
-    fmb_print_stats(&stats, stderr);
-    return bad;
-  }
+  if (bad) return bad; /* nothing ran: no stats line */
   volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
   if (models) return fmb_cli_run_models(&s, models, out, quiet, stop);
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
-    fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   /* the progress line: on a terminal once a run has taken 2 s; --progress asks for it anywhere
@@ -105,7 +105,9 @@ int fmb_cmd_run(int argc, char** argv) {
     int crc = fmb_cli_compare(&c);
     if (crc && !rc) rc = crc;
   }
-  fmb_print_stats(&stats, stderr);
+  /* the stats line tells what a run did; bad input (found in the initial pose, or an output that
+     cannot be written) ran nothing, and the error line is the last word */
+  if (rc != FMB_EXIT_BAD_INPUT) fmb_print_stats(&stats, stderr);
   fmb_free(m);
   return rc;
 }

@@ -9,8 +9,10 @@
 set -euo pipefail
 # liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
 # libarpack2-dev: its sparse shift-invert path (Arnoldi) for large systems
+# libopenmpi-dev, openmpi-bin: `flexmbd sweep` over MPI ranks (mpirun); libhdf5-dev, hdf5-tools: its
+# DIR/sweep.h5 and the h5dump that the sweep test reads it with (docs/sweep.md; both optional to build)
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
-      liblapack-dev libblas-dev libarpack2-dev)
+      liblapack-dev libblas-dev libarpack2-dev libopenmpi-dev openmpi-bin libhdf5-dev hdf5-tools)
 if [ "${1:-}" = "--ci" ]; then
   pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 chromium)
 fi

@@ -50,12 +50,9 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
   }
   /* the beams to switch: every body of type beam */
   fmbDiag diag;
-  fmbStats stats;
-  memset(&stats, 0, sizeof stats);
   fmbModel* m = fmb_load(s->scene, s->overrides, s->nover, fmb_cli_registry(), &diag);
-  if (!m) {
+  if (!m) { /* nothing ran: the error line is the last, no stats line */
     fmb_cli_print_diag(&diag);
-    fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   /* the scene's table files are inputs now too: refuse before any run, not after all of them */
@@ -105,12 +102,9 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
       fmb_cli_print_diag(&res->diag[k]);
       told |= strcmp(res->diag[k].msg, diag.msg) == 0;
     }
-    print_model_stats(model[k], &res->stats[k]);
+    if (res->code[k] != FMB_EXIT_BAD_INPUT) print_model_stats(model[k], &res->stats[k]); /* bad input ran nothing */
   }
-  if (rc && !told) {
-    fmb_cli_print_diag(&diag);
-    if (res->ran == 0) fmb_print_stats(&stats, stderr);
-  }
+  if (rc && !told) fmb_cli_print_diag(&diag);
   free(res);
   free(beams);
   fmb_free(m);
