@@ -77,7 +77,8 @@ int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
   return -1;
 }
 
-/* a warning does not stop the load: FILE:LINE:COL: warning: ... on stderr (or the override) */
+/* a warning does not stop the load: FILE:LINE:COL: warning: ... (or the override), to the thread's
+   warn handler (warn.c) */
 void fmbp_warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
   char msg[600];
   va_list ap;
@@ -88,7 +89,7 @@ void fmbp_warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
   memset(&w, 0, sizeof w);
   diag_at(p, node, &w, msg);
   if (w.line > 0)
-    fprintf(stderr, "%s:%d:%d: warning: %s\n", w.file, w.line, w.col, w.msg);
+    fmb_warn(NULL, "%s:%d:%d: warning: %s", w.file, w.line, w.col, w.msg);
   else
-    fprintf(stderr, "%s: warning: %s\n", w.file, w.msg);
+    fmb_warn(NULL, "%s: warning: %s", w.file, w.msg);
 }

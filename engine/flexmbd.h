@@ -25,8 +25,10 @@ extern "C" {
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
    the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
-   pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). */
-#define FMB_ABI_VERSION 2
+   pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). 3: the
+   stepping API (fmbData, fmb_init, fmb_advance, ...), the warn callback, and inputs: joints gained
+   the optional `input` op and read an input's value with fmb_eval_input. */
+#define FMB_ABI_VERSION 3
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
 #if defined(__GNUC__)
@@ -236,7 +238,7 @@ typedef struct fmbBodyType {
   const struct fmbBodyType* (*variant)(fmbParser* p, fmbNode item);
   /* 0 when this body's K, C, M must be evaluated afresh whenever IDA asks for a new iteration
      matrix. The engine otherwise reassembles them from their last evaluation when only cj has
-     changed (engine/integrate.c), which suits bodies whose tangent changes slowly; a
+     changed (engine/integrator_ida.c), which suits bodies whose tangent changes slowly; a
      geometrically exact beam's axial stiffness EA t t^T turns with its tangent, and stale blocks
      cost Newton failures (spin-up at 15 rad/s, 20 elements: 454 against 123, 1.7x the CPU).
      NULL = 1 (reuse allowed). */
@@ -268,7 +270,7 @@ typedef struct fmbBodyType {
   /* Each coordinate's length scale into metres_per_unit[ncoord]: the metres a point of the body
      moves per unit of the coordinate (1 for a displacement; the length L for a slope, a stretch
      or an angle that swings the body). The engine divides the scene's atol by it for that
-     coordinate and its velocity (engine/integrate.c), so one atol in metres controls slopes and
+     coordinate and its velocity (engine/tolerance.c), so one atol in metres controls slopes and
      displacements alike at any size of the body. NULL = atol as given for every coordinate. */
   void (*length_scale)(const void* self, double* metres_per_unit);
   /* The range where the body's model is accurate (ABI 2, added before any release of it): NULL
@@ -314,6 +316,10 @@ typedef struct fmbJointType {
   const char* example;
   const char* example_damped;
   unsigned flags;
+  /* ABI 3, optional: 1 when this instance takes its value from an input that a program sets
+     between steps (fmb_set_input; a drive or load with `profile: input` / `law: input`), with the
+     scene's initial `value:` in *initial; 0 otherwise. The input's name is the joint's. */
+  int (*input)(const void* self, double* initial);
 } fmbJointType;
 
 /* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
@@ -332,6 +338,9 @@ FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
 /* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
    context or another k (0 would be body 0's column: a wrong place, silently) */
 FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
+/* the current value of this joint's input (its `input` op said 1): the scene's `value:` until a
+   program sets it with fmb_set_input; NaN for a joint without an input */
+FMB_API double fmb_eval_input(const fmbJointEval* ev);
 
 /* ---------------------------------------------------------------------------------------------
  * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
@@ -407,9 +416,12 @@ typedef struct fmbStats {
 
 typedef struct fmbRunOptions {
   const char* csv_path; /* NULL or "-" = stdout */
-  int quiet;            /* no progress lines on stderr */
-  /* a progress line on stderr (t, % of t_end, steps, elapsed, remaining), from progress_after_s
-     of wall time on: rewritten in place on a terminal, one line per update otherwise */
+  /* no progress line and no notes (initial conditions, redundant rows, a switch of formulation);
+     warnings still go out. Messages go to the thread's warn handler (fmb_set_warn). */
+  int quiet;
+  /* a progress message "progress: t = ..." (t, % of t_end, steps, elapsed, remaining), from
+     progress_after_s of wall time on, at most 5 a second when stderr is a terminal (where the
+     flexmbd program rewrites the line in place), one a second otherwise */
   int progress;
   double progress_after_s;
   const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
@@ -505,6 +517,79 @@ FMB_API const char* const* fmb_engine_outputs(const char* group);
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 
 /* ---------------------------------------------------------------------------------------------
+ * Stepping (engine/step.c; docs/api.md). A model is fixed after fmb_load and only read; the state
+ * of one run of it lives in an fmbData (MuJoCo's mjModel / mjData split), so one model can be run
+ * by several data objects, and two data objects (of one model or two) can be advanced in two
+ * threads at once. fmb_run is a loop over these calls (engine/run.c) and writes the same bytes.
+ *
+ *   fmbData* d = fmb_data_new(m, &diag);            everything a run needs is allocated here
+ *   fmb_init(m, d, &diag);                           consistent state at t0 (again: restart)
+ *   while (fmb_data_time(d) < t_end) {
+ *     fmb_set_input(m, d, "motor", torque);          optional: a load or drive between steps
+ *     fmb_advance(m, d, t_next, &diag);              integrate to t_next
+ *     fmb_outputs(m, d, values);                     the CSV row's values at time()
+ *   }
+ *   fmb_data_free(d);
+ *
+ * Return codes: 0; FMB_EXIT_SOLVER (the state is the last good one and diag says when and why);
+ * FMB_EXIT_INTERRUPTED (fmb_data_cancel); FMB_EXIT_BAD_INPUT for misuse: a NULL argument, a data
+ * object of another model or already freed, advance before init, t_out NaN, before time() or
+ * beyond the scene's t_end. A misused call changes nothing.
+ * ------------------------------------------------------------------------------------------- */
+typedef struct fmbData fmbData; /* the state of one run of one model */
+/* one message (no trailing newline): a warning, a note, a progress line; user as given */
+typedef void (*fmbWarnFn)(void* user, const char* message);
+
+/* allocates everything a run needs (state, scratch, outputs); NULL with *diag on failure */
+FMB_API fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag);
+/* NULL is fine; a second free of the same object is detected and ignored while it is among the
+   last FMB_DATA_QUARANTINE freed ones (its memory is held back until then), as is any other call
+   on it (FMB_EXIT_BAD_INPUT); beyond that, using a freed object is undefined */
+FMB_API void fmb_data_free(fmbData* d);
+#define FMB_DATA_QUARANTINE 64
+/* the consistent state at the scene's t0 (initial conditions; inputs back to their `value:`);
+   again = restart from t0. The integrator itself is set up by the first fmb_advance from the
+   state then (after any fmb_set_input). 0 or an exit code with *diag */
+FMB_API int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag);
+/* integrate from time() to t_out, time() <= t_out <= t_end (t_out == time(): nothing to do). A
+   changed input (fmb_set_input) or a run interrupted or failed before restarts the integrator
+   from a consistent state at time(): no step history is carried across the jump. */
+FMB_API int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag);
+FMB_API double fmb_data_time(const fmbData* d); /* NaN for NULL (or before fmb_init) */
+/* the DAE state y = [q, v, lambda, mu, z] and y' (fmb_state_size(m) doubles each; either may be
+   NULL): 0, or FMB_EXIT_BAD_INPUT (NULL or freed d, before fmb_init) */
+FMB_API int fmb_data_state(const fmbData* d, double* y, double* yp);
+/* the scene's outputs: their number (the CSV's columns after t), the name of output i (e.g.
+   "beam.tip_v"; NULL out of range) and their values at time() into out[fmb_noutput(m)], the very
+   numbers the CSV row at that time holds. fmb_outputs: 0, FMB_EXIT_SOLVER when a value is not
+   finite (out still filled), FMB_EXIT_BAD_INPUT for misuse */
+FMB_API int fmb_noutput(const fmbModel* m);
+FMB_API const char* fmb_output_name(const fmbModel* m, int i);
+FMB_API int fmb_outputs(const fmbModel* m, fmbData* d, double* out);
+/* the integrator's counters so far (all backends of this run), t_reached = time(), the CPU time
+   spent in fmb_init and fmb_advance: 0, or FMB_EXIT_BAD_INPUT */
+FMB_API int fmb_data_stats(const fmbData* d, fmbStats* st);
+/* ask the advance in progress, or the next one, to stop: it returns FMB_EXIT_INTERRUPTED with the
+   state at the last good step, and the request is used up (a later advance goes on from there).
+   Only sets a flag: safe from another thread or a signal handler. */
+FMB_API void fmb_data_cancel(fmbData* d);
+/* where this run's messages go: fn(user, message); fn NULL = the thread's default (fmb_set_warn) */
+FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
+/* the calling thread's default handler, for messages while loading and of runs without their own:
+   fn(user, message); fn NULL = silent. Until a thread sets one, messages go to stderr, one line
+   each. */
+FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
+/* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
+   a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
+   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from time() on, as a step (piecewise
+   constant) that the next advance starts from. */
+FMB_API int fmb_ninput(const fmbModel* m);
+FMB_API const char* fmb_input_name(const fmbModel* m, int i);
+FMB_API int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value);
+/* the current value of input `name`: 0, or FMB_EXIT_BAD_INPUT */
+FMB_API int fmb_get_input(const fmbModel* m, const fmbData* d, const char* name, double* value);
+
+/* ---------------------------------------------------------------------------------------------
  * Conformance (engine/conform.c): the checks every registered type must pass, run on its
  * declared example: bad parameters refused with a located message, declared keys = keys read,
  * analytic Jacobian against finite differences, mass matrix symmetric positive definite, marker
@@ -527,7 +612,7 @@ typedef struct fmbStaticOptions {
   int max_iter;     /* Newton iterations per load step; 0 = 30 */
   int max_halvings; /* how often a load step may be halved; 0 = 12 (down to 1/4096 of the load) */
   double tol;       /* Newton stops when max |dq_i| <= tol (1 + |q_i|); 0 = 1e-10 */
-  int quiet;        /* no progress lines on stderr */
+  int quiet;        /* no progress messages (to the warn handler) */
 } fmbStaticOptions;
 
 typedef struct fmbStaticResult {
@@ -590,7 +675,8 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
 /* a table of named numeric columns (row-major values), through the one CSV writer; nrow >= 0
-   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table) */
+   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). With the names "t" and
+   fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
 

@@ -18,6 +18,7 @@
 #include <string.h>
 #include <klu.h>
 
+#include "fd.h"
 #include "internal.h"
 #include "klu_policy.h"
 
@@ -49,6 +50,17 @@ static int gram_factor(int nc, int nq, const double* PhiQ, const unsigned char* 
       G[(size_t)k * nc + i] = s;
     }
   return fmb_lu_factor(nc, G, piv);
+}
+
+/* x -= Phi_q^T G^-1 r: the minimum-norm correction that removes the constraint residual r (nc,
+   overwritten) to first order, with G = Phi_q Phi_q^T as gram_factor left it */
+static void subtract_min_norm(int nc, int nq, const double* PhiQ, const double* G, const int* piv, double* r, double* x) {
+  fmb_lu_solve(nc, G, piv, r);
+  for (int c = 0; c < nq; ++c) {
+    double s = 0.0;
+    for (int k = 0; k < nc; ++k) s += PhiQ[(size_t)k * nq + c] * r[k];
+    x[c] -= s;
+  }
 }
 
 /* Rows of Phi_q that depend on the others (relative tolerance FMB_RANK_TOL): marked in drop[].
@@ -86,12 +98,7 @@ static int project_positions(const fmbModel* m, fmbWorkspace* w, double t, doubl
       if (mark_dependent_rows(nc, nq, PhiQ, drop) < 0 || gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
     }
     for (int r = 0; r < nc; ++r) rhs[r] = drop[r] ? 0.0 : phi[r];
-    fmb_lu_solve(nc, G, piv, rhs);
-    for (int c = 0; c < nq; ++c) {
-      double s = 0.0;
-      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-      q[c] -= s;
-    }
+    subtract_min_norm(nc, nq, PhiQ, G, piv, rhs, q);
   }
   return 1;
 }
@@ -597,8 +604,116 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   return rc;
 }
 
+/* the dense scratch of steps 1-3: Phi_q (row-major nc x nq), phi, phi_t, phi_tt (nc), the Gram
+   matrix (nc^2), pivots and a right-hand side (nq + nc each); 0, or -1 out of memory (all NULL) */
+typedef struct {
+  double *PhiQ, *phi, *phit, *phitt, *G, *rhs;
+  int* piv;
+} Scratch;
+
+static void scratch_free(Scratch* s) {
+  double* bufs[] = {s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->rhs};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(s->piv);
+  memset(s, 0, sizeof *s);
+}
+
+static int scratch_new(const fmbModel* m, Scratch* s) {
+  const size_t nq = (size_t)m->nq, nc = (size_t)m->nc, n = nq + nc + 1;
+  s->PhiQ = calloc((nc ? nc : 1) * nq, sizeof(double));
+  s->phi = calloc(nc + 1, sizeof(double));
+  s->phit = calloc(nc + 1, sizeof(double));
+  s->phitt = calloc(nc + 1, sizeof(double));
+  s->G = calloc(nc * nc + 1, sizeof(double));
+  s->rhs = calloc(n, sizeof(double));
+  s->piv = calloc(n, sizeof(int));
+  if (s->PhiQ && s->phi && s->phit && s->phitt && s->G && s->rhs && s->piv) return 0;
+  scratch_free(s);
+  return -1;
+}
+
+/* The minimum-norm correction of v onto Phi_q v + Phi_t = 0 (the rows marked in drop left out),
+   with Phi_q (row-major nc x nq) and Phi_t at the positions: 0, or 1 when the rows kept are not
+   independent. G, piv, rhs: scratch of nc^2, nc, nc. */
+static int project_velocities(int nc, int nq, const double* PhiQ, const double* phit, const unsigned char* drop, double* G,
+                              int* piv, double* rhs, double* v) {
+  if (gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
+  for (int r = 0; r < nc; ++r) {
+    double s = phit[r];
+    for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
+    rhs[r] = drop[r] ? 0.0 : s;
+  }
+  subtract_min_norm(nc, nq, PhiQ, G, piv, rhs, v);
+  return 0;
+}
+
+/* Step 3 at consistent q, v (y's) and time t: the accelerations (yp's v slice; yp's q slice = v),
+   the multipliers and the bodies' auxiliary unknowns, mu = 0. Scratch: PhiQ (nc x nq), phi, phit,
+   phitt (nc), rhs (nq + nc). 0 or an exit code with diag set. */
+static int accelerations_at(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, double* PhiQ,
+                            double* phi, double* phit, double* phitt, double* rhs, fmbDiag* diag) {
+  const int nq = m->nq;
+  double *q = y, *v = y + nq;
+  int rc = 0;
+  if (fmb_model_has_sparse_body(m)) {
+    /* a body declared a sparse pattern (a banded beam): the dense augmented system would take
+       (nq + nc)^2 memory and cubic time; sparse Newton for a, lambda and the auxiliary unknowns */
+    int nred = 0;
+    fmb_workspace_redundant(w, &nred);
+    if (nred > 0) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                   "redundant constraints with a body that declares a sparse pattern (a banded beam) are not "
+                   "supported yet: remove the repeated joint, or set the beam's `assembly: dense`");
+      return FMB_EXIT_BAD_INPUT;
+    }
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt) || fmb_constraints_gamma(m, w, t, q, v, rhs + nq)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the constraints are not finite at t = %g", t);
+      rc = FMB_EXIT_SOLVER;
+    } else {
+      rc = sparse_accelerations(m, w, t, y, yp, PhiQ, rhs + nq, diag);
+    }
+    return rc;
+  }
+  /* augmented system for accelerations and multipliers */
+  fmbAugmented* aug = fmb_augmented_new(m);
+  if (!aug) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
+    return FMB_EXIT_SOLVER;
+  }
+  int arc = fmb_augmented_solve(m, w, aug, t, q, v, fmb_workspace_redundant(w, NULL), 0.0, yp + nq, y + 2 * nq);
+  memcpy(yp, v, (size_t)nq * sizeof(double));
+  if (arc == FMB_AUG_MASS_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
+                 m->body[fmb_augmented_failed_body(aug)].name, t);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_FORCES_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_SINGULAR) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
+                 "with redundant joints): cannot compute initial accelerations");
+    rc = FMB_EXIT_BAD_INPUT;
+  } else if (arc == FMB_AUG_NOT_FINITE) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
+    rc = FMB_EXIT_SOLVER;
+  }
+  /* the bodies' auxiliary unknowns, consistent with (q, v, a) */
+  for (int b = 1; b < m->nbody && !rc; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bi->nz > 0 && bi->type->aux_initial(bi->self, &m->env, q + bi->qadr, v + bi->qadr, yp + nq + bi->qadr,
+                                            y + m->zoff + bi->zadr, fmb_workspace_plugin(w) + bi->workadr)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the auxiliary unknowns of body '%s' are not finite at t = %g",
+                   bi->name, t);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  fmb_augmented_free(aug);
+  return rc;
+}
+
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st, fmbDiag* diag) {
-  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  const int nq = m->nq, nc = m->nc;
   const double t0 = m->solver.t0;
   double* q = y;
   double* v = y + nq;
@@ -608,18 +723,14 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     const fmbBodyInst* bi = &m->body[b];
     bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
   }
-  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-  double* phi = calloc((size_t)nc + 1, sizeof(double));
-  double* phit = calloc((size_t)nc + 1, sizeof(double));
-  double* phitt = calloc((size_t)nc + 1, sizeof(double));
-  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
-  int* piv = calloc((size_t)n + 1, sizeof(int));
-  double* rhs = calloc((size_t)n + 1, sizeof(double));
+  Scratch sc;
+  const int no_scratch = scratch_new(m, &sc);
+  double *PhiQ = sc.PhiQ, *phi = sc.phi, *phit = sc.phit, *phitt = sc.phitt, *G = sc.G, *rhs = sc.rhs;
+  int* piv = sc.piv;
   double* q0 = calloc((size_t)nq, sizeof(double));
   double* v0 = calloc((size_t)nq, sizeof(double));
-  fmbAugmented* aug = NULL;
   int rc = 0;
-  if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs || !q0 || !v0) {
+  if (no_scratch || !q0 || !v0) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -674,22 +785,10 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     } else {
       memset(drop, 0, (size_t)nc);
     }
-    /* velocities */
-    if (gram_factor(nc, nq, PhiQ, drop, G, piv)) {
+    if (project_velocities(nc, nq, PhiQ, phit, drop, G, piv, rhs, v)) {
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints' equations are not independent at t = %g", t0);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
-    }
-    for (int r = 0; r < nc; ++r) {
-      double s = phit[r];
-      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
-      rhs[r] = drop[r] ? 0.0 : s;
-    }
-    fmb_lu_solve(nc, G, piv, rhs);
-    for (int c = 0; c < nq; ++c) {
-      double s = 0.0;
-      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-      v[c] -= s;
     }
   }
   for (int i = 0; i < nq; ++i) {
@@ -715,71 +814,48 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   st->ic_position_correction = norm2(q0, nq);
   st->ic_velocity_correction = norm2(v0, nq);
 
-  if (fmb_model_has_sparse_body(m)) {
-    /* a body declared a sparse pattern (a banded beam): the dense augmented system would take
-       (nq + nc)^2 memory and cubic time; sparse Newton for a, lambda and the auxiliary unknowns */
-    int nred = 0;
-    fmb_workspace_redundant(w, &nred);
-    if (nred > 0) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "redundant constraints with a body that declares a sparse pattern (a banded beam) are not "
-                   "supported yet: remove the repeated joint, or set the beam's `assembly: dense`");
-      rc = FMB_EXIT_BAD_INPUT;
-      goto done;
-    }
-    if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt) || fmb_constraints_gamma(m, w, t0, q, v, rhs + nq)) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the constraints are not finite at t = %g", t0);
-      rc = FMB_EXIT_SOLVER;
-    } else {
-      rc = sparse_accelerations(m, w, t0, y, yp, PhiQ, rhs + nq, diag);
-    }
-    goto done;
-  }
-  /* augmented system for accelerations and multipliers */
-  aug = fmb_augmented_new(m);
-  if (!aug) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
-    rc = FMB_EXIT_SOLVER;
-    goto done;
-  }
-  int arc = fmb_augmented_solve(m, w, aug, t0, q, v, fmb_workspace_redundant(w, NULL), 0.0, yp + nq, y + 2 * nq);
-  memcpy(yp, v, (size_t)nq * sizeof(double));
-  if (arc == FMB_AUG_MASS_FAILED) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
-                 m->body[fmb_augmented_failed_body(aug)].name, t0);
-    rc = FMB_EXIT_SOLVER;
-  } else if (arc == FMB_AUG_FORCES_FAILED) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
-    rc = FMB_EXIT_SOLVER;
-  } else if (arc == FMB_AUG_SINGULAR) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
-                 "with redundant joints): cannot compute initial accelerations");
-    rc = FMB_EXIT_BAD_INPUT;
-  } else if (arc == FMB_AUG_NOT_FINITE) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
-    rc = FMB_EXIT_SOLVER;
-  }
-  /* the bodies' auxiliary unknowns, consistent with (q, v, a) */
-  for (int b = 1; b < m->nbody && !rc; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    if (bi->nz > 0 && bi->type->aux_initial(bi->self, &m->env, q + bi->qadr, v + bi->qadr, yp + nq + bi->qadr,
-                                            y + m->zoff + bi->zadr, fmb_workspace_plugin(w) + bi->workadr)) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the auxiliary unknowns of body '%s' are not finite at t = %g",
-                   bi->name, t0);
-      rc = FMB_EXIT_SOLVER;
-    }
-  }
+  rc = accelerations_at(m, w, t0, y, yp, PhiQ, phi, phit, phitt, rhs, diag);
 done:
-  fmb_augmented_free(aug);
-  free(PhiQ);
-  free(phi);
-  free(phit);
-  free(phitt);
-  free(G);
-  free(piv);
-  free(rhs);
+  scratch_free(&sc);
   free(q0);
   free(v0);
+  return rc;
+}
+
+/* A consistent state at t from the q, v in y, for a run that goes on after something changed
+   under it (an input set between steps, an interrupted or failed advance: step.c): q projected
+   onto Phi(q, t) = 0 and v onto Phi_q v + Phi_t = 0 with the rows found redundant at t0 left out
+   (steps 1 and 2, minimum-norm), then step 3 as at t0. A jump in a drive's prescribed angle thus
+   moves the bodies onto the new constraint, and a jump in a load gives new accelerations and
+   multipliers. 0 or an exit code with diag set. */
+int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  Scratch sc;
+  int rc = 0;
+  if (scratch_new(m, &sc)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory restarting the integrator at t = %.6g", t);
+    rc = FMB_EXIT_SOLVER;
+  } else if (nc > 0) {
+    unsigned char* drop = fmb_workspace_redundant(w, NULL);
+    double res = 0.0;
+    int iters = 0;
+    if (project_positions(m, w, t, y, y + nq, sc.PhiQ, sc.phi, sc.phit, sc.phitt, sc.G, sc.piv, sc.rhs, drop, &res, &iters) ||
+        fmb_constraints_all(m, w, t, y, y + nq, sc.phi, sc.PhiQ, sc.phit, sc.phitt) ||
+        project_velocities(nc, nq, sc.PhiQ, sc.phit, drop, sc.G, sc.piv, sc.rhs, y + nq)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "the joints cannot be satisfied at t = %.6g after the change (constraint residual %.3g after %d "
+                   "projection steps): a prescribed motion set by fmb_set_input jumped further than the mechanism can "
+                   "follow; change it in smaller steps",
+                   t, res, iters);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  if (!rc) {
+    /* the multipliers' and auxiliary unknowns' derivatives and mu are 0 in a consistent state */
+    memset(y + 2 * nq + nc, 0, (size_t)nc * sizeof(double));
+    memset(yp + 2 * nq, 0, (size_t)(m->ny - 2 * nq) * sizeof(double));
+    rc = accelerations_at(m, w, t, y, yp, sc.PhiQ, sc.phi, sc.phit, sc.phitt, sc.rhs, diag);
+  }
+  scratch_free(&sc);
   return rc;
 }

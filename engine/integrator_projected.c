@@ -96,7 +96,7 @@ static int joint_powers(ProjRun* c, double t, const double* q, const double* v, 
 
 static int proj_rhs(sunrealtype t, N_Vector Y, N_Vector Yd, void* ud) {
   ProjRun* c = ud;
-  if (c->stop && *c->stop) return -1;
+  if (fmb_stop_requested(c->stop)) return -1;
   const int nq = c->m->nq;
   const double *q = N_VGetArrayPointer(Y), *v = q + nq;
   double* f = N_VGetArrayPointer(Yd);
@@ -226,7 +226,7 @@ static int proj_advance(void* self, double tout, double* t_reached, double* y, d
     proj_failed = 1;
   memcpy(yp, y + nq, sizeof(double) * (size_t)nq);
   if (flag >= 0 && !proj_failed) return FMB_ADVANCE_OK;
-  if (c->stop && *c->stop) return FMB_ADVANCE_INTERRUPTED;
+  if (fmb_stop_requested(c->stop)) return FMB_ADVANCE_INTERRUPTED;
   if (flag >= 0) {
     snprintf(why, why_len, "the projection onto the constraints did not converge (the mechanism may have left its "
              "assembled configurations); try a tighter rtol");

@@ -356,7 +356,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }
-    if (c->stop && *c->stop) return NEWTON_FATAL;
+    if (fmb_stop_requested(c->stop)) return NEWTON_FATAL;
     for (int i = 0; i < 3; ++i) {
       for (int k = 0; k < ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
       stage_derivative(c, i, h, c->yps);
@@ -580,7 +580,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
   int zero_start = c->first;
   c->caljac = 0;
   for (;;) {
-    if (c->stop && *c->stop) {
+    if (fmb_stop_requested(c->stop)) {
       *interrupted = 1;
       return FAIL_NONE;
     }
@@ -616,7 +616,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     double hfac = 0.5;
     const int nr = newton(c, &newt, &hfac);
     if (nr == NEWTON_FATAL) {
-      if (c->stop && *c->stop) {
+      if (fmb_stop_requested(c->stop)) {
         *interrupted = 1;
         return FAIL_NONE;
       }

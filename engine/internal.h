@@ -43,6 +43,7 @@ typedef struct fmbJointInst {
      random states at load (pattern.c): a joint at a beam's root touches the frame only */
   int nsup;
   int* sup;
+  int input; /* its index among the model's inputs (fmbJointType.input said 1), or -1 */
 } fmbJointInst;
 
 typedef enum {
@@ -81,7 +82,7 @@ typedef struct fmbSolverSettings {
   /* ggl: the stabilized index-2 DAE of system.c (IDA); projected: index-1 equations with
      minimum-norm multipliers, positions and velocities projected onto the constraints after every
      step (CVODE), which passes singular configurations; auto (default): ggl, and where IDA fails
-     at a rank-deficient constraint Jacobian the run continues with projected (integrate.c,
+     at a rank-deficient constraint Jacobian the run continues with projected (step.c,
      docs/mechanisms.md) */
   enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1, FMB_FORM_AUTO = 2 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */
@@ -136,6 +137,10 @@ struct fmbModel {
   long* colptr; /* ny + 1 */
   long* rowind; /* nnz */
   char vtk_dir[512]; /* the scene's `vtk` key: "" = no animation unless the run asks */
+  /* inputs (fmb_set_input): the joints that take one, in scene order, and their `value:` */
+  int ninput;
+  int* input_joint;
+  double* input_initial;
 };
 
 /* evaluation context a joint sees */
@@ -148,6 +153,7 @@ struct fmbJointEval {
   double* work;    /* plugin scratch (body markers) */
   double* mk;      /* 3 x max body ncoord: marker derivatives before scattering */
   double* js;      /* 2 x max joint columns: the joint's own scratch */
+  const double* input; /* the inputs' current values (the workspace's, set by fmb_set_input) */
 };
 
 /* ---- registry.c: a growable registry of types; plugin.c: loading plugins ---- */
@@ -239,6 +245,22 @@ typedef struct fmbWorkspace fmbWorkspace;
 fmbWorkspace* fmb_workspace_new(const fmbModel* m);
 void fmb_workspace_free(fmbWorkspace* w);
 double* fmb_workspace_plugin(fmbWorkspace* w);
+/* the inputs' current values (m->ninput; the scene's `value:` when the workspace is made) */
+double* fmb_workspace_inputs(fmbWorkspace* w);
+/* where messages of the run on this workspace go (fn NULL: the thread's default, warn.c) */
+typedef struct {
+  fmbWarnFn fn;
+  void* user;
+} fmbWarnSink;
+fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w);
+
+/* ---- warn.c: the library's one way to say something (issue 24): to the workspace's sink, else
+   the thread's default handler (fmb_set_warn), else stderr; w may be NULL (load time) ---- */
+void fmb_warn(fmbWorkspace* w, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 /* a body declared its own sparse pattern (pattern op): dense whole-model systems are avoided */
 int fmb_model_has_sparse_body(const fmbModel* m);
 /* a type's output id for `quantity`: its output_lookup op, or without one the index in its
@@ -298,10 +320,6 @@ int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t
    diagonal entry): used to explain a solver failure at the crossing itself. */
 int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double singular_tol);
 
-/* ---- pattern.c ---- */
-int fmb_pattern_build(fmbModel* m);
-void fmb_pattern_free(fmbModel* m);
-
 /* ---- integrator_ida.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
 struct _generic_SUNMatrix;
 void fmb_sparse_pattern_into(const fmbModel* m, struct _generic_SUNMatrix* J);
@@ -342,6 +360,9 @@ void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size
 #define FMB_MIN_NORM_SHIFT 1e-10
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
                            fmbDiag* diag);
+/* a consistent state at t from y's q and v (projected onto the constraints), for a restart after
+   an input changed (step.c); 0 or an exit code with diag set */
+int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag);
 
 /* ---- static.c ---- */
 /* the poses q at time t against the joints, as a run checks them (ic.c): joints that cannot be
@@ -370,6 +391,9 @@ typedef struct fmbCsv fmbCsv;
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
 int fmb_csv_header(fmbCsv* c, const fmbModel* m); /* 0 ok, -1 write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
+/* a body out of its model's range (fmbBodyType.model_range) named through fmb_warn, once: warned
+   has nbody entries, 1 once a body was named */
+void fmb_warn_model_range(const fmbModel* m, fmbWorkspace* w, double t, const double* y, unsigned char* warned);
 /* puts a file with a header in place (rename), removes one without; -1 with errno on failure */
 int fmb_csv_close(fmbCsv* c);
 /* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */
@@ -384,22 +408,5 @@ fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag);
 int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const double* y); /* 0 ok, -1 write failed */
 int fmb_vtk_set_every(fmbVtk* v, int every); /* write every Nth step only (0, 1: each); -1 when every < 0 */
 void fmb_vtk_close(fmbVtk* v);
-
-/* ---- fd.c ---- */
-double fmb_fd_increment(double y, double ewt);
-/* dense column-major derivative of a body's residual: K = dR/dq, C = dR/dv, M = dR/da */
-int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
-                         const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
-                         double* M, double* work, double* scratch);
-/* a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
-   pattern_jacobian when it has one, else by differences over its pattern, one residual pair per
-   colour; scratch doubles: fmb_body_sparse_scratch */
-size_t fmb_body_sparse_scratch(const fmbBodyInst* b);
-int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                           const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                           double* work, double* scratch);
-/* a body's rows [R; Rz] at (q, v, a, z): residual_aux when it has auxiliary unknowns */
-int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                  const double* z, double* R, double* work);
 
 #endif

@@ -847,6 +847,9 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
   } else {
     fmb_csv_header(c, m);
     const int wr = fmb_csv_row(c, m, w, t, y, yp);
+    unsigned char* warned = wr > 0 ? NULL : calloc((size_t)m->nbody + 1, 1);
+    if (warned) fmb_warn_model_range(m, w, t, y, warned); /* a state out of a body's model's range */
+    free(warned);
     if (wr) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, wr > 0 ? "an output is not finite" : "writing the output failed");
       rc = FMB_EXIT_SOLVER;

@@ -329,7 +329,6 @@ struct fmbCsv {
   int nrow;
   char* line; /* one formatted row */
   size_t cap;
-  unsigned char* range_warned; /* per body: its model_range warning was given (once per run) */
 };
 
 static int write_all(int fd, const char* buf, size_t len) {
@@ -446,9 +445,11 @@ static const double* output_multipliers(const fmbModel* m, fmbWorkspace* w, doub
   return om->lambda;
 }
 
-/* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
+/* the scene's outputs at (t, y) into row[noutput] (every one, also after a value that is not
+   finite: fmb_outputs hands them all over); 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row) {
   const double *q = y, *v = y + m->nq;
+  int not_finite = 0;
   (void)yp;
   fmbEnergy e = {0, 0, 0, 0};
   double cpos = 0.0, cvel = 0.0;
@@ -492,34 +493,31 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
       case FMB_OUT_CONSTRAINT: val = o->id == 0 ? cpos : cvel; break;
       case FMB_OUT_SHAPE: val = shape_value(m, w, o, q); break;
     }
-    if (!isfinite(val)) return 1;
     row[i] = val;
+    not_finite |= !isfinite(val);
   }
-  return 0;
+  return not_finite;
 }
 
 /* A body whose state has left the range where its model is accurate (fmbBodyType.model_range)
-   is named once per run, at the first output time it happens (issue 23: the complete beam 0.29 m
-   off the exact one at 43 % of L, silently). Checked here because a run's rows are its output
-   times; the run goes on, it is the user's call. */
-static void warn_model_range(fmbCsv* c, const fmbModel* m, double t, const double* y) {
-  if (!c->range_warned && !(c->range_warned = calloc((size_t)m->nbody, 1))) return;
+   is named once per run (warned[b]), at the first time it is seen there: at t0 and after every
+   advance (step.c; fmb_run: its output times), and in a state written as a row (modes.c, the
+   static state) (issue 23: the complete beam 0.29 m off the exact one at 43 % of L, silently).
+   The run goes on: it is the user's call. */
+void fmb_warn_model_range(const fmbModel* m, fmbWorkspace* w, double t, const double* y, unsigned char* warned) {
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    if (!bi->type->model_range || c->range_warned[b]) continue;
+    if (!bi->type->model_range || warned[b]) continue;
     char msg[600];
     if (!bi->type->model_range(bi->self, y + bi->qadr, y + m->nq + bi->qadr, msg, sizeof msg)) continue;
-    c->range_warned[b] = 1;
-    /* one call, as the run's other warnings (integrator_ida.c), for issue 24's warn hook to take */
-    fprintf(stderr, "%swarning: t = %.6g: body '%s' has left its model's range: %s\n",
-            isatty(fileno(stderr)) ? "\r\033[K" : "", t, bi->name, msg);
+    warned[b] = 1;
+    fmb_warn(w, "warning: t = %.6g: body '%s' has left its model's range: %s", t, bi->name, msg);
   }
 }
 
 /* 0 ok; 1 a value is not finite (nothing written); -1 a write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp) {
   if (fmb_outputs_eval(m, w, t, y, yp, c->row)) return 1;
-  warn_model_range(c, m, t, y);
   return fmb_csv_values(c, c->row);
 }
 
@@ -531,7 +529,6 @@ int fmb_csv_close(fmbCsv* c) {
   const int rc = fmb_safe_close(c->file, c->wrote_header);
   free(c->line);
   free(c->row);
-  free(c->range_warned);
   free(c);
   return rc;
 }

@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fd.h"
 #include "internal.h"
 
 struct fmbWorkspace {
@@ -41,7 +42,7 @@ struct fmbWorkspace {
   double* cache;
   size_t* cache_adr;
   int cache_valid;
-  double* work_done; /* njoint: accumulated work of each joint (integrate.c fills it) */
+  double* work_done; /* njoint: accumulated work of each joint (step.c fills it) */
   unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
   int nredundant_cap; /* nc */
   /* an object a layer above keeps with the workspace and frees with it (output.c: the augmented
@@ -49,6 +50,8 @@ struct fmbWorkspace {
   void* attached;
   void (*attached_free)(void*);
   double spring_energy0;
+  double* input;    /* m->ninput: the inputs' current values */
+  fmbWarnSink warn; /* where this run's messages go */
 };
 
 #define FMB_BLOCK_CACHE_BYTES ((size_t)256 << 20)
@@ -107,7 +110,9 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->work_done = calloc((size_t)m->njoint + 1, sizeof(double));
   w->redundant = calloc((size_t)m->nc + 1, 1);
   w->nredundant_cap = m->nc;
-  if (!w->redundant) {
+  w->input = calloc((size_t)m->ninput + 1, sizeof(double));
+  if (w->input && m->ninput > 0) memcpy(w->input, m->input_initial, (size_t)m->ninput * sizeof(double));
+  if (!w->redundant || !w->input) {
     fmb_workspace_free(w);
     return NULL;
   }
@@ -147,6 +152,7 @@ void fmb_workspace_free(fmbWorkspace* w) {
   free(w->cache_adr);
   free(w->work_done);
   free(w->redundant);
+  free(w->input);
   if (w->attached_free) w->attached_free(w->attached);
   double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
                     w->K, w->C, w->M, w->fdcol, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
@@ -163,6 +169,8 @@ int fmb_model_has_sparse_body(const fmbModel* m) {
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
 double* fmb_workspace_work(fmbWorkspace* w) { return w->work_done; }
+double* fmb_workspace_inputs(fmbWorkspace* w) { return w->input; }
+fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w) { return &w->warn; }
 unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
   if (count) {
     *count = 0;
@@ -207,6 +215,9 @@ int fmb_eval_col0(const fmbJointEval* ev, int k) {
   if (!ev || (k != 0 && k != 1)) return -1; /* 0 would send a plugin to body 0's columns */
   return k == 1 ? fmb_eval_ncoord(ev, 0) : 0;
 }
+double fmb_eval_input(const fmbJointEval* ev) {
+  return (ev && ev->j->input >= 0 && ev->input) ? ev->input[ev->j->input] : NAN;
+}
 
 int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle, double* dpos_dq,
                int ld, double* dangle_dq) {
@@ -243,7 +254,7 @@ int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols) {
 static int joint_eval(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                       double* phi, double* phi_q, double* phi_t, double* phi_tt) {
   const fmbJointInst* ji = &m->joint[j];
-  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   memset(phi_q, 0, (size_t)ji->nrows * (size_t)ji->ncol * sizeof(double));
   for (int r = 0; r < ji->nrows; ++r) phi_t[r] = phi_tt[r] = 0.0;
   return ji->type->constraint(ji->self, &ev, phi, phi_q, phi_t, phi_tt);
@@ -257,7 +268,7 @@ int fmb_joint_constraint(const fmbModel* m, fmbWorkspace* w, int j, double t, co
 static int joint_force(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        double* Q) {
   const fmbJointInst* ji = &m->joint[j];
-  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   memset(Q, 0, (size_t)ji->ncol * sizeof(double));
   return ji->type->force(ji->self, &ev, Q);
 }
@@ -689,7 +700,7 @@ void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, c
   for (int j = 0; j < m->njoint; ++j) {
     const fmbJointInst* ji = &m->joint[j];
     if (!ji->type->energy) continue;
-    fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+    fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
     e->spring += ji->type->energy(ji->self, &ev);
   }
 }
@@ -812,6 +823,6 @@ int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value) {
   const fmbJointInst* ji = &m->joint[j];
-  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   return ji->type->output(ji->self, id, &ev, value);
 }

@@ -53,6 +53,12 @@ volatile sig_atomic_t* fmb_cli_catch_stop_signals(void);
 /* `s` as a gnuplot string that gnuplot never expands (single-quoted; no command substitution);
    -1 and nothing written when s holds a control character (a line break would end the command) */
 int fmb_cli_gnuplot_string(FILE* g, const char* s);
+/* The library's messages on stderr as the program always printed them (fmb_set_warn, installed by
+   main): one line each, except the progress line on a terminal, rewritten in place; a message
+   while it is shown clears it first. fmb_cli_warn_end ends a progress line left open, so that the
+   stats line comes last on a line of its own. */
+void fmb_cli_warn(void* user, const char* message);
+void fmb_cli_warn_end(void);
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
 

@@ -10,7 +10,9 @@
  * dphi/dt = dphi/dq . v, with v the two bodies' velocities (fmb_eval_v): a rigid body's angular
  * velocity is its third velocity, but asking the marker works for any body, a beam's cross-section
  * included. Potential energy k (phi - angle0)^2 / 2. No constraint rows: a force element, drawn by
- * `--vtk` and `flexmbd view` as the line between its two points (the `attachment` op). */
+ * `--vtk` and `flexmbd view` as the line between its two points (the `attachment` op).
+ * flexmbd has the same element built in (`type: torsion`, joints/torsion.c); this one, registered
+ * as `torsion_spring`, is the worked example of writing a joint outside the tree. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -132,7 +134,7 @@ static const fmbParam torsion_params[] = {
 };
 
 static const fmbJointType torsion_type = {
-    .name = "torsion",
+    .name = "torsion_spring", /* not "torsion": that is a built-in type (joints/torsion.c) */
     .abi = FMB_ABI_VERSION,
     .parse = torsion_parse,
     .destroy = torsion_destroy,
@@ -150,6 +152,6 @@ static const fmbJointType torsion_type = {
 };
 
 static const fmbJointType* const joints[] = {&torsion_type, NULL};
-static const fmbPlugin plugin = {.abi = FMB_ABI_VERSION, .name = "torsion", .version = "1.0", .joints = joints};
+static const fmbPlugin plugin = {.abi = FMB_ABI_VERSION, .name = "torsion_spring", .version = "1.0", .joints = joints};
 
 FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void) { return &plugin; }

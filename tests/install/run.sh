@@ -14,12 +14,7 @@
 #     wrong ABI, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
 #     matrix that is not symmetric, energy that leaks (conform, exit 1);
 #  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc).
-set -u
-src=$1
-build=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work" || exit 1
+. "$(dirname "$0")/prefix.sh"
 fails=0
 fail() {
   echo "FAIL: $*" >&2
@@ -36,10 +31,6 @@ expect() {
   echo "ok: $* -> exit $rc, '$(grep -E -m1 -- "$pattern" "$work/out")'"
 }
 
-T=$work/prefix
-cmake --install "$build" --prefix "$T" >/dev/null || { echo "FAIL: cmake --install" >&2; exit 1; }
-libdir=$(ls -d "$T"/lib*/ | head -n 1)
-libdir=${libdir%/}
 abi=$(sed -n 's/^#define FMB_ABI_VERSION \([0-9]*\).*/\1/p' "$src/engine/flexmbd.h")
 
 # 1. the installed tree
@@ -102,7 +93,7 @@ expect 2 "noplugins.yaml:[0-9]+:[0-9]+: error: .*foundation_bar" "$F" run "$work
 expect 0 "foundation_bar +\\($pc/build/foundation.so\\)" "$F" types --plugin "$pc/build/foundation.so"
 expect 0 'N/m\^2 > 0, required' "$F" types --plugin "$pc/build/foundation.so"
 expect 0 'ok   foundation_bar: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$ex/build/foundation.so" foundation_bar
-expect 0 'conform: 9 types, 0 failed checks' "$F" conform --work "$work/conform"
+expect 0 'conform: 10 types, 0 failed checks' "$F" conform --work "$work/conform"
 expect 0 'agrees with the analytic solution' "$ex/build/check_foundation" "$ex/foundation.yaml" "$work/check.csv"
 expect 0 'agrees with the analytic solution' env LD_LIBRARY_PATH="$libdir" "$pc/check_foundation" "$pc/foundation.yaml" "$work/check_pc.csv"
 cat "$work/out"
@@ -114,7 +105,7 @@ mkdir -p "$jx"
 cp "$share"/examples/joint_plugin/*.c "$share"/examples/joint_plugin/CMakeLists.txt "$share"/examples/joint_plugin/*.yaml "$jx"/
 (cmake -S "$jx" -B "$jx/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$jx/build") \
   >"$work/cmake_joint.log" 2>&1 || fail "examples/joint_plugin does not build: $(tail -n 5 "$work/cmake_joint.log")"
-expect 0 'ok   torsion: 0 failed checks' "$F" conform --plugin "$jx/build/torsion.so" torsion
+expect 0 'ok   torsion_spring: 0 failed checks' "$F" conform --plugin "$jx/build/torsion.so" torsion_spring
 expect 0 'agrees with the analytic solution' "$jx/build/check_torsion" "$jx/torsion.yaml" "$work/torsion.csv"
 expect 0 'N m/rad >= 0, required' "$F" types --plugin "$jx/build/torsion.so"
 "$F" run "$jx/torsion.yaml" -o "$work/torsion_draw.csv" --set solver.t_end=0.1 \
