@@ -409,6 +409,7 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
 typedef struct fmbVtk fmbVtk;
 fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag);
 int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const double* y); /* 0 ok, -1 write failed */
+int fmb_vtk_set_every(fmbVtk* v, int every); /* write every Nth step only (0, 1: each); -1 when every < 0 */
 void fmb_vtk_close(fmbVtk* v);
 
 #endif

@@ -468,6 +468,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
   p.model = m;
   p.reg = reg;
   int rc = fmbp_open(&p, path, overrides, noverrides, diag);
+  if (rc == 0) fmb_safe_note_input(path); /* no output of this process may replace it */
   if (rc == 0) rc = parse_scene(&p, m);
   fmbp_close(&p);
   fmb_registry_free(p.own_reg); /* the types stay: their code is never unloaded */
@@ -481,6 +482,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
 
 void fmb_free(fmbModel* m) {
   if (!m) return;
+
   for (int b = 0; b < m->nbody; ++b)
     if (m->body[b].type && m->body[b].self) m->body[b].type->destroy(m->body[b].self);
   for (int j = 0; j < m->njoint; ++j)
@@ -507,6 +509,15 @@ int fmb_model_body(const fmbModel* m, int i, const char** name, const char** typ
   if (!m || i < 0 || i >= m->nbody - 1) return -1;
   if (name) *name = m->body[i + 1].name;
   if (type) *type = m->body[i + 1].type->name;
+  return 0;
+}
+
+int fmb_model_njoint(const fmbModel* m) { return m ? m->njoint : 0; }
+
+int fmb_model_joint(const fmbModel* m, int i, const char** name, const char** type) {
+  if (!m || i < 0 || i >= m->njoint) return -1;
+  if (name) *name = m->joint[i].name;
+  if (type) *type = m->joint[i].type->name;
   return 0;
 }
 

@@ -4,7 +4,8 @@
 #         (tools/format.sh: the committed .clang-format); and
 #         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
 #         VTK itself (skipped without it); python3-h5py, with which sweep_runs reads DIR/sweep.h5 back
-#         (skipped without it)
+#         (skipped without it); chromium, in which the test view_page loads the page of
+#         `flexmbd view` headless (skipped without it)
 # python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux.
 set -euo pipefail
 # liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
@@ -14,7 +15,7 @@ set -euo pipefail
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
       liblapack-dev libblas-dev libarpack2-dev libopenmpi-dev openmpi-bin libhdf5-dev hdf5-tools)
 if [ "${1:-}" = "--ci" ]; then
-  pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 python3-h5py)
+  pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 python3-h5py chromium)
 fi
 missing=()
 for p in "${pkgs[@]}"; do
