@@ -15,16 +15,34 @@
 
 #include "data.h"
 
-/* a CSV row that could not be written (wr < 0) or held a non-finite value (wr > 0) */
-static int row_failed(const fmbModel* m, int wr, double t, fmbDiag* diag) {
+/* a CSV row that could not be written (wr < 0) or held a non-finite value (wr > 0). The latter names
+   the first column that is not finite, and tells a solution that blew up (the state itself is not
+   finite) from a type's output op that returned NaN or Inf from a finite state (a plugin bug or a
+   quantity undefined there), where advice about the run's tolerances would mislead. */
+static int row_failed(const fmbModel* m, fmbData* d, int wr, fmbDiag* diag) {
+  const double t = d->t;
   if (wr < 0)
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "writing the output failed at t = %.6g (disk full?)", t);
-  else if (wr > 0)
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-                 "stopped at t = %.6g: an output is not finite (the solution blew up): check the initial values "
-                 "and parameters for a zero-length spring or an extreme value, try a tighter rtol or a smaller "
-                 "solver.max_step, and check the model for instability",
-                 t);
+  else if (wr > 0) {
+    fmb_outputs_eval(m, d->w, t, d->y, d->yp, d->row);
+    int col = 1;
+    while (col < m->noutput && isfinite(d->row[col])) ++col;
+    const char* name = col < m->noutput ? m->output[col].name : "?";
+    int state_finite = 1;
+    for (int i = 0; i < m->ny && state_finite; ++i) state_finite = isfinite(d->y[i]) && isfinite(d->yp[i]);
+    const fmbOutKind kind = col < m->noutput ? m->output[col].kind : FMB_OUT_BODY;
+    if (state_finite && (kind == FMB_OUT_BODY || kind == FMB_OUT_JOINT))
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "stopped at t = %.6g: output '%s' is not finite (%g) while the state is: its type's output op "
+                   "returned it (a bug in the type, or a quantity undefined in this state); the rows before are kept",
+                   t, name, col < m->noutput ? d->row[col] : NAN);
+    else
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "stopped at t = %.6g: output '%s' is not finite (the solution blew up): check the initial values "
+                   "and parameters for an extreme value (e.g. a zero-length spring), try a tighter rtol or a smaller "
+                   "solver.max_step, and check the model for instability",
+                   t, name);
+  }
   return wr != 0;
 }
 
@@ -118,11 +136,11 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   }
   if (rc || fmb_stop_requested(stop)) goto done;
   if (fmb_csv_header(csv, m)) {
-    row_failed(m, -1, d->t, diag);
+    row_failed(m, d, -1, diag);
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  if (row_failed(m, write_outputs(csv, vtk, m, d), d->t, diag)) {
+  if (row_failed(m, d, write_outputs(csv, vtk, m, d), diag)) {
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
@@ -133,7 +151,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   for (long k = 1; k <= nout; ++k) {
     const double tout = k == nout ? t_end : t0 + (double)k * dt;
     if ((rc = fmb_advance(m, d, tout, diag))) break;
-    if (row_failed(m, write_outputs(csv, vtk, m, d), d->t, diag)) {
+    if (row_failed(m, d, write_outputs(csv, vtk, m, d), diag)) {
       rc = FMB_EXIT_SOLVER;
       break;
     }

@@ -37,7 +37,7 @@ static const Case cases[] = {
     /* a free body: no joints, so no dead point or singular configuration may be named */
     {"overflow_force", 1000.0, 0.0, 0.0, "the equations kept returning non-finite values",
      "Check parameters and initial values", "singular configuration"},
-    {"infinite_energy", 0.001, 0.0, 0.0, "an output is not finite", "check the initial values and parameters", NULL},
+    {"infinite_energy", 0.001, 0.0, 0.0, "is not finite (the solution blew up)", "check the initial values and parameters", NULL},
     /* a coupler of 1e200 kg: the parameters' scale is to blame, not the mechanism's geometry */
     {"huge_mass", 0.01, 0.0, 0.0, "a parameter is far beyond a physical scale", "check masses, stiffnesses, forces",
      "singular configuration"},

@@ -3,8 +3,11 @@
  *   0 nothing (a unit mass held at its rest pose by unit springs: R = a + q)
  *   1 segmentation fault   2 abort   3 hang (never returns)   4 allocate without end
  *   5 exit 7 (an exit code flexmbd never returns)
+ *   6 its output `level` is NaN from a finite state (tests/failures' nan_output: the message names the
+ *     column and blames the output op, not the run's tolerances)
  * The fault happens at the first evaluation of the equations (so `flexmbd check`, which only
  * loads the scene, passes), in the child, as a broken plugin's would. */
+#include <math.h>
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,7 +41,7 @@ static int faulty_parse(fmbParser* p, fmbNode item, void** self) {
   int* fault = calloc(1, sizeof *fault);
   if (!fault) return fmb_parse_error(p, item, "out of memory");
   *self = fault;
-  return fmb_get_int(p, item, "fault", 0, 0, 5, fault) ? -1 : 0;
+  return fmb_get_int(p, item, "fault", 0, 0, 6, fault) ? -1 : 0;
 }
 static void faulty_destroy(void* self) { free(self); }
 static int faulty_ncoord(const void* self) {
@@ -62,6 +65,13 @@ static int faulty_marker(const void* self, const double* q, const double local[2
   fmb_frame_point(q, local, pos, angle, dpos_dq, dangle_dq);
   return 0;
 }
+/* `level`: 0, or NaN with fault 6 (a broken output op; the equations stay finite) */
+static const char* const faulty_output_names[] = {"level", NULL};
+static int faulty_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
+  (void)id, (void)q, (void)v, (void)work;
+  *value = *(const int*)self == 6 ? NAN : 0.0;
+  return 0;
+}
 static const fmbParam faulty_params[] = {
     {.key = "fault", .kind = FMB_PARAM_NUMBER, .flags = 0, .unit = "-"},
     {.key = NULL},
@@ -74,6 +84,8 @@ static const fmbBodyType faulty = {.name = "faulty",
                                    .initial = faulty_initial,
                                    .residual = faulty_residual,
                                    .marker = faulty_marker,
+                                   .output_names = faulty_output_names,
+                                   .output = faulty_output,
                                    .params = faulty_params,
                                    .example = "fault: 0\n"};
 static const fmbBodyType* const bodies[] = {&faulty, NULL};
