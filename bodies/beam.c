@@ -1516,6 +1516,7 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
     .nwork = beam_nwork, \
     .energy = beam_energy, \
     .output_names = fmb_beam_output_names, \
+    .output_units = fmb_beam_output_units, \
     .output_lookup = beam_output_lookup, \
     .output = beam_output, \
     .describe = beam_describe, \

@@ -735,6 +735,7 @@ const fmbBodyType fmb_body_beam_exact = {
     .jacobian = exact_jacobian,
     .energy = exact_energy,
     .output_names = fmb_beam_output_names,
+    .output_units = fmb_beam_output_units,
     .output_lookup = exact_output_lookup,
     .output = exact_output,
     .describe = exact_describe,

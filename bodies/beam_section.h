@@ -74,6 +74,9 @@ enum { FMB_BEAM_NODE_BASE = 1000, FMB_BEAM_NODE_STRIDE = 4 }; /* node k: u, v, x
 static const char* const fmb_beam_output_names[] = {"tip_u",        "tip_v",     "tip_u_rate", "tip_v_rate",
                                                     "tip_x",        "tip_y",     "ang_momentum", "tip_angle",
                                                     "nodeK_u",      "nodeK_v",   "nodeK_x",    "nodeK_y", NULL};
+/* their units, in the same order (for plot axes) */
+static const char* const fmb_beam_output_units[] = {"m", "m", "m/s", "m/s", "m", "m", "kg m^2/s", "rad",
+                                                    "m", "m", "m",   "m",   NULL};
 
 /* the output id of `quantity` for a beam of ne elements, or -1 */
 static inline int fmb_beam_output_lookup(int ne, const char* quantity) {

@@ -27,7 +27,8 @@ extern "C" {
    the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
    pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). 3: the
    stepping API (fmbData, fmb_init, fmb_advance, ...), the warn callback, and inputs: joints gained
-   the optional `input` op and read an input's value with fmb_eval_input. */
+   the optional `input` op and read an input's value with fmb_eval_input; bodies and joints the
+   optional output_units (what plots and `view` put on their axes). */
 #define FMB_ABI_VERSION 3
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
@@ -279,6 +280,9 @@ typedef struct fmbBodyType {
      at the first output time it happens, with the time (beam: the tip deflection beyond the
      model's measured limit, "use model: exact"). NULL op = no range stated. */
   const char* (*model_range)(const void* self, const double* q, const double* v, char* msg, size_t len);
+  /* ABI 3, optional: the SI unit of each name in output_names (same order; "1" for a pure number),
+     for the axes of plots and of `view` (fmb_output_unit_in). NULL = not declared. */
+  const char* const* output_units;
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -320,6 +324,8 @@ typedef struct fmbJointType {
      between steps (fmb_set_input; a drive or load with `profile: input` / `law: input`), with the
      scene's initial `value:` in *initial; 0 otherwise. The input's name is the joint's. */
   int (*input)(const void* self, double* initial);
+  /* ABI 3, optional: output_names' units, as for bodies */
+  const char* const* output_units;
 } fmbJointType;
 
 /* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
@@ -498,6 +504,10 @@ typedef struct fmbDrawing {
    JOINT.power: W; JOINT.work and energy.*: J; JOINT.reaction_x: N; reaction_torque: N m;
    BODY.shapeK_x: m), or NULL (a type's own output, whose unit is not declared; unknown names) */
 FMB_API const char* fmb_output_unit(const char* column);
+/* the same, and for a type's own output (BODY.tip_v, JOINT.torque) the unit the registry's types
+   declare for that quantity (output_units; a numbered name such as node12_v matches nodeK_v), when
+   every type that declares the quantity agrees on it; NULL otherwise. reg may be NULL. */
+FMB_API const char* fmb_output_unit_in(const fmbRegistry* reg, const char* column);
 /* s as XML text or attribute value (& < > " ' escaped, control characters other than \n \t
    dropped): the VTK collection, JUnit reports */
 FMB_API void fmb_write_xml_text(FILE* f, const char* s);

@@ -117,6 +117,56 @@ const char* fmb_output_unit(const char* column) {
   return NULL; /* a type's own output: its unit is not declared */
 }
 
+/* `quantity` with every run of digits after its first letter written as K (node12_v -> nodeK_v):
+   how numbered outputs are listed in output_names. 0, or -1 when it does not fit. */
+static int numbered_as_k(const char* quantity, char* out, size_t len) {
+  size_t o = 0;
+  for (const char* c = quantity; *c; ++c) {
+    if (o + 2 > len) return -1;
+    if (c != quantity && *c >= '0' && *c <= '9') {
+      out[o++] = 'K';
+      while (c[1] >= '0' && c[1] <= '9') ++c;
+    } else {
+      out[o++] = *c;
+    }
+  }
+  out[o] = '\0';
+  return 0;
+}
+
+/* the unit `names`/`units` give `quantity` (or its numbered form), NULL when none; *conflict set
+   when it differs from *found */
+static void declared_unit(const char* const* names, const char* const* units, const char* quantity, const char* as_k,
+                          const char** found, int* conflict) {
+  if (!names || !units) return;
+  for (int i = 0; names[i]; ++i) {
+    if (strcmp(names[i], quantity) != 0 && strcmp(names[i], as_k) != 0) continue;
+    if (!units[i]) continue;
+    if (*found && strcmp(*found, units[i]) != 0) *conflict = 1;
+    *found = units[i];
+  }
+}
+
+const char* fmb_output_unit_in(const fmbRegistry* reg, const char* column) {
+  const char* unit = fmb_output_unit(column);
+  if (unit || !reg || !column) return unit;
+  const char* dot = strrchr(column, '.');
+  if (!dot || !dot[1]) return NULL;
+  char as_k[128];
+  if (numbered_as_k(dot + 1, as_k, sizeof as_k)) return NULL;
+  const char* found = NULL;
+  int conflict = 0;
+  for (int i = 0; i < fmb_registry_nbodies(reg); ++i) {
+    const fmbBodyType* b = fmb_registry_body(reg, i);
+    declared_unit(b->output_names, b->output_units, dot + 1, as_k, &found, &conflict);
+  }
+  for (int i = 0; i < fmb_registry_njoints(reg); ++i) {
+    const fmbJointType* j = fmb_registry_joint(reg, i);
+    declared_unit(j->output_names, j->output_units, dot + 1, as_k, &found, &conflict);
+  }
+  return conflict ? NULL : found;
+}
+
 int fmb_type_output_id(int (*output_lookup)(const void*, const char*), const void* self, const char* const* names,
                        const char* quantity) {
   if (output_lookup) return output_lookup(self, quantity);

@@ -137,6 +137,16 @@ static const char* missing_joint_op(const fmbJointType* t) {
   return NULL;
 }
 
+/* output_units, when a table declares them, pair with output_names one for one (a shorter list
+   would make fmb_output_unit_in read past its end) */
+static int units_match_names(const char* const* names, const char* const* units) {
+  if (!units) return 1;
+  int n = 0, u = 0;
+  while (names && names[n]) ++n;
+  while (units[u]) ++u;
+  return n == u;
+}
+
 /* a type name is a YAML word: letters, digits, '_' */
 static int valid_name(const char* name) {
   if (!name || !name[0]) return 0;
@@ -182,6 +192,12 @@ int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* orig
       const char* op = k ? missing_joint_op(plugin->joints[i]) : missing_body_op(plugin->bodies[i]);
       if (op) {
         fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0, "%s '%s' has no %s op (required)", kind, name, op);
+        return -1;
+      }
+      if (!(k ? units_match_names(plugin->joints[i]->output_names, plugin->joints[i]->output_units)
+              : units_match_names(plugin->bodies[i]->output_names, plugin->bodies[i]->output_units))) {
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0,
+                     "%s '%s' declares output_units that do not pair one for one with its output_names", kind, name);
         return -1;
       }
       for (int e = 0; e < i; ++e)

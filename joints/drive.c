@@ -62,6 +62,7 @@ static int drive_constraint(const void* self, const fmbJointEval* ev, double* ph
 }
 
 static const char* const drive_outputs[] = {"angle", "speed", NULL};
+static const char* const drive_output_units[] = {"rad", "rad/s", NULL};
 /* angle: the joint's relative angle (angle2 - angle1) as the bodies are, which on the
    constraint manifold is angle0 + f(t); speed: the prescribed relative speed f'(t) */
 static int drive_output(const void* self, int id, const fmbJointEval* ev, double* value) {
@@ -104,6 +105,7 @@ const fmbJointType fmb_joint_drive = {
     .nrows = drive_nrows,
     .constraint = drive_constraint,
     .output_names = drive_outputs,
+    .output_units = drive_output_units,
     .output = drive_output,
     .describe = drive_describe,
     .input = drive_input,

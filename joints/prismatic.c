@@ -155,6 +155,7 @@ static double prismatic_energy(const void* self, const fmbJointEval* ev) {
 }
 
 static const char* const prismatic_outputs[] = {"displacement", "velocity", "tension", NULL};
+static const char* const prismatic_output_units[] = {"m", "m/s", "N", NULL};
 /* slide along the axis, its rate, and the spring-damper's tension */
 static int prismatic_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   const Prismatic* ps = self;
@@ -209,6 +210,7 @@ const fmbJointType fmb_joint_prismatic = {
     .force = prismatic_force,
     .energy = prismatic_energy,
     .output_names = prismatic_outputs,
+    .output_units = prismatic_output_units,
     .output = prismatic_output,
     .params = prismatic_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\nstiffness: 20\nrest_displacement: 0.1\n",

@@ -27,6 +27,7 @@ static int revolute_constraint(const void* self, const fmbJointEval* ev, double*
 }
 
 static const char* const revolute_outputs[] = {"angle", NULL};
+static const char* const revolute_output_units[] = {"rad", NULL};
 /* relative angle body2 - body1 at the pin */
 static int revolute_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   (void)id;
@@ -54,6 +55,7 @@ const fmbJointType fmb_joint_revolute = {
     .attachment = fmbj_two_point_attachment,
     .constraint = revolute_constraint,
     .output_names = revolute_outputs,
+    .output_units = revolute_output_units,
     .output = revolute_output,
     .params = revolute_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\n",

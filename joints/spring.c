@@ -74,6 +74,7 @@ static double spring_energy(const void* self, const fmbJointEval* ev) {
 }
 
 static const char* const spring_outputs[] = {"length", "tension", NULL};
+static const char* const spring_output_units[] = {"m", "N", NULL};
 static int spring_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   const Spring* s = self;
   const int ld = fmb_eval_ncoord(ev, 0) + fmb_eval_ncoord(ev, 1);
@@ -107,6 +108,7 @@ const fmbJointType fmb_joint_spring = {
     .force = spring_force,
     .energy = spring_energy,
     .output_names = spring_outputs,
+    .output_units = spring_output_units,
     .output = spring_output,
     .params = spring_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0.1]\nstiffness: 50\nrest_length: 0.3\n",

@@ -68,6 +68,7 @@ static double torsion_energy(const void* self, const fmbJointEval* ev) {
 }
 
 static const char* const torsion_outputs[] = {"angle", "torque", NULL};
+static const char* const torsion_output_units[] = {"rad", "N m", NULL};
 /* angle: phi = angle2 - angle1; torque: tau, on body2 */
 static int torsion_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   const Torsion* s = self;
@@ -115,6 +116,7 @@ const fmbJointType fmb_joint_torsion = {
     .force = torsion_force,
     .energy = torsion_energy,
     .output_names = torsion_outputs,
+    .output_units = torsion_output_units,
     .output = torsion_output,
     .params = torsion_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\nstiffness: 3\nangle0: 0.2\n",

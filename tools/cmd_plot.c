@@ -173,7 +173,7 @@ static Curve* add_curve(Curve** curves, int* n, long rows) {
 
 /* "name [unit]" when the library knows the column's unit */
 static void with_unit(char* out, size_t len, const char* what, const char* column) {
-  const char* unit = fmb_output_unit(column);
+  const char* unit = fmb_output_unit_in(fmb_cli_registry(), column);
   if (unit) snprintf(out, len, "%s [%s]", what, unit);
   else snprintf(out, len, "%s", what);
 }
@@ -380,9 +380,9 @@ int fmb_cmd_plot(int argc, char** argv) {
     fprintf(g, "set xlabel ");
     quoted(g, a.xlabel ? a.xlabel : label);
     fprintf(g, "\n");
-    const char* yunit = a.shape ? "m" : fmb_output_unit(a.column[0]);
+    const char* yunit = a.shape ? "m" : fmb_output_unit_in(fmb_cli_registry(), a.column[0]);
     for (int c = 1; c < a.ncolumn && yunit; ++c)
-      if (!fmb_output_unit(a.column[c]) || strcmp(fmb_output_unit(a.column[c]), yunit) != 0) yunit = NULL;
+      if (!fmb_output_unit_in(fmb_cli_registry(), a.column[c]) || strcmp(fmb_output_unit_in(fmb_cli_registry(), a.column[c]), yunit) != 0) yunit = NULL;
     const char* what = a.shape ? "y" : a.ncolumn == 1 ? a.column[0] : a.diff ? "difference" : NULL;
     if (a.diff && a.ncolumn == 1) {
       snprintf(label, sizeof label, "%s%s - reference%s", a.absval ? "|" : "", a.column[0], a.absval ? "|" : "");

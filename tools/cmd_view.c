@@ -127,7 +127,7 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
   fputs("],\"units\":[", f); /* the units the library knows (fmb_output_unit), "" otherwise */
   for (int c = 1; c < tb->ncol; ++c) {
     if (c > 1) fputc(',', f);
-    const char* unit = fmb_output_unit(tb->name[c]);
+    const char* unit = fmb_output_unit_in(fmb_cli_registry(), tb->name[c]);
     json_string(f, unit ? unit : "");
   }
   fputs("],\"data\":[", f);
