@@ -121,7 +121,9 @@ static void child_setup(const fmbChildSpec* s, pid_t parent) {
 }
 
 int fmb_pool_start(fmbPool* p, const fmbChildSpec* spec) {
-  Slot* sl = NULL;
+  /* volatile: with vfork the child runs on this frame until it execs, and a local kept in a
+     register or a reused slot might not survive its return (gcc's -Wclobbered) */
+  Slot* volatile sl = NULL;
   for (int i = 0; i < p->nslot && !sl; ++i)
     if (!p->slot[i].pid) sl = &p->slot[i];
   if (!sl) {
