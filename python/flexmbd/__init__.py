@@ -12,6 +12,12 @@ ctypes; this package converts arguments and results, nothing more. docs/python.m
 from ._lib import FlexmbdError, Interrupted, SceneError, SolverError, library_path
 from ._scene import scene_text
 from .model import Cancel, Model, Result, load
+from .analysis import CampbellResult, ModesResult, StaticResult, campbell, modes, static
+from .compare import Comparison, compare
+from .plot import axis_label, unit
+from .study import metric, study
 
 __all__ = ["load", "Model", "Result", "Cancel", "SceneError", "SolverError", "Interrupted", "FlexmbdError",
-           "scene_text", "library_path"]
+           "scene_text", "library_path",
+           "static", "modes", "campbell", "StaticResult", "ModesResult", "CampbellResult", "compare", "Comparison",
+           "study", "metric", "unit", "axis_label"]

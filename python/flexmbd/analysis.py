@@ -1,0 +1,234 @@
+"""Statics, modes and Campbell diagrams (engine/static.c, engine/modes.c through flexmbd.h;
+docs/analysis.md): the library solves, this module hands arrays back."""
+from __future__ import annotations
+
+import ctypes
+import math
+import os
+import tempfile
+from typing import Any, Dict, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _lib
+from .model import Model, Result, Source, load
+
+ModelLike = Union[Model, Source]
+
+
+def _model(scene: ModelLike, set: Optional[Mapping[str, Any]], plugins: Sequence[str] = ()) -> Model:
+    if isinstance(scene, Model):
+        return scene.reload(set) if set else scene
+    return load(scene, set=set, plugins=plugins)
+
+
+class StaticResult:
+    """The static equilibrium, or the steady rotation under a constant-speed drive (fmb_static).
+
+    ``y``, ``yp``: the DAE state ([q, v, λ, μ] and its rate, NumPy arrays); ``t``; ``speed``
+    (rad/s, 0 for an equilibrium) about ``center``; ``residual`` and ``residual_start`` (2-norms of
+    the equations at the solution and at the start), ``iterations``, ``load_steps``; ``outputs``:
+    the scene's outputs there (the row ``flexmbd static -o`` writes), name → value."""
+
+    def __init__(self, model: Model, y: np.ndarray, yp: np.ndarray, res: _lib.StaticResult, outputs: Dict[str, float]):
+        self.model = model
+        self.y, self.yp = y, yp
+        self.t = res.t
+        self.speed = res.speed
+        self.center = (res.center[0], res.center[1])
+        self.residual, self.residual_start = res.residual, res.residual_start
+        self.iterations, self.load_steps = res.iterations, res.load_steps
+        self.outputs = outputs
+
+    def __getitem__(self, name: str) -> float:
+        return self.outputs[name]
+
+    def __repr__(self) -> str:
+        kind = "steady rotation" if self.speed else "static equilibrium"
+        return f"<flexmbd.StaticResult {kind} t={self.t:g} speed={self.speed:g} residual={self.residual:.3e}>"
+
+
+def _dptr(a: np.ndarray):
+    return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+
+def static(scene: ModelLike, *, at: Optional[float] = None, set: Optional[Mapping[str, Any]] = None,
+           plugins: Sequence[str] = (), max_iter: int = 0, max_halvings: int = 0, tol: float = 0.0) -> StaticResult:
+    """Solve the static (or steady-rotation) state of a scene, drives held at ``at`` (None: t0),
+    as ``flexmbd static`` does. 0 for max_iter, max_halvings, tol means the library's default.
+    Raises SceneError (no steady state exists) or SolverError (Newton did not converge)."""
+    m = _model(scene, set, plugins)
+    lib = _lib.library()
+    n = m.state_size
+    y, yp = np.zeros(n), np.zeros(n)
+    opt = _lib.StaticOptions(t=at or 0.0, has_t=int(at is not None), max_iter=max_iter, max_halvings=max_halvings,
+                             tol=tol, quiet=1)
+    res = _lib.StaticResult()
+    diag = _lib.Diag()
+    rc = lib.fmb_static(m.handle, ctypes.byref(opt), _dptr(y), _dptr(yp), ctypes.byref(res), ctypes.byref(diag))
+    if rc:
+        raise m._error(diag, rc)
+    return StaticResult(m, y, yp, res, _state_outputs(m, res.t, y, yp))
+
+
+def _state_outputs(m: Model, t: float, y: np.ndarray, yp: np.ndarray) -> Dict[str, float]:
+    """The scene's outputs at a state, through the library's one row writer (fmb_write_state_row)."""
+    lib = _lib.library()
+    fd, path = tempfile.mkstemp(prefix="flexmbd-state-", suffix=".csv")
+    os.close(fd)
+    try:
+        diag = _lib.Diag()
+        rc = lib.fmb_write_state_row(m.handle, path.encode(), t, _dptr(y), _dptr(yp), ctypes.byref(diag))
+        if rc:
+            raise m._error(diag, rc)
+        r = Result.from_csv(path)
+    finally:
+        os.unlink(path)
+    return {c: float(r[c][0]) for c in r.columns}
+
+
+class ModesResult:
+    """Modes of small motion about a static or steady state (fmb_modes).
+
+    ``frequency`` (rad/s, |s| of the eigenvalue; negative for a divergent mode), ``frequency_hz``,
+    ``damping_ratio`` (−Re s/|s|), ``shapes`` (count × nq complex: the generalized coordinates'
+    motion, largest component 1), ``speed``, ``nreduced`` (degrees of freedom after the
+    constraints), ``sparse`` (computed by the shift-invert Arnoldi path), ``state`` (the
+    StaticResult they are about)."""
+
+    def __init__(self, md: _lib.Modes, state: StaticResult):
+        k, nq = md.count, md.nq
+        self.frequency = np.ctypeslib.as_array(md.frequency, (k,)).copy() if k else np.zeros(0)
+        self.damping_ratio = np.ctypeslib.as_array(md.damping_ratio, (k,)).copy() if k else np.zeros(0)
+        if k and nq:
+            re = np.ctypeslib.as_array(md.shape_re, (k * nq,)).reshape(k, nq)
+            im = np.ctypeslib.as_array(md.shape_im, (k * nq,)).reshape(k, nq)
+            self.shapes = re + 1j * im
+        else:
+            self.shapes = np.zeros((k, nq), dtype=complex)
+        self.frequency_hz = self.frequency / (2.0 * math.pi)
+        self.speed, self.nreduced, self.sparse = md.speed, md.nreduced, bool(md.sparse)
+        self.state = state
+
+    def __len__(self) -> int:
+        return len(self.frequency)
+
+    def __repr__(self) -> str:
+        return f"<flexmbd.ModesResult {len(self)} modes, frequency (rad/s) = {np.array2string(self.frequency, precision=6)}>"
+
+
+_EIGEN_HELP = "method is 'auto', 'dense' or 'sparse'"
+
+
+def _method(method: str) -> int:
+    if method not in _lib.EIGEN_METHODS:
+        raise ValueError(f"flexmbd: {_EIGEN_HELP}, got {method!r}")
+    return _lib.EIGEN_METHODS[method]
+
+
+def _modes_at(m: Model, state: StaticResult, count: int, method: int) -> ctypes.POINTER(_lib.Modes):
+    lib = _lib.library()
+    out = ctypes.POINTER(_lib.Modes)()
+    diag = _lib.Diag()
+    rc = lib.fmb_modes(m.handle, state.t, _dptr(state.y), _dptr(state.yp), count, method, ctypes.byref(out),
+                       ctypes.byref(diag))
+    if rc:
+        raise m._error(diag, rc)
+    return out
+
+
+def modes(scene: ModelLike, *, count: int = 10, at: Optional[float] = None, method: str = "auto",
+          set: Optional[Mapping[str, Any]] = None, plugins: Sequence[str] = ()) -> ModesResult:
+    """Frequencies, damping ratios and shapes about the static or steady state at ``at`` (None:
+    t0), as ``flexmbd modes --count COUNT --at AT --eigen METHOD`` (count <= 0: all, dense)."""
+    m = _model(scene, set, plugins)
+    state = static(m, at=at)
+    md = _modes_at(m, state, count, _method(method))
+    try:
+        return ModesResult(md.contents, state)
+    finally:
+        _lib.library().fmb_modes_free(md)
+
+
+class CampbellResult:
+    """A Campbell diagram: ``speeds`` (rad/s) and ``frequencies`` (len(speeds) × count, rad/s,
+    negative = divergent), each column one mode followed from speed to speed by its shape (the
+    greatest modal assurance criterion, fmb_modes_mac), as ``flexmbd campbell`` tracks them;
+    ``poor_matches``: (speed, mode, MAC) where a mode matched its last shape with MAC < 0.5
+    (take finer speed steps there)."""
+
+    def __init__(self, speeds: np.ndarray, frequencies: np.ndarray, poor: list):
+        self.speeds = speeds
+        self.frequencies = frequencies
+        self.poor_matches = poor
+
+    def plot(self, ax=None, **style):
+        """Frequencies against speed with the 1× speed line (matplotlib); returns the Axes."""
+        from .plot import plot_campbell
+
+        return plot_campbell(self, ax=ax, **style)
+
+
+_EXTRA_MODES = 6  # computed beyond count so that a mode crossing from above can be followed (cmd_campbell.c)
+
+
+def campbell(scene: ModelLike, speed: str, speeds: Sequence[float], *, count: int = 4, at: Optional[float] = None,
+             method: str = "auto", set: Optional[Mapping[str, Any]] = None, plugins: Sequence[str] = ()
+             ) -> CampbellResult:
+    """The modes at each hub speed: ``speed`` is the scene key that sets it (e.g.
+    ``joints.spin.speed``), given each value of ``speeds`` as an override; at each speed the
+    steady state (fmb_static), then its modes (fmb_modes), followed across speeds by MAC."""
+    base = scene if isinstance(scene, Model) else None
+    meth = _method(method)
+    lib = _lib.library()
+    speeds = np.asarray(speeds, dtype=float)
+    freq = np.full((len(speeds), count), np.nan)
+    poor = []
+    prev = None
+    track = list(range(count))
+    try:
+        for i, s in enumerate(speeds):
+            over = dict(set or {})
+            over[speed] = float(s)
+            m = base.reload(over) if base is not None else load(scene, set=over, plugins=plugins)
+            with m:
+                cur = _modes_at(m, static(m, at=at), count + _EXTRA_MODES, meth)
+                if cur.contents.count < count:
+                    n = cur.contents.count
+                    lib.fmb_modes_free(cur)
+                    raise _lib.SceneError(_lib.EXIT_BAD_INPUT, "", 0, 0,
+                                          f"the scene has only {n} modes; count={count} asks for more")
+                if prev is None:
+                    nxt = list(range(count))
+                else:
+                    nxt = _follow(lib, prev, track, cur, count, s, poor)
+                freq[i] = [cur.contents.frequency[j] for j in nxt]
+                track = nxt
+                if prev is not None:
+                    lib.fmb_modes_free(prev)
+                prev = cur
+    finally:
+        if prev is not None:
+            lib.fmb_modes_free(prev)
+    return CampbellResult(speeds, freq, poor)
+
+
+def _follow(lib, prev, track, cur, count, speed, poor) -> list:
+    """Greedy assignment of the tracked modes to the current ones by the largest MAC (the rule of
+    tools/cmd_campbell.c, with the library's fmb_modes_mac)."""
+    ncur = cur.contents.count
+    mac = np.array([[lib.fmb_modes_mac(prev, track[k], cur, j) for j in range(ncur)] for k in range(count)])
+    nxt = [0] * count
+    free_k, free_j = set(range(count)), set(range(ncur))
+    for _ in range(count):
+        best, bk, bj = -1.0, 0, 0
+        for k in sorted(free_k):
+            for j in sorted(free_j):
+                if mac[k, j] > best:
+                    best, bk, bj = mac[k, j], k, j
+        free_k.discard(bk)
+        free_j.discard(bj)
+        nxt[bk] = bj
+        if best < 0.5:
+            poor.append((float(speed), bk + 1, float(best)))
+    return nxt
