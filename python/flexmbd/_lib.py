@@ -189,7 +189,9 @@ def library() -> ctypes.CDLL:
                 errors.append(f"{path}: no such file")
                 continue
             try:
-                lib = ctypes.CDLL(path)
+                # RTLD_GLOBAL: a plugin built without linking libflexmbd resolves its fmb_* calls
+                # against this copy, as it does inside the flexmbd program
+                lib = ctypes.CDLL(path, mode=ctypes.RTLD_GLOBAL)
             except OSError as e:
                 errors.append(str(e))
                 continue

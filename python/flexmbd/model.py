@@ -246,9 +246,13 @@ class Result:
 
     @classmethod
     def from_csv(cls, path: Union[str, "os.PathLike[str]"]) -> "Result":
-        """A CSV written by ``flexmbd run -o`` (or ``to_csv``) read back."""
+        """A CSV written by ``flexmbd run -o`` (or ``to_csv``) read back; the ``#`` lines a
+        regression reference carries before its header are skipped."""
         with open(path, encoding="utf-8") as f:
-            header = f.readline().strip()
+            header = f.readline()
+            while header.startswith("#"):
+                header = f.readline()
+            header = header.strip()
             values = np.loadtxt(f, delimiter=",", ndmin=2)
         columns = header.split(",") if header else []
         if values.size == 0:
