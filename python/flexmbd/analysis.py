@@ -6,17 +6,18 @@ import ctypes
 import math
 import os
 import tempfile
-from typing import Any, Dict, Mapping, Optional, Sequence, Union
+from typing import Dict, Optional, Sequence, Union
 
 import numpy as np
 
 from . import _lib
-from .model import Model, Result, Source, load
+from ._scene import override
+from .model import Model, Overrides, Result, Source, _overrides, load
 
 ModelLike = Union[Model, Source]
 
 
-def _model(scene: ModelLike, set: Optional[Mapping[str, Any]], plugins: Sequence[str] = ()) -> Model:
+def _model(scene: ModelLike, set: Overrides, plugins: Sequence[str] = ()) -> Model:
     if isinstance(scene, Model):
         return scene.reload(set) if set else scene
     return load(scene, set=set, plugins=plugins)
@@ -52,7 +53,7 @@ def _dptr(a: np.ndarray):
     return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
 
 
-def static(scene: ModelLike, *, at: Optional[float] = None, set: Optional[Mapping[str, Any]] = None,
+def static(scene: ModelLike, *, at: Optional[float] = None, set: Overrides = None,
            plugins: Sequence[str] = (), max_iter: int = 0, max_halvings: int = 0, tol: float = 0.0) -> StaticResult:
     """Solve the static (or steady-rotation) state of a scene, drives held at ``at`` (None: t0),
     as ``flexmbd static`` does. 0 for max_iter, max_halvings, tol means the library's default.
@@ -138,7 +139,7 @@ def _modes_at(m: Model, state: StaticResult, count: int, method: int) -> ctypes.
 
 
 def modes(scene: ModelLike, *, count: int = 10, at: Optional[float] = None, method: str = "auto",
-          set: Optional[Mapping[str, Any]] = None, plugins: Sequence[str] = ()) -> ModesResult:
+          set: Overrides = None, plugins: Sequence[str] = ()) -> ModesResult:
     """Frequencies, damping ratios and shapes about the static or steady state at ``at`` (None:
     t0), as ``flexmbd modes --count COUNT --at AT --eigen METHOD`` (count <= 0: all, dense)."""
     m = _model(scene, set, plugins)
@@ -173,7 +174,7 @@ _EXTRA_MODES = 6  # computed beyond count so that a mode crossing from above can
 
 
 def campbell(scene: ModelLike, speed: str, speeds: Sequence[float], *, count: int = 4, at: Optional[float] = None,
-             method: str = "auto", set: Optional[Mapping[str, Any]] = None, plugins: Sequence[str] = ()
+             method: str = "auto", set: Overrides = None, plugins: Sequence[str] = ()
              ) -> CampbellResult:
     """The modes at each hub speed: ``speed`` is the scene key that sets it (e.g.
     ``joints.spin.speed``), given each value of ``speeds`` as an override; at each speed the
@@ -188,8 +189,7 @@ def campbell(scene: ModelLike, speed: str, speeds: Sequence[float], *, count: in
     track = list(range(count))
     try:
         for i, s in enumerate(speeds):
-            over = dict(set or {})
-            over[speed] = float(s)
+            over = _overrides(set) + [override(speed, float(s))]
             m = base.reload(over) if base is not None else load(scene, set=over, plugins=plugins)
             with m:
                 cur = _modes_at(m, static(m, at=at), count + _EXTRA_MODES, meth)

@@ -10,7 +10,7 @@ import os
 import shutil
 import subprocess
 import tempfile
-from typing import Dict, Optional, Sequence, Union
+from typing import Optional, Sequence, Union
 
 from . import _lib
 from .model import Result

@@ -5,12 +5,12 @@ import ctypes
 import os
 import tempfile
 import threading
-from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
 from . import _lib
-from ._lib import SceneError, SolverError, Interrupted, FlexmbdError
+from ._lib import FlexmbdError
 from ._scene import looks_like_yaml, override, scene_text
 
 Source = Union[str, "os.PathLike[str]", Mapping[str, Any]]
@@ -49,12 +49,27 @@ def _plugin_path(p: Union[str, "os.PathLike[str]"]) -> str:
     return p if os.sep in p else os.path.join(".", p)
 
 
-def load(scene: Source, set: Optional[Mapping[str, Any]] = None, plugins: Sequence[Union[str, "os.PathLike[str]"]] = (),
+Overrides = Union[Mapping[str, Any], Sequence[str], None]
+
+
+def _overrides(sets: Overrides) -> List[str]:
+    """{PATH: VALUE} or ["PATH=VALUE", ...] as the --set strings"""
+    if sets is None:
+        return []
+    if isinstance(sets, Mapping):
+        return [override(k, v) for k, v in sets.items()]
+    if isinstance(sets, str):
+        raise TypeError("flexmbd: set= takes a dict {PATH: VALUE} or a list of 'PATH=VALUE' strings, not one string")
+    return [str(s) for s in sets]
+
+
+def load(scene: Source, set: Overrides = None, plugins: Sequence[Union[str, "os.PathLike[str]"]] = (),
          ) -> "Model":
     """Load a scene: a file path, YAML text, or a dict shaped like a scene file.
 
     ``set`` holds overrides as ``flexmbd run --set PATH=VALUE`` takes them, e.g.
-    ``{"bodies.beam.model": "exact", "solver.rtol": 1e-8}``; ``plugins`` are shared objects with
+    ``{"bodies.beam.model": "exact", "solver.rtol": 1e-8}`` (or the strings
+    ``["bodies.beam.model=exact", ...]``); ``plugins`` are shared objects with
     more body and joint types (as ``--plugin``).
 
     Raises SceneError (with .file, .line, .column and .message, ``str()`` the command line's
@@ -62,7 +77,7 @@ def load(scene: Source, set: Optional[Mapping[str, Any]] = None, plugins: Sequen
     temporary file in the current folder (so that file names in them, e.g. a load table, are
     taken from there, as for a scene file there); their errors name ``<string>`` or ``<dict>``
     and count lines in the text (``flexmbd.scene_text(d)`` shows a dict's)."""
-    overrides = [override(k, v) for k, v in (set or {}).items()]
+    overrides = _overrides(set)
     plugin_files = tuple(_plugin_path(p) for p in plugins)
     if isinstance(scene, Mapping):
         return Model._from_text(scene_text(scene), "<dict>", overrides, plugin_files, ("dict", dict(scene)))
@@ -159,10 +174,10 @@ class Model:
         where = self.path or self._rename.get(next(iter(self._rename), ""), "?")
         return f"<flexmbd.Model {where} bodies={list(self.bodies)} t_end={self.solver['t_end']:g}>"
 
-    def reload(self, set: Optional[Mapping[str, Any]] = None) -> "Model":
+    def reload(self, set: Overrides = None) -> "Model":
         """The same scene loaded again with more overrides (later ones win)."""
         kind, what = self._source
-        extra = [override(k, v) for k, v in (set or {}).items()]
+        extra = _overrides(set)
         if kind == "path":
             return Model._load(what, None, self.overrides + extra, tuple(self.plugins), self._source)
         text = scene_text(what) if kind == "dict" else what
