@@ -3,6 +3,7 @@ one table: the local form of ``flexmbd sweep``. A run that crashes its process (
 segfault, an abort) or overruns its timeout costs its own row, nothing else."""
 from __future__ import annotations
 
+import faulthandler
 import math
 import multiprocessing
 import os
@@ -36,6 +37,7 @@ def metric(result: Result, spec: str) -> float:
 
 def _one_run(scene, over: Mapping[str, Any], plugins, t_end, metrics, measure, keep, conn) -> None:
     """In the child: load, run, reduce, send one dict back."""
+    faulthandler.disable()  # a crash is reported in its row; no traceback dump from the child
     row: Dict[str, Any] = {}
     try:
         m = scene.reload(over) if isinstance(scene, Model) else load(scene, set=over, plugins=plugins)
