@@ -3,7 +3,6 @@ timed-out process costs its own row only; metrics are the runs' own numbers."""
 import os
 import time
 
-import numpy as np
 
 import flexmbd
 from conftest import SRC
