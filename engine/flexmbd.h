@@ -25,8 +25,10 @@ extern "C" {
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
    the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
-   pattern_jacobian and length_scale ops (added to 2 before any release of it). */
-#define FMB_ABI_VERSION 2
+   pattern_jacobian and length_scale ops (added to 2 before any release of it). 3: the stepping API
+   (fmbData, fmb_init, fmb_advance, ...), the warn callback, and inputs: joints gained the optional
+   `input` op and read an input's value with fmb_eval_input. */
+#define FMB_ABI_VERSION 3
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
 #if defined(__GNUC__)
@@ -303,6 +305,10 @@ typedef struct fmbJointType {
   const char* example;
   const char* example_damped;
   unsigned flags;
+  /* ABI 3, optional: 1 when this instance takes its value from an input that a program sets
+     between steps (fmb_set_input; a drive or load with `profile: input` / `law: input`), with the
+     scene's initial `value:` in *initial; 0 otherwise. The input's name is the joint's. */
+  int (*input)(const void* self, double* initial);
 } fmbJointType;
 
 /* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
@@ -320,6 +326,9 @@ FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], dou
 FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
 /* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1) */
 FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
+/* the current value of this joint's input (its `input` op said 1): the scene's `value:` until a
+   program sets it with fmb_set_input; NaN for a joint without an input */
+FMB_API double fmb_eval_input(const fmbJointEval* ev);
 
 /* ---------------------------------------------------------------------------------------------
  * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
@@ -448,6 +457,78 @@ FMB_API void fmb_describe(const fmbModel* m, FILE* f);
 FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
+
+/* ---------------------------------------------------------------------------------------------
+ * Stepping (engine/step.c; docs/api.md). A model is fixed after fmb_load and only read; the state
+ * of one run of it lives in an fmbData (MuJoCo's mjModel / mjData split), so one model can be run
+ * by several data objects, and two data objects (of one model or two) can be advanced in two
+ * threads at once. fmb_run is a loop over these calls (engine/run.c) and writes the same bytes.
+ *
+ *   fmbData* d = fmb_data_new(m, &diag);            everything a run needs is allocated here
+ *   fmb_init(m, d, &diag);                           consistent state at t0 (again: restart)
+ *   while (fmb_data_time(d) < t_end) {
+ *     fmb_set_input(m, d, "motor", torque);          optional: a load or drive between steps
+ *     fmb_advance(m, d, t_next, &diag);              integrate to t_next
+ *     fmb_outputs(m, d, values);                     the CSV row's values at time()
+ *   }
+ *   fmb_data_free(d);
+ *
+ * Return codes: 0; FMB_EXIT_SOLVER (the state is the last good one and diag says when and why);
+ * FMB_EXIT_INTERRUPTED (fmb_data_cancel); FMB_EXIT_BAD_INPUT for misuse: a NULL argument, a data
+ * object of another model or already freed, advance before init, t_out NaN, before time() or
+ * beyond the scene's t_end. A misused call changes nothing.
+ * ------------------------------------------------------------------------------------------- */
+typedef struct fmbData fmbData; /* the state of one run of one model */
+/* one message (no trailing newline): a warning, a note, a progress line; user as given */
+typedef void (*fmbWarnFn)(void* user, const char* message);
+
+/* allocates everything a run needs (state, scratch, outputs); NULL with *diag on failure */
+FMB_API fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag);
+/* NULL is fine; a second free of the same object is detected and ignored while it is among the
+   last FMB_DATA_QUARANTINE freed ones (its memory is held back until then), as is any other call
+   on it (FMB_EXIT_BAD_INPUT); beyond that, using a freed object is undefined */
+FMB_API void fmb_data_free(fmbData* d);
+#define FMB_DATA_QUARANTINE 64
+/* the consistent state at the scene's t0 (initial conditions; inputs back to their `value:`);
+   again = restart from t0. 0 or an exit code with *diag */
+FMB_API int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag);
+/* integrate from time() to t_out, time() <= t_out <= t_end (t_out == time(): nothing to do). A
+   changed input (fmb_set_input) or a run interrupted or failed before restarts the integrator
+   from a consistent state at time(): no step history is carried across the jump. */
+FMB_API int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag);
+FMB_API double fmb_data_time(const fmbData* d); /* NaN for NULL (or before fmb_init) */
+/* the DAE state y = [q, v, lambda, mu, z] and y' (fmb_state_size(m) doubles each; either may be
+   NULL): 0, or FMB_EXIT_BAD_INPUT (NULL or freed d, before fmb_init) */
+FMB_API int fmb_data_state(const fmbData* d, double* y, double* yp);
+/* the scene's outputs: their number (the CSV's columns after t), the name of output i (e.g.
+   "beam.tip_v"; NULL out of range) and their values at time() into out[fmb_noutput(m)], the very
+   numbers the CSV row at that time holds. fmb_outputs: 0, FMB_EXIT_SOLVER when a value is not
+   finite (out still filled), FMB_EXIT_BAD_INPUT for misuse */
+FMB_API int fmb_noutput(const fmbModel* m);
+FMB_API const char* fmb_output_name(const fmbModel* m, int i);
+FMB_API int fmb_outputs(const fmbModel* m, fmbData* d, double* out);
+/* the integrator's counters so far (all backends of this run), t_reached = time(), the CPU time
+   spent in fmb_init and fmb_advance: 0, or FMB_EXIT_BAD_INPUT */
+FMB_API int fmb_data_stats(const fmbData* d, fmbStats* st);
+/* ask the advance in progress, or the next one, to stop: it returns FMB_EXIT_INTERRUPTED with the
+   state at the last good step, and the request is used up (a later advance goes on from there).
+   Only sets a flag: safe from another thread or a signal handler. */
+FMB_API void fmb_data_cancel(fmbData* d);
+/* where this run's messages go: fn(user, message); fn NULL = the thread's default (fmb_set_warn) */
+FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
+/* the calling thread's default handler, for messages while loading and of runs without their own:
+   fn(user, message); fn NULL = silent. Until a thread sets one, messages go to stderr, one line
+   each. */
+FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
+/* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
+   a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
+   unknown name, NaN or infinity, misuse); the value holds from time() on, as a step (piecewise
+   constant) that the next advance starts from. */
+FMB_API int fmb_ninput(const fmbModel* m);
+FMB_API const char* fmb_input_name(const fmbModel* m, int i);
+FMB_API int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value);
+/* the current value of input `name`: 0, or FMB_EXIT_BAD_INPUT */
+FMB_API int fmb_get_input(const fmbModel* m, const fmbData* d, const char* name, double* value);
 
 /* ---------------------------------------------------------------------------------------------
  * Conformance (engine/conform.c): the checks every registered type must pass, run on its

@@ -491,6 +491,91 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   return rc;
 }
 
+/* The minimum-norm correction of v onto Phi_q v + Phi_t = 0 (the rows marked in drop left out),
+   with Phi_q (row-major nc x nq) and Phi_t at the positions: 0, or 1 when the rows kept are not
+   independent. G, piv, rhs: scratch of nc^2, nc, nc. */
+static int project_velocities(int nc, int nq, const double* PhiQ, const double* phit, const unsigned char* drop, double* G,
+                              int* piv, double* rhs, double* v) {
+  if (gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
+  for (int r = 0; r < nc; ++r) {
+    double s = phit[r];
+    for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
+    rhs[r] = drop[r] ? 0.0 : s;
+  }
+  fmb_lu_solve(nc, G, piv, rhs);
+  for (int c = 0; c < nq; ++c) {
+    double s = 0.0;
+    for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
+    v[c] -= s;
+  }
+  return 0;
+}
+
+/* Step 3 at consistent q, v (y's) and time t: the accelerations (yp's v slice; yp's q slice = v),
+   the multipliers and the bodies' auxiliary unknowns, mu = 0. Scratch: PhiQ (nc x nq), phi, phit,
+   phitt (nc), rhs (nq + nc). 0 or an exit code with diag set. */
+static int accelerations_at(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, double* PhiQ,
+                            double* phi, double* phit, double* phitt, double* rhs, fmbDiag* diag) {
+  const int nq = m->nq;
+  double *q = y, *v = y + nq;
+  int rc = 0;
+  if (fmb_model_has_sparse_body(m)) {
+    /* a body declared a sparse pattern (a banded beam): the dense augmented system would take
+       (nq + nc)^2 memory and cubic time; sparse Newton for a, lambda and the auxiliary unknowns */
+    int nred = 0;
+    fmb_workspace_redundant(w, &nred);
+    if (nred > 0) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                   "redundant constraints with a body that declares a sparse pattern (a banded beam) are not "
+                   "supported yet: remove the repeated joint, or set the beam's `assembly: dense`");
+      return FMB_EXIT_BAD_INPUT;
+    }
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt) || fmb_constraints_gamma(m, w, t, q, v, rhs + nq)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the constraints are not finite at t = %g", t);
+      rc = FMB_EXIT_SOLVER;
+    } else {
+      rc = sparse_accelerations(m, w, t, y, yp, PhiQ, rhs + nq, diag);
+    }
+    return rc;
+  }
+  /* augmented system for accelerations and multipliers */
+  fmbAugmented* aug = fmb_augmented_new(m);
+  if (!aug) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
+    return FMB_EXIT_SOLVER;
+  }
+  int arc = fmb_augmented_solve(m, w, aug, t, q, v, fmb_workspace_redundant(w, NULL), 0.0, yp + nq, y + 2 * nq);
+  memcpy(yp, v, (size_t)nq * sizeof(double));
+  if (arc == FMB_AUG_MASS_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
+                 m->body[fmb_augmented_failed_body(aug)].name, t);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_FORCES_FAILED) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t);
+    rc = FMB_EXIT_SOLVER;
+  } else if (arc == FMB_AUG_SINGULAR) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
+                 "with redundant joints): cannot compute initial accelerations");
+    rc = FMB_EXIT_BAD_INPUT;
+  } else if (arc == FMB_AUG_NOT_FINITE) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
+    rc = FMB_EXIT_SOLVER;
+  }
+  /* the bodies' auxiliary unknowns, consistent with (q, v, a) */
+  for (int b = 1; b < m->nbody && !rc; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bi->nz > 0 && bi->type->aux_initial(bi->self, &m->env, q + bi->qadr, v + bi->qadr, yp + nq + bi->qadr,
+                                            y + m->zoff + bi->zadr, fmb_workspace_plugin(w) + bi->workadr)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the auxiliary unknowns of body '%s' are not finite at t = %g",
+                   bi->name, t);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  fmb_augmented_free(aug);
+  return rc;
+}
+
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st, fmbDiag* diag) {
   const int nq = m->nq, nc = m->nc, n = nq + nc;
   const double t0 = m->solver.t0;
@@ -511,7 +596,6 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   double* rhs = calloc((size_t)n + 1, sizeof(double));
   double* q0 = calloc((size_t)nq, sizeof(double));
   double* v0 = calloc((size_t)nq, sizeof(double));
-  fmbAugmented* aug = NULL;
   int rc = 0;
   if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs || !q0 || !v0) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
@@ -569,22 +653,10 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     } else {
       memset(drop, 0, (size_t)nc);
     }
-    /* velocities */
-    if (gram_factor(nc, nq, PhiQ, drop, G, piv)) {
+    if (project_velocities(nc, nq, PhiQ, phit, drop, G, piv, rhs, v)) {
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints' equations are not independent at t = %g", t0);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
-    }
-    for (int r = 0; r < nc; ++r) {
-      double s = phit[r];
-      for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
-      rhs[r] = drop[r] ? 0.0 : s;
-    }
-    fmb_lu_solve(nc, G, piv, rhs);
-    for (int c = 0; c < nq; ++c) {
-      double s = 0.0;
-      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-      v[c] -= s;
     }
   }
   for (int i = 0; i < nq; ++i) {
@@ -625,63 +697,8 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   st->ic_position_correction = norm2(q0, nq);
   st->ic_velocity_correction = norm2(v0, nq);
 
-  if (fmb_model_has_sparse_body(m)) {
-    /* a body declared a sparse pattern (a banded beam): the dense augmented system would take
-       (nq + nc)^2 memory and cubic time; sparse Newton for a, lambda and the auxiliary unknowns */
-    int nred = 0;
-    fmb_workspace_redundant(w, &nred);
-    if (nred > 0) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "redundant constraints with a body that declares a sparse pattern (a banded beam) are not "
-                   "supported yet: remove the repeated joint, or set the beam's `assembly: dense`");
-      rc = FMB_EXIT_BAD_INPUT;
-      goto done;
-    }
-    if (fmb_constraints_all(m, w, t0, q, v, phi, PhiQ, phit, phitt) || fmb_constraints_gamma(m, w, t0, q, v, rhs + nq)) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the constraints are not finite at t = %g", t0);
-      rc = FMB_EXIT_SOLVER;
-    } else {
-      rc = sparse_accelerations(m, w, t0, y, yp, PhiQ, rhs + nq, diag);
-    }
-    goto done;
-  }
-  /* augmented system for accelerations and multipliers */
-  aug = fmb_augmented_new(m);
-  if (!aug) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
-    rc = FMB_EXIT_SOLVER;
-    goto done;
-  }
-  int arc = fmb_augmented_solve(m, w, aug, t0, q, v, fmb_workspace_redundant(w, NULL), 0.0, yp + nq, y + 2 * nq);
-  memcpy(yp, v, (size_t)nq * sizeof(double));
-  if (arc == FMB_AUG_MASS_FAILED) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not evaluate the mass matrix of body '%s' at t = %g",
-                 m->body[fmb_augmented_failed_body(aug)].name, t0);
-    rc = FMB_EXIT_SOLVER;
-  } else if (arc == FMB_AUG_FORCES_FAILED) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t0);
-    rc = FMB_EXIT_SOLVER;
-  } else if (arc == FMB_AUG_SINGULAR) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
-                 "with redundant joints): cannot compute initial accelerations");
-    rc = FMB_EXIT_BAD_INPUT;
-  } else if (arc == FMB_AUG_NOT_FINITE) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
-    rc = FMB_EXIT_SOLVER;
-  }
-  /* the bodies' auxiliary unknowns, consistent with (q, v, a) */
-  for (int b = 1; b < m->nbody && !rc; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    if (bi->nz > 0 && bi->type->aux_initial(bi->self, &m->env, q + bi->qadr, v + bi->qadr, yp + nq + bi->qadr,
-                                            y + m->zoff + bi->zadr, fmb_workspace_plugin(w) + bi->workadr)) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the auxiliary unknowns of body '%s' are not finite at t = %g",
-                   bi->name, t0);
-      rc = FMB_EXIT_SOLVER;
-    }
-  }
+  rc = accelerations_at(m, w, t0, y, yp, PhiQ, phi, phit, phitt, rhs, diag);
 done:
-  fmb_augmented_free(aug);
   free(PhiQ);
   free(phi);
   free(phit);
@@ -691,5 +708,55 @@ done:
   free(rhs);
   free(q0);
   free(v0);
+  return rc;
+}
+
+/* A consistent state at t from the q, v in y, for a run that goes on after something changed
+   under it (an input set between steps, an interrupted or failed advance: step.c): q projected
+   onto Phi(q, t) = 0 and v onto Phi_q v + Phi_t = 0 with the rows found redundant at t0 left out
+   (steps 1 and 2, minimum-norm), then step 3 as at t0. A jump in a drive's prescribed angle thus
+   moves the bodies onto the new constraint, and a jump in a load gives new accelerations and
+   multipliers. 0 or an exit code with diag set. */
+int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* phit = calloc((size_t)nc + 1, sizeof(double));
+  double* phitt = calloc((size_t)nc + 1, sizeof(double));
+  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
+  int* piv = calloc((size_t)nc + 1, sizeof(int));
+  double* rhs = calloc((size_t)(nq + nc) + 1, sizeof(double));
+  int rc = 0;
+  if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory restarting the integrator at t = %.6g", t);
+    rc = FMB_EXIT_SOLVER;
+  } else if (nc > 0) {
+    unsigned char* drop = fmb_workspace_redundant(w, NULL);
+    double res = 0.0;
+    int iters = 0;
+    if (project_positions(m, w, t, y, y + nq, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &res, &iters) ||
+        fmb_constraints_all(m, w, t, y, y + nq, phi, PhiQ, phit, phitt) ||
+        project_velocities(nc, nq, PhiQ, phit, drop, G, piv, rhs, y + nq)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "the joints cannot be satisfied at t = %.6g after the change (constraint residual %.3g after %d "
+                   "projection steps): a prescribed motion set by fmb_set_input jumped further than the mechanism can "
+                   "follow; change it in smaller steps",
+                   t, res, iters);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  if (!rc) {
+    /* the multipliers' and auxiliary unknowns' derivatives and mu are 0 in a consistent state */
+    memset(y + 2 * nq + nc, 0, (size_t)nc * sizeof(double));
+    memset(yp + 2 * nq, 0, (size_t)(m->ny - 2 * nq) * sizeof(double));
+    rc = accelerations_at(m, w, t, y, yp, PhiQ, phi, phit, phitt, rhs, diag);
+  }
+  free(PhiQ);
+  free(phi);
+  free(phit);
+  free(phitt);
+  free(G);
+  free(piv);
+  free(rhs);
   return rc;
 }

@@ -18,7 +18,6 @@
 #include <sunlinsol/sunlinsol_klu.h>
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunmatrix/sunmatrix_sparse.h>
-#include <unistd.h>
 
 #include "integrator.h"
 
@@ -195,7 +194,8 @@ static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, 
    the first 2 % of the run) and the velocities' weighted local error estimate exceeds 30x the
    positions', say so and what to set. */
 
-static void watch_step_rate(const fmbModel* m, void* ida, N_Vector ele, N_Vector ewt, double t, StepWatch* sw) {
+static void watch_step_rate(const fmbModel* m, fmbWorkspace* w_run, void* ida, N_Vector ele, N_Vector ewt, double t,
+                            StepWatch* sw) {
   const fmbSolverSettings* so = &m->solver;
   long nst = 0;
   IDAGetNumSteps(ida, &nst);
@@ -219,12 +219,11 @@ static void watch_step_rate(const fmbModel* m, void* ida, N_Vector ele, N_Vector
   }
   if (ev <= 900.0 * eq) return; /* RMS ratio 30 */
   sw->warned = 1;
-  fprintf(stderr, /* on a terminal, over the progress line (it is redrawn at its next update) */
-          "%swarning: t = %.6g: %ld steps so far, %.3g per simulated second (on course for %.3g): the velocities set the "
-          "step (their local error is %.0fx the positions'), i.e. undamped stiff modes that the positions do not "
-          "notice. error_control: full suits smooth prescribed motion only; set solver.error_control: positions "
-          "(the default for beams) after a sudden load (docs/performance.md)\n",
-          isatty(fileno(stderr)) ? "\r\033[K" : "", t, nst, rate, projected, sqrt(ev / fmax(eq, 1e-300)));
+  fmb_warn(w_run, "warning: t = %.6g: %ld steps so far, %.3g per simulated second (on course for %.3g): the velocities "
+           "set the step (their local error is %.0fx the positions'), i.e. undamped stiff modes that the positions do "
+           "not notice. error_control: full suits smooth prescribed motion only; set solver.error_control: positions "
+           "(the default for beams) after a sudden load (docs/performance.md)",
+           t, nst, rate, projected, sqrt(ev / fmax(eq, 1e-300)));
 }
 
 static void ida_destroy(void* self) {
@@ -349,8 +348,8 @@ static int fall_back_to_full(IdaRun* c, double t_good, double tout, double* tret
   SUNLinSolFree(c->LS);
   c->LS = full;
   c->fresh = 0; /* the next Jacobian recomputes the bodies' blocks */
-  fprintf(stderr, "note: t = %.6g: IDA failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
-          "from the last good step with klu_full (the whole matrix)\n", t_good);
+  fmb_warn(c->w, "note: t = %.6g: IDA failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+           "from the last good step with klu_full (the whole matrix)", t_good);
   *tret = t_good;
   return IDASolve(c->ida, tout, tret, c->y, c->yp, IDA_NORMAL);
 }
@@ -407,7 +406,7 @@ static void ida_stats(const void* self, fmbStats* st) {
 
 static void ida_after_row(void* self, double t) {
   IdaRun* c = self;
-  watch_step_rate(c->m, c->ida, c->watch_ele, c->ewt, t, &c->watch);
+  watch_step_rate(c->m, c->w, c->ida, c->watch_ele, c->ewt, t, &c->watch);
 }
 
 const fmbIntegratorOps fmb_integrator_ida = {

@@ -42,6 +42,7 @@ typedef struct fmbJointInst {
      random states at load (pattern.c): a joint at a beam's root touches the frame only */
   int nsup;
   int* sup;
+  int input; /* its index among the model's inputs (fmbJointType.input said 1), or -1 */
 } fmbJointInst;
 
 typedef enum {
@@ -135,6 +136,10 @@ struct fmbModel {
   long* colptr; /* ny + 1 */
   long* rowind; /* nnz */
   char vtk_dir[512]; /* the scene's `vtk` key: "" = no animation unless the run asks */
+  /* inputs (fmb_set_input): the joints that take one, in scene order, and their `value:` */
+  int ninput;
+  int* input_joint;
+  double* input_initial;
 };
 
 /* evaluation context a joint sees */
@@ -147,6 +152,7 @@ struct fmbJointEval {
   double* work;    /* plugin scratch (body markers) */
   double* mk;      /* 3 x max body ncoord: marker derivatives before scattering */
   double* js;      /* 2 x max joint columns: the joint's own scratch */
+  const double* input; /* the inputs' current values (the workspace's, set by fmb_set_input) */
 };
 
 /* ---- registry.c: a growable registry of types; plugin.c: loading plugins ---- */
@@ -213,6 +219,22 @@ typedef struct fmbWorkspace fmbWorkspace;
 fmbWorkspace* fmb_workspace_new(const fmbModel* m);
 void fmb_workspace_free(fmbWorkspace* w);
 double* fmb_workspace_plugin(fmbWorkspace* w);
+/* the inputs' current values (m->ninput; the scene's `value:` when the workspace is made) */
+double* fmb_workspace_inputs(fmbWorkspace* w);
+/* where messages of the run on this workspace go (fn NULL: the thread's default, warn.c) */
+typedef struct {
+  fmbWarnFn fn;
+  void* user;
+} fmbWarnSink;
+fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w);
+
+/* ---- warn.c: the library's one way to say something (issue 24): to the workspace's sink, else
+   the thread's default handler (fmb_set_warn), else stderr; w may be NULL (load time) ---- */
+void fmb_warn(fmbWorkspace* w, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 2, 3)))
+#endif
+    ;
 /* a body declared its own sparse pattern (pattern op): dense whole-model systems are avoided */
 int fmb_model_has_sparse_body(const fmbModel* m);
 /* a type's output id for `quantity`: its output_lookup op, or without one the index in its
@@ -339,6 +361,9 @@ void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size
 #define FMB_MIN_NORM_SHIFT 1e-10
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
                            fmbDiag* diag);
+/* a consistent state at t from y's q and v (projected onto the constraints), for a restart after
+   an input changed (step.c); 0 or an exit code with diag set */
+int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag);
 
 /* ---- static.c ---- */
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,

@@ -314,9 +314,11 @@ int fmb_csv_values(fmbCsv* c, const double* values) {
   return write_line(c, c->line, used) ? -1 : 0;
 }
 
-/* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
+/* the scene's outputs at (t, y) into row[noutput] (every one, also after a value that is not
+   finite: fmb_outputs hands them all over); 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row) {
   const double *q = y, *v = y + m->nq;
+  int not_finite = 0;
   (void)yp;
   fmbEnergy e = {0, 0, 0, 0};
   double cpos = 0.0, cvel = 0.0;
@@ -365,10 +367,10 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
       case FMB_OUT_CONSTRAINT: val = o->id == 0 ? cpos : cvel; break;
       case FMB_OUT_SHAPE: val = shape_value(m, w, o, q); break;
     }
-    if (!isfinite(val)) return 1;
     row[i] = val;
+    not_finite |= !isfinite(val);
   }
-  return 0;
+  return not_finite;
 }
 
 /* 0 ok; 1 a value is not finite (nothing written); -1 a write failed */

@@ -1,13 +1,16 @@
 /* quad.c — Gauss–Legendre rules: the one quadrature of the project.
  * Nodes are the roots of P_n, found by Newton's method from Tricomi's initial guess; weights
- * w_i = 2 / ((1 - x_i^2) P_n'(x_i)^2). Mapped to [0, 1]. Computed once per n and cached. */
+ * w_i = 2 / ((1 - x_i^2) P_n'(x_i)^2). Mapped to [0, 1]. Computed once for every n, the first
+ * time any is asked for (pthread_once: two threads loading two models at once must not fill the
+ * table together). */
 #include <math.h>
+#include <pthread.h>
 
 #include "flexmbd.h"
 
 static double rule_x[FMB_GAUSS_MAX + 1][FMB_GAUSS_MAX];
 static double rule_w[FMB_GAUSS_MAX + 1][FMB_GAUSS_MAX];
-static int rule_ready[FMB_GAUSS_MAX + 1];
+static pthread_once_t rules_once = PTHREAD_ONCE_INIT;
 
 static void legendre(int n, double x, double* p, double* dp) {
   double p0 = 1.0, p1 = x;
@@ -37,7 +40,10 @@ static void build_rule(int n) {
     rule_x[n][n - 1 - i] = 0.5 * (x + 1.0);
     rule_w[n][n - 1 - i] = 0.5 * w;
   }
-  rule_ready[n] = 1;
+}
+
+static void build_rules(void) {
+  for (int n = 2; n <= FMB_GAUSS_MAX; ++n) build_rule(n);
 }
 
 int fmb_gauss_legendre01(int n, double* x, double* w) {
@@ -47,7 +53,7 @@ int fmb_gauss_legendre01(int n, double* x, double* w) {
     w[0] = 1.0;
     return 0;
   }
-  if (!rule_ready[n]) build_rule(n);
+  pthread_once(&rules_once, build_rules);
   for (int i = 0; i < n; ++i) {
     x[i] = rule_x[n][i];
     w[i] = rule_w[n][i];

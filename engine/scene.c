@@ -262,7 +262,9 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
   if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list for 'joints' (each item a mapping with name and type)");
   int n = fmbp_seq_len(p, list);
   m->joint = calloc((size_t)n + 1, sizeof *m->joint);
-  if (!m->joint) return fmb_parse_error(p, list, "out of memory");
+  m->input_joint = calloc((size_t)n + 1, sizeof *m->input_joint);
+  m->input_initial = calloc((size_t)n + 1, sizeof *m->input_initial);
+  if (!m->joint || !m->input_joint || !m->input_initial) return fmb_parse_error(p, list, "out of memory");
   const char* const* names = p->reg->joint_names;
   for (int i = 0; i < n; ++i) {
     fmbNode item = fmbp_seq_item(p, list, i);
@@ -281,6 +283,14 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
     j->nrows = j->type->nrows ? j->type->nrows(j->self) : 0;
     m->nc += j->nrows;
     if (j->ncol > m->max_joint_cols) m->max_joint_cols = j->ncol;
+    /* a joint whose value a program sets between steps (fmb_set_input) */
+    j->input = -1;
+    double initial = 0.0;
+    if (j->type->input && j->type->input(j->self, &initial)) {
+      m->input_joint[m->ninput] = m->njoint - 1;
+      m->input_initial[m->ninput] = initial;
+      j->input = m->ninput++;
+    }
   }
   return 0;
 }
@@ -456,6 +466,8 @@ void fmb_free(fmbModel* m) {
   fmb_pattern_free(m);
   free(m->body);
   free(m->joint);
+  free(m->input_joint);
+  free(m->input_initial);
   free(m->output);
   free(m);
 }

@@ -451,7 +451,7 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
       memcpy(x, xt, (size_t)n * sizeof(double));
       done_s = st;
       res->load_steps++;
-      if (!opt.quiet && st < 1.0) fprintf(stderr, "static: load %.4g reached in %d Newton iterations\n", st, it + 1);
+      if (!opt.quiet && st < 1.0) fmb_warn(w, "static: load %.4g reached in %d Newton iterations", st, it + 1);
       if (ds < 1.0) ds *= 2.0; /* a step that worked: try a longer one */
     } else {
       ds *= 0.5;
@@ -473,7 +473,7 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
         rc = FMB_EXIT_SOLVER;
         goto done;
       }
-      if (!opt.quiet) fprintf(stderr, "static: Newton failed at load %.4g; halving the load step to %.3g\n", st, ds);
+      if (!opt.quiet) fmb_warn(w, "static: Newton failed at load %.4g; halving the load step to %.3g", st, ds);
     }
   }
   if (eval_F(&s, x, G)) {

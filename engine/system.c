@@ -47,6 +47,8 @@ struct fmbWorkspace {
   struct fmbAugmented* aug; /* outputs' multipliers (need_multipliers only) */
   double* lambda;
   double spring_energy0;
+  double* input;    /* m->ninput: the inputs' current values */
+  fmbWarnSink warn; /* where this run's messages go */
 };
 
 #define FMB_BLOCK_CACHE_BYTES ((size_t)256 << 20)
@@ -105,7 +107,9 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->work_done = calloc((size_t)m->njoint + 1, sizeof(double));
   w->redundant = calloc((size_t)m->nc + 1, 1);
   w->nredundant_cap = m->nc;
-  if (!w->redundant) {
+  w->input = calloc((size_t)m->ninput + 1, sizeof(double));
+  if (w->input && m->ninput > 0) memcpy(w->input, m->input_initial, (size_t)m->ninput * sizeof(double));
+  if (!w->redundant || !w->input) {
     fmb_workspace_free(w);
     return NULL;
   }
@@ -155,6 +159,7 @@ void fmb_workspace_free(fmbWorkspace* w) {
   free(w->cache_adr);
   free(w->work_done);
   free(w->redundant);
+  free(w->input);
   fmb_augmented_free(w->aug);
   free(w->lambda);
   double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
@@ -172,6 +177,8 @@ int fmb_model_has_sparse_body(const fmbModel* m) {
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
 double* fmb_workspace_work(fmbWorkspace* w) { return w->work_done; }
+double* fmb_workspace_inputs(fmbWorkspace* w) { return w->input; }
+fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w) { return &w->warn; }
 unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
   if (count) {
     *count = 0;
@@ -218,6 +225,9 @@ const double* fmb_eval_v(const fmbJointEval* ev, int k) {
 double* fmb_eval_scratch(const fmbJointEval* ev) { return ev ? ev->js : NULL; }
 
 int fmb_eval_col0(const fmbJointEval* ev, int k) { return k == 1 ? fmb_eval_ncoord(ev, 0) : 0; }
+double fmb_eval_input(const fmbJointEval* ev) {
+  return (ev && ev->j->input >= 0 && ev->input) ? ev->input[ev->j->input] : NAN;
+}
 
 int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle, double* dpos_dq,
                int ld, double* dangle_dq) {
@@ -254,7 +264,7 @@ int fmb_joint_cols(const fmbModel* m, const fmbJointInst* j, int* cols) {
 static int joint_eval(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                       double* phi, double* phi_q, double* phi_t, double* phi_tt) {
   const fmbJointInst* ji = &m->joint[j];
-  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   memset(phi_q, 0, (size_t)ji->nrows * (size_t)ji->ncol * sizeof(double));
   for (int r = 0; r < ji->nrows; ++r) phi_t[r] = phi_tt[r] = 0.0;
   return ji->type->constraint(ji->self, &ev, phi, phi_q, phi_t, phi_tt);
@@ -268,7 +278,7 @@ int fmb_joint_constraint(const fmbModel* m, fmbWorkspace* w, int j, double t, co
 static int joint_force(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        double* Q) {
   const fmbJointInst* ji = &m->joint[j];
-  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   memset(Q, 0, (size_t)ji->ncol * sizeof(double));
   return ji->type->force(ji->self, &ev, Q);
 }
@@ -673,7 +683,7 @@ void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, c
   for (int j = 0; j < m->njoint; ++j) {
     const fmbJointInst* ji = &m->joint[j];
     if (!ji->type->energy) continue;
-    fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+    fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
     e->spring += ji->type->energy(ji->self, &ev);
   }
 }
@@ -796,6 +806,6 @@ int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value) {
   const fmbJointInst* ji = &m->joint[j];
-  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js};
+  fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   return ji->type->output(ji->self, id, &ev, value);
 }

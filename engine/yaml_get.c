@@ -298,7 +298,8 @@ int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, d
   return number_at(p, n, key, flags, out);
 }
 
-/* a warning does not stop the load: FILE:LINE:COL: warning: ... on stderr (or the override) */
+/* a warning does not stop the load: FILE:LINE:COL: warning: ... (or the override) to the thread's
+   warn handler (warn.c) */
 static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 3, 4)))
@@ -314,9 +315,9 @@ static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
   memset(&w, 0, sizeof w);
   diag_at(p, node, &w, msg);
   if (w.line > 0)
-    fprintf(stderr, "%s:%d:%d: warning: %s\n", w.file, w.line, w.col, w.msg);
+    fmb_warn(NULL, "%s:%d:%d: warning: %s", w.file, w.line, w.col, w.msg);
   else
-    fprintf(stderr, "%s: warning: %s\n", w.file, w.msg);
+    fmb_warn(NULL, "%s: warning: %s", w.file, w.msg);
 }
 
 /* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */

@@ -113,3 +113,25 @@ int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, i
     }
   return 0;
 }
+
+/* 1 while a progress line is on a terminal without its newline */
+static int progress_open;
+
+void fmb_cli_warn(void* user, const char* message) {
+  (void)user;
+  const int tty = isatty(STDERR_FILENO);
+  if (tty && strncmp(message, "progress: ", 10) == 0) {
+    fprintf(stderr, "\r%s\033[K", message);
+    progress_open = 1;
+  } else {
+    /* over the progress line (redrawn at its next update) */
+    fprintf(stderr, "%s%s\n", tty && progress_open ? "\r\033[K" : "", message);
+    progress_open = 0;
+  }
+  fflush(stderr);
+}
+
+void fmb_cli_warn_end(void) {
+  if (progress_open) fputc('\n', stderr);
+  progress_open = 0;
+}

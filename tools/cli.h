@@ -30,6 +30,12 @@ int fmb_cli_check_input(const char* path, const char* what);
 /* FMB_EXIT_BAD_INPUT after saying so when `out` is the same file (device and inode, whatever
    the names) as one of the n inputs, else 0; "-" and a file that does not exist are never inputs */
 int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n);
+/* The library's messages on stderr as the program always printed them (fmb_set_warn, installed by
+   main): one line each, except the progress line on a terminal, rewritten in place; a message
+   while it is shown clears it first. fmb_cli_warn_end ends a progress line left open, so that the
+   stats line comes last on a line of its own. */
+void fmb_cli_warn(void* user, const char* message);
+void fmb_cli_warn_end(void);
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
 

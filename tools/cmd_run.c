@@ -103,6 +103,7 @@ int fmb_cmd_run(int argc, char** argv) {
                        .vtk_dir = vtk,
                        .stop = &stop_requested};
   int rc = fmb_run(m, &opt, &stats, &diag);
+  fmb_cli_warn_end();
   if (rc) fmb_cli_print_diag(&diag);
   if (reference) {
     /* one line per column on stdout: the error against the reference and what the run cost */

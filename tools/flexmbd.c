@@ -49,6 +49,7 @@ static void usage(FILE* f) {
 }
 
 int main(int argc, char** argv) {
+  fmb_set_warn(fmb_cli_warn, NULL);
   if (argc < 2) {
     usage(stderr);
     return FMB_EXIT_BAD_INPUT;

@@ -1,0 +1,51 @@
+/* data.h — the state of one run of one model (fmbData, engine/step.c), private to the engine: the
+ * stepping functions and the run loop (run.c) that writes files on top of them. Everything a run
+ * changes lives here or in its workspace; the model is only read. */
+#ifndef FMB_DATA_H
+#define FMB_DATA_H
+
+#include <signal.h>
+
+#include "integrator.h"
+
+struct fmbData {
+  unsigned magic; /* FMB_DATA_LIVE while usable; FMB_DATA_FREED in quarantine (step.c) */
+  const fmbModel* m;
+  fmbWorkspace* w;
+  int initialised; /* fmb_init succeeded (or got as far as a state at t0: ic_done) */
+  int ic_done;     /* the initial conditions were found (fmb_run reports them even if init then fails) */
+  double t;
+  double *y, *yp; /* the whole state (q, v, multipliers, auxiliary unknowns), as the outputs read it */
+  double* atol;   /* ny absolute tolerances (fmb_absolute_tolerances), fixed per model */
+  double* row;    /* m->noutput: the outputs' values, t first (fmb_outputs) */
+  /* the integrator backend: created at the first advance from (t, y, yp); NULL again after an
+     input changed or an advance was interrupted or failed, when `restart` also asks for a
+     consistent state at t first */
+  const fmbIntegratorOps* ops;
+  void* integ;
+  int restart;
+  fmbStats before;     /* counters of the backends retired so far */
+  double* work_before; /* njoint: work done before the current backend started */
+  double* redundant_phi; /* nc: the redundant rows' residuals, checked after every advance */
+  /* formulation: auto: the state at the start of the advance in progress, which a switch to the
+     projected formulation starts from, and where and why IDA gave up */
+  int may_switch;
+  struct {
+    double t, *y, *yp;
+  } start;
+  struct {
+    double t, h;
+    char why[1200];
+  } switched;
+  volatile sig_atomic_t cancel;      /* fmb_data_cancel */
+  const volatile sig_atomic_t* stop; /* what the backends watch: &cancel, or fmb_run's flag */
+  int quiet;                         /* fmb_run --quiet: no notes (warnings still go out) */
+  fmbStats ic;                       /* the initial projection's corrections */
+  int interrupted;
+  double cpu_s;
+};
+
+/* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
+void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
+
+#endif

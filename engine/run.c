@@ -1,0 +1,161 @@
+/* run.c — fmb_run: a whole run into files, as a loop over the stepping API (step.c): fmb_init,
+ * then for every output time fmb_advance and the row (the CSV through the one writer, output.c;
+ * the animation's frame, vtk.c), the progress line and the stop flag of a signal handler. What a
+ * step does (the backends, the checks, the `formulation: auto` switch) is step.c's; a program that
+ * steps by itself and writes the rows through fmb_write_table gets the same bytes (the test
+ * tests/core/test_step.c). On any failure every row so far is already on disk and the message
+ * says when, why, and what to try. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "data.h"
+
+/* a CSV row that could not be written (wr < 0) or held a non-finite value (wr > 0) */
+static int row_failed(const fmbModel* m, int wr, double t, fmbDiag* diag) {
+  if (wr < 0)
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "writing the output failed at t = %.6g (disk full?)", t);
+  else if (wr > 0)
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                 "stopped at t = %.6g: an output is not finite (the solution blew up): check the initial values "
+                 "and parameters for a zero-length spring or an extreme value, try a tighter rtol or a smaller "
+                 "solver.max_step, and check the model for instability",
+                 t);
+  return wr != 0;
+}
+
+/* the CSV row, then the animation's frame (if any): what row_failed reads */
+static int write_outputs(fmbCsv* csv, fmbVtk* vtk, const fmbModel* m, fmbData* d) {
+  int wr = fmb_csv_row(csv, m, d->w, d->t, d->y, d->yp);
+  if (wr == 0 && vtk && fmb_vtk_step(vtk, m, d->w, d->t, d->y)) wr = -1;
+  return wr;
+}
+
+/* The progress line, a message like any other (fmb_warn): silent for the first `after` seconds
+   of wall time (short runs print nothing), then at most 5 updates a second when stderr is a
+   terminal (where the command line's handler rewrites the line in place, tools/cli.c) and one a
+   second elsewhere (--progress into a file or pipe: one line each). */
+typedef struct {
+  int on, tty;
+  double after, start, last;
+} Progress;
+
+static double wall_seconds(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static void progress_update(Progress* pr, const fmbModel* m, fmbData* d) {
+  if (!pr->on) return;
+  const double now = wall_seconds(), elapsed = now - pr->start;
+  if (elapsed < pr->after || now - pr->last < (pr->tty ? 0.2 : 1.0)) return;
+  fmbStats sofar;
+  fmb_data_stats(d, &sofar);
+  const double done = (d->t - m->solver.t0) / (m->solver.t_end - m->solver.t0);
+  char remaining[32] = "?";
+  if (done > 0.0) snprintf(remaining, sizeof remaining, "%.1f s", elapsed * (1.0 - done) / done);
+  fmb_warn(d->w, "progress: t = %.6g of %g (%.0f %%), %ld steps, %.1f s elapsed, ~%s remaining", d->t, m->solver.t_end,
+           100.0 * done, sofar.steps, elapsed, remaining);
+  pr->last = now;
+}
+
+int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* diag) {
+  fmbStats local_stats;
+  fmbDiag local_diag;
+  if (!st) st = &local_stats;
+  if (!diag) diag = &local_diag;
+  memset(st, 0, sizeof *st);
+  memset(diag, 0, sizeof *diag);
+  if (!m) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_run: no model (NULL)");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  const clock_t c0 = clock();
+  st->t_reached = m->solver.t0;
+  const int quiet = opt && opt->quiet;
+  const volatile sig_atomic_t* stop = opt ? opt->stop : NULL;
+  fmbCsv* csv = fmb_csv_open(opt ? opt->csv_path : NULL, diag);
+  if (!csv) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
+  const char* vtk_dir = (opt && opt->vtk_dir) ? opt->vtk_dir : (m->vtk_dir[0] ? m->vtk_dir : NULL);
+  fmbVtk* vtk = NULL;
+  if (vtk_dir && !(vtk = fmb_vtk_open(m, vtk_dir, diag))) {
+    fmb_csv_close(csv);
+    return diag->code ? diag->code : FMB_EXIT_SOLVER;
+  }
+  fmbData* d = fmb_data_new(m, diag);
+  if (!d) {
+    fmb_vtk_close(vtk);
+    fmb_csv_close(csv);
+    return diag->code ? diag->code : FMB_EXIT_SOLVER;
+  }
+  d->quiet = quiet;
+  fmb_data_watch(d, stop);
+  Progress progress = {opt && opt->progress && !quiet, isatty(fileno(stderr)), opt ? opt->progress_after_s : 0.0,
+                       wall_seconds(), 0.0};
+
+  int rc = fmb_init(m, d, diag);
+  if (d->ic_done && !quiet) {
+    fmb_warn(d->w, "initial conditions: position correction %.3g, velocity correction %.3g",
+             d->ic.ic_position_correction, d->ic.ic_velocity_correction);
+    int nredundant = 0;
+    const unsigned char* redundant = fmb_workspace_redundant(d->w, &nredundant);
+    if (nredundant) {
+      char rows[600];
+      fmb_name_rows(m, redundant, rows, sizeof rows);
+      fmb_warn(d->w, "redundant constraints: %s repeat%s the other joints' equations: left out of the equations, their "
+               "share of the reactions by the minimum-norm rule", rows, nredundant == 1 ? "s" : "");
+    }
+  }
+  if (rc || (stop && *stop)) goto done;
+  if (fmb_csv_header(csv, m)) {
+    row_failed(m, -1, d->t, diag);
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  if (row_failed(m, write_outputs(csv, vtk, m, d), d->t, diag)) {
+    rc = FMB_EXIT_SOLVER;
+    goto done;
+  }
+  st->rows_written = 1;
+
+  const double dt = m->solver.output_step, t_end = m->solver.t_end, t0 = m->solver.t0;
+  const long nout = (long)ceil((t_end - t0) / dt - 1e-9);
+  for (long k = 1; k <= nout; ++k) {
+    const double tout = k == nout ? t_end : t0 + (double)k * dt;
+    if ((rc = fmb_advance(m, d, tout, diag))) break;
+    if (row_failed(m, write_outputs(csv, vtk, m, d), d->t, diag)) {
+      rc = FMB_EXIT_SOLVER;
+      break;
+    }
+    st->rows_written++;
+    progress_update(&progress, m, d);
+    if (stop && *stop) break;
+  }
+
+done:
+  if (rc == FMB_EXIT_INTERRUPTED || (stop && *stop && !rc)) {
+    rc = FMB_EXIT_INTERRUPTED;
+    memset(diag, 0, sizeof *diag);
+    fmb_diag_set(diag, rc, m->path, 0, 0, "interrupted at t = %.6g (SIGINT or SIGTERM): the %ld rows written so far are kept",
+                 d->t, st->rows_written);
+  }
+  const long rows = st->rows_written;
+  fmb_data_stats(d, st);
+  st->rows_written = rows;
+  st->interrupted = rc == FMB_EXIT_INTERRUPTED;
+  st->status_ok = rc == 0;
+  fmb_data_free(d);
+  fmb_vtk_close(vtk);
+  if (fmb_csv_close(csv) && !rc) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not put the output in place: %s", strerror(errno));
+    rc = FMB_EXIT_SOLVER;
+    st->status_ok = 0;
+  }
+  st->cpu_s = (double)(clock() - c0) / CLOCKS_PER_SEC;
+  return rc;
+}

@@ -1,0 +1,465 @@
+/* step.c — the stepping API (flexmbd.h "Stepping", docs/api.md): the state of a run in an
+ * fmbData, advanced by fmb_advance(m, d, t_out) as MuJoCo's mj_step(const mjModel*, mjData*).
+ *
+ * What every advance does, wherever the caller stops: one integrator backend (integrator.h) from
+ * time() to t_out, then the checks a CSV row had (mass definiteness, a body's own validity,
+ * redundant rows still holding), the work integrals, and the backend's after-row hook. The
+ * `formulation: auto` switch lives here too, not in the run loop: it is part of how the state gets
+ * from time() to t_out (where IDA fails at a singular configuration the advance goes on with the
+ * projected formulation from the state the advance started from, so a caller never sees it half
+ * done), and a program stepping by itself gets it exactly as fmb_run does.
+ *
+ * Output files, progress and signals are the run loop's (run.c): nothing here writes a file.
+ *
+ * A freed fmbData is kept in a quarantine of the last FMB_DATA_QUARANTINE freed ones before its
+ * memory goes back to malloc, its magic changed: a call with a stale pointer finds FREED and
+ * refuses, without reading freed memory (so AddressSanitizer accepts the test of that path), and
+ * a double free is ignored. (Box2D's ids carry a generation for the same purpose; a pointer API
+ * cannot, so the memory itself is held back.) */
+#include <math.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "data.h"
+
+#define FMB_DATA_LIVE 0x44424d46u  /* "FMBD" */
+#define FMB_DATA_FREED 0x45455246u /* "FREE" */
+
+/* how close to rank-deficient Phi_q must be where IDA failed for `formulation: auto` to switch to
+   the projected formulation: a row whose part independent of the others is below 1e-2 of the
+   largest row (a parallelogram within about half a degree of flat; IDA on the GGL system gave up
+   at 0.3 mrad before the flat position in scenes/parallelogram.yaml) */
+#define FMB_AUTO_SWITCH_RANK_TOL 1e-2
+
+static pthread_mutex_t quarantine_lock = PTHREAD_MUTEX_INITIALIZER;
+static fmbData* quarantine[FMB_DATA_QUARANTINE];
+static int quarantine_next;
+
+static int live(const fmbData* d) { return d && d->magic == FMB_DATA_LIVE; }
+
+/* the misuse every call on (m, d) refuses; 0 when usable */
+static int misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDiag* diag) {
+  const char* path = m ? m->path : "";
+  if (!m) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no model (NULL)", fn);
+  else if (!d) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no data object (NULL)", fn);
+  else if (d->magic == FMB_DATA_FREED)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: the data object was freed (fmb_data_free)", fn);
+  else if (d->magic != FMB_DATA_LIVE)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: not a data object made by fmb_data_new", fn);
+  else if (d->m != m)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0,
+                 "%s: the data object belongs to another model (fmb_data_new was given a different one)", fn);
+  else
+    return 0;
+  return FMB_EXIT_BAD_INPUT;
+}
+
+static void add_stats(fmbStats* to, const fmbStats* from) {
+  to->steps += from->steps;
+  to->residuals += from->residuals;
+  to->jacobians += from->jacobians;
+  to->newton_iters += from->newton_iters;
+  to->error_test_fails += from->error_test_fails;
+  to->conv_fails += from->conv_fails;
+  to->jacobians_reused += from->jacobians_reused;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+static void release(fmbData* d) {
+  if (d->integ) d->ops->destroy(d->integ);
+  d->integ = NULL;
+  double* bufs[] = {d->y, d->yp, d->atol, d->row, d->work_before, d->redundant_phi, d->start.y, d->start.yp};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  fmb_workspace_free(d->w);
+  d->w = NULL;
+}
+
+fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (!m) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_data_new: no model (NULL)");
+    return NULL;
+  }
+  fmbData* d = calloc(1, sizeof *d);
+  if (!d) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up a run");
+    return NULL;
+  }
+  const size_t ny = (size_t)m->ny + 1;
+  d->m = m;
+  d->w = fmb_workspace_new(m);
+  d->y = calloc(ny, sizeof(double));
+  d->yp = calloc(ny, sizeof(double));
+  d->atol = calloc(ny, sizeof(double));
+  d->row = calloc((size_t)m->noutput + 1, sizeof(double));
+  d->work_before = calloc((size_t)m->njoint + 1, sizeof(double));
+  d->redundant_phi = calloc((size_t)m->nc + 1, sizeof(double));
+  d->may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
+  if (d->may_switch) {
+    d->start.y = calloc(ny, sizeof(double));
+    d->start.yp = calloc(ny, sizeof(double));
+  }
+  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi ||
+      (d->may_switch && (!d->start.y || !d->start.yp))) {
+    release(d);
+    free(d);
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
+    return NULL;
+  }
+  fmb_absolute_tolerances(m, d->atol);
+  d->ops = fmb_integrator_for(m);
+  d->stop = &d->cancel;
+  d->t = NAN;
+  d->magic = FMB_DATA_LIVE;
+  return d;
+}
+
+void fmb_data_free(fmbData* d) {
+  if (!d) return;
+  pthread_mutex_lock(&quarantine_lock);
+  if (d->magic != FMB_DATA_LIVE) { /* freed already (still in quarantine), or not ours */
+    pthread_mutex_unlock(&quarantine_lock);
+    return;
+  }
+  release(d);
+  d->magic = FMB_DATA_FREED;
+  fmbData* evicted = quarantine[quarantine_next];
+  quarantine[quarantine_next] = d;
+  quarantine_next = (quarantine_next + 1) % FMB_DATA_QUARANTINE;
+  pthread_mutex_unlock(&quarantine_lock);
+  free(evicted);
+}
+
+void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop) {
+  if (live(d)) d->stop = stop ? stop : &d->cancel;
+}
+
+void fmb_data_cancel(fmbData* d) {
+  if (d) d->cancel = 1; /* only a store: a signal handler may call it */
+}
+
+void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user) {
+  if (!live(d)) return;
+  fmbWarnSink* sink = fmb_workspace_warn(d->w);
+  sink->fn = fn;
+  sink->user = user;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+/* the backend's counters join the run's, its work integrals the work done before; the next
+   advance creates a new one (after a consistent state at time() when restart is set) */
+static void retire_backend(fmbData* d, int restart) {
+  const fmbModel* m = d->m;
+  if (d->integ) {
+    fmbStats sofar;
+    memset(&sofar, 0, sizeof sofar);
+    d->ops->stats(d->integ, &sofar);
+    add_stats(&d->before, &sofar);
+    d->ops->destroy(d->integ);
+    d->integ = NULL;
+    if (m->need_work && m->njoint > 0)
+      memcpy(d->work_before, fmb_workspace_work(d->w), sizeof(double) * (size_t)m->njoint);
+  }
+  d->restart |= restart;
+}
+
+static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
+  const fmbBodyInst* b = &m->body[bad - 1];
+  const char* hint = (b->type && b->type->indefinite_mass) ? b->type->indefinite_mass(b->self) : NULL;
+  fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+               "stopped at t = %.6g: the mass matrix is no longer positive definite (singular or indefinite) on the "
+               "constraint manifold (body '%s')%s%s",
+               t, b->name, hint ? ": " : "", hint ? hint : "");
+}
+
+int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (misused(m, d, "fmb_init", diag)) return FMB_EXIT_BAD_INPUT;
+  const clock_t c0 = clock();
+  fmbWorkspace* w = d->w;
+  if (d->integ) d->ops->destroy(d->integ);
+  d->integ = NULL;
+  d->ops = fmb_integrator_for(m);
+  d->restart = 0;
+  d->initialised = d->ic_done = d->interrupted = 0;
+  d->cancel = 0;
+  d->cpu_s = 0.0;
+  memset(&d->before, 0, sizeof d->before);
+  memset(&d->ic, 0, sizeof d->ic);
+  d->switched.t = -1.0;
+  d->switched.h = 0.0;
+  d->switched.why[0] = '\0';
+  memset(d->work_before, 0, sizeof(double) * (size_t)(m->njoint + 1));
+  memset(fmb_workspace_work(w), 0, sizeof(double) * (size_t)(m->njoint + 1));
+  if (m->ninput > 0) memcpy(fmb_workspace_inputs(w), m->input_initial, sizeof(double) * (size_t)m->ninput);
+  d->t = m->solver.t0;
+  int rc = fmb_initial_conditions(m, w, d->y, d->yp, &d->ic, diag);
+  if (!rc) {
+    d->ic_done = 1;
+    const int bad = fmb_check_mass(m, w, d->t, d->y, d->y + m->nq, 0.0);
+    if (bad) {
+      mass_failure(m, bad, d->t, diag);
+      rc = FMB_EXIT_SOLVER;
+    }
+  }
+  if (!rc && m->need_work) { /* the force elements' potential at t0 enters energy.balance */
+    fmbEnergy e0;
+    fmb_energy(m, w, d->t, d->y, d->y + m->nq, &e0);
+    *fmb_workspace_spring_energy0(w) = e0.spring;
+  }
+  d->initialised = rc == 0;
+  d->cpu_s += (double)(clock() - c0) / CLOCKS_PER_SEC;
+  return rc;
+}
+
+/* A row left out as redundant must keep holding: if it stops (the joints were dependent only at
+   t0, or only on part of the motion) the run would silently lose a joint. Checked after every
+   advance. */
+static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, const double* y, double* phi, fmbDiag* diag) {
+  int count = 0;
+  const unsigned char* drop = fmb_workspace_redundant(w, &count);
+  if (!count || fmb_constraints_all(m, w, t, y, y + m->nq, phi, NULL, NULL, NULL)) return 0;
+  double scale = 1.0;
+  for (int i = 0; i < m->nq; ++i) scale = fmax(scale, fabs(y[i]));
+  for (int r = 0; r < m->nc; ++r)
+    if (drop[r] && fabs(phi[r]) > 1e3 * (m->solver.atol + m->solver.rtol * scale)) {
+      unsigned char one[1024] = {0};
+      char name[200] = "";
+      if (r < (int)sizeof one) {
+        one[r] = 1;
+        fmb_name_rows(m, one, name, sizeof name);
+      }
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "stopped at t = %.6g: %s, left out as redundant at the start, no longer holds (residual %.3g): the "
+                   "joints repeat each other only on part of the motion; remove the repeated joint", t, name, phi[r]);
+      return 1;
+    }
+  return 0;
+}
+
+/* a body's own validity check (e.g. a beam deforming beyond its length: a runaway solution) */
+static int invalid_state(const fmbModel* m, double t, const double* y, fmbDiag* diag) {
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->type->invalid_state) continue;
+    const char* why = bi->type->invalid_state(bi->self, y + bi->qadr, y + m->nq + bi->qadr);
+    if (why) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "stopped at t = %.6g: body '%s': %s", t, bi->name, why);
+      return 1;
+    }
+  }
+  return 0;
+}
+
+/* a backend at time(): created from the state there, made consistent first after a change */
+static int ensure_backend(const fmbModel* m, fmbData* d, fmbDiag* diag) {
+  if (d->integ) return 0;
+  if (d->restart) {
+    const int rc = fmb_consistent_state(m, d->w, d->t, d->y, d->yp, diag);
+    if (rc) return rc;
+    d->restart = 0;
+  }
+  const fmbIntegratorSetup setup = {m, d->w, d->stop, d->atol};
+  d->integ = d->ops->create(&setup, d->t, d->y, d->yp, diag);
+  return d->integ ? 0 : diag->code ? diag->code : FMB_EXIT_SOLVER;
+}
+
+static int interrupted(const fmbModel* m, fmbData* d, fmbDiag* diag) {
+  d->interrupted = 1;
+  if (d->stop == &d->cancel) d->cancel = 0; /* used up; fmb_run's own flag stays as its signal set it */
+  retire_backend(d, 1);
+  fmb_diag_set(diag, FMB_EXIT_INTERRUPTED, m->path, 0, 0, "interrupted at t = %.6g", d->t);
+  return FMB_EXIT_INTERRUPTED;
+}
+
+static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
+  fmbWorkspace* w = d->w;
+  const size_t ny = (size_t)m->ny;
+  int rc = ensure_backend(m, d, diag);
+  if (rc) return rc;
+  if (d->may_switch && d->ops != &fmb_integrator_projected) {
+    d->start.t = d->t;
+    memcpy(d->start.y, d->y, sizeof(double) * ny);
+    memcpy(d->start.yp, d->yp, sizeof(double) * ny);
+  }
+  for (;;) {
+    double tret = d->t, h = 0.0;
+    char why[1200] = "";
+    const int flag = d->ops->advance(d->integ, t_out, &tret, d->y, d->yp, &h, why, sizeof why);
+    d->t = tret;
+    if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && *d->stop)) return interrupted(m, d, diag);
+    if (flag == FMB_ADVANCE_FAILED && d->ops != &fmb_integrator_projected && d->may_switch &&
+        fmb_rank_deficient_at(m, w, tret, d->y, d->y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
+      /* a singular configuration: the GGL system's Newton matrix (IDA's or radau5's) is singular
+         here; the projected formulation (minimum-norm multipliers) passes it, for the rest of the
+         run. It starts from where this advance started (fmb_run: the last output row), not from
+         the last good step: that one lies next to the singular configuration, where a start with
+         no step history failed (scenes/parallelogram.yaml at rtol 1e-8: IDA gave up 2e-4 rad
+         before the flat position, CVODE started there stopped at it). The work integrals go on
+         from their values there. */
+      if (!d->quiet)
+        fmb_warn(w, "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
+                 "the mechanism can change branch); continuing with the projected formulation (set solver.formulation: "
+                 "ggl to stop instead)", tret);
+      retire_backend(d, 0);
+      d->ops = &fmb_integrator_projected;
+      d->t = d->start.t;
+      memcpy(d->y, d->start.y, sizeof(double) * ny);
+      memcpy(d->yp, d->start.yp, sizeof(double) * ny);
+      if ((rc = ensure_backend(m, d, diag))) return rc;
+      d->switched.t = tret;
+      d->switched.h = h;
+      snprintf(d->switched.why, sizeof d->switched.why, "%s", why);
+      continue;
+    }
+    if (flag != FMB_ADVANCE_OK) {
+      const int bad = fmb_check_mass(m, w, tret, d->y, d->y + m->nq, 1e-5);
+      if (bad)
+        mass_failure(m, bad, tret, diag);
+      else if (d->switched.t >= 0 && tret - d->switched.t < m->solver.output_step) /* no further: IDA's reason */
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s (the projected "
+                     "formulation, tried from t = %.6g, did not get further)", tret, d->switched.h, d->switched.why,
+                     d->switched.t);
+      else
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h, why);
+      retire_backend(d, 1);
+      return FMB_EXIT_SOLVER;
+    }
+    if (m->need_work && m->njoint > 0) {
+      double* work = fmb_workspace_work(w);
+      d->ops->work(d->integ, work);
+      for (int j = 0; j < m->njoint; ++j) work[j] += d->work_before[j];
+    }
+    int nred = 0;
+    fmb_workspace_redundant(w, &nred);
+    if (invalid_state(m, d->t, d->y, diag) || (nred && redundant_row_broken(m, w, d->t, d->y, d->redundant_phi, diag)))
+      return FMB_EXIT_SOLVER;
+    const int bad = fmb_check_mass(m, w, d->t, d->y, d->y + m->nq, 0.0);
+    if (bad) {
+      mass_failure(m, bad, d->t, diag);
+      return FMB_EXIT_SOLVER;
+    }
+    if (d->ops->after_row) d->ops->after_row(d->integ, d->t);
+    return 0;
+  }
+}
+
+int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (misused(m, d, "fmb_advance", diag)) return FMB_EXIT_BAD_INPUT;
+  if (!d->initialised) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_advance: the data object has no state yet: call fmb_init first (or it failed)");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (isnan(t_out) || t_out < d->t) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_advance: t_out = %g is before the run's time %.17g: a run goes forward (fmb_init starts it again)",
+                 t_out, d->t);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (t_out > m->solver.t_end) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_advance: t_out = %.17g is beyond the scene's t_end = %.17g (set solver.t_end for a longer run)",
+                 t_out, m->solver.t_end);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (*d->stop) return interrupted(m, d, diag); /* cancelled between two advances */
+  if (t_out == d->t) return 0;
+  const clock_t c0 = clock();
+  const int rc = step_to(m, d, t_out, diag);
+  d->cpu_s += (double)(clock() - c0) / CLOCKS_PER_SEC;
+  return rc;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+double fmb_data_time(const fmbData* d) { return live(d) ? d->t : NAN; }
+
+int fmb_data_state(const fmbData* d, double* y, double* yp) {
+  if (!live(d) || !d->ic_done) return FMB_EXIT_BAD_INPUT;
+  if (y) memcpy(y, d->y, sizeof(double) * (size_t)d->m->ny);
+  if (yp) memcpy(yp, d->yp, sizeof(double) * (size_t)d->m->ny);
+  return 0;
+}
+
+int fmb_noutput(const fmbModel* m) { return m && m->noutput > 0 ? m->noutput - 1 : 0; }
+
+const char* fmb_output_name(const fmbModel* m, int i) {
+  return (m && i >= 0 && i < m->noutput - 1) ? m->output[i + 1].name : NULL;
+}
+
+int fmb_outputs(const fmbModel* m, fmbData* d, double* out) {
+  if (misused(m, d, "fmb_outputs", NULL) || !out || !d->ic_done) return FMB_EXIT_BAD_INPUT;
+  const int not_finite = fmb_outputs_eval(m, d->w, d->t, d->y, d->yp, d->row);
+  if (m->noutput > 1) memcpy(out, d->row + 1, sizeof(double) * (size_t)(m->noutput - 1));
+  return not_finite ? FMB_EXIT_SOLVER : 0;
+}
+
+int fmb_data_stats(const fmbData* d, fmbStats* st) {
+  if (!live(d) || !st) return FMB_EXIT_BAD_INPUT;
+  memset(st, 0, sizeof *st);
+  if (d->integ) d->ops->stats(d->integ, st);
+  add_stats(st, &d->before);
+  st->t_reached = d->t;
+  st->status_ok = d->initialised;
+  st->interrupted = d->interrupted;
+  st->ic_position_correction = d->ic.ic_position_correction;
+  st->ic_velocity_correction = d->ic.ic_velocity_correction;
+  st->cpu_s = d->cpu_s;
+  return 0;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+
+int fmb_ninput(const fmbModel* m) { return m ? m->ninput : 0; }
+
+const char* fmb_input_name(const fmbModel* m, int i) {
+  return (m && i >= 0 && i < m->ninput) ? m->joint[m->input_joint[i]].name : NULL;
+}
+
+static int input_index(const fmbModel* m, const char* name) {
+  for (int i = 0; name && i < m->ninput; ++i)
+    if (strcmp(m->joint[m->input_joint[i]].name, name) == 0) return i;
+  return -1;
+}
+
+int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value) {
+  fmbDiag diag;
+  memset(&diag, 0, sizeof diag);
+  if (misused(m, d, "fmb_set_input", &diag)) return FMB_EXIT_BAD_INPUT;
+  const int i = input_index(m, name);
+  if (i < 0 || !isfinite(value)) {
+    if (i < 0)
+      fmb_warn(d->w, "fmb_set_input: no input named '%s' (%d inputs: a drive with `profile: input` or a load with "
+               "`law: input` is one, named by its joint)", name ? name : "(NULL)", m->ninput);
+    else
+      fmb_warn(d->w, "fmb_set_input: input '%s' = %g: not a finite number", name, value);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  double* input = fmb_workspace_inputs(d->w);
+  if (input[i] == value) return 0; /* no jump: the step history stays valid */
+  input[i] = value;
+  /* the equations change at time(): a BDF or Radau history across the jump would be wrong, so
+     the next advance starts afresh from a state made consistent with the new value */
+  retire_backend(d, 1);
+  return 0;
+}
+
+int fmb_get_input(const fmbModel* m, const fmbData* d, const char* name, double* value) {
+  if (misused(m, d, "fmb_get_input", NULL) || !value) return FMB_EXIT_BAD_INPUT;
+  const int i = input_index(m, name);
+  if (i < 0) return FMB_EXIT_BAD_INPUT;
+  *value = fmb_workspace_inputs(d->w)[i];
+  return 0;
+}

@@ -1,0 +1,223 @@
+/* test_step.c — the stepping API (flexmbd.h "Stepping", issue 24) against fmb_run.
+ *
+ * 1. For every shipped scene (scenes/ and its folders, found on disk so a new scene is covered
+ *    without editing this file) and for runs that take the driver's other paths (formulation: auto
+ *    leaving IDA at a flat parallelogram, ggl failing there with exit 3, radau5), a program that calls fmb_init, then fmb_advance to
+ *    each output time and fmb_outputs, and writes its rows through the public fmb_write_table,
+ *    produces the very bytes of fmb_run's CSV, the same exit code and the same counters.
+ * 2. Two data objects of two models advanced at once in two threads give the values one thread
+ *    gives (nothing shared between runs: the quadrature table, the warn handler, the quarantine).
+ * 3. One data object run twice (fmb_init again = restart) gives the same values both times. */
+#include <glob.h>
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "testlib.h"
+
+/* a whole file into memory (NUL-terminated); NULL when unreadable */
+static char* slurp(const char* path, size_t* len) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return NULL;
+  size_t cap = 1 << 16, n = 0, got;
+  char* buf = malloc(cap);
+  while (buf && (got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+    n += got;
+    if (cap - n < 2) buf = realloc(buf, cap *= 2);
+  }
+  fclose(f);
+  if (buf) buf[n] = '\0';
+  *len = n;
+  return buf;
+}
+
+typedef struct {
+  int ncol, nrow, cap;
+  double* values; /* row-major, t first */
+  int rc;
+  int time_wrong; /* an advance ended elsewhere than asked (counted here: threads call step_run) */
+  fmbStats stats;
+  char why[1024];
+} Table;
+
+/* fmb_run's loop written with the public calls only: every output time t0 + k output_step (the
+   last one t_end), the values at each; stops where fmb_run stops (an advance failing, a value not
+   finite) */
+static void step_run(const fmbModel* m, Table* tab) {
+  memset(tab, 0, sizeof *tab);
+  fmbDiag diag;
+  fmbSolverInfo si;
+  fmb_model_solver(m, &si);
+  tab->ncol = fmb_noutput(m) + 1;
+  fmbData* d = fmb_data_new(m, &diag);
+  if (!d) {
+    tab->rc = diag.code;
+    return;
+  }
+  tab->rc = fmb_init(m, d, &diag);
+  const long nout = (long)ceil((si.t_end - si.t0) / si.output_step - 1e-9);
+  for (long k = 0; !tab->rc && k <= nout; ++k) {
+    if (k > 0) {
+      const double tout = k == nout ? si.t_end : si.t0 + (double)k * si.output_step;
+      if ((tab->rc = fmb_advance(m, d, tout, &diag))) break;
+      tab->time_wrong += fmb_data_time(d) != tout;
+    }
+    if (tab->nrow == tab->cap) {
+      tab->cap = tab->cap ? 2 * tab->cap : 256;
+      tab->values = realloc(tab->values, sizeof(double) * (size_t)tab->cap * (size_t)tab->ncol);
+    }
+    double* row = tab->values + (size_t)tab->nrow * (size_t)tab->ncol;
+    row[0] = fmb_data_time(d);
+    if (fmb_outputs(m, d, row + 1)) { /* fmb_run: "an output is not finite", no row */
+      tab->rc = FMB_EXIT_SOLVER;
+      break;
+    }
+    tab->nrow++;
+  }
+  snprintf(tab->why, sizeof tab->why, "%s", diag.msg);
+  fmb_data_stats(d, &tab->stats);
+  fmb_data_free(d);
+}
+
+static int write_table(const fmbModel* m, const Table* tab, const char* path) {
+  const char** names = malloc(sizeof(char*) * (size_t)tab->ncol);
+  names[0] = "t";
+  for (int i = 1; i < tab->ncol; ++i) names[i] = fmb_output_name(m, i - 1);
+  fmbDiag diag;
+  const int rc = fmb_write_table(path, tab->ncol, names, tab->nrow, tab->values, &diag);
+  free(names);
+  return rc;
+}
+
+/* one scene (absolute path) with overrides: fmb_run's CSV against the stepped one */
+static void compare(const char* scene, const char* const* sets, int nsets, const char* tag, int expect_rc) {
+  fmbDiag diag;
+  fmbModel* m = fmb_load(scene, sets, nsets, fmb_builtin_registry(), &diag);
+  ENSURE(m != NULL);
+  if (!m) {
+    fprintf(stderr, "%s: %s\n", scene, diag.msg);
+    return;
+  }
+  char run_csv[1024], step_csv[1024], name[300];
+  snprintf(name, sizeof name, "step-%s-run.csv", tag);
+  fmbt_out_path(name, run_csv, sizeof run_csv);
+  snprintf(name, sizeof name, "step-%s-step.csv", tag);
+  fmbt_out_path(name, step_csv, sizeof step_csv);
+  fmbStats rs;
+  fmbRunOptions opt = {.csv_path = run_csv, .quiet = 1};
+  const int rrc = fmb_run(m, &opt, &rs, &diag);
+  Table tab;
+  step_run(m, &tab);
+  ENSURE(write_table(m, &tab, step_csv) == 0);
+  size_t na = 0, nb = 0;
+  char* a = slurp(run_csv, &na);
+  char* b = slurp(step_csv, &nb);
+  const int same = a && b && na == nb && memcmp(a, b, na) == 0;
+  ENSURE(same);
+  ENSURE(rrc == tab.rc);
+  ENSURE(rrc == expect_rc);
+  ENSURE(tab.time_wrong == 0);
+  ENSURE(rs.rows_written == tab.nrow);
+  ENSURE(rs.steps == tab.stats.steps && rs.residuals == tab.stats.residuals && rs.jacobians == tab.stats.jacobians &&
+         rs.newton_iters == tab.stats.newton_iters && rs.error_test_fails == tab.stats.error_test_fails);
+  ENSURE(rs.t_reached == tab.stats.t_reached);
+  printf("%-44s %s: %ld rows, %zu bytes, exit %d/%d, %ld/%ld steps%s%s\n", tag, same ? "identical" : "DIFFER",
+         rs.rows_written, na, rrc, tab.rc, rs.steps, tab.stats.steps, tab.rc ? ": " : "", tab.rc ? tab.why : "");
+  free(a);
+  free(b);
+  free(tab.values);
+  fmb_free(m);
+}
+
+typedef struct {
+  const fmbModel* m;
+  Table tab;
+} Job;
+
+static void* job_main(void* arg) {
+  Job* j = arg;
+  fmb_set_warn(NULL, NULL); /* this thread's runs say nothing */
+  step_run(j->m, &j->tab);
+  return NULL;
+}
+
+static int same_table(const Table* a, const Table* b) {
+  return a->rc == b->rc && a->nrow == b->nrow && a->ncol == b->ncol &&
+         memcmp(a->values, b->values, sizeof(double) * (size_t)a->nrow * (size_t)a->ncol) == 0;
+}
+
+int main(void) {
+  char pattern[1024];
+  int nscenes = 0;
+  const char* const levels[] = {"scenes/*.yaml", "scenes/*/*.yaml", "scenes/*/*/*.yaml"};
+  for (int l = 0; l < 3; ++l) {
+    glob_t g;
+    if (glob(fmbt_path(levels[l], pattern, sizeof pattern), 0, NULL, &g) != 0) continue;
+    for (size_t i = 0; i < g.gl_pathc; ++i) {
+      const char* rel = g.gl_pathv[i] + strlen(FLEXMBD_SOURCE_DIR) + 1;
+      char tag[200];
+      snprintf(tag, sizeof tag, "%s", rel);
+      for (char* c = tag; *c; ++c)
+        if (*c == '/') *c = '_';
+      compare(g.gl_pathv[i], NULL, 0, tag, 0);
+      nscenes++;
+    }
+    globfree(&g);
+  }
+  ENSURE(nscenes >= 14); /* the scenes shipped when this test was written */
+  printf("%d shipped scenes\n", nscenes);
+
+  /* the driver's other paths: auto leaves IDA at the flat position (0.277 s) for the projected
+     formulation, restarting from the last row; ggl stops there (rows so far, exit 3); radau5 */
+  char scene[1024];
+  fmbt_path("scenes/parallelogram.yaml", scene, sizeof scene);
+  const char* auto_set[] = {"solver.formulation=auto"};
+  compare(scene, auto_set, 1, "parallelogram-auto-switch", 0);
+  const char* ggl_set[] = {"solver.formulation=ggl"};
+  compare(scene, ggl_set, 1, "parallelogram-ggl-fails", FMB_EXIT_SOLVER);
+  fmbt_path("scenes/paper/spinup_w4.yaml", scene, sizeof scene);
+  const char* radau_set[] = {"solver.integrator=radau5"};
+  compare(scene, radau_set, 1, "spinup_w4-radau5", 0);
+
+  /* two models in two threads at once, against the same runs one after the other */
+  fmbDiag diag;
+  char s1[1024], s2[1024];
+  fmbModel* m1 = fmb_load(fmbt_path("scenes/slider_crank.yaml", s1, sizeof s1), NULL, 0, fmb_builtin_registry(), &diag);
+  fmbModel* m2 = fmb_load(fmbt_path("scenes/exact/spinup_w15_exact.yaml", s2, sizeof s2), NULL, 0, fmb_builtin_registry(),
+                          &diag);
+  ENSURE(m1 && m2);
+  if (m1 && m2) {
+    Job alone[2] = {{m1, {0}}, {m2, {0}}}, together[2] = {{m1, {0}}, {m2, {0}}};
+    job_main(&alone[0]);
+    job_main(&alone[1]);
+    pthread_t th[2];
+    for (int k = 0; k < 2; ++k) pthread_create(&th[k], NULL, job_main, &together[k]);
+    for (int k = 0; k < 2; ++k) pthread_join(th[k], NULL);
+    for (int k = 0; k < 2; ++k) {
+      ENSURE(alone[k].tab.rc == 0 && alone[k].tab.nrow > 10 && together[k].tab.time_wrong == 0);
+      ENSURE(same_table(&alone[k].tab, &together[k].tab));
+      printf("thread %d: %d rows x %d columns, %s alone\n", k, together[k].tab.nrow, together[k].tab.ncol,
+             same_table(&alone[k].tab, &together[k].tab) ? "identical to" : "DIFFERENT from");
+      free(alone[k].tab.values);
+      free(together[k].tab.values);
+    }
+    /* fmb_init again restarts: the same run twice on one data object */
+    fmbData* d = fmb_data_new(m1, &diag);
+    double first[64], second[64];
+    const int n = fmb_noutput(m1);
+    ENSURE(n > 0 && n <= 64);
+    fmbSolverInfo si;
+    fmb_model_solver(m1, &si);
+    for (int pass = 0; pass < 2 && n <= 64; ++pass) {
+      ENSURE(fmb_init(m1, d, &diag) == 0);
+      ENSURE(fmb_data_time(d) == si.t0);
+      ENSURE(fmb_advance(m1, d, 0.5 * (si.t0 + si.t_end), &diag) == 0);
+      ENSURE(fmb_outputs(m1, d, pass ? second : first) == 0);
+    }
+    ENSURE(memcmp(first, second, sizeof(double) * (size_t)n) == 0);
+    fmb_data_free(d);
+  }
+  fmb_free(m1);
+  fmb_free(m2);
+  return fmbt_finish("test_step");
+}
