@@ -9,15 +9,15 @@
 Everything is computed by the C library (libflexmbd, found as flexmbd._lib describes) through
 ctypes; this package converts arguments and results, nothing more. docs/python.md is the guide.
 """
-from ._lib import FlexmbdError, Interrupted, SceneError, SolverError, library_path
+from ._lib import FlexmbdError, FlexmbdWarning, Interrupted, SceneError, SolverError, library_path
 from ._scene import scene_text
-from .model import Cancel, Model, Result, load
+from .model import Cancel, Model, Result, Simulation, load, output_times
 from .analysis import CampbellResult, ModesResult, StaticResult, campbell, modes, static
 from .compare import Comparison, compare
 from .plot import axis_label, unit
 from .study import metric, study
 
-__all__ = ["load", "Model", "Result", "Cancel", "SceneError", "SolverError", "Interrupted", "FlexmbdError",
+__all__ = ["load", "Model", "Result", "Simulation", "Cancel", "output_times", "FlexmbdWarning", "SceneError", "SolverError", "Interrupted", "FlexmbdError",
            "scene_text", "library_path",
            "static", "modes", "campbell", "StaticResult", "ModesResult", "CampbellResult", "compare", "Comparison",
            "study", "metric", "unit", "axis_label"]

@@ -23,7 +23,7 @@ from typing import Optional
 
 #: the plugin/library ABI this package's struct layouts are written for (engine/flexmbd.h
 #: FMB_ABI_VERSION, also the shared library's SOVERSION)
-ABI = 2
+ABI = 3
 
 EXIT_OK = 0
 EXIT_BAD_INPUT = 2
@@ -116,7 +116,7 @@ class Modes(ctypes.Structure):
                 ("shape_im", ctypes.POINTER(ctypes.c_double))]
 
 
-#: fmbStats is only ever passed to the library (fmb_run fills it, fmb_print_stats prints it), never
+#: fmbStats is only ever passed to the library (fmb_data_stats fills it, fmb_print_stats prints it), never
 #: read field by field: the package reads the stats *line*, so fields the library adds later
 #: (e.g. integrator=) appear without a change here. The buffer is larger than the struct will be.
 STATS_BYTES = 1024
@@ -147,6 +147,23 @@ _PROTOTYPES = {
     "fmb_modes_mac": (ctypes.c_double, [ctypes.POINTER(Modes), ctypes.c_int, ctypes.POINTER(Modes), ctypes.c_int]),
     "fmb_write_state_row": (ctypes.c_int, [_P, ctypes.c_char_p, ctypes.c_double, ctypes.POINTER(ctypes.c_double),
                                            ctypes.POINTER(ctypes.c_double), _D]),
+    "fmb_data_new": (_P, [_P, _D]),
+    "fmb_data_free": (None, [_P]),
+    "fmb_init": (ctypes.c_int, [_P, _P, _D]),
+    "fmb_advance": (ctypes.c_int, [_P, _P, ctypes.c_double, _D]),
+    "fmb_data_time": (ctypes.c_double, [_P]),
+    "fmb_data_state": (ctypes.c_int, [_P, ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double)]),
+    "fmb_noutput": (ctypes.c_int, [_P]),
+    "fmb_output_name": (ctypes.c_char_p, [_P, ctypes.c_int]),
+    "fmb_outputs": (ctypes.c_int, [_P, _P, ctypes.POINTER(ctypes.c_double)]),
+    "fmb_data_stats": (ctypes.c_int, [_P, _P]),
+    "fmb_data_cancel": (None, [_P]),
+    "fmb_data_set_warn": (None, [_P, _P, _P]),
+    "fmb_set_warn": (None, [_P, _P]),
+    "fmb_ninput": (ctypes.c_int, [_P]),
+    "fmb_input_name": (ctypes.c_char_p, [_P, ctypes.c_int]),
+    "fmb_set_input": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.c_double]),
+    "fmb_get_input": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.POINTER(ctypes.c_double)]),
     "fmb_write_table": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_int,
                                        ctypes.POINTER(ctypes.c_double), _D]),
 }
@@ -274,3 +291,28 @@ def stats_dict(stats_buffer) -> dict:
     """The stats line fmb_print_stats prints for an fmbStats, as a dict."""
     lib = library()
     return parse_stats_line(print_to_string(lib.fmb_print_stats, stats_buffer))
+
+
+class FlexmbdWarning(UserWarning):
+    """A message of the library (a note, a warning) while loading or running: the text the
+    command line prints on stderr."""
+
+
+WarnFn = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
+
+
+def _to_warnings(user, message) -> None:
+    import warnings
+
+    warnings.warn(message.decode("utf-8", "replace"), FlexmbdWarning, stacklevel=2)
+
+
+#: the library's messages become Python warnings (flexmbd.FlexmbdWarning): kept alive here, as
+#: the library holds the pointer
+WARN_TO_PYTHON = WarnFn(_to_warnings)
+
+
+def route_warnings() -> None:
+    """Send this thread's library messages (loading, statics, runs without their own handler) to
+    Python's warnings (fmb_set_warn's handler is per thread)."""
+    library().fmb_set_warn(ctypes.cast(WARN_TO_PYTHON, ctypes.c_void_p), None)

@@ -2,10 +2,12 @@
 from __future__ import annotations
 
 import ctypes
+import math
 import os
 import tempfile
 import threading
-from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+import weakref
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
@@ -92,7 +94,8 @@ class Model:
 
     Attributes: ``path`` (the scene file, None for text or a dict), ``overrides`` (the
     ``PATH=VALUE`` strings applied), ``plugins``, ``solver`` (t0, t_end, rtol, atol, output_step
-    after the overrides), ``bodies`` (name → type) and ``state_size``."""
+    after the overrides), ``bodies`` (name → type), ``output_names`` (the CSV's columns after t),
+    ``inputs`` (what Simulation.set_load can set) and ``state_size``."""
 
     def __init__(self) -> None:  # use flexmbd.load
         self._ptr: Optional[int] = None
@@ -123,6 +126,7 @@ class Model:
         arr = (ctypes.c_char_p * max(1, len(overrides)))(*[o.encode() for o in overrides])
         diag = _lib.Diag()
         rename = {path: shown} if shown else {}
+        _lib.route_warnings()
         ptr = lib.fmb_load(path.encode(), arr, len(overrides), reg, ctypes.byref(diag))
         if not ptr:
             raise _lib.error_from(diag, rename)
@@ -130,6 +134,7 @@ class Model:
         m._ptr = ptr
         m._rename = rename
         m.path = None if shown else path
+        m._shown_path = shown or path
         m.overrides = list(overrides)
         m.plugins = list(plugins)
         m._source = source
@@ -142,6 +147,8 @@ class Model:
             lib.fmb_model_body(ptr, i, ctypes.byref(name), ctypes.byref(typ))
             m.bodies[name.value.decode()] = typ.value.decode()
         m.state_size = lib.fmb_state_size(ptr)
+        m.output_names = [lib.fmb_output_name(ptr, i).decode() for i in range(lib.fmb_noutput(ptr))]
+        m.inputs = [lib.fmb_input_name(ptr, i).decode() for i in range(lib.fmb_ninput(ptr))]
         return m
 
     # -- lifetime ------------------------------------------------------------------------------
@@ -188,61 +195,256 @@ class Model:
         return _lib.error_from(diag, self._rename, default_code)
 
     # -- running -------------------------------------------------------------------------------
-    def run(self, t_end: Optional[float] = None, *, check: bool = True, cancel: Optional["Cancel"] = None) -> "Result":
+    def run(self, t_end: Optional[float] = None, *, check: bool = True, cancel: Optional["Cancel"] = None,
+            warn: Optional[Callable[[str], None]] = None) -> "Result":
         """Integrate from t0 to t_end (None: the scene's ``solver.t_end``) and return the outputs.
 
         The rows are the ones ``flexmbd run`` writes (``Result.to_csv`` gives the same bytes).
         When the solver stops, SolverError is raised with the rows so far in its ``.result``
         (``check=False``: the Result is returned, ``.status`` says ``failed``, ``.error`` why).
         ``cancel.set()`` from another thread stops the run after its current step (Interrupted).
-        The library runs without the GIL: other Python threads run meanwhile."""
+        The library's messages go to ``warn(text)``, by default Python's warnings
+        (flexmbd.FlexmbdWarning). The library runs without the GIL: other Python threads run
+        meanwhile."""
         if t_end is not None and t_end != self.solver["t_end"]:
             with self.reload({"solver.t_end": float(t_end)}) as m:
-                return m.run(check=check, cancel=cancel)
-        return _run_whole(self, check, cancel)
+                return m.run(check=check, cancel=cancel, warn=warn)
+        return _run_whole(self, check, cancel, warn)
+
+    def start(self, *, warn: Optional[Callable[[str], None]] = None, cancel: Optional["Cancel"] = None
+              ) -> "Simulation":
+        """A run to step by hand, initialised at t0 (see Simulation)."""
+        return Simulation(self, warn=warn, cancel=cancel)
 
 
 class Cancel:
-    """A flag that stops a run from another thread (``flexmbd.Cancel()``, ``.set()``)."""
+    """A flag that stops runs from another thread: ``c = flexmbd.Cancel()``, pass it to
+    ``Model.run(cancel=c)`` or ``Model.start(cancel=c)``, then ``c.set()``. The advance in progress
+    returns at its next step (fmb_data_cancel) and the run raises Interrupted with its rows."""
 
     def __init__(self) -> None:
-        self._flag = ctypes.c_int(0)
-        self._hooks: list = []
+        self._set = False
+        self._sims: "weakref.WeakSet[Simulation]" = weakref.WeakSet()
+        self._lock = threading.Lock()
 
     def set(self) -> None:
-        self._flag.value = 1
-        for hook in list(self._hooks):
-            hook()
+        with self._lock:
+            self._set = True
+            sims = list(self._sims)
+        for sim in sims:
+            sim.cancel()
 
     def is_set(self) -> bool:
-        return bool(self._flag.value)
+        return self._set
+
+    def _watch(self, sim: "Simulation") -> None:
+        with self._lock:
+            self._sims.add(sim)
+            already = self._set
+        if already:
+            sim.cancel()
 
 
-def _run_whole(model: Model, check: bool, cancel: Optional[Cancel]) -> "Result":
-    """fmb_run into a temporary CSV, read back."""
-    lib = _lib.library()
-    fd, path = tempfile.mkstemp(prefix="flexmbd-run-", suffix=".csv")
-    os.close(fd)
-    try:
-        stop = cancel._flag if cancel is not None else ctypes.c_int(0)
-        opt = _lib.RunOptions(csv_path=path.encode(), quiet=1, progress=0, progress_after_s=0.0, vtk_dir=None,
-                              stop=ctypes.pointer(stop))
-        stats = ctypes.create_string_buffer(_lib.STATS_BYTES)
+def _output_grid(solver: Mapping[str, float]) -> Tuple[int, Callable[[int], float]]:
+    """The rows `flexmbd run` writes: their count - 1 (nout) and the time of row k, t0 + k
+    output_step, the last one t_end (engine/run.c's grid, which fmb_run steps to as well)."""
+    t0, t_end, dt = solver["t0"], solver["t_end"], solver["output_step"]
+    nout = int(math.ceil((t_end - t0) / dt - 1e-9))
+    return nout, (lambda k: t_end if k == nout else t0 + float(k) * dt)  # t0 + (double)k * dt, as in C
+
+
+def output_times(solver: Mapping[str, float]) -> np.ndarray:
+    """The times of the rows `flexmbd run` writes for these solver settings (Model.solver)."""
+    nout, at = _output_grid(solver)
+    return np.array([at(k) for k in range(nout + 1)])
+
+
+class Simulation:
+    """One run of a model, stepped by the caller (the library's fmbData): ``model.start()``.
+
+        sim = model.start()
+        while sim.t < 5:
+            sim.set_load("motor", -k * sim["hub.theta"])   # a joint with profile/law: input
+            sim.advance(sim.t + 0.01)
+
+    ``advance(t_out)`` integrates to t_out (time ≤ t_out ≤ the scene's t_end); a changed input
+    takes effect from the current time as a step and the integrator restarts there (no history
+    across the jump). ``outputs()`` gives the scene's outputs now (the values a CSV row at this time
+    holds), ``sim[name]`` one of them, ``state()`` the DAE state (y, y'), ``stats`` the counters so
+    far. Errors: SolverError (the state stays at the last good step), Interrupted (``cancel()``,
+    from any thread), SceneError for misuse (t_out before t, NaN or beyond t_end; an unknown input).
+    Each call into the library releases the GIL."""
+
+    def __init__(self, model: Model, warn: Optional[Callable[[str], None]] = None,
+                 cancel: Optional[Cancel] = None) -> None:
+        lib = _lib.library()
+        self.model = model
         diag = _lib.Diag()
-        rc = lib.fmb_run(model.handle, ctypes.byref(opt), stats, ctypes.byref(diag))
-        result = Result.from_csv(path) if os.path.getsize(path) > 0 else None
-        st = _lib.stats_dict(stats)
-    finally:
-        os.unlink(path)
-    if result is None:
-        result = Result([], np.zeros((0, 0)), st)
-    result.stats = st
-    if rc:
-        err = model._error(diag, rc)
-        result.error = err
-        err.result = result
-        if check or rc == _lib.EXIT_BAD_INPUT:
-            raise err
+        _lib.route_warnings()
+        self._ptr = lib.fmb_data_new(model.handle, ctypes.byref(diag))
+        if not self._ptr:
+            raise model._error(diag)
+        if warn is not None:
+            self._warn = _lib.WarnFn(lambda user, msg: warn(msg.decode("utf-8", "replace")))
+            lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
+        self.output_names: List[str] = model.output_names
+        self._row = np.zeros(len(self.output_names))
+        self._row_ptr = self._row.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        if cancel is not None:
+            cancel._watch(self)
+        self.restart()
+
+    @property
+    def handle(self) -> int:
+        """The fmbData pointer."""
+        if not self._ptr:
+            raise ValueError("flexmbd: the simulation was closed")
+        return self._ptr
+
+    def restart(self) -> None:
+        """Back to the consistent state at t0 (fmb_init), inputs at their scene values."""
+        diag = _lib.Diag()
+        rc = _lib.library().fmb_init(self.model.handle, self.handle, ctypes.byref(diag))
+        if rc:
+            raise self.model._error(diag, rc)
+
+    @property
+    def t(self) -> float:
+        """The time the state is at."""
+        return _lib.library().fmb_data_time(self.handle)
+
+    def advance(self, t_out: float) -> None:
+        """Integrate to t_out (raises SolverError, Interrupted, or SceneError for misuse)."""
+        diag = _lib.Diag()
+        rc = _lib.library().fmb_advance(self.model.handle, self.handle, float(t_out), ctypes.byref(diag))
+        if rc:
+            raise self.model._error(diag, rc)
+
+    def _outputs_into(self, out) -> int:
+        return _lib.library().fmb_outputs(self.model.handle, self.handle, out)
+
+    def outputs(self) -> Dict[str, float]:
+        """The scene's outputs at time t, name → value (a non-finite value raises SolverError)."""
+        rc = self._outputs_into(self._row_ptr)
+        if rc == _lib.EXIT_SOLVER:
+            raise _lib.SolverError(rc, self.model.path or "", 0, 0, f"an output is not finite at t = {self.t:.6g}")
+        if rc:
+            raise _lib.FlexmbdError(rc, "", 0, 0, "fmb_outputs refused the call")
+        return dict(zip(self.output_names, self._row.tolist()))
+
+    def __getitem__(self, name: str) -> float:
+        if name == "t":
+            return self.t
+        values = self.outputs()
+        try:
+            return values[name]
+        except KeyError:
+            raise KeyError(f"no output '{name}' (outputs: {', '.join(self.output_names)}; add it to the scene's "
+                           "outputs: list)") from None
+
+    def state(self) -> Tuple[np.ndarray, np.ndarray]:
+        """(y, y') of the DAE: [q, v, λ, μ, z] and its rate (copies)."""
+        n = self.model.state_size
+        y, yp = np.zeros(n), np.zeros(n)
+        _lib.library().fmb_data_state(self.handle, y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                                      yp.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        return y, yp
+
+    @property
+    def inputs(self) -> List[str]:
+        """The names of the inputs set_load can change (joints with profile/law: input)."""
+        return self.model.inputs
+
+    def set_load(self, name: str, value: float) -> None:
+        """Set input `name` (a load with `law: input`, a drive with `profile: input`) from now on
+        (fmb_set_input): piecewise constant, the next advance starts from it."""
+        rc = _lib.library().fmb_set_input(self.model.handle, self.handle, name.encode(), float(value))
+        if rc:
+            known = ", ".join(self.inputs) or "none: give a joint profile: input or law: input"
+            raise _lib.SceneError(rc, "", 0, 0, f"set_load('{name}', {value!r}): not an input or not a finite "
+                                  f"value (inputs: {known})")
+
+    def get_load(self, name: str) -> float:
+        """The current value of input `name`."""
+        v = ctypes.c_double()
+        if _lib.library().fmb_get_input(self.model.handle, self.handle, name.encode(), ctypes.byref(v)):
+            raise KeyError(f"no input '{name}' (inputs: {', '.join(self.inputs)})")
+        return v.value
+
+    @property
+    def stats(self) -> dict:
+        """The counters so far, as the stats line's fields (status says ok: the run goes on)."""
+        buf = ctypes.create_string_buffer(_lib.STATS_BYTES)
+        _lib.library().fmb_data_stats(self.handle, buf)
+        return _lib.stats_dict(buf)
+
+    def cancel(self) -> None:
+        """Stop the advance in progress (or the next one) with Interrupted; safe from any thread."""
+        ptr = self._ptr
+        if ptr:
+            _lib.library().fmb_data_cancel(ptr)
+
+    def close(self) -> None:
+        """Free the library's data object now (also done when collected)."""
+        ptr, self._ptr = self._ptr, None
+        if ptr:
+            _lib.library().fmb_data_free(ptr)
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self) -> "Simulation":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<flexmbd.Simulation t={self.t:g} of {self.model!r}>" if self._ptr else "<flexmbd.Simulation closed>"
+
+
+def _run_whole(model: Model, check: bool, cancel: Optional[Cancel], warn) -> "Result":
+    """fmb_run's loop (engine/run.c) on the stepping API: the row at t0 after fmb_init, then one
+    fmb_advance and one row per output time; the rows go straight into one NumPy array."""
+    nout, time_of = _output_grid(model.solver)
+    names = ["t"] + model.output_names
+    values = np.zeros((min(nout + 1, 4096), len(names)))  # grown by doubling: t_end may be far
+    nrow = 0
+    error: Optional[FlexmbdError] = None
+    sim = None
+    try:
+        sim = Simulation(model, warn=warn, cancel=cancel)
+        for k in range(nout + 1):
+            if k > 0:
+                sim.advance(time_of(k))
+            if k == len(values):
+                values = np.concatenate([values, np.zeros_like(values)])
+            row = values[k]
+            row[0] = sim.t
+            rc = sim._outputs_into(row[1:].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+            if rc:  # fmb_run stops here too, without the row
+                raise _lib.SolverError(rc, model._shown_path, 0, 0,
+                                       f"stopped at t = {sim.t:.6g}: an output is not finite (the solution blew up)")
+            nrow = k + 1
+            if cancel is not None and cancel.is_set() and k < nout:
+                raise _lib.Interrupted(_lib.EXIT_INTERRUPTED, model._shown_path, 0, 0,
+                                       f"interrupted at t = {sim.t:.6g} (Cancel.set()): the {nrow} rows so far are kept")
+    except (_lib.SolverError, _lib.Interrupted) as e:
+        error = e
+    stats = {}
+    if sim is not None:
+        stats = sim.stats
+        stats["status"] = "ok" if error is None else ("interrupted" if isinstance(error, _lib.Interrupted) else "failed")
+        sim.close()
+    result = Result(names, values[:nrow], stats)
+    if error is not None:
+        result.error = error
+        error.result = result
+        if check:
+            raise error
     return result
 
 
