@@ -233,7 +233,7 @@ typedef struct fmbBodyType {
   const struct fmbBodyType* (*variant)(fmbParser* p, fmbNode item);
   /* 0 when this body's K, C, M must be evaluated afresh whenever IDA asks for a new iteration
      matrix. The engine otherwise reassembles them from their last evaluation when only cj has
-     changed (engine/integrate.c), which suits bodies whose tangent changes slowly; a
+     changed (engine/integrator_ida.c), which suits bodies whose tangent changes slowly; a
      geometrically exact beam's axial stiffness EA t t^T turns with its tangent, and stale blocks
      cost Newton failures (spin-up at 15 rad/s, 20 elements: 454 against 123, 1.7x the CPU).
      NULL = 1 (reuse allowed). */
@@ -265,7 +265,7 @@ typedef struct fmbBodyType {
   /* Each coordinate's length scale into metres_per_unit[ncoord]: the metres a point of the body
      moves per unit of the coordinate (1 for a displacement; the length L for a slope, a stretch
      or an angle that swings the body). The engine divides the scene's atol by it for that
-     coordinate and its velocity (engine/integrate.c), so one atol in metres controls slopes and
+     coordinate and its velocity (engine/tolerance.c), so one atol in metres controls slopes and
      displacements alike at any size of the body. NULL = atol as given for every coordinate. */
   void (*length_scale)(const void* self, double* metres_per_unit);
 } fmbBodyType;

@@ -1,8 +1,9 @@
 /* integrator.h — integrators behind an ops table, as body and joint types are (docs/style.md).
- * The run driver (integrate.c) owns what every run does: initial conditions, the CSV and VTK rows,
- * the checks at each row (mass definiteness, a body's own validity, redundant rows), progress,
- * interrupts and the failure message's frame. A backend owns how the state advances from one
- * output time to the next and what it needs for that (its own vectors, matrices, solver).
+ * The stepping API (step.c) owns what every run does: initial conditions, the checks after each
+ * advance (mass definiteness, a body's own validity, redundant rows), interrupts, the failure
+ * message's frame and the `formulation: auto` switch; the run loop (run.c) the CSV and VTK rows
+ * and progress. A backend owns how the state advances from one time a caller asks for to the
+ * next and what it needs for that (its own vectors, matrices, solver).
  *
  * Built-in backends (integrator_*.c), chosen by fmb_integrator_for():
  *   ida        IDA (BDF, variable order and step) on the GGL index-2 system of system.c, KLU
@@ -22,7 +23,7 @@ typedef struct {
   const fmbModel* m;
   fmbWorkspace* w;
   const volatile sig_atomic_t* stop; /* may be NULL; non-zero: end after the step in progress */
-  const double* atol;                /* ny absolute tolerances, one per unknown (integrate.c) */
+  const double* atol;                /* ny absolute tolerances, one per unknown (tolerance.c) */
 } fmbIntegratorSetup;
 
 /* fmbIntegratorOps.advance's results */
@@ -44,7 +45,8 @@ typedef struct fmbIntegratorOps {
   /* counters so far (steps, residuals, jacobians, newton_iters, error_test_fails, conv_fails,
      jacobians_reused); the driver fills the rest of fmbStats */
   void (*stats)(const void* self, fmbStats* st);
-  /* optional: after each output row at t (e.g. a warning when the step rate explodes) */
+  /* optional: after each successful advance to t (fmb_run: each output row; e.g. a warning when
+     the step rate explodes) */
   void (*after_row)(void* self, double t);
   void (*destroy)(void* self);
 } fmbIntegratorOps;

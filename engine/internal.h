@@ -81,7 +81,7 @@ typedef struct fmbSolverSettings {
   /* ggl: the stabilized index-2 DAE of system.c (IDA); projected: index-1 equations with
      minimum-norm multipliers, positions and velocities projected onto the constraints after every
      step (CVODE), which passes singular configurations; auto (default): ggl, and where IDA fails
-     at a rank-deficient constraint Jacobian the run continues with projected (integrate.c,
+     at a rank-deficient constraint Jacobian the run continues with projected (step.c,
      docs/mechanisms.md) */
   enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1, FMB_FORM_AUTO = 2 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */

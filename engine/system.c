@@ -41,7 +41,7 @@ struct fmbWorkspace {
   double* cache;
   size_t* cache_adr;
   int cache_valid;
-  double* work_done; /* njoint: accumulated work of each joint (integrate.c fills it) */
+  double* work_done; /* njoint: accumulated work of each joint (step.c fills it) */
   unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
   int nredundant_cap; /* nc */
   struct fmbAugmented* aug; /* outputs' multipliers (need_multipliers only) */

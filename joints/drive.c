@@ -54,7 +54,7 @@ static int drive_constraint(const void* self, const fmbJointEval* ev, double* ph
     if (k == 0)
       for (int i = 0; i < n; ++i) phi_q[c0 + i] = -phi_q[c0 + i];
   }
-  fmbj_motion_eval(&d->motion, fmb_eval_time(ev), f);
+  fmbj_motion_eval(&d->motion, ev, f);
   phi[0] = (ang[1] - ang[0]) - d->angle0 - f[0];
   phi_t[0] = -f[1];
   phi_tt[0] = -f[2];
@@ -76,10 +76,12 @@ static int drive_output(const void* self, int id, const fmbJointEval* ev, double
     return 0;
   }
   double f[3];
-  fmbj_motion_eval(&d->motion, fmb_eval_time(ev), f);
+  fmbj_motion_eval(&d->motion, ev, f);
   *value = f[1];
   return 0;
 }
+
+static int drive_input(const void* self, double* initial) { return fmbj_law_input(&((const Drive*)self)->motion.law, initial); }
 
 static void drive_describe(const void* self, FILE* f) {
   const Drive* d = self;
@@ -104,6 +106,7 @@ const fmbJointType fmb_joint_drive = {
     .output_names = drive_outputs,
     .output = drive_output,
     .describe = drive_describe,
+    .input = drive_input,
     .params = drive_params,
     .example = "joint: pin\nprofile: harmonic\namplitude: 0.2\nfrequency: 3\n",
     .flags = FMB_TYPE_DOES_WORK,

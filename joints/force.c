@@ -47,7 +47,7 @@ static int load_force(const void* self, const fmbJointEval* ev, double* Q) {
   const int n = fmb_eval_ncoord(ev, 0);
   double* D = fmb_eval_scratch(ev); /* rows: dpx/dq, dpy/dq; then dangle/dq */
   double pos[2], ang;
-  const double s = fmbj_law_eval(&l->law, fmb_eval_time(ev)).s;
+  const double s = fmbj_law_at(&l->law, ev).s;
   int rc = fmb_marker(ev, 0, l->point, pos, &ang, D, n, NULL);
   if (rc) return rc;
   double F[2] = {s * l->force[0], s * l->force[1]};
@@ -63,6 +63,8 @@ static int load_force(const void* self, const fmbJointEval* ev, double* Q) {
   }
   return rc;
 }
+
+static int load_input(const void* self, double* initial) { return fmbj_law_input(&((const Load*)self)->law, initial); }
 
 static void load_describe(const void* self, FILE* out) {
   const Load* l = self;
@@ -89,6 +91,7 @@ const fmbJointType fmb_joint_force = {
     .destroy = load_destroy,
     .bodies = load_bodies,
     .force = load_force,
+    .input = load_input,
     .params = load_params,
     .example = "body: b\npoint: [0.5, 0]\nforce: [1, 2]\ntorque: 0.5\nlaw: harmonic\nfrequency: 3\nframe: body\n",
     .flags = FMB_TYPE_DOES_WORK,

@@ -98,7 +98,7 @@ static int prismatic_constraint(const void* self, const fmbJointEval* ev, double
   }
   if (ps->driven) {
     double f[3];
-    fmbj_motion_eval(&ps->motion, fmb_eval_time(ev), f);
+    fmbj_motion_eval(&ps->motion, ev, f);
     phi[2] = sl.s - ps->offset - f[0];
     phi_t[2] = -f[1];
     phi_tt[2] = -f[2];
@@ -164,6 +164,11 @@ static int prismatic_output(const void* self, int id, const fmbJointEval* ev, do
   return rc;
 }
 
+static int prismatic_input(const void* self, double* initial) {
+  const Prismatic* ps = self;
+  return ps->driven && fmbj_law_input(&ps->motion.law, initial);
+}
+
 static void prismatic_describe(const void* self, FILE* out) {
   const Prismatic* ps = self;
   fprintf(out, "slides along [%g, %g] of body1, relative angle held at %g rad", ps->axis[0], ps->axis[1], ps->angle);
@@ -185,6 +190,7 @@ static const fmbParam prismatic_params[] = {
     {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = "m/s", .doc = "profile constant, ramp: (final) speed"},
     {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = "m/s", .doc = "profile spinup: final speed"},
     {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = "m", .doc = "profile harmonic"},
+    {.key = "value", .kind = FMB_PARAM_NUMBER, .unit = "m", .fallback = "0", .doc = "profile input: f until a program sets it"},
     FMBJ_LAW_KEYS("profile "),
     {.key = NULL},
 };
@@ -194,6 +200,7 @@ const fmbJointType fmb_joint_prismatic = {
     .abi = FMB_ABI_VERSION,
     .parse = prismatic_parse,
     .describe = prismatic_describe,
+    .input = prismatic_input,
     .destroy = prismatic_destroy,
     .bodies = fmbj_two_point_bodies,
     .nrows = prismatic_nrows,

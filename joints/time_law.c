@@ -5,7 +5,7 @@
 
 #include "time_law.h"
 
-const char* const fmbj_law_names[] = {"constant", "ramp", "harmonic", "spinup", "table", NULL};
+const char* const fmbj_law_names[] = {"constant", "ramp", "harmonic", "spinup", "table", "input", NULL};
 
 static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
   if (fmb_get_table(p, item, "table", FMB_REQUIRED, &law->t, &law->s, &law->n)) return -1;
@@ -18,8 +18,10 @@ static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
   return 0;
 }
 
-static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
+static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law, int angular) {
   switch (law->kind) {
+    case FMB_LAW_INPUT:
+      return angular ? fmb_get_angle(p, item, "value", 0, &law->value) : fmb_get_double(p, item, "value", 0, &law->value);
     case FMB_LAW_RAMP:
     case FMB_LAW_SPINUP: return fmb_get_double(p, item, "ramp_time", FMB_REQUIRED | FMB_POSITIVE, &law->ramp_time);
     case FMB_LAW_HARMONIC:
@@ -37,7 +39,7 @@ int fmbj_law_parse(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
   int kind = FMB_LAW_CONSTANT;
   if (fmb_get_choice(p, item, "law", 0, fmbj_law_names, &kind)) return -1;
   law->kind = (fmbLawKind)kind;
-  return parse_kind(p, item, law);
+  return parse_kind(p, item, law, 0);
 }
 
 void fmbj_law_free(fmbTimeLaw* law) {
@@ -113,13 +115,27 @@ fmbLawValue fmbj_law_eval(const fmbTimeLaw* law, double t) {
       break;
     }
     case FMB_LAW_TABLE: return table_eval(law, t);
+    case FMB_LAW_INPUT: v.s = v.integral = NAN; break;
   }
   return v;
 }
 
+fmbLawValue fmbj_law_at(const fmbTimeLaw* law, const fmbJointEval* ev) {
+  if (law->kind != FMB_LAW_INPUT) return fmbj_law_eval(law, fmb_eval_time(ev));
+  /* piecewise constant: no rate; the integral is not used (an input motion is a position law) */
+  const fmbLawValue v = {fmb_eval_input(ev), 0.0, 0.0, NAN};
+  return v;
+}
+
+int fmbj_law_input(const fmbTimeLaw* law, double* initial) {
+  if (law->kind != FMB_LAW_INPUT) return 0;
+  *initial = law->value;
+  return 1;
+}
+
 /* ------------------------------------------------------------------------------------------ */
 
-const char* const fmbj_motion_names[] = {"constant", "ramp", "harmonic", "spinup", "table", NULL};
+const char* const fmbj_motion_names[] = {"constant", "ramp", "harmonic", "spinup", "table", "input", NULL};
 
 int fmbj_motion_parse(fmbParser* p, fmbNode item, int angular, fmbMotion* mo) {
   memset(mo, 0, sizeof *mo);
@@ -137,13 +153,14 @@ int fmbj_motion_parse(fmbParser* p, fmbNode item, int angular, fmbMotion* mo) {
       rc = angular ? fmb_get_angle(p, item, "amplitude", FMB_REQUIRED, &mo->magnitude)
                    : fmb_get_double(p, item, "amplitude", FMB_REQUIRED, &mo->magnitude);
       break;
-    case FMB_LAW_TABLE: break;
+    case FMB_LAW_TABLE:
+    case FMB_LAW_INPUT: break;
   }
-  return rc || parse_kind(p, item, &mo->law) ? -1 : 0;
+  return rc || parse_kind(p, item, &mo->law, angular) ? -1 : 0;
 }
 
-void fmbj_motion_eval(const fmbMotion* mo, double t, double f[3]) {
-  const fmbLawValue v = fmbj_law_eval(&mo->law, t);
+void fmbj_motion_eval(const fmbMotion* mo, const fmbJointEval* ev, double f[3]) {
+  const fmbLawValue v = fmbj_law_at(&mo->law, ev);
   const double a = mo->magnitude;
   if (mo->integrate) {
     f[0] = a * v.integral;
@@ -157,6 +174,6 @@ void fmbj_motion_eval(const fmbMotion* mo, double t, double f[3]) {
 }
 
 const char* fmbj_motion_name(const fmbMotion* mo) {
-  static const char* const described[] = {"constant speed", "speed ramp", "harmonic", "spin-up (Eq. 41)", "table"};
+  static const char* const described[] = {"constant speed", "speed ramp", "harmonic", "spin-up (Eq. 41)", "table", "input"};
   return described[mo->law.kind];
 }

@@ -7,6 +7,8 @@
  *   spinup    s = t/Tn - sin(2 pi t/Tn)/(2 pi) for t <= Tn, 1 after: the speed profile of
  *             Liu, Hong & Liu (2009), Eq. 41 (its integral is the paper's spin-up angle)
  *   table     s piecewise linear through [t, value] rows, held at the end values outside
+ *   input     s set by a program between steps (fmb_set_input; the joint's `input` op), constant
+ *             between two settings; `value:` is its value until then (issue 24, docs/api.md)
  * A load multiplies its force and torque by s(t); a prescribed motion (fmbMotion) is either a
  * magnitude times the integral of s (constant, ramp, spinup: laws of the speed) or a magnitude
  * times s itself (harmonic, table: laws of the position). */
@@ -14,7 +16,7 @@
 #define FLEXMBD_TIME_LAW_H
 #include "flexmbd.h"
 
-typedef enum { FMB_LAW_CONSTANT, FMB_LAW_RAMP, FMB_LAW_HARMONIC, FMB_LAW_SPINUP, FMB_LAW_TABLE } fmbLawKind;
+typedef enum { FMB_LAW_CONSTANT, FMB_LAW_RAMP, FMB_LAW_HARMONIC, FMB_LAW_SPINUP, FMB_LAW_TABLE, FMB_LAW_INPUT } fmbLawKind;
 
 typedef struct {
   fmbLawKind kind;
@@ -22,6 +24,7 @@ typedef struct {
   int n;                        /* table rows */
   double *t, *s, *integral;     /* table points; integral of s from t[0] to t[i] */
   double integral_at_zero;      /* of s from t[0] to 0 (tables may start before or after 0) */
+  double value;                 /* input: the initial value (`value:`) */
 } fmbTimeLaw;
 
 /* s, ds/dt, d2s/dt2 and the integral of s from 0 to t */
@@ -30,9 +33,14 @@ typedef struct {
 } fmbLawValue;
 
 /* keys: `law` (default constant) and the law's own: ramp_time (ramp, spinup), frequency, phase
-   (harmonic), table (table: [[t, s], ...] or a CSV file name) */
+   (harmonic), table (table: [[t, s], ...] or a CSV file name), value (input) */
 int fmbj_law_parse(fmbParser* p, fmbNode item, fmbTimeLaw* law);
+/* s at time t; an input law has no value of its own (NaN): fmbj_law_at reads it from ev */
 fmbLawValue fmbj_law_eval(const fmbTimeLaw* law, double t);
+/* s at the evaluation's time, an input law's the value the program set */
+fmbLawValue fmbj_law_at(const fmbTimeLaw* law, const fmbJointEval* ev);
+/* a joint type's `input` op for its law: 1 with the initial value when the law is `input` */
+int fmbj_law_input(const fmbTimeLaw* law, double* initial);
 void fmbj_law_free(fmbTimeLaw* law);
 const char* fmbj_law_name(const fmbTimeLaw* law);
 
@@ -42,7 +50,8 @@ const char* fmbj_law_name(const fmbTimeLaw* law);
      ramp     (speed, ramp_time):   the speed ramps linearly to `speed` over ramp_time
      spinup   (omega0, ramp_time):  Eq. 41, the speed rises smoothly to omega0 over ramp_time
      harmonic (amplitude, frequency, phase):  f = amplitude sin(frequency t + phase)
-     table    (table):              f piecewise linear through the [t, f] rows */
+     table    (table):              f piecewise linear through the [t, f] rows
+     input    (value):              f set by a program between steps, held between settings */
 typedef struct {
   fmbTimeLaw law;
   double magnitude;
@@ -61,14 +70,16 @@ extern const char* const fmbj_law_names[], * const fmbj_motion_names[];
       {.key = "table", .kind = FMB_PARAM_TABLE, .doc = what "table: [[t, value], ...] or a CSV file (required)"}
 #define FMBJ_LAW_PARAMS                                                                                             \
   {.key = "law", .kind = FMB_PARAM_CHOICE, .choices = fmbj_law_names, .fallback = "constant", .doc = "time law s(t) scaling force and torque"}, \
-      FMBJ_LAW_KEYS("")
+      FMBJ_LAW_KEYS(""),                                                                                            \
+      {.key = "value", .kind = FMB_PARAM_NUMBER, .unit = "1", .fallback = "0", .doc = "input: s until a program sets it (fmb_set_input)"}
 #define FMBJ_MOTION_PARAMS(UNIT)                                                                                    \
   {.key = "profile", .kind = FMB_PARAM_CHOICE, .flags = FMB_REQUIRED, .choices = fmbj_motion_names, .doc = "f(t), docs/scenes.md"}, \
       {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "constant, ramp: (final) speed (required)"}, \
       {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "spinup: final speed (required)"},     \
       {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = UNIT, .doc = "harmonic: f = amplitude sin(frequency t + phase) (required)"}, \
+      {.key = "value", .kind = FMB_PARAM_NUMBER, .unit = UNIT, .fallback = "0", .doc = "input: f until a program sets it (fmb_set_input)"}, \
       FMBJ_LAW_KEYS("")
-/* f, f', f'' */
-void fmbj_motion_eval(const fmbMotion* motion, double t, double f[3]);
+/* f, f', f'' at the evaluation's time (an input: the value set, f' = f'' = 0) */
+void fmbj_motion_eval(const fmbMotion* motion, const fmbJointEval* ev, double f[3]);
 const char* fmbj_motion_name(const fmbMotion* motion);
 #endif

@@ -9,7 +9,7 @@
 
 extern const fmbBodyType fmb_body_ground, fmb_body_rigid, fmb_body_beam;
 extern const fmbJointType fmb_joint_revolute, fmb_joint_fixed, fmb_joint_drive, fmb_joint_spring, fmb_joint_force,
-    fmb_joint_prismatic;
+    fmb_joint_prismatic, fmb_joint_torsion;
 
 static const fmbBodyType* const builtin_bodies[] = {
     &fmb_body_ground,
@@ -25,6 +25,7 @@ static const fmbJointType* const builtin_joints[] = {
     &fmb_joint_spring,
     &fmb_joint_force,
     &fmb_joint_prismatic,
+    &fmb_joint_torsion,
     NULL,
 };
 
