@@ -301,10 +301,39 @@ class FlexmbdWarning(UserWarning):
 WarnFn = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
 
 
-def _to_warnings(user, message) -> None:
-    import warnings
+_capture = threading.local()  # .messages: a list while a call's messages are wanted as its error text
 
-    warnings.warn(message.decode("utf-8", "replace"), FlexmbdWarning, stacklevel=2)
+
+def deliver(message: bytes, handler=None) -> None:
+    """A library message: into the capture list of this thread when one is open, else to
+    `handler(text)`, else to Python's warnings."""
+    text = message.decode("utf-8", "replace")
+    held = getattr(_capture, "messages", None)
+    if held is not None:
+        held.append(text)
+    elif handler is not None:
+        handler(text)
+    else:
+        import warnings
+
+        warnings.warn(text, FlexmbdWarning, stacklevel=3)
+
+
+class captured_messages:
+    """`with captured_messages() as msgs:` — the library's messages during the block, for a call
+    that reports misuse only as a message (fmb_set_input)."""
+
+    def __enter__(self) -> list:
+        self._outer = getattr(_capture, "messages", None)
+        _capture.messages = []
+        return _capture.messages
+
+    def __exit__(self, *exc) -> None:
+        _capture.messages = self._outer
+
+
+def _to_warnings(user, message) -> None:
+    deliver(message)
 
 
 #: the library's messages become Python warnings (flexmbd.FlexmbdWarning): kept alive here, as

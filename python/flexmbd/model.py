@@ -285,7 +285,7 @@ class Simulation:
         if not self._ptr:
             raise model._error(diag)
         if warn is not None:
-            self._warn = _lib.WarnFn(lambda user, msg: warn(msg.decode("utf-8", "replace")))
+            self._warn = _lib.WarnFn(lambda user, msg: _lib.deliver(msg, warn))
             lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
         self.output_names: List[str] = model.output_names
         self._row = np.zeros(len(self.output_names))
@@ -358,11 +358,10 @@ class Simulation:
     def set_load(self, name: str, value: float) -> None:
         """Set input `name` (a load with `law: input`, a drive with `profile: input`) from now on
         (fmb_set_input): piecewise constant, the next advance starts from it."""
-        rc = _lib.library().fmb_set_input(self.model.handle, self.handle, name.encode(), float(value))
+        with _lib.captured_messages() as said:
+            rc = _lib.library().fmb_set_input(self.model.handle, self.handle, name.encode(), float(value))
         if rc:
-            known = ", ".join(self.inputs) or "none: give a joint profile: input or law: input"
-            raise _lib.SceneError(rc, "", 0, 0, f"set_load('{name}', {value!r}): not an input or not a finite "
-                                  f"value (inputs: {known})")
+            raise _lib.SceneError(rc, "", 0, 0, "; ".join(said) or f"set_load('{name}', {value!r}) refused")
 
     def get_load(self, name: str) -> float:
         """The current value of input `name`."""
