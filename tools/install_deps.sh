@@ -3,12 +3,14 @@
 #   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; and
 #         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
 #         VTK itself (skipped without it)
-# python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux.
+# python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux; python3-numpy is
+# what the Python package (python/flexmbd, docs/python.md) needs, python3-matplotlib draws its
+# plots (optional for the package, used by docs/python.md), python3-pytest runs its tests.
 set -euo pipefail
 # liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
 # libarpack2-dev: its sparse shift-invert path (Arnoldi) for large systems
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
-      liblapack-dev libblas-dev libarpack2-dev)
+      liblapack-dev libblas-dev libarpack2-dev python3-numpy python3-matplotlib python3-pytest)
 if [ "${1:-}" = "--ci" ]; then
   pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9)
 fi
