@@ -50,6 +50,17 @@ static int gram_factor(int nc, int nq, const double* PhiQ, const unsigned char* 
   return fmb_lu_factor(nc, G, piv);
 }
 
+/* x -= Phi_q^T G^-1 r: the minimum-norm correction that removes the constraint residual r (nc,
+   overwritten) to first order, with G = Phi_q Phi_q^T as gram_factor left it */
+static void subtract_min_norm(int nc, int nq, const double* PhiQ, const double* G, const int* piv, double* r, double* x) {
+  fmb_lu_solve(nc, G, piv, r);
+  for (int c = 0; c < nq; ++c) {
+    double s = 0.0;
+    for (int k = 0; k < nc; ++k) s += PhiQ[(size_t)k * nq + c] * r[k];
+    x[c] -= s;
+  }
+}
+
 /* Rows of Phi_q that depend on the others (relative tolerance FMB_RANK_TOL): marked in drop[].
    Returns the rank, or -1 out of memory. */
 #define FMB_RANK_TOL 1e-9
@@ -85,12 +96,7 @@ static int project_positions(const fmbModel* m, fmbWorkspace* w, double t, doubl
       if (mark_dependent_rows(nc, nq, PhiQ, drop) < 0 || gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
     }
     for (int r = 0; r < nc; ++r) rhs[r] = drop[r] ? 0.0 : phi[r];
-    fmb_lu_solve(nc, G, piv, rhs);
-    for (int c = 0; c < nq; ++c) {
-      double s = 0.0;
-      for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-      q[c] -= s;
-    }
+    subtract_min_norm(nc, nq, PhiQ, G, piv, rhs, q);
   }
   return 1;
 }
@@ -502,12 +508,7 @@ static int project_velocities(int nc, int nq, const double* PhiQ, const double* 
     for (int c = 0; c < nq; ++c) s += PhiQ[(size_t)r * nq + c] * v[c];
     rhs[r] = drop[r] ? 0.0 : s;
   }
-  fmb_lu_solve(nc, G, piv, rhs);
-  for (int c = 0; c < nq; ++c) {
-    double s = 0.0;
-    for (int r = 0; r < nc; ++r) s += PhiQ[(size_t)r * nq + c] * rhs[r];
-    v[c] -= s;
-  }
+  subtract_min_norm(nc, nq, PhiQ, G, piv, rhs, v);
   return 0;
 }
 

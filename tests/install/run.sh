@@ -14,12 +14,7 @@
 #     wrong ABI, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
 #     matrix that is not symmetric, energy that leaks (conform, exit 1);
 #  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc).
-set -u
-src=$1
-build=$2
-work=$3
-rm -rf "$work"
-mkdir -p "$work" || exit 1
+. "$(dirname "$0")/prefix.sh"
 fails=0
 fail() {
   echo "FAIL: $*" >&2
@@ -36,10 +31,6 @@ expect() {
   echo "ok: $* -> exit $rc, '$(grep -E -m1 -- "$pattern" "$work/out")'"
 }
 
-T=$work/prefix
-cmake --install "$build" --prefix "$T" >/dev/null || { echo "FAIL: cmake --install" >&2; exit 1; }
-libdir=$(ls -d "$T"/lib*/ | head -n 1)
-libdir=${libdir%/}
 abi=$(sed -n 's/^#define FMB_ABI_VERSION \([0-9]*\).*/\1/p' "$src/engine/flexmbd.h")
 
 # 1. the installed tree
