@@ -18,6 +18,7 @@ ModelLike = Union[Model, Source]
 
 
 def _model(scene: ModelLike, set: Overrides, plugins: Sequence[str] = ()) -> Model:
+    _lib.route_warnings()  # this thread's library messages become FlexmbdWarning
     if isinstance(scene, Model):
         return scene.reload(set) if set else scene
     return load(scene, set=set, plugins=plugins)
