@@ -89,7 +89,40 @@ def load(scene: Source, set: Overrides = None, plugins: Sequence[Union[str, "os.
     return Model._load(path, None, overrides, plugin_files, ("path", os.path.abspath(path)))
 
 
-class Model:
+class _Owned:
+    """An object of the library this Python object owns (``_ptr``), freed by ``_free`` (the name
+    of the library's function) on close(), at the end of a ``with`` block, or when collected."""
+
+    _ptr: Optional[int] = None
+    _free = ""
+
+    @property
+    def handle(self) -> int:
+        """The library's pointer (fmbModel*, fmbData*), for calls this package does not wrap."""
+        if not self._ptr:
+            raise ValueError(f"flexmbd: the {type(self).__name__} was closed")
+        return self._ptr
+
+    def close(self) -> None:
+        """Free the library's object now (also done when this one is collected)."""
+        ptr, self._ptr = self._ptr, None
+        if ptr:
+            getattr(_lib.library(), self._free)(ptr)
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class Model(_Owned):
     """A loaded scene (the library's fmbModel): fixed after loading, runnable many times.
 
     Attributes: ``path`` (the scene file, None for text or a dict), ``overrides`` (the
@@ -97,8 +130,10 @@ class Model:
     after the overrides), ``bodies`` (name → type), ``output_names`` (the CSV's columns after t),
     ``inputs`` (what Simulation.set_load can set) and ``state_size``."""
 
+    _free = "fmb_free"
+
     def __init__(self) -> None:  # use flexmbd.load
-        self._ptr: Optional[int] = None
+        self._ptr = None
         self._rename: Dict[str, str] = {}
 
     @classmethod
@@ -150,32 +185,6 @@ class Model:
         m.output_names = [lib.fmb_output_name(ptr, i).decode() for i in range(lib.fmb_noutput(ptr))]
         m.inputs = [lib.fmb_input_name(ptr, i).decode() for i in range(lib.fmb_ninput(ptr))]
         return m
-
-    # -- lifetime ------------------------------------------------------------------------------
-    def close(self) -> None:
-        """Free the library's model now (also done when the object is collected)."""
-        ptr, self._ptr = self._ptr, None
-        if ptr:
-            _lib.library().fmb_free(ptr)
-
-    def __del__(self) -> None:
-        try:
-            self.close()
-        except Exception:
-            pass
-
-    def __enter__(self) -> "Model":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
-
-    @property
-    def handle(self) -> int:
-        """The fmbModel pointer (for calls this package does not wrap)."""
-        if not self._ptr:
-            raise ValueError("flexmbd: the model was closed")
-        return self._ptr
 
     def __repr__(self) -> str:
         where = self.path or self._rename.get(next(iter(self._rename), ""), "?")
@@ -259,7 +268,7 @@ def output_times(solver: Mapping[str, float]) -> np.ndarray:
     return np.array([at(k) for k in range(nout + 1)])
 
 
-class Simulation:
+class Simulation(_Owned):
     """One run of a model, stepped by the caller (the library's fmbData): ``model.start()``.
 
         sim = model.start()
@@ -274,6 +283,8 @@ class Simulation:
     far. Errors: SolverError (the state stays at the last good step), Interrupted (``cancel()``,
     from any thread), SceneError for misuse (t_out before t, NaN or beyond t_end; an unknown input).
     Each call into the library releases the GIL."""
+
+    _free = "fmb_data_free"
 
     def __init__(self, model: Model, warn: Optional[Callable[[str], None]] = None,
                  cancel: Optional[Cancel] = None) -> None:
@@ -293,13 +304,6 @@ class Simulation:
         if cancel is not None:
             cancel._watch(self)
         self.restart()
-
-    @property
-    def handle(self) -> int:
-        """The fmbData pointer."""
-        if not self._ptr:
-            raise ValueError("flexmbd: the simulation was closed")
-        return self._ptr
 
     def restart(self) -> None:
         """Back to the consistent state at t0 (fmb_init), inputs at their scene values."""
@@ -382,24 +386,6 @@ class Simulation:
         ptr = self._ptr
         if ptr:
             _lib.library().fmb_data_cancel(ptr)
-
-    def close(self) -> None:
-        """Free the library's data object now (also done when collected)."""
-        ptr, self._ptr = self._ptr, None
-        if ptr:
-            _lib.library().fmb_data_free(ptr)
-
-    def __del__(self) -> None:
-        try:
-            self.close()
-        except Exception:
-            pass
-
-    def __enter__(self) -> "Simulation":
-        return self
-
-    def __exit__(self, *exc) -> None:
-        self.close()
 
     def __repr__(self) -> str:
         return f"<flexmbd.Simulation t={self.t:g} of {self.model!r}>" if self._ptr else "<flexmbd.Simulation closed>"

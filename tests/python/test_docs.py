@@ -5,34 +5,16 @@ in the sh blocks is this interpreter; `sh norun` / `python norun` blocks are sho
 import contextlib
 import io
 import os
-import re
 import subprocess
 import sys
 import warnings
 
 from conftest import BUILD, SRC
 
+sys.path.insert(0, os.path.join(SRC, "tests"))
+from markdown_blocks import blocks  # noqa: E402  (tests/markdown_blocks.py, shared with tests/ux/test_docs.py)
+
 PAGE = os.path.join(SRC, "docs", "python.md")
-FENCE = re.compile(r"^```+\s*([^`]*)$")
-
-
-def blocks(path):
-    lines = open(path, encoding="utf-8").read().split("\n")
-    i = 0
-    while i < len(lines):
-        m = FENCE.match(lines[i])
-        if not m:
-            i += 1
-            continue
-        start, info, body = i + 1, m.group(1).split(), []
-        i += 1
-        while i < len(lines) and not re.match(r"^```+\s*$", lines[i]):
-            body.append(lines[i])
-            i += 1
-        yield start, info, "\n".join(body) + "\n"
-        i += 1
-
-
 def test_python_md_runs(out):
     assert run_page(PAGE, out) >= 10
     for png in ("w15_tip.png", "w15_models.png", "campbell.png"):
@@ -67,14 +49,14 @@ def run_page(page, out, langs=("sh", "bash", "python")):
                 continue
             where = f"{doc}:{line}"
             if info[0] in ("sh", "bash"):
-                p = subprocess.run(["bash", "-e", "-c", code], cwd=out, env=env, capture_output=True, text=True)
+                p = subprocess.run(["bash", "-e", "-c", "\n".join(code)], cwd=out, env=env, capture_output=True, text=True)
                 assert p.returncode == 0, f"{where}: exit {p.returncode}: {p.stderr[-800:]}"
             elif info[0] == "python":
                 buf = io.StringIO()
                 with contextlib.redirect_stdout(buf), warnings.catch_warnings():
                     warnings.simplefilter("error", DeprecationWarning)
                     try:
-                        exec(compile(code, where, "exec"), namespace)
+                        exec(compile("\n".join(code) + "\n", where, "exec"), namespace)
                     except Exception as e:
                         raise AssertionError(f"{where}: {type(e).__name__}: {e}\noutput so far:\n{buf.getvalue()}")
                 print(f"--- {where}\n{buf.getvalue()}")
