@@ -48,3 +48,15 @@ def test_timeout_kills_one_run():
     sets = [{"solver.t_end": 0.3}, {"solver.t_end": 0.5}]
     rows = flexmbd.study(os.path.join(SRC, "scenes", "pendulum.yaml"), sets, processes=2, timeout=3, measure=measure)
     assert [r["status"] for r in rows] == ["timeout", "ok"]
+
+
+def test_study_of_a_model_keeps_results():
+    """a Model (loaded with its own override, t_end = 1) is re-loaded in each child with the
+    set on top; keep_results brings each Result back"""
+    base = flexmbd.load(SPINUP, set={"solver.t_end": 1})
+    rows = flexmbd.study(base, [{"bodies.beam.elements": 4}, {"bodies.beam.elements": 8}], processes=2,
+                         keep_results=True)
+    for row in rows:
+        direct = flexmbd.load(SPINUP, set={"solver.t_end": 1, "bodies.beam.elements": row["bodies.beam.elements"]}).run()
+        assert row["status"] == "ok" and row["result"].columns == direct.columns
+        assert (row["result"].values == direct.values).all()
