@@ -26,8 +26,9 @@ _registries_lock = threading.Lock()
 
 def _registry(plugins: Tuple[str, ...]) -> int:
     lib = _lib.library()
+    key = tuple(os.path.realpath(p) for p in plugins)  # the same files, whatever the folder or spelling
     with _registries_lock:
-        reg = _registries.get(plugins)
+        reg = _registries.get(key)
         if reg:
             return reg
         reg = lib.fmb_registry_new()
@@ -41,7 +42,7 @@ def _registry(plugins: Tuple[str, ...]) -> int:
             if lib.fmb_registry_load(reg, so.encode(), ctypes.byref(diag)):
                 lib.fmb_registry_free(reg)
                 raise _lib.error_from(diag)
-        _registries[plugins] = reg
+        _registries[key] = reg
         return reg
 
 
