@@ -46,7 +46,7 @@ def test_timeout_kills_one_run():
         return {}
 
     sets = [{"solver.t_end": 0.3}, {"solver.t_end": 0.5}]
-    rows = flexmbd.study(os.path.join(SRC, "scenes", "pendulum.yaml"), sets, processes=2, timeout=3, measure=measure)
+    rows = flexmbd.study(os.path.join(SRC, "scenes", "pendulum.yaml"), sets, processes=2, timeout=4, measure=measure)
     assert [r["status"] for r in rows] == ["timeout", "ok"]
 
 
