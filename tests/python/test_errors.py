@@ -47,3 +47,14 @@ def test_missing_file_and_plugin():
     with pytest.raises(flexmbd.SceneError) as e:
         flexmbd.load(os.path.join(SRC, "scenes", "pendulum.yaml"), plugins=["/nonexistent/plugin.so"])
     assert "plugin.so" in str(e.value)
+
+
+def test_library_warnings_become_python_warnings():
+    """a load-time warning (an angle of 170 taken as radians) arrives as FlexmbdWarning with the
+    text the command line prints"""
+    scene = os.path.join(SRC, "scenes", "pendulum.yaml")
+    _, _, err = cli("check", scene, "--set", "bodies.bob.angle=170")
+    cli_warning = [l for l in err.splitlines() if "warning:" in l][0]
+    with pytest.warns(flexmbd.FlexmbdWarning) as w:
+        flexmbd.load(scene, set={"bodies.bob.angle": 170})
+    assert [str(x.message) for x in w] == [cli_warning]
