@@ -88,13 +88,6 @@ class SolverInfo(ctypes.Structure):
     _fields_ = [(n, ctypes.c_double) for n in ("t0", "t_end", "rtol", "atol", "output_step")]
 
 
-class RunOptions(ctypes.Structure):
-    """fmbRunOptions (stop: a pointer to a sig_atomic_t, an int on Linux)"""
-    _fields_ = [("csv_path", ctypes.c_char_p), ("quiet", ctypes.c_int), ("progress", ctypes.c_int),
-                ("progress_after_s", ctypes.c_double), ("vtk_dir", ctypes.c_char_p),
-                ("stop", ctypes.POINTER(ctypes.c_int))]
-
-
 class StaticOptions(ctypes.Structure):
     """fmbStaticOptions"""
     _fields_ = [("t", ctypes.c_double), ("has_t", ctypes.c_int), ("max_iter", ctypes.c_int),
@@ -131,7 +124,6 @@ _PROTOTYPES = {
     "fmb_builtin_plugin": (_P, []),
     "fmb_load": (_P, [ctypes.c_char_p, ctypes.POINTER(ctypes.c_char_p), ctypes.c_int, _P, _D]),
     "fmb_free": (None, [_P]),
-    "fmb_run": (ctypes.c_int, [_P, ctypes.POINTER(RunOptions), _P, _D]),
     "fmb_print_stats": (None, [_P, _P]),
     "fmb_model_solver": (ctypes.c_int, [_P, ctypes.POINTER(SolverInfo)]),
     "fmb_model_nbody": (ctypes.c_int, [_P]),

@@ -13,7 +13,7 @@ import flexmbd
 from flexmbd import _lib
 from conftest import BUILD, SRC, cli
 
-STRUCTS = {"fmbDiag": _lib.Diag, "fmbSolverInfo": _lib.SolverInfo, "fmbRunOptions": _lib.RunOptions,
+STRUCTS = {"fmbDiag": _lib.Diag, "fmbSolverInfo": _lib.SolverInfo,
            "fmbStaticOptions": _lib.StaticOptions, "fmbStaticResult": _lib.StaticResult, "fmbModes": _lib.Modes}
 
 
