@@ -35,6 +35,13 @@ def metric(result: Result, spec: str) -> float:
                   "rms": lambda a: np.sqrt(np.mean(a * a))}[how](x))
 
 
+def _keys(over) -> Dict[str, Any]:
+    """a set's values for its row: {PATH: VALUE} as given, or "PATH=VALUE" strings split"""
+    if isinstance(over, Mapping):
+        return dict(over)
+    return dict(item.partition("=")[::2] for item in over)
+
+
 def _one_run(scene, over: Mapping[str, Any], plugins, t_end, metrics, measure, keep, conn) -> None:
     """In the child: load, run, reduce, send one dict back."""
     faulthandler.disable()  # a crash is reported in its row; no traceback dump from the child
@@ -61,7 +68,7 @@ def _one_run(scene, over: Mapping[str, Any], plugins, t_end, metrics, measure, k
     conn.close()
 
 
-def study(scene: Union[Model, Source], overrides: Sequence[Mapping[str, Any]], *, processes: Optional[int] = None,
+def study(scene: Union[Model, Source], overrides: Sequence[Union[Mapping[str, Any], Sequence[str]]], *, processes: Optional[int] = None,
           metrics: Sequence[str] = (), measure: Optional[Callable[[Result], Mapping[str, Any]]] = None,
           t_end: Optional[float] = None, timeout: Optional[float] = None, keep_results: bool = False,
           plugins: Sequence[str] = ()) -> List[Dict[str, Any]]:
@@ -89,7 +96,7 @@ def study(scene: Union[Model, Source], overrides: Sequence[Mapping[str, Any]], *
             code = proc.exitcode if proc.exitcode is not None else -9
             row = {"status": "crashed", "exit_code": code,
                    "message": f"the run's process died ({'signal ' + str(-code) if code < 0 else 'exit ' + str(code)})"}
-        rows[i] = {**dict(overrides[i]), **row}
+        rows[i] = {**_keys(overrides[i]), **row}
         conn.close()
 
     while pending or running:
