@@ -296,9 +296,9 @@ class Simulation(_Owned):
         self._ptr = lib.fmb_data_new(model.handle, ctypes.byref(diag))
         if not self._ptr:
             raise model._error(diag)
-        if warn is not None:
-            self._warn = _lib.WarnFn(lambda user, msg: _lib.deliver(msg, warn))
-            lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
+        # this run's messages go to `warn` or Python's warnings whichever thread advances it
+        self._warn = _lib.WarnFn(lambda user, msg: _lib.deliver(msg, warn)) if warn is not None else _lib.WARN_TO_PYTHON
+        lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
         self.output_names: List[str] = model.output_names
         self._row = np.zeros(len(self.output_names))
         self._row_ptr = self._row.ctypes.data_as(ctypes.POINTER(ctypes.c_double))

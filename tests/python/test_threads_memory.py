@@ -3,6 +3,8 @@
 import gc
 import os
 import resource
+import subprocess
+import sys
 import threading
 
 import numpy as np
@@ -14,34 +16,69 @@ PENDULUM = os.path.join(SRC, "scenes", "pendulum.yaml")
 SPINUP = os.path.join(SRC, "scenes", "paper", "spinup_w4.yaml")
 
 
-def test_gil_released_during_a_run():
-    """A run that would take hours (t_end = 1e6 s) is started in a thread; it can end only by the
-    Cancel another thread sets. While it is inside the library, the main thread loads and runs a
-    whole other scene to the end, then cancels it. Were the GIL held during the C call, the main
-    thread could not run a line of Python before the long run ended: the test would hang (ctest's
-    timeout fails it) instead of passing."""
-    long = flexmbd.load(PENDULUM, set={"solver.t_end": 1e6})
-    cancel = flexmbd.Cancel()
-    entered = threading.Event()
-    got = {}
+GIL_SCENARIO = """
+import os, sys, threading, time
+import flexmbd
+pendulum, spinup = sys.argv[1:3]
+long = flexmbd.load(pendulum, set={"solver.t_end": 1e6, "solver.min_step": 1e-12, "solver.max_steps": 100000000})
+sim = long.start()
+box = {}
 
-    def long_run():
-        entered.set()
-        got["long"] = long.run(check=False, cancel=cancel)
+def worker():
+    box["tid"] = threading.get_native_id()
+    try:
+        sim.advance(1e6)              # ONE call into the library: hours of work unless cancelled
+        box["end"] = "returned"
+    except flexmbd.Interrupted:
+        box["end"] = "interrupted"
+    except flexmbd.FlexmbdError as e:
+        box["end"] = repr(str(e))
 
-    t = threading.Thread(target=long_run)
-    t.start()
-    assert entered.wait(30)
-    short = flexmbd.load(SPINUP).run()  # a whole run while the other one goes on
-    alive_after_short = t.is_alive()
-    cancel.set()
-    t.join(60)
-    assert not t.is_alive()
-    assert short.status == "ok" and short.t[-1] == 20.0
-    assert alive_after_short, "the long run ended by itself: it cannot (t_end = 1e6 s)"
-    r = got["long"]
-    assert r.status == "interrupted" and isinstance(r.error, flexmbd.Interrupted)
-    assert 0.0 < r.t[-1] < 1e6 and r.stats["t_reached"] >= r.t[-1]
+def cpu_ticks(tid):                   # the thread's user + system CPU time (clock ticks)
+    with open(f"/proc/self/task/{tid}/stat") as f:
+        fields = f.read().rsplit(")", 1)[1].split()
+    return int(fields[11]) + int(fields[12])
+
+t = threading.Thread(target=worker)
+t.start()
+while "tid" not in box:
+    time.sleep(0.001)
+start = cpu_ticks(box["tid"])
+# the worker spends CPU only inside that call: seeing it grow, this thread runs Python while the
+# other is in the library
+deadline = time.monotonic() + 60
+while t.is_alive() and cpu_ticks(box["tid"]) < start + 5 and time.monotonic() < deadline:
+    time.sleep(0.01)
+grown = cpu_ticks(box["tid"]) - start if t.is_alive() else -1
+short = flexmbd.load(spinup).run()   # a whole run, in this thread, meanwhile
+still_inside = t.is_alive()
+sim.cancel()
+t.join(60)
+print(grown, short.status, short.t[-1], still_inside, box.get("end"), sim.t)
+"""
+
+
+def test_gil_released_during_a_run(out):
+    """One thread makes ONE call into the library that would run for hours (advance to t = 1e6 s
+    of the pendulum); it ends only when another thread cancels it. Meanwhile the main thread sees
+    the worker's CPU time grow (it spends CPU only inside that call), runs a whole other scene,
+    and cancels. Were the GIL held during the call, the main thread could not run a line of Python
+    until it returned, which it never does: the scenario runs in a child process, so that a hang
+    fails this test after 120 s instead of stalling the suite."""
+    script = os.path.join(out, "gil.py")
+    with open(script, "w") as f:
+        f.write(GIL_SCENARIO)
+    try:
+        p = subprocess.run([sys.executable, script, PENDULUM, SPINUP], capture_output=True, text=True, timeout=120)
+    except subprocess.TimeoutExpired:
+        raise AssertionError("the main thread could not run while another was in the library: the GIL is held")
+    assert p.returncode == 0, p.stderr
+    assert "interrupted" in p.stdout, p.stdout  # else the long call ended by itself: it says why
+    grown, status, t_last, still_inside, end, t_stop = p.stdout.split()
+    assert int(grown) >= 5, "the worker used no CPU inside the library"
+    assert status == "ok" and float(t_last) == 20.0  # the other scene ran to its end meanwhile
+    assert still_inside == "True" and end == "interrupted"  # the long call was still going until cancelled
+    assert 0.0 < float(t_stop) < 1e6
 
 
 def test_two_threads_give_the_one_thread_results():
