@@ -204,6 +204,10 @@ def library() -> ctypes.CDLL:
             except OSError as e:
                 errors.append(str(e))
                 continue
+            missing = [fn for fn in _PROTOTYPES if not hasattr(lib, fn)]
+            if missing:  # another ABI: its structs would not be ours either
+                errors.append(f"{path} has no {missing[0]} (not flexmbd ABI {ABI})")
+                continue
             for fn, (res, args) in _PROTOTYPES.items():
                 f = getattr(lib, fn)
                 f.restype = res
