@@ -42,10 +42,13 @@ struct fmbData {
   int quiet;                         /* fmb_run --quiet: no notes (warnings still go out) */
   fmbStats ic;                       /* the initial projection's corrections */
   int interrupted;
-  double cpu_s;
+  int failed;   /* the last init or advance failed (fmb_data_stats' status) */
+  double cpu_s; /* CPU time of this thread in init and advance */
 };
 
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
+/* free a data object that never left the engine (fmb_run's) at once, without the quarantine */
+void fmb_data_destroy(fmbData* d);
 
 #endif

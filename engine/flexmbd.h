@@ -490,7 +490,8 @@ FMB_API fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag);
 FMB_API void fmb_data_free(fmbData* d);
 #define FMB_DATA_QUARANTINE 64
 /* the consistent state at the scene's t0 (initial conditions; inputs back to their `value:`);
-   again = restart from t0. 0 or an exit code with *diag */
+   again = restart from t0. The integrator itself is set up by the first fmb_advance from the
+   state then (after any fmb_set_input). 0 or an exit code with *diag */
 FMB_API int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag);
 /* integrate from time() to t_out, time() <= t_out <= t_end (t_out == time(): nothing to do). A
    changed input (fmb_set_input) or a run interrupted or failed before restarts the integrator
@@ -613,7 +614,8 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
    `amplitude` (its units: m or rad) */
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
-/* a table of named numeric columns (row-major values), through the one CSV writer */
+/* a table of named numeric columns (row-major values), through the one CSV writer: with the names
+   "t" and fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
 

@@ -497,6 +497,34 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   return rc;
 }
 
+/* the dense scratch of steps 1-3: Phi_q (row-major nc x nq), phi, phi_t, phi_tt (nc), the Gram
+   matrix (nc^2), pivots and a right-hand side (nq + nc each); 0, or -1 out of memory (all NULL) */
+typedef struct {
+  double *PhiQ, *phi, *phit, *phitt, *G, *rhs;
+  int* piv;
+} Scratch;
+
+static void scratch_free(Scratch* s) {
+  double* bufs[] = {s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->rhs};
+  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(s->piv);
+  memset(s, 0, sizeof *s);
+}
+
+static int scratch_new(const fmbModel* m, Scratch* s) {
+  const size_t nq = (size_t)m->nq, nc = (size_t)m->nc, n = nq + nc + 1;
+  s->PhiQ = calloc((nc ? nc : 1) * nq, sizeof(double));
+  s->phi = calloc(nc + 1, sizeof(double));
+  s->phit = calloc(nc + 1, sizeof(double));
+  s->phitt = calloc(nc + 1, sizeof(double));
+  s->G = calloc(nc * nc + 1, sizeof(double));
+  s->rhs = calloc(n, sizeof(double));
+  s->piv = calloc(n, sizeof(int));
+  if (s->PhiQ && s->phi && s->phit && s->phitt && s->G && s->rhs && s->piv) return 0;
+  scratch_free(s);
+  return -1;
+}
+
 /* The minimum-norm correction of v onto Phi_q v + Phi_t = 0 (the rows marked in drop left out),
    with Phi_q (row-major nc x nq) and Phi_t at the positions: 0, or 1 when the rows kept are not
    independent. G, piv, rhs: scratch of nc^2, nc, nc. */
@@ -578,7 +606,7 @@ static int accelerations_at(const fmbModel* m, fmbWorkspace* w, double t, double
 }
 
 int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st, fmbDiag* diag) {
-  const int nq = m->nq, nc = m->nc, n = nq + nc;
+  const int nq = m->nq, nc = m->nc;
   const double t0 = m->solver.t0;
   double* q = y;
   double* v = y + nq;
@@ -588,17 +616,14 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     const fmbBodyInst* bi = &m->body[b];
     bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
   }
-  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-  double* phi = calloc((size_t)nc + 1, sizeof(double));
-  double* phit = calloc((size_t)nc + 1, sizeof(double));
-  double* phitt = calloc((size_t)nc + 1, sizeof(double));
-  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
-  int* piv = calloc((size_t)n + 1, sizeof(int));
-  double* rhs = calloc((size_t)n + 1, sizeof(double));
+  Scratch sc;
+  const int no_scratch = scratch_new(m, &sc);
+  double *PhiQ = sc.PhiQ, *phi = sc.phi, *phit = sc.phit, *phitt = sc.phitt, *G = sc.G, *rhs = sc.rhs;
+  int* piv = sc.piv;
   double* q0 = calloc((size_t)nq, sizeof(double));
   double* v0 = calloc((size_t)nq, sizeof(double));
   int rc = 0;
-  if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs || !q0 || !v0) {
+  if (no_scratch || !q0 || !v0) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory computing initial conditions");
     rc = FMB_EXIT_SOLVER;
     goto done;
@@ -700,13 +725,7 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
 
   rc = accelerations_at(m, w, t0, y, yp, PhiQ, phi, phit, phitt, rhs, diag);
 done:
-  free(PhiQ);
-  free(phi);
-  free(phit);
-  free(phitt);
-  free(G);
-  free(piv);
-  free(rhs);
+  scratch_free(&sc);
   free(q0);
   free(v0);
   return rc;
@@ -720,24 +739,18 @@ done:
    multipliers. 0 or an exit code with diag set. */
 int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag) {
   const int nq = m->nq, nc = m->nc;
-  double* PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
-  double* phi = calloc((size_t)nc + 1, sizeof(double));
-  double* phit = calloc((size_t)nc + 1, sizeof(double));
-  double* phitt = calloc((size_t)nc + 1, sizeof(double));
-  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
-  int* piv = calloc((size_t)nc + 1, sizeof(int));
-  double* rhs = calloc((size_t)(nq + nc) + 1, sizeof(double));
+  Scratch sc;
   int rc = 0;
-  if (!PhiQ || !phi || !phit || !phitt || !G || !piv || !rhs) {
+  if (scratch_new(m, &sc)) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory restarting the integrator at t = %.6g", t);
     rc = FMB_EXIT_SOLVER;
   } else if (nc > 0) {
     unsigned char* drop = fmb_workspace_redundant(w, NULL);
     double res = 0.0;
     int iters = 0;
-    if (project_positions(m, w, t, y, y + nq, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &res, &iters) ||
-        fmb_constraints_all(m, w, t, y, y + nq, phi, PhiQ, phit, phitt) ||
-        project_velocities(nc, nq, PhiQ, phit, drop, G, piv, rhs, y + nq)) {
+    if (project_positions(m, w, t, y, y + nq, sc.PhiQ, sc.phi, sc.phit, sc.phitt, sc.G, sc.piv, sc.rhs, drop, &res, &iters) ||
+        fmb_constraints_all(m, w, t, y, y + nq, sc.phi, sc.PhiQ, sc.phit, sc.phitt) ||
+        project_velocities(nc, nq, sc.PhiQ, sc.phit, drop, sc.G, sc.piv, sc.rhs, y + nq)) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                    "the joints cannot be satisfied at t = %.6g after the change (constraint residual %.3g after %d "
                    "projection steps): a prescribed motion set by fmb_set_input jumped further than the mechanism can "
@@ -750,14 +763,8 @@ int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y
     /* the multipliers' and auxiliary unknowns' derivatives and mu are 0 in a consistent state */
     memset(y + 2 * nq + nc, 0, (size_t)nc * sizeof(double));
     memset(yp + 2 * nq, 0, (size_t)(m->ny - 2 * nq) * sizeof(double));
-    rc = accelerations_at(m, w, t, y, yp, PhiQ, phi, phit, phitt, rhs, diag);
+    rc = accelerations_at(m, w, t, y, yp, sc.PhiQ, sc.phi, sc.phit, sc.phitt, sc.rhs, diag);
   }
-  free(PhiQ);
-  free(phi);
-  free(phit);
-  free(phitt);
-  free(G);
-  free(piv);
-  free(rhs);
+  scratch_free(&sc);
   return rc;
 }

@@ -149,7 +149,7 @@ done:
   st->rows_written = rows;
   st->interrupted = rc == FMB_EXIT_INTERRUPTED;
   st->status_ok = rc == 0;
-  fmb_data_free(d);
+  fmb_data_destroy(d);
   fmb_vtk_close(vtk);
   if (fmb_csv_close(csv) && !rc) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not put the output in place: %s", strerror(errno));

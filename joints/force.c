@@ -1,5 +1,5 @@
 /* force.c — an applied load: force [fx, fy] at `point` on `body` and a torque, both scaled by a
- * time law s(t) (time_law.c: constant, ramp, harmonic, spinup, table). With `frame: global` the
+ * time law s(t) (time_law.c: constant, ramp, harmonic, spinup, table, input). With `frame: global` the
  * force keeps its direction in the global frame; with `frame: body` it is given in the frame of
  * the material point and turns with it (a follower load: F = R(angle) F_local, angle = the
  * marker's angle, which on a beam includes the local slope).

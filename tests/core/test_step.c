@@ -7,7 +7,10 @@
  *    produces the very bytes of fmb_run's CSV, the same exit code and the same counters.
  * 2. Two data objects of two models advanced at once in two threads give the values one thread
  *    gives (nothing shared between runs: the quadrature table, the warn handler, the quarantine).
- * 3. One data object run twice (fmb_init again = restart) gives the same values both times. */
+ * 3. One data object run twice (fmb_init again = restart) gives the same values both times.
+ * 4. Messages go where they are sent: a load-time warning to the thread's default handler, a run's
+ *    notes to its own handler (fmb_data_set_warn) and not the default, nothing anywhere after
+ *    fmb_set_warn(NULL, NULL). */
 #include <glob.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -146,6 +149,58 @@ static int same_table(const Table* a, const Table* b) {
          memcmp(a->values, b->values, sizeof(double) * (size_t)a->nrow * (size_t)a->ncol) == 0;
 }
 
+typedef struct {
+  int count;
+  char last[600];
+} Heard;
+
+static void hear(void* user, const char* message) {
+  Heard* h = user;
+  h->count++;
+  snprintf(h->last, sizeof h->last, "%s", message);
+}
+
+static void messages(void) {
+  Heard by_default = {0, ""}, by_run = {0, ""};
+  fmb_set_warn(hear, &by_default);
+  char path[1024];
+  FILE* f = fopen(fmbt_out_path("step-warning.yaml", path, sizeof path), "w");
+  if (!f) return;
+  fputs("solver: {t_end: 0.1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1, angle: 10}]\n", f);
+  fclose(f);
+  fmbDiag diag;
+  fmbModel* m = fmb_load(path, NULL, 0, fmb_builtin_registry(), &diag); /* angle 10: radians, or degrees? */
+  ENSURE(m != NULL);
+  ENSURE(by_default.count == 1 && strstr(by_default.last, "step-warning.yaml:2:") && strstr(by_default.last, "warning:"));
+  ENSURE(by_default.last[strlen(by_default.last) - 1] != '\n'); /* one message, no newline */
+  printf("load-time warning to the thread's handler: %s\n", by_default.last);
+  fmb_free(m);
+
+  char scene[1024];
+  const char* sets[] = {"solver.formulation=auto", "solver.t_end=1"};
+  m = fmb_load(fmbt_path("scenes/parallelogram.yaml", scene, sizeof scene), sets, 2, fmb_builtin_registry(), &diag);
+  ENSURE(m != NULL);
+  if (m) {
+    fmbData* d = fmb_data_new(m, &diag);
+    fmb_data_set_warn(d, hear, &by_run);
+    by_default.count = 0;
+    ENSURE(fmb_init(m, d, &diag) == 0 && fmb_advance(m, d, 1.0, &diag) == 0);
+    ENSURE(by_run.count >= 1 && strstr(by_run.last, "continuing with the projected formulation"));
+    ENSURE(by_default.count == 0);
+    printf("the run's notes to its own handler: %d, the last: %.60s...\n", by_run.count, by_run.last);
+    /* without its own handler the run's notes go to the thread's; with none set, nowhere */
+    fmb_data_set_warn(d, NULL, NULL);
+    ENSURE(fmb_init(m, d, &diag) == 0 && fmb_advance(m, d, 1.0, &diag) == 0);
+    ENSURE(by_default.count == by_run.count);
+    fmb_set_warn(NULL, NULL);
+    const int before = by_default.count + by_run.count;
+    ENSURE(fmb_init(m, d, &diag) == 0 && fmb_advance(m, d, 1.0, &diag) == 0);
+    ENSURE(by_default.count + by_run.count == before);
+    fmb_data_free(d);
+    fmb_free(m);
+  }
+}
+
 int main(void) {
   char pattern[1024];
   int nscenes = 0;
@@ -219,5 +274,6 @@ int main(void) {
   }
   fmb_free(m1);
   fmb_free(m2);
+  messages();
   return fmbt_finish("test_step");
 }

@@ -115,8 +115,9 @@ int main(void) {
   fmb_data_cancel(d);
   fmb_data_cancel(d); /* twice is once */
   ENSURE(fmb_advance(m, d, 0.5, &diag) == FMB_EXIT_INTERRUPTED && fmb_data_time(d) == 0.3);
+  ENSURE(fmb_data_stats(d, &st) == 0 && st.interrupted && !st.status_ok);
   ENSURE(fmb_advance(m, d, 0.5, &diag) == 0 && fmb_data_time(d) == 0.5);
-  ENSURE(fmb_data_stats(d, &st) == 0 && st.t_reached == 0.5 && st.steps > 0);
+  ENSURE(fmb_data_stats(d, &st) == 0 && st.t_reached == 0.5 && st.steps > 0 && st.status_ok && !st.interrupted);
 
   /* after free: refused without reading freed memory (ASan would say so), a second free ignored */
   fmb_data_free(d);
