@@ -404,9 +404,12 @@ typedef struct fmbStats {
 
 typedef struct fmbRunOptions {
   const char* csv_path; /* NULL or "-" = stdout */
-  int quiet;            /* no progress lines on stderr */
-  /* a progress line on stderr (t, % of t_end, steps, elapsed, remaining), from progress_after_s
-     of wall time on: rewritten in place on a terminal, one line per update otherwise */
+  /* no progress line and no notes (initial conditions, redundant rows, a switch of formulation);
+     warnings still go out. Messages go to the thread's warn handler (fmb_set_warn). */
+  int quiet;
+  /* a progress message "progress: t = ..." (t, % of t_end, steps, elapsed, remaining), from
+     progress_after_s of wall time on, at most 5 a second when stderr is a terminal (where the
+     flexmbd program rewrites the line in place), one a second otherwise */
   int progress;
   double progress_after_s;
   const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
@@ -523,7 +526,7 @@ FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
 FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
 /* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
    a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
-   unknown name, NaN or infinity, misuse); the value holds from time() on, as a step (piecewise
+   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from time() on, as a step (piecewise
    constant) that the next advance starts from. */
 FMB_API int fmb_ninput(const fmbModel* m);
 FMB_API const char* fmb_input_name(const fmbModel* m, int i);
@@ -554,7 +557,7 @@ typedef struct fmbStaticOptions {
   int max_iter;     /* Newton iterations per load step; 0 = 30 */
   int max_halvings; /* how often a load step may be halved; 0 = 12 (down to 1/4096 of the load) */
   double tol;       /* Newton stops when max |dq_i| <= tol (1 + |q_i|); 0 = 1e-10 */
-  int quiet;        /* no progress lines on stderr */
+  int quiet;        /* no progress messages (to the warn handler) */
 } fmbStaticOptions;
 
 typedef struct fmbStaticResult {

@@ -302,7 +302,17 @@ static int ensure_backend(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   return d->integ ? 0 : diag->code ? diag->code : FMB_EXIT_SOLVER;
 }
 
+/* the joints' work since t0 into the workspace (the outputs read it): the backend's integrals
+   from where it started, plus the work done before */
+static void update_work(const fmbModel* m, fmbData* d) {
+  if (!m->need_work || m->njoint == 0 || !d->integ) return;
+  double* work = fmb_workspace_work(d->w);
+  d->ops->work(d->integ, work);
+  for (int j = 0; j < m->njoint; ++j) work[j] += d->work_before[j];
+}
+
 static int interrupted(const fmbModel* m, fmbData* d, fmbDiag* diag) {
+  update_work(m, d); /* up to where it stopped: a run that goes on keeps its energy balance */
   d->interrupted = 1;
   if (d->stop == &d->cancel) d->cancel = 0; /* used up; fmb_run's own flag stays as its signal set it */
   retire_backend(d, 1);
@@ -360,14 +370,11 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
                      d->switched.t);
       else
         fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h, why);
+      update_work(m, d);
       retire_backend(d, 1);
       return FMB_EXIT_SOLVER;
     }
-    if (m->need_work && m->njoint > 0) {
-      double* work = fmb_workspace_work(w);
-      d->ops->work(d->integ, work);
-      for (int j = 0; j < m->njoint; ++j) work[j] += d->work_before[j];
-    }
+    update_work(m, d);
     int nred = 0;
     fmb_workspace_redundant(w, &nred);
     if (invalid_state(m, d->t, d->y, diag) || (nred && redundant_row_broken(m, w, d->t, d->y, d->redundant_phi, diag)))

@@ -193,7 +193,11 @@ static void cancelling(void) {
          t_end, worst, si.rtol);
 
   /* from another thread, during an advance over the whole run */
-  fmbModel* slow = load("scenes/slider_crank.yaml");
+  char fourbar[1024];
+  const char* longer[] = {"solver.t_end=100", "outputs=[crank.theta, rocker.theta, motor.work, energy.balance]"};
+  fmbModel* slow = fmb_load(fmbt_path("scenes/fourbar.yaml", fourbar, sizeof fourbar), longer, 2, fmb_builtin_registry(),
+                            &diag);
+  ENSURE(slow != NULL);
   if (slow) {
     fmbData* e = fmb_data_new(slow, &diag);
     fmb_model_solver(slow, &si);
@@ -210,6 +214,26 @@ static void cancelling(void) {
       ENSURE(rc == 0 && fmb_advance(slow, e, si.t_end, &diag) == FMB_EXIT_INTERRUPTED);
     printf("cancelled from another thread after 20 ms: %s at t = %g\n", rc ? "interrupted" : "finished first",
            fmb_data_time(e));
+    /* going on from there: the work integrals carry over from where the advance stopped, so the
+       motor's work and the energy balance T + V - W agree with a run never interrupted to within
+       that run's own drift of the balance over 100 s (the integration error: 2.7e-3 J of 98.7 J),
+       and the angles to 100 rtol. Work lost at the stop would be the motor's work up to there,
+       tens of J (it swings between -55 and 22 J). */
+    if (rc == FMB_EXIT_INTERRUPTED && fmb_noutput(slow) == 4) {
+      ENSURE(fmb_advance(slow, e, si.t_end, &diag) == 0);
+      fmbData* whole = fmb_data_new(slow, &diag);
+      double x[4], z[4], z0[4];
+      ENSURE(fmb_init(slow, whole, &diag) == 0 && fmb_outputs(slow, whole, z0) == 0);
+      ENSURE(fmb_advance(slow, whole, si.t_end, &diag) == 0);
+      ENSURE(fmb_outputs(slow, e, x) == 0 && fmb_outputs(slow, whole, z) == 0);
+      const double drift = fabs(z[3] - z0[3]), angles = fmax(fabs(x[0] - z[0]), fabs(x[1] - z[1]));
+      printf("continued to t = %g: angles within %.3g rad, motor.work within %.3g J, energy.balance within %.3g J of "
+             "the uninterrupted run (whose balance drifts by %.3g J)\n",
+             si.t_end, angles, fabs(x[2] - z[2]), fabs(x[3] - z[3]), drift);
+      ENSURE(angles < 1e2 * si.rtol * fmax(1.0, fabs(z[0])));
+      ENSURE(fabs(x[2] - z[2]) < 3.0 * drift && fabs(x[3] - z[3]) < 3.0 * drift);
+      fmb_data_free(whole);
+    }
     fmb_data_free(e);
     fmb_free(slow);
   }

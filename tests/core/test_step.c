@@ -5,8 +5,9 @@
  *    leaving IDA at a flat parallelogram, ggl failing there with exit 3, radau5), a program that calls fmb_init, then fmb_advance to
  *    each output time and fmb_outputs, and writes its rows through the public fmb_write_table,
  *    produces the very bytes of fmb_run's CSV, the same exit code and the same counters.
- * 2. Two data objects of two models advanced at once in two threads give the values one thread
- *    gives (nothing shared between runs: the quadrature table, the warn handler, the quarantine).
+ * 2. Two models loaded and advanced at once in two threads, and two data objects of one model in
+ *    two more, give the values one thread gives (nothing shared between runs: the quadrature
+ *    table, the warn handler, the quarantine; the model only read).
  * 3. One data object run twice (fmb_init again = restart) gives the same values both times.
  * 4. Messages go where they are sent: a load-time warning to the thread's default handler, a run's
  *    notes to its own handler (fmb_data_set_warn) and not the default, nothing anywhere after
@@ -133,14 +134,20 @@ static void compare(const char* scene, const char* const* sets, int nsets, const
 }
 
 typedef struct {
-  const fmbModel* m;
+  const fmbModel* m; /* a model to run, or NULL: load `path` in the thread */
+  const char* path;
   Table tab;
 } Job;
 
 static void* job_main(void* arg) {
   Job* j = arg;
   fmb_set_warn(NULL, NULL); /* this thread's runs say nothing */
-  step_run(j->m, &j->tab);
+  fmbDiag diag;
+  fmbModel* own = j->m ? NULL : fmb_load(j->path, NULL, 0, fmb_builtin_registry(), &diag);
+  memset(&j->tab, 0, sizeof j->tab);
+  j->tab.rc = -1;
+  if (j->m || own) step_run(j->m ? j->m : own, &j->tab);
+  fmb_free(own);
   return NULL;
 }
 
@@ -234,28 +241,32 @@ int main(void) {
   const char* radau_set[] = {"solver.integrator=radau5"};
   compare(scene, radau_set, 1, "spinup_w4-radau5", 0);
 
-  /* two models in two threads at once, against the same runs one after the other */
+  /* two models loaded and run in two threads at once, and two data objects of one model in two
+     more, against the same runs one after the other */
   fmbDiag diag;
   char s1[1024], s2[1024];
-  fmbModel* m1 = fmb_load(fmbt_path("scenes/slider_crank.yaml", s1, sizeof s1), NULL, 0, fmb_builtin_registry(), &diag);
-  fmbModel* m2 = fmb_load(fmbt_path("scenes/exact/spinup_w15_exact.yaml", s2, sizeof s2), NULL, 0, fmb_builtin_registry(),
-                          &diag);
-  ENSURE(m1 && m2);
-  if (m1 && m2) {
-    Job alone[2] = {{m1, {0}}, {m2, {0}}}, together[2] = {{m1, {0}}, {m2, {0}}};
+  fmbt_path("scenes/slider_crank.yaml", s1, sizeof s1);
+  fmbt_path("scenes/exact/spinup_w15_exact.yaml", s2, sizeof s2);
+  fmbModel* m1 = fmb_load(s1, NULL, 0, fmb_builtin_registry(), &diag);
+  ENSURE(m1 != NULL);
+  if (m1) {
+    Job alone[2] = {{NULL, s1, {0}}, {NULL, s2, {0}}};
+    Job together[4] = {{NULL, s1, {0}}, {NULL, s2, {0}}, {m1, NULL, {0}}, {m1, NULL, {0}}};
     job_main(&alone[0]);
     job_main(&alone[1]);
-    pthread_t th[2];
-    for (int k = 0; k < 2; ++k) pthread_create(&th[k], NULL, job_main, &together[k]);
-    for (int k = 0; k < 2; ++k) pthread_join(th[k], NULL);
-    for (int k = 0; k < 2; ++k) {
-      ENSURE(alone[k].tab.rc == 0 && alone[k].tab.nrow > 10 && together[k].tab.time_wrong == 0);
-      ENSURE(same_table(&alone[k].tab, &together[k].tab));
-      printf("thread %d: %d rows x %d columns, %s alone\n", k, together[k].tab.nrow, together[k].tab.ncol,
-             same_table(&alone[k].tab, &together[k].tab) ? "identical to" : "DIFFERENT from");
-      free(alone[k].tab.values);
+    pthread_t th[4];
+    for (int k = 0; k < 4; ++k) pthread_create(&th[k], NULL, job_main, &together[k]);
+    for (int k = 0; k < 4; ++k) pthread_join(th[k], NULL);
+    for (int k = 0; k < 4; ++k) {
+      const Job* ref = &alone[k == 1];
+      ENSURE(ref->tab.rc == 0 && ref->tab.nrow > 10 && together[k].tab.time_wrong == 0);
+      ENSURE(same_table(&ref->tab, &together[k].tab));
+      printf("thread %d (%s): %d rows x %d columns, %s alone\n", k, k < 2 ? "own model" : "shared model",
+             together[k].tab.nrow, together[k].tab.ncol, same_table(&ref->tab, &together[k].tab) ? "identical to" : "DIFFERENT from");
       free(together[k].tab.values);
     }
+    free(alone[0].tab.values);
+    free(alone[1].tab.values);
     /* fmb_init again restarts: the same run twice on one data object */
     fmbData* d = fmb_data_new(m1, &diag);
     double first[64], second[64];
@@ -273,7 +284,6 @@ int main(void) {
     fmb_data_free(d);
   }
   fmb_free(m1);
-  fmb_free(m2);
   messages();
   return fmbt_finish("test_step");
 }

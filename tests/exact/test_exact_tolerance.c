@@ -1,6 +1,6 @@
 /*
  * test_exact_tolerance.c — absolute tolerances in metres for the exact beam (fmbBodyType.
- * length_scale, engine/integrate.c): geometric similarity.
+ * length_scale, engine/tolerance.c): geometric similarity.
  *
  * The paper's omega0 = 15 spin-up beam scaled by s (length x s, area x s^2, second moment x s^4,
  * density and modulus kept, so times scale by s: ramp time and run x s, omega0 / s) is the same
