@@ -24,7 +24,7 @@ QUICK=0; FULL=0
 for a in "$@"; do case $a in --quick) QUICK=1 ;; --full) FULL=1 ;; esac; done
 mkdir -p "$RES"
 EXE=$B/bench_scaling
-cc -std=c11 -O3 -DNDEBUG -D_DEFAULT_SOURCE -Wall -Wextra -Wpedantic -Wshadow -Iengine -Itools bench/scaling.c -o "$EXE" \
+cc -std=c11 -O3 -DNDEBUG -D_DEFAULT_SOURCE -Wall -Wextra -Wpedantic -Wshadow -Iengine -Ibuiltin bench/scaling.c -o "$EXE" \
   "$B/libflexmbd.a" -lsundials_idas -lsundials_nvecserial -lsundials_sunlinsolklu \
   -lsundials_sunmatrixsparse -lsundials_sunlinsoldense -lsundials_sunmatrixdense -lklu -lyaml -lm
 F=${FLEXMBD:-$B/flexmbd}

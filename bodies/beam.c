@@ -155,6 +155,7 @@ static void int_weights(double le, double xi, double pw[5]) {
  * ------------------------------------------------------------------------------------------- */
 static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
 static const char* const assembly_names[] = {"auto", "dense", "banded", NULL};
+static const char* const integration_names[] = {"reduced", "full", NULL}; /* model: exact's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on: below it the dense blocks are small
    and the fewer unknowns win (docs/performance.md, "Scaling") */
@@ -212,6 +213,11 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_double(p, item, "damping", FMB_OPTIONAL | FMB_NONNEGATIVE, &b->beta);
   int assembly = ASSEMBLY_AUTO;
   err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, assembly_names, &assembly);
+  /* `integration` chooses the exact model's quadrature (bodies/beam_exact.c); these three models
+     have theirs in quadrature_points, so they check the word and ignore it: a scene written for
+     `model: exact` then runs under every model (`run --models`, docs/models.md) */
+  int integration = 0;
+  err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, integration_names, &integration);
   if (!err) {
     b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
     b->ng = default_points(b->model);
@@ -1291,7 +1297,7 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
  * ------------------------------------------------------------------------------------------- */
 enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
        OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
-       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_NTIP = FMB_BEAM_NTIP };
+       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE, OUT_NTIP = FMB_BEAM_NTIP };
 enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 
 static int beam_output_lookup(const void* self, const char* quantity) {
@@ -1319,7 +1325,6 @@ static void deformation_at(const Beam* b, const double* p, const double* pd, dou
 }
 
 static int beam_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
-  (void)work;
   const Beam* b = self;
   double x = b->L;
   int comp = id;
@@ -1333,6 +1338,12 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   } else if (id == OUT_ANG_MOMENTUM) {
     fmbEnergy en;
     beam_integrals(b, NULL, q, v, &en, value);
+    return 0;
+  } else if (id == OUT_TIP_ANGLE) {
+    const double tip[2] = {b->L, 0.0};
+    double pos[2], angle;
+    if (beam_marker(b, q, tip, pos, &angle, NULL, NULL, work)) return -1;
+    *value = angle - q[2];
     return 0;
   }
   double u[2], ud[2];
@@ -1349,6 +1360,49 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   return 0;
 }
 
+/* The range where each model is accurate, from its measured error against the exact beam
+   (docs/models.md, "Each model's range"). Error = the largest |tip_v - exact| over a run relative
+   to the exact peak deflection; d = the model's own peak |tip_v| / L (what the run sees):
+     complete: 0.01 % at d = 1.0 % (paper spin-up w0 = 1), 0.14 % at 3.9 % (w0 = 4), 1.9 % at 10.9 %
+               (w0 = 15), 4.3 % at 17.0 % (the rotor starter, w0 = 6 over 5 s), 46 % at 43 % (the
+               same at w0 = 15): error ~ d^2.5;
+     FOAC:     0.05 % at 3.9 %, 0.31 % at 10.9 %, 4.3 % at 36.6 % (starter at w0 = 15), 6.3 % at
+               45.7 % (w0 = 20).
+   The limit is the deflection where the error reaches 5 % of the deflection, interpolated between
+   the two measured points around it: 18 % of L for complete (and ZOAC, whose kinematics are the
+   same), 40 % for FOAC. The paper's cases (at most 10.9 %) and the starter (17.0 %) lie inside.
+   ZOAC has no centrifugal stiffening: 4 % off at w0 = 1, a quarter of its first clamped bending
+   frequency w1; with the stiffening it lacks growing like w^2 the error reaches ~5 % near 0.3 w1,
+   and the beam diverges at w1. */
+static double beam_first_frequency(const Beam* b) {
+  return 1.8751040687119611 * 1.8751040687119611 * sqrt(b->Emod * b->Izz / (b->rho * b->A)) / (b->L * b->L);
+}
+static double beam_deflection_limit(const Beam* b) { return b->model == BEAM_FOAC ? 0.40 : 0.18; }
+enum { ZOAC_SPIN_LIMIT_PERCENT = 30 };
+
+static const char* beam_model_range(const void* self, const double* q, const double* v, char* msg, size_t len) {
+  const Beam* b = self;
+  double tip = 0.0;
+  beam_output(b, OUT_TIP_V, q, v, &tip, NULL);
+  const double limit = beam_deflection_limit(b), w1 = beam_first_frequency(b);
+  if (fabs(tip) > limit * b->L) {
+    snprintf(msg, len,
+             "its tip deflects %.3g m, %.1f %% of its length, beyond the %.0f %% up to which the %s model stays within "
+             "about 5 %% of the geometrically exact beam (docs/models.md); use `model: exact`",
+             fabs(tip), 100.0 * fabs(tip) / b->L, 100.0 * limit, model_names[b->model]);
+    return msg;
+  }
+  if (b->model == BEAM_ZOAC && fabs(v[2]) > 0.01 * ZOAC_SPIN_LIMIT_PERCENT * w1) {
+    snprintf(msg, len,
+             "it turns at %.3g rad/s, %.0f %% of its first bending frequency %.3g rad/s: ZOAC has no centrifugal "
+             "stiffening, is off by more than about 5 %% beyond %d %% and diverges at 100 %% (docs/models.md); use "
+             "`model: complete` or `model: exact`",
+             fabs(v[2]), 100.0 * fabs(v[2]) / w1, w1, ZOAC_SPIN_LIMIT_PERCENT);
+    return msg;
+  }
+  return NULL;
+}
+
 static void beam_describe(const void* self, FILE* f) {
   const Beam* b = self;
   static const char* const terms[] = {"w_c dropped (no coupling deformation)",
@@ -1357,6 +1411,13 @@ static void beam_describe(const void* self, FILE* f) {
   fprintf(f, "%s model, %d elements, %d Gauss points/element, %s%s, %s assembly", model_names[b->model], b->ne, b->ng,
           terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "",
           b->banded ? "banded (coupling sums as auxiliary unknowns)" : "dense");
+  /* its range (beam_model_range): the run warns when it is left */
+  fprintf(f, "; accurate while the tip deflects less than %.0f %% of the length (%.3g m)", 100.0 * beam_deflection_limit(b),
+          beam_deflection_limit(b) * b->L);
+  if (b->model == BEAM_ZOAC)
+    fprintf(f, " and it turns slower than %d %% of its first bending frequency (%.3g rad/s)", ZOAC_SPIN_LIMIT_PERCENT,
+            0.01 * ZOAC_SPIN_LIMIT_PERCENT * beam_first_frequency(b));
+  if (b->model == BEAM_FOAC) fprintf(f, ", under prescribed rotation only");
   fputc('\n', f);
 }
 
@@ -1402,7 +1463,6 @@ static int beam_velocity_error_test(const void* self) {
 
 /* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
 static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
-static const char* const exact_integrations[] = {"reduced", "full", NULL};
 
 static const fmbParam beam_params[] = {
     FMB_BEAM_SECTION_PARAMS(MAX_ELEMENTS),
@@ -1414,22 +1474,17 @@ static const fmbParam beam_params[] = {
      .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
     {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 4,
      .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
-    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
-     .doc = "model: exact only: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full)"},
+    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = integration_names,
+     .doc = "model: exact: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full); "
+            "the other models ignore it"},
     {.key = "assembly", .kind = FMB_PARAM_CHOICE, .fallback = "auto", .choices = assembly_names,
      .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
     {.key = NULL},
 };
 
-/* stations equally spaced from the clamped root to the tip; by default one per node */
 static int beam_centreline(const void* self, int n, double* local) {
   const Beam* b = self;
-  if (!local) return b->ne + 1;
-  for (int i = 0; i < n; ++i) {
-    local[2 * i] = n > 1 ? b->L * (double)i / (double)(n - 1) : 0.0;
-    local[2 * i + 1] = 0.0;
-  }
-  return n;
+  return fmb_beam_centreline(b->L, b->ne, n, local);
 }
 
 /* `model: exact` (the geometrically exact beam) is its own implementation behind the same type
@@ -1477,7 +1532,8 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
     .naux = beam_naux, \
     .residual_aux = beam_residual_aux, \
     .aux_initial = beam_aux_initial, \
-    .pattern = beam_pattern
+    .pattern = beam_pattern, \
+    .model_range = beam_model_range
 
 const fmbBodyType fmb_body_beam = {BEAM_OPS, .jacobian = beam_jacobian, .pattern_jacobian = beam_pattern_jacobian};
 static const fmbBodyType beam_fd = {BEAM_OPS};

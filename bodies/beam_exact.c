@@ -601,18 +601,24 @@ static void exact_energy(const void* self, const fmbEnv* env, const double* q, c
    transverse displacement in the frame (the complete model's u(L) and w2(L)) */
 enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
        OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
-       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_NTIP = FMB_BEAM_NTIP };
+       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE, OUT_NTIP = FMB_BEAM_NTIP };
 enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 static int exact_output_lookup(const void* self, const char* quantity) {
   return fmb_beam_output_lookup(((const BeamExact*)self)->ne, quantity);
 }
 
 static int exact_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
-  (void)work;
   const BeamExact* b = self;
   if (id == OUT_ANG_MOMENTUM) {
     fmbEnergy en;
     exact_integrals(b, NULL, q, v, &en, value);
+    return 0;
+  }
+  if (id == OUT_TIP_ANGLE) {
+    const double tip[2] = {b->L, 0.0};
+    double pos[2], angle;
+    if (exact_marker(b, q, tip, pos, &angle, NULL, NULL, work)) return -1;
+    *value = angle - q[2];
     return 0;
   }
   int node = b->ne, comp = id;
@@ -642,7 +648,8 @@ static int exact_output(const void* self, int id, const double* q, const double*
 
 static void exact_describe(const void* self, FILE* f) {
   const BeamExact* b = self;
-  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly\n",
+  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly; "
+          "no range limit (its accuracy is the mesh's and the tolerance's, docs/models.md)\n",
           b->ne, b->integration == INTEGRATION_FULL ? "full" : "reduced",
           b->integration == INTEGRATION_FULL ? "axial at 5, bending at 3 Gauss points"
                                              : "axial at 3 Lobatto, bending at 2 Gauss points",
@@ -693,6 +700,12 @@ static const char* exact_invalid_state(const void* self, const double* q, const 
   return NULL;
 }
 
+/* the deformed centreline for `BODY.shape` and the VTK polyline, as the other models draw it */
+static int exact_centreline(const void* self, int n, double* local) {
+  const BeamExact* b = self;
+  return fmb_beam_centreline(b->L, b->ne, n, local);
+}
+
 /* what `flexmbd conform` needs to check this table on its own (tests/exact/test_exact_conform.c:
    beam.c's table, which the registry holds, declares the keys of type beam for users) */
 static const fmbParam exact_params[] = {
@@ -732,6 +745,7 @@ const fmbBodyType fmb_body_beam_exact = {
     .pattern = exact_pattern,
     .pattern_jacobian = exact_pattern_jacobian,
     .length_scale = exact_length_scale,
+    .centreline = exact_centreline,
     .params = exact_params,
     .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
                "model: exact\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",

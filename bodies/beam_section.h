@@ -51,13 +51,29 @@ static inline void fmb_beam_locate(double le, int ne, double x, int* e, double* 
   *e = k;
   *xi = x / le - k;
 }
+/* fmbBodyType.centreline of every beam model: n stations equally spaced on the reference line
+   from the clamped root (x = 0) to the tip (x = L); by default one per node. Both files answer
+   `marker` at (x, 0) with the deformed centreline point of arc length x, so `BODY.shape` and the
+   VTK polyline draw each model's own deformed shape. */
+static inline int fmb_beam_centreline(double L, int ne, int n, double* local) {
+  if (!local) return ne + 1;
+  for (int i = 0; i < n; ++i) {
+    local[2 * i] = n > 1 ? L * (double)i / (double)(n - 1) : 0.0;
+    local[2 * i + 1] = 0.0;
+  }
+  return n;
+}
+
 /* The outputs every beam model gives (the same ids, so `--models` compares like with like): the
-   tip's deformation, its rates and position, the angular momentum, and nodeK_u/v/x/y at node K. */
+   tip's deformation, its rates and position, the angular momentum, the tip cross-section's angle
+   to the frame (the marker's angle at (L, 0) less theta: the slope w2'(L) of the small-strain
+   models, atan2 of the tangent for the exact one), and nodeK_u/v/x/y at node K. */
 enum { FMB_BEAM_TIP_U, FMB_BEAM_TIP_V, FMB_BEAM_TIP_U_RATE, FMB_BEAM_TIP_V_RATE, FMB_BEAM_TIP_X, FMB_BEAM_TIP_Y,
-       FMB_BEAM_ANG_MOMENTUM, FMB_BEAM_NTIP };
+       FMB_BEAM_ANG_MOMENTUM, FMB_BEAM_TIP_ANGLE, FMB_BEAM_NTIP };
 enum { FMB_BEAM_NODE_BASE = 1000, FMB_BEAM_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
-static const char* const fmb_beam_output_names[] = {"tip_u", "tip_v", "tip_u_rate", "tip_v_rate", "tip_x", "tip_y",
-                                                    "ang_momentum", "nodeK_u", "nodeK_v", "nodeK_x", "nodeK_y", NULL};
+static const char* const fmb_beam_output_names[] = {"tip_u",        "tip_v",     "tip_u_rate", "tip_v_rate",
+                                                    "tip_x",        "tip_y",     "ang_momentum", "tip_angle",
+                                                    "nodeK_u",      "nodeK_v",   "nodeK_x",    "nodeK_y", NULL};
 
 /* the output id of `quantity` for a beam of ne elements, or -1 */
 static inline int fmb_beam_output_lookup(int ne, const char* quantity) {

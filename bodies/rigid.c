@@ -120,4 +120,5 @@ const fmbBodyType fmb_body_rigid = {
     .describe = rigid_describe,
     .params = rigid_params,
     .example = "mass: 2\ninertia: 0.3\nposition: [0.1, 0.2]\nangle: 0.3\nvelocity: [0.5, 1.0]\nangular_velocity: 2.0\n",
+    .flags = FMB_TYPE_CONFORM_FIXTURE, /* conform's two bodies a and b */
 };

@@ -21,6 +21,7 @@
 #include <klu.h>
 
 #include "internal.h"
+#include "klu_policy.h"
 
 struct fmbAugmented {
   int nq, nc, n;
@@ -34,9 +35,7 @@ struct fmbAugmented {
   int *eoff, *entry;
   long *pos_phi, *pos_phit, *pos_diag;
   double *phi, *phit, *phitt, *phiq_v, *rhs, *Mb;
-  klu_l_common common;
-  klu_l_symbolic* sym;
-  klu_l_numeric* num;
+  fmbKlu* klu; /* klu.c: the one KLU policy */
   double mdiag, pmax; /* scales of the last assembly (for the Tikhonov shift) */
   int failed_body;
 };
@@ -158,12 +157,10 @@ fmbAugmented* fmb_augmented_new(const fmbModel* m) {
     }
     g->pos_diag[rr] = find_entry(g, nq + rr, nq + rr);
   }
-  klu_l_defaults(&g->common);
   /* plain partial pivoting (KLU's default 1e-3 prefers a diagonal pivot 1000x smaller than the
      column's largest: a small inertia beside unit constraint rows is then a poor pivot) */
-  g->common.tol = 1.0;
-  g->sym = klu_l_analyze(n, g->Ap, g->Ai, &g->common);
-  if (!g->sym) goto fail;
+  g->klu = fmb_klu_new(n, g->Ap, g->Ai, FMB_KLU_PARTIAL_PIVOTING);
+  if (!g->klu) goto fail;
   free(cols);
   return g;
 fail:
@@ -174,8 +171,7 @@ fail:
 
 void fmb_augmented_free(fmbAugmented* g) {
   if (!g) return;
-  if (g->num) klu_l_free_numeric(&g->num, &g->common);
-  if (g->sym) klu_l_free_symbolic(&g->sym, &g->common);
+  fmb_klu_free(g->klu);
   free(g->Ap);
   free(g->Ai);
   free(g->Ax);
@@ -241,21 +237,14 @@ static int assemble(const fmbModel* m, fmbWorkspace* w, fmbAugmented* g, double 
   const double eps = tikhonov * pmax * pmax / fmax(mdiag, 1e-300);
   for (int rr = 0; rr < g->nc; ++rr) g->Ax[g->pos_diag[rr]] = (drop && drop[rr]) ? 1.0 : -eps;
   /* the pivot order of the last factorization, refreshed (KLU allocates then) only when the
-     condition estimates say it has degraded, as schur.c does: near a singular configuration the
+     condition estimates say it has degraded (klu.c's policy): near a singular configuration the
      order of the last one can become a bad one */
-  if (!g->num || !klu_l_refactor(g->Ap, g->Ai, g->Ax, g->sym, g->num, &g->common) ||
-      !klu_l_rcond(g->sym, g->num, &g->common) ||
-      (g->common.rcond < FMB_KLU_RCOND_TINY &&
-       (!klu_l_condest(g->Ap, g->Ax, g->sym, g->num, &g->common) || g->common.condest > 1.0 / FMB_KLU_RCOND_TINY))) {
-    if (g->num) klu_l_free_numeric(&g->num, &g->common);
-    g->num = klu_l_factor(g->Ap, g->Ai, g->Ax, g->sym, &g->common);
-  }
-  if (!g->num || g->common.status != KLU_OK) return FMB_AUG_SINGULAR;
+  if (fmb_klu_factor(g->klu, g->Ax) != FMB_KLU_OK) return FMB_AUG_SINGULAR;
   return 0;
 }
 
 static int solve_rhs(fmbAugmented* g) {
-  if (!klu_l_solve(g->sym, g->num, g->n, 1, g->rhs, &g->common)) return FMB_AUG_SINGULAR;
+  if (fmb_klu_solve(g->klu, g->rhs)) return FMB_AUG_SINGULAR;
   for (int i = 0; i < g->n; ++i)
     if (!isfinite(g->rhs[i])) return FMB_AUG_NOT_FINITE;
   return 0;

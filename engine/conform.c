@@ -95,10 +95,25 @@ typedef struct {
   int joint;          /* probing a joint type */
   double gravity;     /* -9.81 or 0 */
   const char* outputs; /* the outputs list, or NULL */
+  /* the fixture's body and joint types (FMB_TYPE_CONFORM_FIXTURE): the engine names no type */
+  const char *fixture_body, *fixture_joint;
 } SceneSpec;
 
+/* the first registered body or joint type that declares itself fit for the fixture, or NULL */
+static const char* fixture_type(const fmbRegistry* reg, int joint) {
+  if (joint) {
+    for (int i = 0; i < reg->njoints; ++i)
+      if (reg->joints[i]->flags & FMB_TYPE_CONFORM_FIXTURE) return reg->joints[i]->name;
+  } else {
+    for (int i = 0; i < reg->nbodies; ++i)
+      if (reg->bodies[i]->flags & FMB_TYPE_CONFORM_FIXTURE) return reg->bodies[i]->name;
+  }
+  return NULL;
+}
+
 /* Writes the scene; returns the file line (1-based) of the probe's first item line. The fixture
-   (fmbJointType's comment): rigid a pinned to ground at its left end, rigid b to its right. */
+   (fmbJointType's comment): body a pinned to ground at its left end, body b to its right, of the
+   types flagged FMB_TYPE_CONFORM_FIXTURE (a rigid body and a pin). */
 static int scene_write(const char* path, const char* type, const Lines* l, const SceneSpec* s) {
   FILE* f = fopen(path, "w");
   if (!f) return -1;
@@ -107,14 +122,16 @@ static int scene_write(const char* path, const char* type, const Lines* l, const
   EMIT("solver: {t_end: %g, rtol: 1e-10, atol: 1e-12, output_step: %g}\n", CONFORM_T_END, CONFORM_T_END / 100);
   EMIT("gravity: [0, %g]\n", s->gravity);
   EMIT("bodies:\n");
-  EMIT("  - {name: a, type: rigid, mass: 1, inertia: 0.1, position: [0.5, 0], velocity: [0, 0.5], angular_velocity: 1}\n");
-  EMIT("  - {name: b, type: rigid, mass: 1.5, inertia: 0.2, position: [1.5, 0], velocity: [0.3, -0.2], angular_velocity: -1}\n");
+  EMIT("  - {name: a, type: %s, mass: 1, inertia: 0.1, position: [0.5, 0], velocity: [0, 0.5], angular_velocity: 1}\n",
+       s->fixture_body);
+  EMIT("  - {name: b, type: %s, mass: 1.5, inertia: 0.2, position: [1.5, 0], velocity: [0.3, -0.2], angular_velocity: -1}\n",
+       s->fixture_body);
   if (!s->joint) EMIT("  - name: probe\n    type: %s\n", type), line++;
   const int first_body_line = line;
   if (!s->joint)
     for (int i = 0; i < l->n; ++i) EMIT("    %s\n", l->line[i]);
   EMIT("joints:\n");
-  EMIT("  - {name: pin, type: revolute, body1: ground, body2: a, point2: [-0.5, 0]}\n");
+  EMIT("  - {name: pin, type: %s, body1: ground, body2: a, point2: [-0.5, 0]}\n", s->fixture_joint);
   if (s->joint) EMIT("  - name: probe\n    type: %s\n", type), line++;
   const int first_joint_line = line;
   if (s->joint)
@@ -578,7 +595,7 @@ static int energy_run(Report* r, const char* scene, const char* csv, const fmbRe
 static void check_energy(Report* r, const char* base, const char* type, const Lines* ex, const char* damped,
                          unsigned flags, int has_energy, const char* outputs, int joint, const fmbRegistry* reg) {
   char scene[1100], csv[1100];
-  SceneSpec s = {joint, -9.81, outputs};
+  SceneSpec s = {joint, -9.81, outputs, fixture_type(reg, 0), fixture_type(reg, 1)};
   double drift, rise, lost;
   snprintf(scene, sizeof scene, "%s-free.yaml", base);
   snprintf(csv, sizeof csv, "%s-free.csv", base);
@@ -663,7 +680,12 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
     e += len;
   }
   snprintf(scene, sizeof scene, "%s.yaml", base);
-  SceneSpec s = {joint, -9.81, NULL};
+  SceneSpec s = {joint, -9.81, NULL, fixture_type(reg, 0), fixture_type(reg, 1)};
+  if (!s.fixture_body || !s.fixture_joint) {
+    result(&r, 0, "example", "no %s type in the registry declares FMB_TYPE_CONFORM_FIXTURE: the conformance scene has "
+           "no fixture (register the built-in types too)", !s.fixture_body ? "body" : "joint");
+    return r.failed;
+  }
   /* the declared parameters are the registered table's: a variant's own keys are checked by
      the plain type's run */
   if (!extra) check_params(&r, scene, type_name, joint ? jt->params : bt->params, &ex, &s, reg);

@@ -24,8 +24,8 @@ struct fmbData {
   const fmbIntegratorOps* ops;
   void* integ;
   int restart;
-  fmbStats before;     /* counters of the backends retired so far */
-  double* work_before; /* njoint: work done before the current backend started */
+  fmbStats before;       /* counters of the backends retired so far */
+  double* work_before;   /* njoint: work done before the current backend started */
   double* redundant_phi; /* nc: the redundant rows' residuals, checked after every advance */
   /* formulation: auto: the state at the start of the advance in progress, which a switch to the
      projected formulation starts from, and where and why IDA gave up */
@@ -41,6 +41,7 @@ struct fmbData {
   const volatile sig_atomic_t* stop; /* what the backends watch: &cancel, or fmb_run's flag */
   int quiet;                         /* fmb_run --quiet: no notes (warnings still go out) */
   fmbStats ic;                       /* the initial projection's corrections */
+  unsigned char* range_warned;       /* nbody: the body's model_range warning was given (once per run) */
   int interrupted;
   int failed;   /* the last init or advance failed (fmb_data_stats' status) */
   double cpu_s; /* CPU time of this thread in init and advance */

@@ -9,6 +9,14 @@
 
 #include "internal.h"
 
+/* a body's rows [R; Rz] at (q, v, a, z): residual_aux when it has auxiliary unknowns (the only
+   evaluation the differences below need; ic.c calls it too) */
+int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                  const double* z, double* R, double* work) {
+  if (b->nz > 0) return b->type->residual_aux(b->self, env, q, v, a, z, R, R + b->nq, work);
+  return b->type->residual(b->self, env, q, v, a, R, work);
+}
+
 /* IDA's difference increment: sqrt(eps) |y|, but never below the error tolerance 1/ewt */
 double fmb_fd_increment(double y, double ewt) {
   const double srur = 1.4901161193847656e-08; /* sqrt(DBL_EPSILON) */
@@ -87,14 +95,17 @@ int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* 
  * Four residuals per colour, and the number of colours does not grow with a banded body's size:
  * an O(n) residual gives an O(n) Jacobian.
  * ------------------------------------------------------------------------------------------- */
-size_t fmb_fd_sparse_scratch(const fmbBodyInst* b) {
+static size_t fd_sparse_scratch(const fmbBodyInst* b) {
   const size_t nq = (size_t)b->nq, n = nq + (size_t)b->nz;
   return 3 * nq + (size_t)b->nz + 4 * n; /* q, v, a, z copies (3 nq + nz); R0, R1, Rm, steps (n each) */
 }
 
-int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                       const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                       double* work, double* scratch) {
+/* the same over a body's sparse pattern (b->pcolptr/prowind), one residual pair per colour:
+   K = d[R; Rz]/dq (and d/dz in the z columns), C = d/dv, M = d/da, each in pattern order
+   (pnnz). z: the body's auxiliary unknowns (NULL when nz = 0). scratch: fd_sparse_scratch. */
+static int fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                          const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
+                          double* work, double* scratch) {
   const int nq = b->nq, nz = b->nz, n = nq + nz;
   double* qq = scratch;
   double* vv = qq + nq;
@@ -184,5 +195,33 @@ int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q,
       }
     }
   }
+  return 0;
+}
+
+/* K, C, M of a sparse body (internal.h). The analytic op's pair-order values sit in scratch and are
+   summed into their CSC entries: duplicate pairs (element blocks sharing a node) add up. */
+size_t fmb_body_sparse_scratch(const fmbBodyInst* b) {
+  const size_t fd = fd_sparse_scratch(b), exact = 3 * (size_t)b->npair;
+  return b->type && b->type->pattern_jacobian && exact > fd ? exact : fd;
+}
+
+int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                           const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
+                           double* work, double* scratch) {
+  if (!b->type->pattern_jacobian)
+    return fd_body_sparse(b, env, q, v, a, z, ewt_q, ewt_v, K, C, M, work, scratch);
+  double *Kp = scratch, *Cp = Kp + b->npair, *Mp = Cp + b->npair;
+  const int rc = b->type->pattern_jacobian(b->self, env, q, v, a, z, Kp, Cp, Mp, work);
+  if (rc) return rc;
+  memset(K, 0, sizeof(double) * (size_t)b->pnnz);
+  memset(C, 0, sizeof(double) * (size_t)b->pnnz);
+  memset(M, 0, sizeof(double) * (size_t)b->pnnz);
+  for (long k = 0; k < b->npair; ++k) {
+    K[b->ppos[k]] += Kp[k];
+    C[b->ppos[k]] += Cp[k];
+    M[b->ppos[k]] += Mp[k];
+  }
+  for (long k = 0; k < b->pnnz; ++k)
+    if (!isfinite(K[k]) || !isfinite(C[k]) || !isfinite(M[k])) return 1; /* a wild trial step: IDA cuts it */
   return 0;
 }

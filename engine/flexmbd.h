@@ -25,9 +25,9 @@ extern "C" {
    of every function below. A plugin built for another number is refused when it is loaded
    (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
    the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
-   pattern_jacobian and length_scale ops (added to 2 before any release of it). 3: the stepping API
-   (fmbData, fmb_init, fmb_advance, ...), the warn callback, and inputs: joints gained the optional
-   `input` op and read an input's value with fmb_eval_input. */
+   pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). 3: the
+   stepping API (fmbData, fmb_init, fmb_advance, ...), the warn callback, and inputs: joints gained
+   the optional `input` op and read an input's value with fmb_eval_input. */
 #define FMB_ABI_VERSION 3
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
@@ -154,8 +154,13 @@ typedef struct fmbParam {
 
 /* type flags (fmbBodyType.flags, fmbJointType.flags) */
 enum {
-  FMB_TYPE_DOES_WORK = 1 << 0 /* feeds energy in (a prescribed motion, an applied load): conform
-                                 skips the energy-conservation run */
+  FMB_TYPE_DOES_WORK = 1 << 0, /* feeds energy in (a prescribed motion, an applied load): conform
+                                  skips the energy-conservation run */
+  /* conform's fixture (fmb_conform) is made of the first registered body type and joint type
+     with this flag, so that the engine names no type: the body must take mass, inertia,
+     position, velocity and angular_velocity (a rigid body with a frame), the joint body1, body2
+     and point2 (a pin joining two bodies' points) */
+  FMB_TYPE_CONFORM_FIXTURE = 1 << 1
 };
 
 /* ---------------------------------------------------------------------------------------------
@@ -188,7 +193,7 @@ typedef struct fmbBodyType {
   void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
                  double* work);
   /* named outputs beyond the frame's x, y, theta, omega, vx, vy (which the engine provides for
-     every body with ncoord >= 3): lookup returns an id >= 0 or -1 (NULL: the id is the name's
+     every body with a frame: ncoord >= 3, or a marker that places the origin [0, 0]): lookup returns an id >= 0 or -1 (NULL: the id is the name's
      index in output_names); output evaluates one id. */
   const char* const* output_names; /* NULL-terminated, for listings */
   int (*output_lookup)(const void* self, const char* quantity);
@@ -268,6 +273,12 @@ typedef struct fmbBodyType {
      coordinate and its velocity (engine/tolerance.c), so one atol in metres controls slopes and
      displacements alike at any size of the body. NULL = atol as given for every coordinate. */
   void (*length_scale)(const void* self, double* metres_per_unit);
+  /* The range where the body's model is accurate (ABI 2, added before any release of it): NULL
+     while the state (q, v) is inside it; otherwise the body writes into msg[len] what left the
+     range, by how much, and what to use instead, and returns msg. The run warns once per body,
+     at the first output time it happens, with the time (beam: the tip deflection beyond the
+     model's measured limit, "use model: exact"). NULL op = no range stated. */
+  const char* (*model_range)(const void* self, const double* q, const double* v, char* msg, size_t len);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -324,7 +335,8 @@ FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], dou
                double* dpos_dq, int ld, double* dangle_dq);
 /* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
 FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
-/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1) */
+/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
+   context or another k (0 would be body 0's column: a wrong place, silently) */
 FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 /* the current value of this joint's input (its `input` op said 1): the scene's `value:` until a
    program sets it with fmb_set_input; NaN for a joint without an input */
@@ -382,7 +394,7 @@ FMB_API const fmbJointType* fmb_registry_joint(const fmbRegistry* reg, int i);
 /* where type i came from: "built-in" or the plugin's file */
 FMB_API const char* fmb_registry_body_origin(const fmbRegistry* reg, int i);
 FMB_API const char* fmb_registry_joint_origin(const fmbRegistry* reg, int i);
-/* the types shipped with flexmbd (tools/builtin.c), registered like any plugin */
+/* the types shipped with flexmbd (builtin/builtin.c), registered like any plugin */
 FMB_API const fmbPlugin* fmb_builtin_plugin(void);
 
 /* ---------------------------------------------------------------------------------------------
@@ -458,6 +470,12 @@ FMB_API void fmb_describe(const fmbModel* m, FILE* f);
    joint name and row, and whether the start is a singular configuration. 0, or an exit code with
    *diag filled (joints that cannot be satisfied). */
 FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
+/* the outputs the engine itself gives, as NULL-terminated names (NULL for an unknown group):
+   "frame" (BODY.x y theta omega vx vy, for every body with a frame: one whose marker places its
+   origin), "power" (JOINT.power work, for a joint with constraint rows or a force), "reaction"
+   (JOINT.reaction_x ..., for a joint with constraint rows), "energy" (energy.*), "constraint"
+   (constraint.*). `flexmbd types` lists them from here, the loader resolves them from here. */
+FMB_API const char* const* fmb_engine_outputs(const char* group);
 /* the `stats: status=ok|failed|interrupted ...` line (nothing when s or f is NULL) */
 FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
 
@@ -599,11 +617,13 @@ enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
 /* Linearize the DAE about the state (y, yp) at time t (from fmb_static: the rotating-frame
    terms of a steady rotation are included), eliminate the constraints and solve the
    eigenproblem (`method`). Returns 0 with *out (the caller frees it with fmb_modes_free)
-   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag. */
+   holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag
+   (FMB_EXIT_BAD_INPUT for a `method` other than FMB_EIGEN_* or a time that is not finite). */
 FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
               fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
-/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1] */
+/* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
+   NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);
 /* the scene's outputs at state (y, yp), one CSV row (header first) */
 FMB_API int fmb_write_state_row(const fmbModel* m, const char* path, double t, const double* y, const double* yp,
@@ -614,13 +634,93 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
                           const char* path, fmbDiag* diag);
 /* mode k (0-based) as a ParaView animation in dir (created; DIR/SCENE.pvd and one .vtu per frame,
    the run's VTK writer): `frames` states over one period, the largest coordinate moving by
-   `amplitude` (its units: m or rad) */
+   `amplitude` (its units: m or rad; positive and finite, else FMB_EXIT_BAD_INPUT) */
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
-/* a table of named numeric columns (row-major values), through the one CSV writer: with the names
-   "t" and fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
+/* a table of named numeric columns (row-major values), through the one CSV writer; nrow >= 0
+   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). With the names "t" and
+   fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                     fmbDiag* diag);
+
+/* A scene as fmb_load takes it, for the analyses that load it again with an override of their own
+   (one per hub speed, one per beam model): path, the caller's overrides and the registry, read
+   only during the call. */
+typedef struct fmbSceneSource {
+  const char* path;
+  const char* const* overrides;
+  int noverrides;
+  const fmbRegistry* reg;
+} fmbSceneSource;
+
+/* Load the scene with `extra` (may be NULL) after its overrides, and solve its static or steady
+   state (fmb_static): *m, *y, *yp are the caller's (fmb_free, free) also on failure (NULL when
+   not made). Returns 0 or an exit code with *diag. */
+FMB_API int fmb_load_steady(const fmbSceneSource* scene, const char* extra, const fmbStaticOptions* opt, fmbModel** m,
+                            double** y, double** yp, fmbStaticResult* res, fmbDiag* diag);
+
+/* ---------------------------------------------------------------------------------------------
+ * Campbell diagram (engine/campbell.c; docs/analysis.md): for each hub speed the steady state
+ * (fmb_load_steady with `speed_key=SPEED`), then its modes, each mode followed from speed to
+ * speed by its shape (the largest modal assurance criterion with its shape at the speed before,
+ * assigned greedily), not by its rank in frequency.
+ * ------------------------------------------------------------------------------------------- */
+#define FMB_CAMPBELL_MAX_MODES 64
+typedef struct fmbCampbellOptions {
+  const char* speed_key;   /* the scene key that sets the hub speed, e.g. joints.spin.speed */
+  int count;               /* modes followed, 1 .. FMB_CAMPBELL_MAX_MODES (0 = 4) */
+  int method;              /* FMB_EIGEN_* */
+  fmbStaticOptions steady; /* for fmb_static at each speed */
+} fmbCampbellOptions;
+
+typedef struct fmbCampbell {
+  int nspeed;        /* speeds asked for */
+  int done;          /* speeds computed, from the first on (rows filled) */
+  int count;         /* modes followed */
+  double* speed;     /* nspeed, rad/s */
+  double* frequency; /* nspeed x count, row i at i * count: mode k at speed i (rad/s; negative = divergent) */
+  double* mac;       /* nspeed x count: MAC of mode k with its own shape at speed i - 1 (1 at the first
+                        speed); below 0.5 the speeds are too far apart to follow it reliably */
+  /* internal: the last speed's modes and which of them each followed mode is */
+  fmbModes* last;
+  int* track;
+} fmbCampbell;
+
+/* The diagram at speeds[0 .. nspeed). Returns 0, or an exit code with *diag (the scene, a speed
+   whose steady state or modes fail, fewer modes than opt->count); *out (free it with
+   fmb_campbell_free) holds the speeds done before a failure as well. */
+FMB_API int fmb_campbell(const fmbSceneSource* scene, const fmbCampbellOptions* opt, const double* speeds, int nspeed,
+                         fmbCampbell** out, fmbDiag* diag);
+/* The same in steps, for a caller that computes the speeds' modes itself (in other processes):
+   an empty diagram; the modes at one speed (at least opt->count + FMB_CAMPBELL_EXTRA_MODES of
+   them when the system has that many, so that a mode crossing from above can be followed); and
+   the modes at speeds[c->done] added in order (c takes `modes` over, also on failure). */
+#define FMB_CAMPBELL_EXTRA_MODES 6
+FMB_API fmbCampbell* fmb_campbell_new(const double* speeds, int nspeed, int count);
+FMB_API int fmb_campbell_modes_at(const fmbSceneSource* scene, const fmbCampbellOptions* opt, double speed,
+                                  fmbModes** modes, fmbDiag* diag);
+FMB_API int fmb_campbell_add(fmbCampbell* c, fmbModes* modes, fmbDiag* diag);
+FMB_API void fmb_campbell_free(fmbCampbell* c);
+
+/* ---------------------------------------------------------------------------------------------
+ * One scene, several models (engine/models.c; docs/models.md): the scene run once per model,
+ * the named bodies' `model` key set to it (`bodies.NAME.model=M`, as --set would), the outputs
+ * side by side in one CSV: t (from the longest run), then each model's columns as NAME@MODEL. A
+ * model whose run stops keeps its rows; its later cells are `nan`.
+ * ------------------------------------------------------------------------------------------- */
+#define FMB_MODELS_MAX 8
+typedef struct fmbModelsResult {
+  int ran;                        /* models run, in order (their entries below are filled) */
+  int code[FMB_MODELS_MAX];       /* fmb_run's result for each */
+  fmbStats stats[FMB_MODELS_MAX];
+  fmbDiag diag[FMB_MODELS_MAX];   /* why a model's run stopped (code 0: it did not) */
+} fmbModelsResult;
+/* opt->csv_path (required, a file: not "-") receives the merged table; each run takes quiet and
+   stop from opt. Every model is loaded before any runs (a misspelt model is bad input, not a late
+   failure). Returns 0, or the largest exit code of the runs, or an exit code for the scene, the
+   models or the merged file with *diag saying why; *res (may be NULL) says what each run did. */
+FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int nbody, const char* const* models,
+                           int nmodel, const fmbRunOptions* opt, fmbModelsResult* res, fmbDiag* diag);
 
 /* ---------------------------------------------------------------------------------------------
  * Writing a file without losing one (engine/safe_file.c): the content goes to a temporary file

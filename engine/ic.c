@@ -19,6 +19,7 @@
 #include <klu.h>
 
 #include "internal.h"
+#include "klu_policy.h"
 
 #define FMB_IC_PHI_TOL 1e-10   /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
 #define FMB_ASSEMBLY_TOL 1e-6  /* m or rad: a larger initial correction changes the mechanism */
@@ -195,6 +196,112 @@ static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double
   return converged;
 }
 
+/* The joint whose equations are furthest from holding at (t, q): the largest |Phi| over its
+   rows, into *residual; -1 when none can be evaluated. The buffers are the caller's (nc and
+   nc x nq doubles). Names the joint an initial-pose error is about. */
+static int worst_joint(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* phi,
+                       double* PhiQ, double* phit, double* phitt, double* residual) {
+  int worst = -1;
+  *residual = 0.0;
+  if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt)) return -1;
+  for (int j = 0; j < m->njoint; ++j)
+    for (int r = 0; r < m->joint[j].nrows; ++r) {
+      const double a = fabs(phi[m->joint[j].rowadr + r]);
+      if (a > *residual || worst < 0) *residual = a, worst = j;
+    }
+  return worst;
+}
+
+/* an initial-pose error at joint j's item in the scene (file:line:column and its name), or at the
+   scene when there is no such joint */
+static void joint_error(const fmbModel* m, int j, fmbDiag* diag, const char* what, const char* rest) {
+  if (j >= 0)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, m->joint[j].line, m->joint[j].col, "joint '%s' %s%s",
+                 m->joint[j].name, what, rest);
+  else
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints %s%s", what, rest);
+}
+
+/* joints that the projection could not satisfy (run and check say the same): named at the one
+   furthest from holding where the projection stopped */
+static void unsatisfiable_error(const fmbModel* m, fmbWorkspace* w, double t0, const double* q, const double* v,
+                                double* phi, double* PhiQ, double* phit, double* phitt, double res, int it,
+                                fmbDiag* diag) {
+  /* far from the origin double precision cannot resolve FMB_IC_PHI_TOL: say so */
+  const double qmax = max_abs(q, m->nq);
+  char far[160] = "";
+  if (qmax * 1e-15 > 0.1 * FMB_IC_PHI_TOL)
+    snprintf(far, sizeof far, "; coordinates reach %.3g, too far out for double precision to hold joints to %g", qmax,
+             FMB_IC_PHI_TOL);
+  double rj = 0.0;
+  const int j = worst_joint(m, w, t0, q, v, phi, PhiQ, phit, phitt, &rj);
+  char rest[500];
+  snprintf(rest, sizeof rest,
+           " at t = %g (its residual %.3g; constraint residual %.3g, tolerance %g, after %d projection steps): check "
+           "the joints' points and the bodies' initial poses; joints that repeat each other must agree%s",
+           t0, rj, res, FMB_IC_PHI_TOL, it, far);
+  joint_error(m, j, diag, j >= 0 ? "cannot be satisfied together with the other joints" : "cannot all be satisfied",
+              rest);
+}
+
+/* The projection's change dq of the poses given: beyond FMB_ASSEMBLY_TOL on some body, and
+   unless the scene says `initial: assemble`, the poses do not satisfy the joints: named at the
+   joint furthest from holding in them (pose_joint, its residual). 1 with *diag filled, or 0. */
+static int pose_moved_error(const fmbModel* m, const double* dq, int pose_joint, double pose_residual, fmbDiag* diag) {
+  int worst = 0;
+  double moved = 0.0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const double d = max_abs(dq + m->body[b].qadr, m->body[b].nq);
+    if (d > moved) {
+      moved = d;
+      worst = b;
+    }
+  }
+  if (!(moved > FMB_ASSEMBLY_TOL) || m->assemble) return 0;
+  char rest[500];
+  snprintf(rest, sizeof rest,
+           " (off by %.3g m or rad): the joints move body '%s' by %.3g (the largest change of one of its coordinates, "
+           "m or rad; tolerance %g). Give poses that satisfy the joints, or write `initial: assemble` at the top level "
+           "to let flexmbd move the bodies onto them",
+           pose_residual, m->body[worst].name, moved, FMB_ASSEMBLY_TOL);
+  joint_error(m, pose_joint, diag, "is not satisfied by the poses given", rest);
+  return 1;
+}
+
+int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  if (nc == 0) return 0;
+  double* v = calloc((size_t)nq + 1, sizeof(double));
+  double* dq = calloc((size_t)nq + 1, sizeof(double));
+  double* PhiQ = calloc((size_t)nc * nq + 1, sizeof(double));
+  double* phi = calloc((size_t)nc + 1, sizeof(double));
+  double* phit = calloc((size_t)nc + 1, sizeof(double));
+  double* phitt = calloc((size_t)nc + 1, sizeof(double));
+  double* G = calloc((size_t)nc * nc + 1, sizeof(double));
+  double* rhs = calloc((size_t)nq + nc + 1, sizeof(double));
+  int* piv = calloc((size_t)nq + nc + 1, sizeof(int));
+  unsigned char* drop = calloc((size_t)nc + 1, 1);
+  int rc = 0;
+  if (!v || !dq || !PhiQ || !phi || !phit || !phitt || !G || !rhs || !piv || !drop) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory checking the initial poses");
+    rc = FMB_EXIT_SOLVER;
+  } else {
+    double pose_residual = 0.0, res = 0.0;
+    const int pose_joint = worst_joint(m, w, t, q, v, phi, PhiQ, phit, phitt, &pose_residual);
+    int rank = nc, it = 0;
+    memcpy(dq, q, (size_t)nq * sizeof(double));
+    if (!settle_positions(m, w, t, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it)) {
+      unsatisfiable_error(m, w, t, q, v, phi, PhiQ, phit, phitt, res, it, diag);
+      rc = FMB_EXIT_BAD_INPUT;
+    } else {
+      for (int i = 0; i < nq; ++i) dq[i] = q[i] - dq[i];
+      if (pose_moved_error(m, dq, pose_joint, pose_residual, diag)) rc = FMB_EXIT_BAD_INPUT;
+    }
+  }
+  free(v), free(dq), free(PhiQ), free(phi), free(phit), free(phitt), free(G), free(rhs), free(piv), free(drop);
+  return rc;
+}
+
 /* The constraints at the scene's initial state, projected: what fmb_count_redundant and
    fmb_check_constraints both report. */
 typedef struct {
@@ -255,9 +362,7 @@ int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory checking the constraints");
     rc = FMB_EXIT_SOLVER;
   } else if (!s.settled) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the joints cannot all be satisfied at t = %g (constraint residual %.3g after %d projection steps)", t0,
-                 s.res, s.iters);
+    unsatisfiable_error(m, s.w, t0, s.q, s.v, s.phi, s.PhiQ, s.phit, s.phitt, s.res, s.iters, diag);
     rc = FMB_EXIT_BAD_INPUT;
   } else {
     char rows[600] = "";
@@ -347,10 +452,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   Triplets t = {0, 0, NULL, NULL, NULL};
   SuiteSparse_long *Ap = calloc((size_t)N + 1, sizeof(SuiteSparse_long)), *Ai = NULL;
   double* Ax = NULL;
-  klu_l_common common;
-  klu_l_defaults(&common);
-  klu_l_symbolic* sym = NULL;
-  klu_l_numeric* num = NULL;
+  fmbKlu* lu = NULL; /* klu.c; G_x keeps its pattern from one iteration to the next */
   int rc = (!x || !G || !Qj || !ewt || !blk || !Ap || !Rb || !scratch) ? FMB_EXIT_SOLVER : 0;
   const char* why = "out of memory computing initial accelerations";
   /* the joints' forces: all forces less the bodies' own (-R at a = 0) */
@@ -456,16 +558,14 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
         Ai[j + 1] = r;
         Ax[j + 1] = vv;
       }
-    if (!sym) sym = klu_l_analyze(N, Ap, Ai, &common);
-    if (num) klu_l_free_numeric(&num, &common);
-    num = sym ? klu_l_factor(Ap, Ai, Ax, sym, &common) : NULL;
-    if (!num) {
+    if (!lu) lu = fmb_klu_new(N, Ap, Ai, 0);
+    if (!lu || fmb_klu_factor(lu, Ax) != FMB_KLU_OK) {
       rc = FMB_EXIT_BAD_INPUT;
       why = "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
             "with redundant joints): cannot compute initial accelerations";
       break;
     }
-    if (!klu_l_solve(sym, num, N, 1, G, &common)) {
+    if (fmb_klu_solve(lu, G)) {
       rc = FMB_EXIT_SOLVER;
       break;
     }
@@ -490,8 +590,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
     memcpy(y + 2 * nq, lam, (size_t)nc * sizeof(double));
     memcpy(y + m->zoff, z, (size_t)nz * sizeof(double));
   }
-  if (num) klu_l_free_numeric(&num, &common);
-  if (sym) klu_l_free_symbolic(&sym, &common);
+  fmb_klu_free(lu);
   free(x), free(G), free(Qj), free(ewt), free(blk), free(Rb), free(scratch), free(Ap), free(Ai), free(Ax);
   free(t.row), free(t.col), free(t.val);
   return rc;
@@ -640,21 +739,15 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
   memcpy(v0, v, (size_t)nq * sizeof(double));
 
   unsigned char* drop = fmb_workspace_redundant(w, NULL);
+  /* the joint furthest from holding in the poses given: the one a pose error names */
+  double pose_residual = 0.0;
+  const int pose_joint = nc > 0 ? worst_joint(m, w, t0, q, v, phi, PhiQ, phit, phitt, &pose_residual) : -1;
   if (nc > 0) {
     double res = 0.0;
     int it = 0, rank = nc;
     const int converged = settle_positions(m, w, t0, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, &rank, &res, &it);
     if (!converged) {
-      /* far from the origin double precision cannot resolve FMB_IC_PHI_TOL: say so */
-      const double qmax = max_abs(q, nq);
-      char far[160] = "";
-      if (qmax * 1e-15 > 0.1 * FMB_IC_PHI_TOL)
-        snprintf(far, sizeof far, "; coordinates reach %.3g, too far out for double precision to hold joints to %g",
-                 qmax, FMB_IC_PHI_TOL);
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "the joints cannot all be satisfied at t = %g (constraint residual %.3g, tolerance %g, after %d projection "
-                   "steps): check the joints' points and the bodies' initial poses; joints that repeat each other must agree%s",
-                   t0, res, FMB_IC_PHI_TOL, it, far);
+      unsatisfiable_error(m, w, t0, q, v, phi, PhiQ, phit, phitt, res, it, diag);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
@@ -662,7 +755,12 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
       char rows[600];
       fmb_name_rows(m, drop, rows, sizeof rows);
       if (singular_here(m, w, t0, q, v, drop, rank)) {
-        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+        int first = -1; /* located at the first joint named */
+        for (int j = 0; j < m->njoint && first < 0; ++j)
+          for (int r = 0; r < m->joint[j].nrows; ++r)
+            if (drop[m->joint[j].rowadr + r]) first = j;
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, first >= 0 ? m->joint[first].line : 0,
+                     first >= 0 ? m->joint[first].col : 0,
                      "the mechanism starts in a singular configuration at t = %g: %s depend%s on the other joints' "
                      "equations here but not nearby (a dead point or a flat linkage); start it away from that position",
                      t0, rows, rank == nc - 1 ? "s" : "");
@@ -701,22 +799,7 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
     rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }
-  /* the body the projection moved most: beyond FMB_ASSEMBLY_TOL only if the scene asks */
-  int worst = 0;
-  double moved = 0.0;
-  for (int b = 1; b < m->nbody; ++b) {
-    const double d = max_abs(q0 + m->body[b].qadr, m->body[b].nq);
-    if (d > moved) {
-      moved = d;
-      worst = b;
-    }
-  }
-  if (moved > FMB_ASSEMBLY_TOL && !m->assemble) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the joints are not satisfied by the poses given: they move body '%s' by %.3g (the largest change of "
-                 "one of its coordinates, m or rad; tolerance %g). Give poses that satisfy the joints, or write "
-                 "`initial: assemble` at the top level to let flexmbd move the bodies onto them",
-                 m->body[worst].name, moved, FMB_ASSEMBLY_TOL);
+  if (pose_moved_error(m, q0, pose_joint, pose_residual, diag)) {
     rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }

@@ -5,12 +5,15 @@
  * and progress. A backend owns how the state advances from one time a caller asks for to the
  * next and what it needs for that (its own vectors, matrices, solver).
  *
- * Built-in backends (integrator_*.c), chosen by fmb_integrator_for():
+ * Built-in backends (integrator_*.c), listed once in fmb_integrators[] (integrator_select.c) and
+ * chosen by fmb_integrator_for():
  *   ida        IDA (BDF, variable order and step) on the GGL index-2 system of system.c, KLU
  *   radau5     Radau IIA of order 5 (3 stages, after Hairer & Wanner's RADAU5) on the same GGL
  *              system, KLU real and complex (solver.integrator: radau5)
  *   projected  the index-1 form with minimum-norm multipliers and projections onto the
- *              constraints (solver.formulation: projected; passes singular configurations) */
+ *              constraints (solver.formulation: projected; passes singular configurations)
+ * A backend's name is its ops' .name: solver.integrator's words are the names of the GGL
+ * backends in the table, and the messages take the name from there. */
 #ifndef FMB_INTEGRATOR_H
 #define FMB_INTEGRATOR_H
 
@@ -18,6 +21,7 @@
 #include <stddef.h>
 
 #include "internal.h"
+#include "schur.h"
 
 typedef struct {
   const fmbModel* m;
@@ -26,11 +30,36 @@ typedef struct {
   const double* atol;                /* ny absolute tolerances, one per unknown (tolerance.c) */
 } fmbIntegratorSetup;
 
+/* A stop request (fmbIntegratorSetup.stop; NULL: none): set by a signal handler in the same thread
+   (fmb_run's SIGINT) or by another thread (fmb_data_cancel), so read and written atomically:
+   a lock-free atomic int is what both may touch (C11 7.14.1.1, 7.17.5). */
+static inline int fmb_stop_requested(const volatile sig_atomic_t* stop) {
+#if defined(__GNUC__)
+  return stop && __atomic_load_n(stop, __ATOMIC_RELAXED);
+#else
+  return stop && *stop;
+#endif
+}
+static inline void fmb_stop_set(volatile sig_atomic_t* stop, int value) {
+#if defined(__GNUC__)
+  __atomic_store_n(stop, value, __ATOMIC_RELAXED);
+#else
+  *stop = value;
+#endif
+}
+
 /* fmbIntegratorOps.advance's results */
 enum { FMB_ADVANCE_OK = 0, FMB_ADVANCE_FAILED = -1, FMB_ADVANCE_INTERRUPTED = -2 };
 
 typedef struct fmbIntegratorOps {
-  const char* name;
+  const char* name; /* the word solver.integrator takes (GGL backends), and the one messages use */
+  /* 1: integrates the projected formulation (solver.formulation: projected, or auto after a
+     singular configuration); 0: a GGL backend, named by solver.integrator */
+  int projected;
+  /* optional: the backend's cross-key rules, checked at load once the bodies are parsed (e.g.
+     radau5 refuses formulation: projected). 0 when the model suits the backend, else -1 with the
+     error reported through fmb_parse_error at the offending key of the scene's `solver` node. */
+  int (*check)(const fmbModel* m, fmbParser* p, fmbNode solver);
   /* Set up from the consistent initial state y, yp (all ny unknowns: q, v, multipliers, a body's
      auxiliary unknowns) at t0. NULL with *diag set on failure. When m->need_work, the joints'
      powers (fmb_joint_power) are integrated from t0 into m->njoint work integrals. */
@@ -55,7 +84,22 @@ extern const fmbIntegratorOps fmb_integrator_ida;
 extern const fmbIntegratorOps fmb_integrator_projected;
 extern const fmbIntegratorOps fmb_integrator_radau5;
 
+/* every backend, NULL-terminated; the first GGL one is the default of solver.integrator */
+extern const fmbIntegratorOps* const fmb_integrators[];
+
+/* 1 when the model's constraint manifold holds a singular configuration near its motion (a
+   scan along the manifold from the initial state, engine/singular.c): `formulation: auto` then
+   starts on the projected formulation */
+int fmb_needs_singular_method(const fmbModel* m);
+
 /* the backend the model's solver settings ask for */
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m);
+
+/* solver.integrator's words: the GGL backends' names, NULL-terminated, into names[cap] and their
+   ops into ops[cap] (same order); returns how many */
+int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int cap);
+
+/* the cross-key rules of every backend the model may run on: 0, or -1 with the parse error set */
+int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver);
 
 #endif

@@ -46,7 +46,7 @@ typedef struct {
   fmbStats before_reinit; /* IDA's counters up to the fallback's IDAReInit (which zeroes them) */
 } IdaRun;
 
-static int stop_requested(const IdaRun* c) { return c->stop && *c->stop; }
+static int stop_requested(const IdaRun* c) { return fmb_stop_requested(c->stop); }
 
 /* IDA asks for a new iteration matrix when cj has changed by more than 25 % or after a Newton
    convergence failure. Only the first needs nothing new from the bodies: their K, C, M do not
@@ -411,6 +411,8 @@ static void ida_after_row(void* self, double t) {
 
 const fmbIntegratorOps fmb_integrator_ida = {
     .name = "ida",
+    .projected = 0,
+    .check = NULL,
     .create = ida_create,
     .advance = ida_advance,
     .work = ida_work,

@@ -44,13 +44,14 @@
  *
  * Everything is allocated in create(); advance() allocates only when KLU has to choose new pivots
  * (a refactorization whose condition estimate has degraded), as SUNDIALS' own KLU module does. */
-#include <klu.h>
+#include <klu.h> /* SuiteSparse_long */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "integrator.h"
+#include "klu_policy.h"
 
 /* Radau IIA (s = 3) nodes, collocation matrix inverse, its eigen-decomposition (T, T^-1 as in
    RADAU5; T^-1 A^-1 T = diag(gamma, [[alpha, -beta], [beta, alpha]]) to 1e-15 when written, and a
@@ -112,9 +113,7 @@ typedef struct {
   /* Jacobian parts on the model's CSC pattern, and the two iteration matrices */
   double *jy, *jyp, *e1, *e2;
   SuiteSparse_long *colptr, *rowind;
-  klu_l_common common;
-  klu_l_symbolic* symbolic;
-  klu_l_numeric *num1, *num2;
+  fmbKlu *lu1, *lu2; /* klu_full: E1 (real) and E2 (complex) on the whole pattern (klu.c) */
   /* solver.linear_solver: klu (default): both systems with the position rows eliminated
      (schur.c); klu_full: KLU on the whole matrices above */
   fmbSchur *red1, *red2;
@@ -134,9 +133,8 @@ typedef struct {
 static void radau_destroy(void* self) {
   RadauRun* c = self;
   if (!c) return;
-  if (c->num1) klu_l_free_numeric(&c->num1, &c->common);
-  if (c->num2) klu_zl_free_numeric(&c->num2, &c->common);
-  if (c->symbolic) klu_l_free_symbolic(&c->symbolic, &c->common);
+  fmb_klu_free(c->lu1);
+  fmb_klu_free(c->lu2);
   fmb_schur_free(c->red1);
   fmb_schur_free(c->red2);
   double** vs[] = {&c->atol, &c->scal, &c->ewt, &c->y, &c->yp, &c->ys, &c->yps, &c->e2rhs, &c->err, &c->err2,
@@ -212,14 +210,14 @@ static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* 
   if (!ok) goto oom;
   for (int i = 0; i <= ny; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
   for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
-  klu_l_defaults(&c->common);
   if (m->solver.linear_solver == FMB_LS_KLU) {
     c->red1 = fmb_schur_new(m, 0);
     c->red2 = fmb_schur_new(m, 1);
   } else {
-    c->symbolic = klu_l_analyze(ny, c->colptr, c->rowind, &c->common);
+    c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0);
+    c->lu2 = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX);
   }
-  if (m->solver.linear_solver == FMB_LS_KLU ? !c->red1 || !c->red2 : !c->symbolic) {
+  if (m->solver.linear_solver == FMB_LS_KLU ? !c->red1 || !c->red2 : !c->lu1 || !c->lu2) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
     radau_destroy(c);
     return NULL;
@@ -292,28 +290,6 @@ static int evaluate_jacobian(RadauRun* c) {
   return 0;
 }
 
-/* a refactorization with the old pivot order, or a new factorization when that is missing or its
-   condition estimate has degraded (as SUNDIALS' KLU module decides); 0 ok, 1 singular */
-static int factor(RadauRun* c, klu_l_numeric** num, double* data, int complex_values) {
-  const double tiny = pow(2.220446049250313e-16, 2.0 / 3.0);
-  if (*num) {
-    const SuiteSparse_long ok =
-        complex_values ? klu_zl_refactor(c->colptr, c->rowind, data, c->symbolic, *num, &c->common)
-                       : klu_l_refactor(c->colptr, c->rowind, data, c->symbolic, *num, &c->common);
-    const SuiteSparse_long rc = ok ? (complex_values ? klu_zl_rcond(c->symbolic, *num, &c->common)
-                                                     : klu_l_rcond(c->symbolic, *num, &c->common))
-                                   : 0;
-    if (ok && rc && c->common.rcond >= tiny) return 0;
-    if (complex_values)
-      klu_zl_free_numeric(num, &c->common);
-    else
-      klu_l_free_numeric(num, &c->common);
-  }
-  *num = complex_values ? klu_zl_factor(c->colptr, c->rowind, data, c->symbolic, &c->common)
-                        : klu_l_factor(c->colptr, c->rowind, data, c->symbolic, &c->common);
-  return *num ? 0 : 1;
-}
-
 /* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized */
 static int decompose(RadauRun* c) {
   const long nnz = c->m->nnz;
@@ -324,7 +300,7 @@ static int decompose(RadauRun* c) {
     c->e2[2 * k + 1] = b * c->jyp[k];
   }
   const int failed = c->red1 ? fmb_schur_factor(c->red1, c->e1) || fmb_schur_factor(c->red2, c->e2)
-                            : factor(c, &c->num1, c->e1, 0) || factor(c, &c->num2, c->e2, 1);
+                            : fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK || fmb_klu_factor(c->lu2, c->e2) != FMB_KLU_OK;
   if (failed) {
     c->h_lu = 0.0;
     return 1;
@@ -336,12 +312,12 @@ static int decompose(RadauRun* c) {
 /* in place: b = E1^-1 b, and b = E2^-1 b with b complex (interleaved); 0 ok, 1 failed */
 static int solve_real(RadauRun* c, double* b) {
   if (c->red1) return fmb_schur_solve(c->red1, b);
-  return klu_l_solve(c->symbolic, c->num1, c->ny, 1, b, &c->common) ? 0 : 1;
+  return fmb_klu_solve(c->lu1, b);
 }
 
 static int solve_complex(RadauRun* c, double* b) {
   if (c->red2) return fmb_schur_solve(c->red2, b);
-  return klu_zl_solve(c->symbolic, c->num2, c->ny, 1, b, &c->common) ? 0 : 1;
+  return fmb_klu_solve(c->lu2, b);
 }
 
 /* y += J_y' x on the CSC pattern */
@@ -380,7 +356,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }
-    if (c->stop && *c->stop) return NEWTON_FATAL;
+    if (fmb_stop_requested(c->stop)) return NEWTON_FATAL;
     for (int i = 0; i < 3; ++i) {
       for (int k = 0; k < ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
       stage_derivative(c, i, h, c->yps);
@@ -604,7 +580,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
   int zero_start = c->first;
   c->caljac = 0;
   for (;;) {
-    if (c->stop && *c->stop) {
+    if (fmb_stop_requested(c->stop)) {
       *interrupted = 1;
       return FAIL_NONE;
     }
@@ -640,7 +616,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     double hfac = 0.5;
     const int nr = newton(c, &newt, &hfac);
     if (nr == NEWTON_FATAL) {
-      if (c->stop && *c->stop) {
+      if (fmb_stop_requested(c->stop)) {
         *interrupted = 1;
         return FAIL_NONE;
       }
@@ -766,8 +742,25 @@ static void radau_stats(const void* self, fmbStats* st) {
   st->jacobians_reused = c->lu_reuses;
 }
 
+/* radau5's cross-key rules */
+static int radau_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
+  /* radau5 integrates the GGL system; the projected formulation has its own backend (CVODE) */
+  if (m->solver.formulation == FMB_FORM_PROJECTED)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "integrator"),
+                           "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
+                           "integrator (CVODE): drop one of the two keys");
+  /* radau5's systems are complex as well as real; SUNDIALS' dense LU is real only */
+  if (m->solver.linear_solver == FMB_LS_DENSE)
+    return fmb_parse_error(p, fmb_find_key(p, solver, "linear_solver"),
+                           "integrator: radau5 solves with KLU: linear_solver klu (the position rows eliminated, "
+                           "default) or klu_full (the whole matrix); dense is IDA's only");
+  return 0;
+}
+
 const fmbIntegratorOps fmb_integrator_radau5 = {
     .name = "radau5",
+    .projected = 0,
+    .check = radau_check,
     .create = radau_create,
     .advance = radau_advance,
     .work = radau_work,

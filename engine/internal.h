@@ -36,6 +36,7 @@ typedef struct fmbJointInst {
   const fmbJointType* type;
   void* self;
   int body[2];   /* body indices, -1 = none */
+  int line, col; /* its item in the scene (1-based), for messages after parsing (initial pose) */
   int ncol;      /* nq(body0) + nq(body1) */
   int rowadr, nrows;
   /* the columns (of the ncol) its constraint or force can depend on, found by evaluating it at
@@ -87,7 +88,7 @@ typedef struct fmbSolverSettings {
   int positions_only; /* error test on q only (error_control: positions) */
   /* the GGL system's integrator: IDA (BDF, default) or Radau IIA of order 5 (integrator_radau.c),
      which keeps order 5 on undamped structural modes where BDF is capped at 2 */
-  enum { FMB_INTEG_IDA = 0, FMB_INTEG_RADAU5 = 1 } integrator;
+  const struct fmbIntegratorOps* integrator; /* one of fmb_integrators[] (integrator.h), never projected */
   long max_steps_per_output;
 } fmbSolverSettings;
 
@@ -183,6 +184,15 @@ struct fmbParser {
   const char* const* overrides;
   const char* looked[64];   /* keys looked up in the current item, for "expected one of" */
   int nlooked;
+  /* every key the current mapping may have, when known before its keys are read (fmbp_expect):
+     the loader's own list (top level, solver, an item's name and type) and the item's type's
+     declared params. They make "expected one of" complete, and let a missing required key be
+     reported after an unknown key beside it (the typo that explains it, with did you mean). */
+  const char* const* valid;
+  const fmbParam* params;
+  int expect_complete; /* valid and params name every key the mapping may have */
+  const char* what;    /* the mapping for messages ("body 'bob' (type rigid)"), or NULL */
+  unsigned plausibility_warned; /* the plausibility rules (yaml_get.c) that have warned: once each */
   /* named materials and sections (top-level `materials:`/`sections:` maps): while a body or
      joint item is parsed, keys it does not have are looked up in the entries it names */
   fmbNode item;             /* the item being parsed, or -1 */
@@ -199,6 +209,12 @@ fmbNode fmbp_root(fmbParser* p);
 yaml_node_t* fmbp_node(fmbParser* p, fmbNode n);
 /* start a new item (resets the looked-up key list); check that every key of `map` was looked up */
 void fmbp_begin_item(fmbParser* p);
+/* the scene's top-level keys, the two required ones (solver, bodies) first (engine/scene.c) */
+extern const char* const fmb_scene_keys[];
+/* the keys the current mapping may have: `keys` (NULL-terminated) and a type's `params`, either
+   NULL; `complete` when together they name every key it may have; `what` names the mapping in
+   messages (kept as a pointer: it must live while the mapping is read). Reset by fmbp_begin_item. */
+void fmbp_expect(fmbParser* p, const char* what, const char* const* keys, const fmbParam* params, int complete);
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what);
 int fmbp_is_map(fmbParser* p, fmbNode n);
 int fmbp_is_seq(fmbParser* p, fmbNode n);
@@ -207,10 +223,20 @@ fmbNode fmbp_seq_item(fmbParser* p, fmbNode seq, int i);
 const char* fmbp_scalar(fmbParser* p, fmbNode n); /* NULL if not a scalar */
 int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]);
 
-/* ---- diag ---- */
+/* ---- diag.c ---- */
 void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...)
 #if defined(__GNUC__)
     __attribute__((format(printf, 6, 7)))
+#endif
+    ;
+/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
+   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
+#define FMB_OVERRIDE_SHOWN 80
+const char* fmbp_shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]);
+/* a warning about a scene's node that does not stop the load: FILE:LINE:COL: warning: ... */
+void fmbp_warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
 #endif
     ;
 
@@ -274,9 +300,6 @@ void fmb_constraint_norms(const fmbModel* m, fmbWorkspace* w, double t, const do
                           double* vel);
 double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        const double* lambda);
-/* multipliers consistent with (q, v) at t (ic.c's augmented system; IDA's own between steps are
-   interpolated outside its error test), or y's when that system cannot be solved */
-const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y);
 /* force (global x, y) and torque (about the joint's point) that joint j's constraint forces exert
    on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
 int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
@@ -287,6 +310,9 @@ double* fmb_workspace_work(fmbWorkspace* w);
 /* per constraint row: 1 = redundant, out of the equations; *count (may be NULL) = how many */
 unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count);
 double* fmb_workspace_spring_energy0(fmbWorkspace* w);
+/* the slot of an object a layer above keeps with the workspace (output.c's multipliers), freed
+   with it by free_fn (set when not NULL): the workspace calls nothing above system.c */
+void** fmb_workspace_attached(fmbWorkspace* w, void (*free_fn)(void*));
 int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t, const double* q, const double* v,
                      double* value);
 /* reduced mass check for models that may lose definiteness: 0 ok, else body index + 1.
@@ -297,25 +323,6 @@ int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q
 /* ---- pattern.c ---- */
 int fmb_pattern_build(fmbModel* m);
 void fmb_pattern_free(fmbModel* m);
-void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals,
-                       int ld, double scale);
-void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v);
-
-/* ---- schur.c: KLU on the GGL Newton systems with the position rows eliminated ---- */
-/* One Newton matrix on the model's pattern, real or complex (values interleaved (re, im)), solved
-   through the Schur complement of its position rows. Factor: 0 ok, 1 recoverable (singular),
-   -1 KLU failed outright; solve in place: 0 ok, 1 failed. Allocates in new only (and when KLU
-   picks a new pivot order). */
-typedef struct fmbSchur fmbSchur;
-fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values);
-int fmb_schur_factor(fmbSchur* s, const double* J);
-int fmb_schur_solve(fmbSchur* s, double* x);
-void fmb_schur_forget(fmbSchur* s); /* drop the factorization: the next one chooses pivots afresh */
-void fmb_schur_free(fmbSchur* s);
-/* the real one as IDA's SUNLinearSolver */
-struct _generic_SUNLinearSolver;
-struct _SUNContext;
-struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
 
 /* ---- integrator_ida.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
 struct _generic_SUNMatrix;
@@ -335,10 +342,6 @@ int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order
 /* constraint rows that depend on the others at the initial state and nearby (redundant, not a
    singular start); 0 when none or when the joints cannot be satisfied (the run says why) */
 int fmb_count_redundant(const fmbModel* m);
-/* KLU refactorizations keep their pivot order while the cheap estimate 1/rcond, then condest,
-   stay below eps^(-2/3) = 1 / FMB_KLU_RCOND_TINY (as SUNDIALS' KLU module; schur_kernels.h,
-   augmented.c) */
-#define FMB_KLU_RCOND_TINY 3.666852862501036e-11
 typedef struct fmbAugmented fmbAugmented; /* augmented.c: the index-1 system on a sparse matrix */
 enum { FMB_AUG_MASS_FAILED = 1, FMB_AUG_FORCES_FAILED, FMB_AUG_SINGULAR, FMB_AUG_NOT_FINITE };
 fmbAugmented* fmb_augmented_new(const fmbModel* m);
@@ -366,6 +369,10 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
 int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag);
 
 /* ---- static.c ---- */
+/* the poses q at time t against the joints, as a run checks them (ic.c): joints that cannot be
+   satisfied, or poses they would move by more than FMB_ASSEMBLY_TOL without `initial: assemble`,
+   are bad input (FMB_EXIT_BAD_INPUT, named at the joint); q is left projected onto them */
+int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag);
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
 /* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
@@ -381,12 +388,16 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
 /* global position of a body's material point (its marker); 0 ok */
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle);
-void fmb_outputs_default(fmbModel* m);
+/* no `outputs:` list: x, y, theta, omega of every moving body with a frame; 0, or -1 out of memory */
+int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;
 /* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
 int fmb_csv_header(fmbCsv* c, const fmbModel* m); /* 0 ok, -1 write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
+/* a body out of its model's range (fmbBodyType.model_range) named through fmb_warn, once: warned
+   has nbody entries, 1 once a body was named */
+void fmb_warn_model_range(const fmbModel* m, fmbWorkspace* w, double t, const double* y, unsigned char* warned);
 /* puts a file with a header in place (rename), removes one without; -1 with errno on failure */
 int fmb_csv_close(fmbCsv* c);
 /* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */
@@ -407,16 +418,9 @@ double fmb_fd_increment(double y, double ewt);
 int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
                          const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
                          double* M, double* work, double* scratch);
-/* the same over a body's sparse pattern (b->pcolptr/prowind), one residual pair per colour:
-   K = d[R; Rz]/dq (and d/dz in the z columns), C = d/dv, M = d/da, each in pattern order
-   (pnnz). z: the body's auxiliary unknowns (NULL when nz = 0). scratch: fmb_fd_sparse_scratch. */
-size_t fmb_fd_sparse_scratch(const fmbBodyInst* b);
-int fmb_fd_body_sparse(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                       const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                       double* work, double* scratch);
-/* ---- pattern.c: a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
-   pattern_jacobian when it has one, else by differences (fmb_fd_body_sparse); scratch doubles:
-   fmb_body_sparse_scratch ---- */
+/* a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
+   pattern_jacobian when it has one, else by differences over its pattern, one residual pair per
+   colour; scratch doubles: fmb_body_sparse_scratch */
 size_t fmb_body_sparse_scratch(const fmbBodyInst* b);
 int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                            const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,

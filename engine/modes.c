@@ -25,9 +25,9 @@
 #include <string.h>
 
 #include "internal.h"
+#include "klu_policy.h"
 
 #include <arpack/arpack.h>
-#include <klu.h>
 
 /* coordinates from which `auto` takes the sparse path for a few modes: bench/modes.sh measured
    the crossover between 8 and 16 beam elements (27 and 51 coordinates) for 4 modes */
@@ -159,7 +159,7 @@ static int classify(const double* wr, const double* wi, int n2, int inverted, Ro
 
 typedef struct {
   int n, nnz;
-  int *p, *i;
+  SuiteSparse_long *p, *i; /* KLU's index type: the saddle-point matrix goes to klu.c */
   double* x;
 } Csc;
 
@@ -180,8 +180,8 @@ static int csc_build(Csc* a, int nt, const double* top, int ldt, int nc, const d
     for (int r = 0; r < nc; ++r) nnz += 2 * (J0[(size_t)j * ny + prow + r] != 0.0);
   }
   a->n = n;
-  a->p = malloc((size_t)(n + 1) * sizeof(int));
-  a->i = malloc((size_t)(nnz + 1) * sizeof(int));
+  a->p = malloc((size_t)(n + 1) * sizeof(SuiteSparse_long));
+  a->i = malloc((size_t)(nnz + 1) * sizeof(SuiteSparse_long));
   a->x = malloc((size_t)(nnz + 1) * sizeof(double));
   if (!a->p || !a->i || !a->x) return -1;
   int k = 0;
@@ -216,7 +216,7 @@ static void csc_matvec_add(const Csc* a, const double* x, double* y) {
   for (int j = 0; j < a->n; ++j) {
     const double xj = x[j];
     if (xj == 0.0) continue;
-    for (int k = a->p[j]; k < a->p[j + 1]; ++k) y[a->i[k]] += a->x[k] * xj;
+    for (SuiteSparse_long k = a->p[j]; k < a->p[j + 1]; ++k) y[a->i[k]] += a->x[k] * xj;
   }
 }
 
@@ -232,9 +232,7 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
   if (ncv > n2) ncv = n2;
   const int lworkl = 3 * ncv * ncv + 6 * ncv;
   Csc S = {0, 0, NULL, NULL, NULL}, Cs = S, Ms = S;
-  klu_common common;
-  klu_symbolic* sym = NULL;
-  klu_numeric* num = NULL;
+  fmbKlu* lu = NULL;
   double *resid = calloc((size_t)n2, sizeof(double)), *V = calloc((size_t)n2 * ncv, sizeof(double));
   double *workd = calloc((size_t)3 * n2, sizeof(double)), *workl = calloc((size_t)lworkl, sizeof(double));
   double *rhs = calloc((size_t)ns, sizeof(double)), *dr = calloc((size_t)nev + 1, sizeof(double));
@@ -247,10 +245,8 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
       csc_build(&Ms, nq, M, nq, 0, J0, ny, 0))
     goto done;
   rc = 1;
-  klu_defaults(&common);
-  sym = klu_analyze(ns, S.p, S.i, &common);
-  num = sym ? klu_factor(S.p, S.i, S.x, sym, &common) : NULL;
-  if (!num || common.status != KLU_OK) goto done;
+  lu = fmb_klu_new(ns, S.p, S.i, 0);
+  if (!lu || fmb_klu_factor(lu, S.x) != FMB_KLU_OK) goto done;
   int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
   iparam[0] = 1;    /* exact shifts */
   iparam[2] = 3000; /* restarts */
@@ -264,7 +260,7 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
     csc_matvec_add(&Cs, x, rhs);
     csc_matvec_add(&Ms, x + nq, rhs);
     for (int i = 0; i < nq; ++i) rhs[i] = -rhs[i];
-    klu_solve(sym, num, ns, 1, rhs, &common);
+    fmb_klu_solve(lu, rhs);
     memcpy(yv, rhs, (size_t)nq * sizeof(double));
     memcpy(yv + nq, x, (size_t)nq * sizeof(double));
   } while (1);
@@ -289,8 +285,7 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
   dr = di = Z = NULL;
   rc = 0;
 done:
-  if (num) klu_free_numeric(&num, &common);
-  if (sym) klu_free_symbolic(&sym, &common);
+  fmb_klu_free(lu);
   csc_free(&S);
   csc_free(&Cs);
   csc_free(&Ms);
@@ -316,74 +311,134 @@ void fmb_modes_free(fmbModes* md) {
   free(md);
 }
 
-int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
-              fmbModes** out, fmbDiag* diag) {
-  fmbDiag local;
-  if (!diag) diag = &local;
-  memset(diag, 0, sizeof *diag);
-  if (!m || !y || !yp || !out) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_modes: NULL model, state or result");
-    return FMB_EXIT_BAD_INPUT;
-  }
-  *out = NULL;
-  const int nq = m->nq, nc = m->nc, ny = m->ny;
-  const double speed = state_speed(m, y, y + nq);
-  int rc = 0, info = 0, rank = 0, nr = nq, nvec = 0, nroot = 0, symmetric = 0, inverted = 0, sparse_used = 0;
+/* ---------------------------------------------------------------------------------------------
+ * fmb_modes in stages, each owning what it allocates and freeing it on one path: assemble the
+ * linearization (M1), solve it sparse (M4) or reduce it to the free motions (M2) and solve that
+ * dense (symmetric, else M3), then pack the modes. */
+
+static int out_of_memory(const fmbModel* m, fmbDiag* diag) {
+  fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory for the modal analysis (%d coordinates)", m->nq);
+  return FMB_EXIT_SOLVER;
+}
+
+/* (M1) about the state: nq x nq column-major blocks, and J0 (ny x ny) for the constraint rows */
+typedef struct {
+  double speed;           /* the rigid rotation the state has */
+  double *J0, *K, *Cg, *M; /* dF/dy at cj = 0; stiffness, damping + gyroscopic, mass (rotating frame) */
+} Linearized;
+
+static void linearized_free(Linearized* L) {
+  free(L->J0);
+  free(L->K);
+  free(L->Cg);
+  free(L->M);
+  memset(L, 0, sizeof *L);
+}
+
+static int linearize(const fmbModel* m, double t, const double* y, const double* yp, Linearized* L, fmbDiag* diag) {
+  const int nq = m->nq, ny = m->ny;
+  memset(L, 0, sizeof *L);
+  L->speed = state_speed(m, y, y + nq);
   fmbWorkspace* w = fmb_workspace_new(m);
-  double* J0 = calloc((size_t)ny * ny, sizeof(double));
   double* J1 = calloc((size_t)ny * ny, sizeof(double));
   double* ewt = calloc((size_t)ny, sizeof(double));
-  double* K = calloc((size_t)nq * nq, sizeof(double));
   double* C = calloc((size_t)nq * nq, sizeof(double));
-  double* M = calloc((size_t)nq * nq, sizeof(double));
-  double* Cg = calloc((size_t)nq * nq, sizeof(double));
-  double* VT = calloc((size_t)nq * nq, sizeof(double));
-  double* sv = calloc((size_t)nq + 1, sizeof(double));
-  double *N = NULL, *tmp = NULL, *Mr = NULL, *Cr = NULL, *Kr = NULL, *S = NULL, *wr = NULL, *wi = NULL, *V = NULL,
-         *work = NULL;
-  Root* roots = NULL;
-  int* ipiv = NULL;
-  fmbModes* md = NULL;
-  if (!w || !J0 || !J1 || !ewt || !K || !C || !M || !Cg || !VT || !sv) goto oom;
-  for (int i = 0; i < ny; ++i) ewt[i] = 1.0 / (1e-8 * (1.0 + fabs(y[i])));
-  if (fmb_system_jacobian(m, w, t, 0.0, y, yp, ewt, 0, NULL, J0) ||
-      fmb_system_jacobian(m, w, t, 1.0, y, yp, ewt, 1, NULL, J1)) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations cannot be differentiated at t = %g", t);
-    rc = FMB_EXIT_SOLVER;
-    goto done;
-  }
-  for (int j = 0; j < nq; ++j)
-    for (int i = 0; i < nq; ++i) {
-      const size_t k = (size_t)j * nq + i;
-      K[k] = J0[(size_t)j * ny + nq + i];
-      C[k] = J0[(size_t)(nq + j) * ny + nq + i];
-      M[k] = J1[(size_t)(nq + j) * ny + nq + i] - C[k];
-      Cg[k] = C[k];
+  L->J0 = calloc((size_t)ny * ny, sizeof(double));
+  L->K = calloc((size_t)nq * nq, sizeof(double));
+  L->M = calloc((size_t)nq * nq, sizeof(double));
+  L->Cg = calloc((size_t)nq * nq, sizeof(double));
+  int rc = 0;
+  if (!w || !J1 || !ewt || !C || !L->J0 || !L->K || !L->M || !L->Cg) {
+    rc = out_of_memory(m, diag);
+  } else {
+    for (int i = 0; i < ny; ++i) ewt[i] = 1.0 / (1e-8 * (1.0 + fabs(y[i])));
+    if (fmb_system_jacobian(m, w, t, 0.0, y, yp, ewt, 0, NULL, L->J0) ||
+        fmb_system_jacobian(m, w, t, 1.0, y, yp, ewt, 1, NULL, J1)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations cannot be differentiated at t = %g", t);
+      rc = FMB_EXIT_SOLVER;
     }
-  fmb_rotation_terms(m, speed, C, M, nq, K, Cg); /* (M1) */
-  /* a few modes of a large system: shift-invert Arnoldi (bench/modes.sh: the crossover) */
-  const int use_sparse = count > 0 && 4 * count < nq &&
-                         (method == FMB_EIGEN_SPARSE || (method == FMB_EIGEN_AUTO && nq >= FMB_SPARSE_MIN_COORDS));
+  }
+  if (!rc) {
+    for (int j = 0; j < nq; ++j)
+      for (int i = 0; i < nq; ++i) {
+        const size_t k = (size_t)j * nq + i;
+        L->K[k] = L->J0[(size_t)j * ny + nq + i];
+        C[k] = L->J0[(size_t)(nq + j) * ny + nq + i];
+        L->M[k] = J1[(size_t)(nq + j) * ny + nq + i] - C[k];
+        L->Cg[k] = C[k];
+      }
+    fmb_rotation_terms(m, L->speed, C, L->M, nq, L->K, L->Cg); /* (M1) */
+  }
+  fmb_workspace_free(w);
+  free(J1);
+  free(ewt);
+  free(C);
+  if (rc) linearized_free(L);
+  return rc;
+}
 
-  /* null space of Phi_q (nc x nq): the right singular vectors beyond its rank */
-  if (use_sparse) {
-    const int sp = sparse_modes(nq, nc, ny, J0, K, Cg, M, count, &wr, &wi, &V, &nvec);
-    if (sp < 0) goto oom;
-    if (sp == 0) {
-      roots = calloc((size_t)nvec + 1, sizeof(Root));
-      if (!roots) goto oom;
-      /* nvec: converged Ritz values; the vectors' rows are [dq; dq'] over all coordinates */
-      if ((nroot = classify(wr, wi, nvec, 1, roots)) < 0) goto oom;
-      nr = nq - nc;
-      nvec = 2 * nq;
-      sparse_used = 1;
-      goto have_roots;
-    }
-    /* singular (rigid motions) or no convergence: the dense path below */
+/* the roots found and their eigenvectors (columns of V, nvec rows each) */
+typedef struct {
+  Root* roots;
+  int nroot;
+  double* V;
+  int nvec;
+  int sparse; /* from the sparse path: the vectors are over the coordinates (no N) */
+} Eigen;
+
+static void eigen_free(Eigen* E) {
+  free(E->roots);
+  free(E->V);
+  memset(E, 0, sizeof *E);
+}
+
+/* (M4): 0 with E filled, 1 when the path does not apply (E empty), or an exit code */
+static int solve_sparse(const fmbModel* m, const Linearized* L, int count, Eigen* E, fmbDiag* diag) {
+  const int nq = m->nq;
+  double *wr = NULL, *wi = NULL;
+  int nconv = 0;
+  memset(E, 0, sizeof *E);
+  const int sp = sparse_modes(nq, m->nc, m->ny, L->J0, L->K, L->Cg, L->M, count, &wr, &wi, &E->V, &nconv);
+  int rc = sp < 0 ? out_of_memory(m, diag) : sp;
+  if (!rc) {
+    /* nconv converged Ritz values; the vectors' rows are [dq; dq'] over all coordinates */
+    E->roots = calloc((size_t)nconv + 1, sizeof(Root));
+    if (!E->roots || (E->nroot = classify(wr, wi, nconv, 1, E->roots)) < 0) rc = out_of_memory(m, diag);
+    E->nvec = 2 * nq;
+    E->sparse = 1;
   }
-  if (nc > 0) {
-    double* P = calloc((size_t)nc * nq, sizeof(double));
-    if (!P) goto oom;
+  free(wr);
+  free(wi);
+  if (rc) eigen_free(E);
+  return rc;
+}
+
+/* (M2): N, an orthonormal basis of the null space of Phi_q (nq x nr), and the reduced blocks */
+typedef struct {
+  int nr;
+  double *N, *Mr, *Cr, *Kr;
+} Reduced;
+
+static void reduced_free(Reduced* R) {
+  free(R->N);
+  free(R->Mr);
+  free(R->Cr);
+  free(R->Kr);
+  memset(R, 0, sizeof *R);
+}
+
+/* the right singular vectors of Phi_q (nc x nq, from J0's rows) into VT, its rank into *rank */
+static int constraint_svd(const fmbModel* m, const double* J0, double* VT, int* rank, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc, ny = m->ny;
+  *rank = 0;
+  if (nc == 0) return 0;
+  double* P = calloc((size_t)nc * nq, sizeof(double));
+  double* sv = calloc((size_t)nq + 1, sizeof(double));
+  double* work = NULL;
+  int info = 0, rc = 0;
+  if (!P || !sv) {
+    rc = out_of_memory(m, diag);
+  } else {
     for (int j = 0; j < nq; ++j)
       for (int r = 0; r < nc; ++r) P[(size_t)j * nc + r] = J0[(size_t)j * ny + 2 * nq + r];
     int lwork = -1, one = 1;
@@ -391,135 +446,145 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, &q1, &lwork, &info);
     lwork = (int)q1 + 1;
     work = malloc((size_t)lwork * sizeof(double));
-    if (!work) {
-      free(P);
-      goto oom;
-    }
-    dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, work, &lwork, &info);
-    free(P);
-    free(work);
-    work = NULL;
-    if (info) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the SVD of the constraint Jacobian failed (LAPACK info %d)", info);
-      rc = FMB_EXIT_SOLVER;
-      goto done;
-    }
-    for (int i = 0; i < (nc < nq ? nc : nq); ++i)
-      if (sv[i] > 1e-10 * sv[0]) rank++;
+    if (!work) rc = out_of_memory(m, diag);
+    else dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, work, &lwork, &info);
   }
-  nr = nq - rank;
-  if (nr == 0) {
+  if (!rc && info) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the SVD of the constraint Jacobian failed (LAPACK info %d)", info);
+    rc = FMB_EXIT_SOLVER;
+  }
+  for (int i = 0; !rc && i < (nc < nq ? nc : nq); ++i)
+    if (sv[i] > 1e-10 * sv[0]) ++*rank;
+  free(P);
+  free(sv);
+  free(work);
+  return rc;
+}
+
+static int reduce_constraints(const fmbModel* m, const Linearized* L, Reduced* R, fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc;
+  memset(R, 0, sizeof *R);
+  double* VT = calloc((size_t)nq * nq, sizeof(double));
+  double* tmp = NULL;
+  int rank = 0;
+  int rc = VT ? constraint_svd(m, L->J0, VT, &rank, diag) : out_of_memory(m, diag);
+  const int nr = nq - rank;
+  if (!rc && nr == 0) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints leave no motion: there are no modes");
     rc = FMB_EXIT_BAD_INPUT;
-    goto done;
   }
-  N = malloc((size_t)nq * nr * sizeof(double));
-  tmp = malloc((size_t)nq * nr * sizeof(double));
-  Mr = malloc((size_t)nr * nr * sizeof(double));
-  Cr = malloc((size_t)nr * nr * sizeof(double));
-  Kr = malloc((size_t)nr * nr * sizeof(double));
-  roots = calloc((size_t)2 * nr, sizeof(Root));
-  ipiv = calloc((size_t)2 * nr, sizeof(int));
-  if (!N || !tmp || !Mr || !Cr || !Kr || !roots || !ipiv) goto oom;
-  for (int k = 0; k < nr; ++k)
-    for (int i = 0; i < nq; ++i) N[(size_t)k * nq + i] = nc > 0 ? VT[(size_t)i * nq + rank + k] : (i == k);
-  reduce(nq, nr, N, M, nq, tmp, Mr); /* (M2) */
-  reduce(nq, nr, N, Cg, nq, tmp, Cr);
-  reduce(nq, nr, N, K, nq, tmp, Kr);
+  if (!rc) {
+    R->nr = nr;
+    R->N = malloc((size_t)nq * nr * sizeof(double));
+    tmp = malloc((size_t)nq * nr * sizeof(double));
+    R->Mr = malloc((size_t)nr * nr * sizeof(double));
+    R->Cr = malloc((size_t)nr * nr * sizeof(double));
+    R->Kr = malloc((size_t)nr * nr * sizeof(double));
+    if (!R->N || !tmp || !R->Mr || !R->Cr || !R->Kr) rc = out_of_memory(m, diag);
+  }
+  if (!rc) {
+    for (int k = 0; k < nr; ++k)
+      for (int i = 0; i < nq; ++i) R->N[(size_t)k * nq + i] = nc > 0 ? VT[(size_t)i * nq + rank + k] : (i == k);
+    reduce(nq, nr, R->N, L->M, nq, tmp, R->Mr); /* (M2) */
+    reduce(nq, nr, R->N, L->Cg, nq, tmp, R->Cr);
+    reduce(nq, nr, R->N, L->K, nq, tmp, R->Kr);
+  }
+  free(VT);
+  free(tmp);
+  if (rc) reduced_free(R);
+  return rc;
+}
 
+/* Symmetric-definite (Cr = 0, Kr symmetric), symmetrized against difference noise. Solved
+   inverted when Kr is positive definite, Mr x = (1/w^2) Kr x: the error of a dense eigen-solver
+   is eps times the largest eigenvalue, so the form whose largest eigenvalues are the low modes
+   gives them to full precision (the direct form lost 1e-6 of w1 at 64 elements, where
+   (w_max/w1)^2 ~ 1e10). 0 with E filled, 1 when neither Kr nor Mr is definite, or an exit code. */
+static int solve_symmetric(const fmbModel* m, const Reduced* R, Eigen* E, fmbDiag* diag) {
+  const int nr = R->nr;
   const size_t nn = (size_t)nr * nr;
-  const double kn = fro(Kr, nn), mn = fro(Mr, nn), cn = fro(Cr, nn);
-  double asym = 0.0;
-  for (int j = 0; j < nr; ++j)
-    for (int i = 0; i < j; ++i) asym = fmax(asym, fabs(Kr[(size_t)j * nr + i] - Kr[(size_t)i * nr + j]));
-  /* the Ritz basis of the shapes: eigenvectors in columns of V, nvec rows */
-  if (cn <= 1e-9 * sqrt(kn * mn) && asym <= 1e-6 * kn) {
-    /* symmetric-definite, symmetrized against difference noise. Solved inverted when Kr is
-       positive definite, Mr x = (1/w^2) Kr x: the error of a dense eigen-solver is eps times the
-       largest eigenvalue, so the form whose largest eigenvalues are the low modes gives them to
-       full precision (the direct form lost 1e-6 of w1 at 64 elements, where (w_max/w1)^2 ~ 1e10) */
-    S = malloc(nn * sizeof(double));
-    double* B = malloc(nn * sizeof(double));
-    wr = malloc((size_t)nr * sizeof(double));
-    if (!S || !B || !wr) {
-      free(B);
-      goto oom;
-    }
-    for (int pass = 0; pass < 2 && !symmetric; ++pass) {
-      const double* A_ = pass == 0 ? Mr : Kr;
-      const double* B_ = pass == 0 ? Kr : Mr;
-      for (int j = 0; j < nr; ++j)
-        for (int i = 0; i < nr; ++i) {
-          S[(size_t)j * nr + i] = 0.5 * (A_[(size_t)j * nr + i] + A_[(size_t)i * nr + j]);
-          B[(size_t)j * nr + i] = 0.5 * (B_[(size_t)j * nr + i] + B_[(size_t)i * nr + j]);
-        }
-      int itype = 1, lwork = -1;
-      double q1 = 0.0;
-      dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, &q1, &lwork, &info);
-      lwork = (int)q1 + 1;
-      free(work);
-      work = malloc((size_t)lwork * sizeof(double));
-      if (!work) {
-        free(B);
-        goto oom;
+  memset(E, 0, sizeof *E);
+  double* S = malloc(nn * sizeof(double));
+  double* B = malloc(nn * sizeof(double));
+  double* wr = malloc((size_t)nr * sizeof(double));
+  double* work = NULL;
+  E->roots = calloc((size_t)2 * nr, sizeof(Root));
+  int rc = S && B && wr && E->roots ? 1 : out_of_memory(m, diag);
+  for (int pass = 0; pass < 2 && rc == 1; ++pass) {
+    const double* A_ = pass == 0 ? R->Mr : R->Kr;
+    const double* B_ = pass == 0 ? R->Kr : R->Mr;
+    for (int j = 0; j < nr; ++j)
+      for (int i = 0; i < nr; ++i) {
+        S[(size_t)j * nr + i] = 0.5 * (A_[(size_t)j * nr + i] + A_[(size_t)i * nr + j]);
+        B[(size_t)j * nr + i] = 0.5 * (B_[(size_t)j * nr + i] + B_[(size_t)i * nr + j]);
       }
-      dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, work, &lwork, &info);
-      if (info) continue; /* B not definite: Kr (unstable, rigid motions) or Mr (FOAC) */
-      symmetric = 1;
-      V = S;
-      S = NULL;
-      nvec = nr;
-      for (int k = 0; k < nr; ++k) {
-        const double l = pass == 0 ? (wr[k] != 0.0 ? 1.0 / wr[k] : INFINITY) : wr[k]; /* w^2 */
-        roots[nroot++] = (Root){l >= 0 ? sqrt(l) : -sqrt(-l), l >= 0 ? 0.0 : -1.0, k, 0};
-      }
-    }
-    free(B);
+    int itype = 1, lwork = -1, info = 0;
+    double q1 = 0.0;
+    dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, &q1, &lwork, &info);
+    lwork = (int)q1 + 1;
     free(work);
-    work = NULL;
-    if (!symmetric) {
-      free(S);
-      S = NULL;
-      free(wr);
-      wr = NULL;
+    work = malloc((size_t)lwork * sizeof(double));
+    if (!work) {
+      rc = out_of_memory(m, diag);
+      break;
+    }
+    dsygv_(&itype, "V", "U", &nr, S, &nr, B, &nr, wr, work, &lwork, &info);
+    if (info) continue; /* B not definite: Kr (unstable, rigid motions) or Mr (FOAC) */
+    rc = 0;
+    E->V = S;
+    S = NULL;
+    E->nvec = nr;
+    for (int k = 0; k < nr; ++k) {
+      const double l = pass == 0 ? (wr[k] != 0.0 ? 1.0 / wr[k] : INFINITY) : wr[k]; /* w^2 */
+      E->roots[E->nroot++] = (Root){l >= 0 ? sqrt(l) : -sqrt(-l), l >= 0 ? 0.0 : -1.0, k, 0};
     }
   }
-  if (!symmetric) {
-    /* (M3), inverted when Kr is regular (as above: the low modes become the largest):
-         B = [-Kr^-1 Cr  -Kr^-1 Mr; I 0],  B [r; r'] = (1/s) [r; r']
-       else direct with X = Mr^-1 [Kr Cr] */
-    const int n2 = 2 * nr, nrhs = 2 * nr;
-    double* X = malloc((size_t)nr * n2 * sizeof(double));
-    double* F = malloc(nn * sizeof(double));
-    S = calloc((size_t)n2 * n2, sizeof(double));
-    wr = malloc((size_t)n2 * sizeof(double));
-    wi = malloc((size_t)n2 * sizeof(double));
-    V = malloc((size_t)n2 * n2 * sizeof(double));
-    if (!X || !F || !S || !wr || !wi || !V) {
-      free(X);
-      free(F);
-      goto oom;
-    }
-    memcpy(F, Kr, nn * sizeof(double));
-    memcpy(X, Cr, nn * sizeof(double));
-    memcpy(X + nn, Mr, nn * sizeof(double));
+  free(S);
+  free(B);
+  free(wr);
+  free(work);
+  if (rc) eigen_free(E);
+  return rc;
+}
+
+/* (M3), inverted when Kr is regular (as above: the low modes become the largest):
+     B = [-Kr^-1 Cr  -Kr^-1 Mr; I 0],  B [r; r'] = (1/s) [r; r']
+   else direct with X = Mr^-1 [Kr Cr]. 0 with E filled, or an exit code. */
+static int solve_first_order(const fmbModel* m, double t, const Reduced* R, Eigen* E, fmbDiag* diag) {
+  const int nr = R->nr, n2 = 2 * nr, nrhs = 2 * nr;
+  const size_t nn = (size_t)nr * nr;
+  memset(E, 0, sizeof *E);
+  double* X = malloc((size_t)nr * n2 * sizeof(double));
+  double* F = malloc(nn * sizeof(double));
+  double* S = calloc((size_t)n2 * n2, sizeof(double));
+  double* wr = malloc((size_t)n2 * sizeof(double));
+  double* wi = malloc((size_t)n2 * sizeof(double));
+  int* ipiv = calloc((size_t)2 * nr, sizeof(int));
+  double* work = NULL;
+  E->V = malloc((size_t)n2 * n2 * sizeof(double));
+  E->roots = calloc((size_t)2 * nr, sizeof(Root));
+  int rc = X && F && S && wr && wi && ipiv && E->V && E->roots ? 0 : out_of_memory(m, diag);
+  int info = 0, inverted = 0;
+  if (!rc) {
+    memcpy(F, R->Kr, nn * sizeof(double));
+    memcpy(X, R->Cr, nn * sizeof(double));
+    memcpy(X + nn, R->Mr, nn * sizeof(double));
     dgesv_(&nr, &nrhs, F, &nr, ipiv, X, &nr, &info);
     inverted = info == 0;
     if (!inverted) {
-      memcpy(F, Mr, nn * sizeof(double));
-      memcpy(X, Kr, nn * sizeof(double));
-      memcpy(X + nn, Cr, nn * sizeof(double));
+      memcpy(F, R->Mr, nn * sizeof(double));
+      memcpy(X, R->Kr, nn * sizeof(double));
+      memcpy(X + nn, R->Cr, nn * sizeof(double));
       dgesv_(&nr, &nrhs, F, &nr, ipiv, X, &nr, &info);
     }
-    free(F);
     if (info) {
-      free(X);
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                    "the mass matrix on the free motions is singular at t = %g: no modes (a massless degree of freedom, "
                    "or a FOAC beam whose mass matrix lost definiteness)", t);
       rc = FMB_EXIT_SOLVER;
-      goto done;
     }
+  }
+  if (!rc) {
     /* inverted: top rows [-X_C  -X_M], bottom [I 0]; direct: top [0 I], bottom [-X_K  -X_C] */
     for (int j = 0; j < nr; ++j)
       for (int i = 0; i < nr; ++i) {
@@ -537,20 +602,20 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
       else
         S[(size_t)(nr + j) * n2 + j] = 1.0;
     }
-    free(X);
     int lwork = -1, one = 1;
     double q1 = 0.0, vl = 0.0;
-    dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, V, &n2, &q1, &lwork, &info);
+    dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, E->V, &n2, &q1, &lwork, &info);
     lwork = (int)q1 + 1;
     work = malloc((size_t)lwork * sizeof(double));
-    if (!work) goto oom;
-    dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, V, &n2, work, &lwork, &info);
-    if (info) {
+    if (!work) rc = out_of_memory(m, diag);
+    else dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, E->V, &n2, work, &lwork, &info);
+    if (!rc && info) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the eigenvalue solver did not converge (LAPACK dgeev info %d)", info);
       rc = FMB_EXIT_SOLVER;
-      goto done;
     }
-    nvec = n2;
+  }
+  if (!rc) {
+    E->nvec = n2;
     /* back to s = 1/mu; the conjugate pair swaps the sign of Im, the stored vector (re at k, im
        at k + 1) then belongs to Im s < 0: its conjugate is the Im s > 0 root's (sign below) */
     if (inverted)
@@ -564,30 +629,64 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
           wi[k] = 0.0;
         }
       }
-    if ((nroot = classify(wr, wi, n2, inverted, roots)) < 0) goto oom;
+    if ((E->nroot = classify(wr, wi, n2, inverted, E->roots)) < 0) rc = out_of_memory(m, diag);
   }
-have_roots:
-  qsort(roots, (size_t)nroot, sizeof(Root), cmp_root);
-  if (count <= 0 || count > nroot) count = nroot;
-  md = calloc(1, sizeof *md);
-  if (!md) goto oom;
+  free(X);
+  free(F);
+  free(S);
+  free(wr);
+  free(wi);
+  free(ipiv);
+  free(work);
+  if (rc) eigen_free(E);
+  return rc;
+}
+
+/* dense on the free motions: symmetric-definite when there are no velocity terms, else (M3) */
+static int solve_dense(const fmbModel* m, double t, const Reduced* R, Eigen* E, fmbDiag* diag) {
+  const int nr = R->nr;
+  const size_t nn = (size_t)nr * nr;
+  const double kn = fro(R->Kr, nn), mn = fro(R->Mr, nn), cn = fro(R->Cr, nn);
+  double asym = 0.0;
+  for (int j = 0; j < nr; ++j)
+    for (int i = 0; i < j; ++i) asym = fmax(asym, fabs(R->Kr[(size_t)j * nr + i] - R->Kr[(size_t)i * nr + j]));
+  if (cn <= 1e-9 * sqrt(kn * mn) && asym <= 1e-6 * kn) {
+    const int rc = solve_symmetric(m, R, E, diag);
+    if (rc != 1) return rc;
+  }
+  return solve_first_order(m, t, R, E, diag);
+}
+
+/* the first `count` roots by |frequency| as fmbModes, shapes back over the coordinates (N x, or
+   the vector itself on the sparse path) and scaled so the largest component is 1 */
+static int pack_modes(const fmbModel* m, Eigen* E, const Reduced* R, double speed, int count, fmbModes** out,
+                      fmbDiag* diag) {
+  const int nq = m->nq, nr = E->sparse ? nq - m->nc : R->nr, nvec = E->nvec;
+  const double* N = E->sparse ? NULL : R->N;
+  qsort(E->roots, (size_t)E->nroot, sizeof(Root), cmp_root);
+  if (count <= 0 || count > E->nroot) count = E->nroot;
+  fmbModes* md = calloc(1, sizeof *md);
+  if (!md) return out_of_memory(m, diag);
   md->count = count;
   md->nq = nq;
   md->nreduced = nr;
-  md->sparse = sparse_used;
+  md->sparse = E->sparse;
   md->speed = speed;
   md->frequency = calloc((size_t)count + 1, sizeof(double));
   md->damping_ratio = calloc((size_t)count + 1, sizeof(double));
   md->shape_re = calloc((size_t)count * nq + 1, sizeof(double));
   md->shape_im = calloc((size_t)count * nq + 1, sizeof(double));
-  if (!md->frequency || !md->damping_ratio || !md->shape_re || !md->shape_im) goto oom;
+  if (!md->frequency || !md->damping_ratio || !md->shape_re || !md->shape_im) {
+    fmb_modes_free(md);
+    return out_of_memory(m, diag);
+  }
   for (int k = 0; k < count; ++k) {
-    const Root* r = &roots[k];
+    const Root* r = &E->roots[k];
     md->frequency[k] = r->freq;
     md->damping_ratio[k] = r->zeta;
     /* displacement part of the eigenvector (first nr rows), back to q: N x */
-    const double* xr = V + (size_t)r->col * nvec;
-    const double* xi = r->complex_ ? V + (size_t)(r->col + 1) * nvec : NULL;
+    const double* xr = E->V + (size_t)r->col * nvec;
+    const double* xi = r->complex_ ? E->V + (size_t)(r->col + 1) * nvec : NULL;
     const double isign = r->complex_ < 0 ? -1.0 : 1.0; /* the conjugate (inverted form) */
     double* pr = md->shape_re + (size_t)k * nq;
     double* pi = md->shape_im + (size_t)k * nq;
@@ -622,40 +721,54 @@ have_roots:
     }
   }
   *out = md;
-  md = NULL;
-  goto done;
-oom:
-  fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory for the modal analysis (%d coordinates)", nq);
-  rc = FMB_EXIT_SOLVER;
-done:
-  fmb_modes_free(md);
-  fmb_workspace_free(w);
-  free(J0);
-  free(J1);
-  free(ewt);
-  free(K);
-  free(C);
-  free(M);
-  free(Cg);
-  free(VT);
-  free(sv);
-  free(N);
-  free(tmp);
-  free(Mr);
-  free(Cr);
-  free(Kr);
-  free(S);
-  free(wr);
-  free(wi);
-  free(V);
-  free(work);
-  free(roots);
-  free(ipiv);
+  return 0;
+}
+
+int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
+              fmbModes** out, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (!m || !y || !yp || !out) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_modes: NULL model, state or result");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  *out = NULL;
+  /* an unknown method once ran the dense path silently; a time of nan linearized at nan */
+  if (method != FMB_EIGEN_AUTO && method != FMB_EIGEN_DENSE && method != FMB_EIGEN_SPARSE) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: method %d is not FMB_EIGEN_AUTO, _DENSE or _SPARSE",
+                 method);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (!isfinite(t)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the time %g is not finite", t);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  Linearized L;
+  Reduced R;
+  Eigen E;
+  memset(&R, 0, sizeof R);
+  memset(&E, 0, sizeof E);
+  int rc = linearize(m, t, y, yp, &L, diag);
+  if (rc) return rc;
+  /* a few modes of a large system: shift-invert Arnoldi (bench/modes.sh: the crossover); when it
+     does not apply (a singular saddle-point matrix: rigid motions; no convergence), dense */
+  const int use_sparse = count > 0 && 4 * count < m->nq &&
+                         (method == FMB_EIGEN_SPARSE || (method == FMB_EIGEN_AUTO && m->nq >= FMB_SPARSE_MIN_COORDS));
+  rc = use_sparse ? solve_sparse(m, &L, count, &E, diag) : 1;
+  if (rc == 1) {
+    rc = reduce_constraints(m, &L, &R, diag);
+    if (!rc) rc = solve_dense(m, t, &R, &E, diag);
+  }
+  if (!rc) rc = pack_modes(m, &E, &R, L.speed, count, out, diag);
+  linearized_free(&L);
+  reduced_free(&R);
+  eigen_free(&E);
   return rc;
 }
 
 double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k) {
-  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return 0.0;
+  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return NAN; /* not 0: "orthogonal" */
   const double *ar = a->shape_re + (size_t)i * a->nq, *ai = a->shape_im + (size_t)i * a->nq;
   const double *br = b->shape_re + (size_t)k * b->nq, *bi = b->shape_im + (size_t)k * b->nq;
   double re = 0.0, im = 0.0, na = 0.0, nb = 0.0;
@@ -675,8 +788,9 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
                     fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (ncol <= 0 || !names || (nrow > 0 && !values)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns or no values");
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
+  if (ncol <= 0 || !names || nrow < 0 || (nrow > 0 && !values)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns, no values or a negative row count");
     return FMB_EXIT_BAD_INPUT;
   }
   fmbCsv* c = fmb_csv_open(path, diag);
@@ -696,6 +810,7 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
                         fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_state_row: NULL model or state");
     return FMB_EXIT_BAD_INPUT;
@@ -709,6 +824,9 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
   } else {
     fmb_csv_header(c, m);
     const int wr = fmb_csv_row(c, m, w, t, y, yp);
+    unsigned char* warned = wr > 0 ? NULL : calloc((size_t)m->nbody + 1, 1);
+    if (warned) fmb_warn_model_range(m, w, t, y, warned); /* a state out of a body's model's range */
+    free(warned);
     if (wr) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, wr > 0 ? "an output is not finite" : "writing the output failed");
       rc = FMB_EXIT_SOLVER;
@@ -723,6 +841,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
                           const char* path, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
   if (!m || !y || !yp || !md || md->nq != m->nq) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
@@ -778,7 +897,9 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
                              double amplitude, int frames, const char* dir, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
-  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2) {
+  memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
+  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2 || !(amplitude > 0.0) ||
+      !isfinite(amplitude)) { /* an amplitude of 0, -1 or nan drew a still or inverted mode */
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_animation: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
   }

@@ -14,12 +14,59 @@
 #include "internal.h"
 
 static const char* const frame_names[] = {"x", "y", "theta", "omega", "vx", "vy", NULL};
+
+/* A body with a frame is one whose marker places its origin (local [0, 0]) with an angle: the frame
+   outputs x, y, theta are that point and angle, omega, vx, vy their rates. A body with three or
+   more coordinates has its frame first, as flexmbd.h's convention says (q = [x, y, theta, ...]:
+   read straight from q and v); one with fewer (a point mass, q = [x, y]) has one when its marker
+   answers at the origin in the pose the scene gives it, and the frame outputs then come from the
+   marker and its derivatives. Only the ground has none (it does not move). */
+static int body_has_frame(fmbParser* p, const fmbModel* m, int b) {
+  static const double origin[2] = {0.0, 0.0};
+  double pos[2], angle;
+  return m->body[b].nq >= 3 || fmb_initial_marker(p, b, origin, pos, &angle) == 0;
+}
+
+/* frame output `id` (index into frame_names) of body b at (q, v) */
+static double frame_value(const fmbModel* m, fmbWorkspace* w, int b, int id, const double* q, const double* v) {
+  const fmbBodyInst* bi = &m->body[b];
+  if (bi->nq >= 3) {
+    static const int src[] = {0, 1, 2, 2, 0, 1}; /* x y theta | omega vx vy from v */
+    return (id < 3 ? q : v)[bi->qadr + src[id]];
+  }
+  /* fewer than 3 coordinates: the marker at the origin, its rates by the chain rule (dpos/dq) v */
+  static const double origin[2] = {0.0, 0.0};
+  double pos[2], angle, dpos[4] = {0, 0, 0, 0}, dangle[2] = {0, 0};
+  if (bi->type->marker(bi->self, q + bi->qadr, origin, pos, &angle, dpos, dangle,
+                       fmb_workspace_plugin(w) + bi->workadr))
+    return NAN;
+  const double* vb = v + bi->qadr;
+  double rate[3] = {0.0, 0.0, 0.0}; /* omega, vx, vy */
+  for (int i = 0; i < bi->nq; ++i) {
+    rate[0] += dangle[i] * vb[i];
+    rate[1] += dpos[i] * vb[i];
+    rate[2] += dpos[bi->nq + i] * vb[i];
+  }
+  const double value[6] = {pos[0], pos[1], angle, rate[0], rate[1], rate[2]};
+  return value[id];
+}
 static const char* const energy_names[] = {"kinetic", "strain", "gravity", "spring", "total", "balance", NULL};
 /* outputs the engine provides for joints: power and work for any joint that constrains or
    applies forces, the reaction for a constraining one */
 static const char* const power_names[] = {"power", "work", NULL};
 static const char* const reaction_names[] = {"reaction_x", "reaction_y", "reaction_torque", NULL};
 static const char* const constraint_names[] = {"position", "velocity", NULL};
+
+const char* const* fmb_engine_outputs(const char* group) {
+  static const struct {
+    const char* group;
+    const char* const* names;
+  } groups[] = {{"frame", frame_names},   {"power", power_names},           {"reaction", reaction_names},
+                {"energy", energy_names}, {"constraint", constraint_names}};
+  for (size_t i = 0; group && i < sizeof groups / sizeof groups[0]; ++i)
+    if (strcmp(group, groups[i].group) == 0) return groups[i].names;
+  return NULL;
+}
 
 static int lookup(const char* const* names, const char* s) {
   for (int i = 0; names[i]; ++i)
@@ -51,6 +98,7 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
   owner[len] = '\0';
   const char* qty = dot + 1;
   char avail[700] = "";
+  const char* none = "none";
   if (strcmp(owner, "energy") == 0) {
     o->kind = FMB_OUT_ENERGY;
     o->id = lookup(energy_names, qty);
@@ -75,12 +123,14 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
     if (b >= 0) {
       const fmbBodyInst* bi = &m->body[b];
       o->owner = b;
-      if (bi->nq >= 3 && (o->id = lookup(frame_names, qty)) >= 0) {
+      const int framed = body_has_frame(p, m, b);
+      if (framed && (o->id = lookup(frame_names, qty)) >= 0) {
         o->kind = FMB_OUT_FRAME;
       } else if ((o->id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, qty)) >= 0) {
         o->kind = FMB_OUT_BODY;
       }
-      if (bi->nq >= 3) list_names(avail, sizeof avail, frame_names);
+      if (framed) list_names(avail, sizeof avail, frame_names);
+      none = "none: no frame (its marker cannot place the point [0, 0]) and no outputs of its own";
       list_names(avail, sizeof avail, bi->type->output_names);
     } else {
       const fmbJointInst* ji = &m->joint[j];
@@ -101,7 +151,9 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
       list_names(avail, sizeof avail, ji->type->output_names);
     }
   }
-  if (o->id < 0) return fmb_parse_error(p, node, "output '%s': unknown quantity '%s' (available: %s)", text, qty, avail);
+  if (o->id < 0)
+    return fmb_parse_error(p, node, "output '%s': unknown quantity '%s' (available: %s)", text, qty,
+                           avail[0] ? avail : none);
   return 0;
 }
 
@@ -197,17 +249,14 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
   return 0;
 }
 
-void fmb_outputs_default(fmbModel* m) {
-  int n = 1;
-  for (int b = 1; b < m->nbody; ++b)
-    if (m->body[b].nq >= 3) n += 4;
-  m->output = calloc((size_t)n, sizeof *m->output);
-  if (!m->output) return;
+int fmb_outputs_default(fmbParser* p, fmbModel* m) {
+  m->output = calloc(1 + 4 * (size_t)m->nbody, sizeof *m->output);
+  if (!m->output) return -1;
   m->output[0].kind = FMB_OUT_TIME;
   snprintf(m->output[0].name, sizeof m->output[0].name, "t");
   m->noutput = 1;
   for (int b = 1; b < m->nbody; ++b) {
-    if (m->body[b].nq < 3) continue;
+    if (m->body[b].nq == 0 || !body_has_frame(p, m, b)) continue; /* a fixed frame's columns are constants */
     for (int k = 0; k < 4; ++k) {
       fmbOutput* o = &m->output[m->noutput++];
       o->kind = FMB_OUT_FRAME;
@@ -216,6 +265,7 @@ void fmb_outputs_default(fmbModel* m) {
       snprintf(o->name, sizeof o->name, "%s.%s", m->body[b].name, frame_names[k]);
     }
   }
+  return 0;
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -314,6 +364,44 @@ int fmb_csv_values(fmbCsv* c, const double* values) {
   return write_line(c, c->line, used) ? -1 : 0;
 }
 
+/* The multipliers the reaction outputs show: consistent with (q, v) at t from the augmented
+   system (augmented.c; IDA's own between steps are interpolated outside its error test), or y's
+   when that system cannot be solved. Made at the first row that needs them and kept with the
+   workspace, which frees it. */
+typedef struct {
+  fmbAugmented* aug; /* NULL with a body that declared a sparse pattern (a banded beam: the
+                        augmented system takes (nq + nc)^2 memory there), where IDA's own are used */
+  double* lambda;
+} OutputMultipliers;
+
+static void output_multipliers_free(void* p) {
+  OutputMultipliers* om = p;
+  if (!om) return;
+  fmb_augmented_free(om->aug);
+  free(om->lambda);
+  free(om);
+}
+
+static const double* output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y) {
+  void** slot = fmb_workspace_attached(w, output_multipliers_free);
+  OutputMultipliers* om = *slot;
+  if (!om && (om = calloc(1, sizeof *om)) != NULL) {
+    *slot = om;
+    if (!fmb_model_has_sparse_body(m)) {
+      om->aug = fmb_augmented_new(m);
+      om->lambda = calloc((size_t)m->nc + 1, sizeof(double));
+    }
+  }
+  if (!om || !om->aug || !om->lambda) return y + 2 * m->nq;
+  int nred = 0;
+  fmb_workspace_redundant(w, &nred);
+  /* with redundant rows the multipliers are not unique: the minimum-norm ones, the limit of the
+     Tikhonov-regularized system as its shift -> 0 */
+  if (fmb_augmented_solve(m, w, om->aug, t, y, y + m->nq, NULL, nred ? FMB_MIN_NORM_SHIFT : 0.0, NULL, om->lambda))
+    return y + 2 * m->nq;
+  return om->lambda;
+}
+
 /* the scene's outputs at (t, y) into row[noutput] (every one, also after a value that is not
    finite: fmb_outputs hands them all over); 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row) {
@@ -324,19 +412,14 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
   double cpos = 0.0, cvel = 0.0;
   if (m->need_energy) fmb_energy(m, w, t, q, v, &e);
   if (m->need_constraint) fmb_constraint_norms(m, w, t, q, v, &cpos, &cvel);
-  const double* lam = m->need_multipliers ? fmb_output_multipliers(m, w, t, y) : y + 2 * m->nq;
+  const double* lam = m->need_multipliers ? output_multipliers(m, w, t, y) : y + 2 * m->nq;
   double* work = fmb_workspace_plugin(w);
   for (int i = 0; i < m->noutput; ++i) {
     const fmbOutput* o = &m->output[i];
     double val = 0.0;
     switch (o->kind) {
       case FMB_OUT_TIME: val = t; break;
-      case FMB_OUT_FRAME: {
-        const fmbBodyInst* b = &m->body[o->owner];
-        static const int src[] = {0, 1, 2, 2, 0, 1}; /* x y theta | omega vx vy from v */
-        val = (o->id < 3 ? q : v)[b->qadr + src[o->id]];
-        break;
-      }
+      case FMB_OUT_FRAME: val = frame_value(m, w, o->owner, o->id, q, v); break;
       case FMB_OUT_BODY: {
         const fmbBodyInst* b = &m->body[o->owner];
         if (b->type->output(b->self, o->id, q + b->qadr, v + b->qadr, &val, work + b->workadr)) val = NAN;
@@ -371,6 +454,22 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
     not_finite |= !isfinite(val);
   }
   return not_finite;
+}
+
+/* A body whose state has left the range where its model is accurate (fmbBodyType.model_range)
+   is named once per run (warned[b]), at the first time it is seen there: at t0 and after every
+   advance (step.c; fmb_run: its output times), and in a state written as a row (modes.c, the
+   static state) (issue 23: the complete beam 0.29 m off the exact one at 43 % of L, silently).
+   The run goes on: it is the user's call. */
+void fmb_warn_model_range(const fmbModel* m, fmbWorkspace* w, double t, const double* y, unsigned char* warned) {
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->type->model_range || warned[b]) continue;
+    char msg[600];
+    if (!bi->type->model_range(bi->self, y + bi->qadr, y + m->nq + bi->qadr, msg, sizeof msg)) continue;
+    warned[b] = 1;
+    fmb_warn(w, "warning: t = %.6g: body '%s' has left its model's range: %s", t, bi->name, msg);
+  }
 }
 
 /* 0 ok; 1 a value is not finite (nothing written); -1 a write failed */

@@ -158,34 +158,6 @@ fail:
   return -1;
 }
 
-/* K, C, M of a sparse body (internal.h). The analytic op's pair-order values sit in scratch and are
-   summed into their CSC entries: duplicate pairs (element blocks sharing a node) add up. */
-size_t fmb_body_sparse_scratch(const fmbBodyInst* b) {
-  const size_t fd = fmb_fd_sparse_scratch(b), exact = 3 * (size_t)b->npair;
-  return b->type && b->type->pattern_jacobian && exact > fd ? exact : fd;
-}
-
-int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                           const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                           double* work, double* scratch) {
-  if (!b->type->pattern_jacobian)
-    return fmb_fd_body_sparse(b, env, q, v, a, z, ewt_q, ewt_v, K, C, M, work, scratch);
-  double *Kp = scratch, *Cp = Kp + b->npair, *Mp = Cp + b->npair;
-  const int rc = b->type->pattern_jacobian(b->self, env, q, v, a, z, Kp, Cp, Mp, work);
-  if (rc) return rc;
-  memset(K, 0, sizeof(double) * (size_t)b->pnnz);
-  memset(C, 0, sizeof(double) * (size_t)b->pnnz);
-  memset(M, 0, sizeof(double) * (size_t)b->pnnz);
-  for (long k = 0; k < b->npair; ++k) {
-    K[b->ppos[k]] += Kp[k];
-    C[b->ppos[k]] += Cp[k];
-    M[b->ppos[k]] += Mp[k];
-  }
-  for (long k = 0; k < b->pnnz; ++k)
-    if (!isfinite(K[k]) || !isfinite(C[k]) || !isfinite(M[k])) return 1; /* a wild trial step: IDA cuts it */
-  return 0;
-}
-
 void fmb_pattern_free(fmbModel* m) {
   for (int b = 0; m->body && b < m->nbody; ++b) {
     free(m->body[b].ppos);
@@ -338,34 +310,4 @@ int fmb_pattern_build(fmbModel* m) {
   free(cstart);
   free(byc);
   return 0;
-}
-
-/* position of (r, c) in the data array; the entry must be in the pattern */
-static long find_entry(const fmbModel* m, int r, int c) {
-  long lo = m->colptr[c], hi = m->colptr[c + 1] - 1;
-  while (lo <= hi) {
-    long mid = (lo + hi) / 2;
-    if (m->rowind[mid] < r)
-      lo = mid + 1;
-    else if (m->rowind[mid] > r)
-      hi = mid - 1;
-    else
-      return mid;
-  }
-  return -1;
-}
-
-void fmb_csc_add(const fmbModel* m, double* data, int r, int c, double v) {
-  long k = find_entry(m, r, c);
-  if (k >= 0) data[k] += v;
-}
-
-void fmb_csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals, int ld,
-                       double scale) {
-  for (int j = 0; j < nc; ++j) {
-    long k = find_entry(m, r0, c0 + j);
-    if (k < 0) continue; /* not in the pattern: a programming error caught by the FD tests */
-    const double* col = vals + (size_t)j * (size_t)ld;
-    for (int i = 0; i < nr; ++i) data[k + i] += scale * col[i];
-  }
 }

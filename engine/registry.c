@@ -1,6 +1,6 @@
 /* registry.c — the types a loader knows: a growable list of body and joint type tables, each
  * with the file it came from. Every type enters through fmb_registry_add, the built-ins
- * included (tools/builtin.c hands in a descriptor like any plugin): one door, one set of checks.
+ * included (builtin/builtin.c hands in a descriptor like any plugin): one door, one set of checks.
  * The registry holds pointers only; the tables live in the library or in a loaded plugin, which
  * is never unloaded (engine/plugin.c). */
 #include <stdlib.h>

@@ -107,11 +107,13 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     if (nredundant) {
       char rows[600];
       fmb_name_rows(m, redundant, rows, sizeof rows);
-      fmb_warn(d->w, "redundant constraints: %s repeat%s the other joints' equations: left out of the equations, their "
-               "share of the reactions by the minimum-norm rule", rows, nredundant == 1 ? "s" : "");
+      fmb_warn(d->w,
+               "redundant constraints: %s repeat%s the other joints' equations: left out of the equations, their "
+               "share of the reactions by the minimum-norm rule",
+               rows, nredundant == 1 ? "s" : "");
     }
   }
-  if (rc || (stop && *stop)) goto done;
+  if (rc || fmb_stop_requested(stop)) goto done;
   if (fmb_csv_header(csv, m)) {
     row_failed(m, -1, d->t, diag);
     rc = FMB_EXIT_SOLVER;
@@ -134,15 +136,16 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     }
     st->rows_written++;
     progress_update(&progress, m, d);
-    if (stop && *stop) break;
+    if (fmb_stop_requested(stop)) break;
   }
 
 done:
-  if (rc == FMB_EXIT_INTERRUPTED || (stop && *stop && !rc)) {
+  if (rc == FMB_EXIT_INTERRUPTED || (fmb_stop_requested(stop) && !rc)) {
     rc = FMB_EXIT_INTERRUPTED;
     memset(diag, 0, sizeof *diag);
-    fmb_diag_set(diag, rc, m->path, 0, 0, "interrupted at t = %.6g (SIGINT or SIGTERM): the %ld rows written so far are kept",
-                 d->t, st->rows_written);
+    fmb_diag_set(diag, rc, m->path, 0, 0,
+                 "interrupted at t = %.6g (SIGINT or SIGTERM): the %ld rows written so far are kept", d->t,
+                 st->rows_written);
   }
   const long rows = st->rows_written;
   fmb_data_stats(d, st);

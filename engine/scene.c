@@ -8,6 +8,7 @@
 #include <sys/resource.h>
 #include <unistd.h>
 
+#include "integrator.h"
 #include "internal.h"
 
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
@@ -41,6 +42,11 @@ static int get_atol(fmbParser* p, fmbNode node, double* atol, int* is_auto) {
   return fmb_get_double(p, node, "atol", FMB_POSITIVE, atol);
 }
 
+/* the keys of `solver:`, in the order parse_solver reads them: the one list for its messages */
+static const char* const solver_keys[] = {"t_end",         "rtol",      "atol",      "output_step", "max_step",
+                                          "min_step",      "linear_solver", "error_control", "max_steps", "max_order",
+                                          "formulation",   "integrator", NULL};
+
 static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   fmbSolverSettings* s = &m->solver;
   s->t0 = 0.0;
@@ -53,13 +59,22 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
   if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
-  if (!fmbp_is_map(p, node)) return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys t_end, rtol, atol, output_step, max_step, min_step, max_order, error_control, linear_solver, max_steps, formulation, integrator)");
+  if (!fmbp_is_map(p, node)) {
+    char keys[400] = "";
+    for (size_t i = 0, used = 0; solver_keys[i]; ++i)
+      used += (size_t)snprintf(keys + used, sizeof keys - used, "%s%s", i ? ", " : "", solver_keys[i]);
+    return fmb_parse_error(p, node, "expected a mapping for 'solver' (keys %s)", keys);
+  }
   fmbp_begin_item(p);
+  fmbp_expect(p, "solver", solver_keys, NULL, 1);
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
-  static const char* const integrators[] = {"ida", "radau5", NULL}; /* order of FMB_INTEG_* */
-  int formulation = FMB_FORM_AUTO, integrator = FMB_INTEG_IDA;
+  /* the GGL backends' names, from the one table of integrators (integrator_select.c) */
+  const char* integrators[8];
+  const fmbIntegratorOps* integrator_ops[8];
+  fmb_integrator_choices(integrators, integrator_ops, 8);
+  int formulation = FMB_FORM_AUTO, integrator = 0;
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
@@ -78,17 +93,7 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_choice(p, node, "integrator", 0, integrators, &integrator))
     return -1;
   s->formulation = formulation;
-  s->integrator = integrator;
-  /* radau5 integrates the GGL system; the projected formulation has its own backend (CVODE) */
-  if (integrator == FMB_INTEG_RADAU5 && formulation == FMB_FORM_PROJECTED)
-    return fmb_parse_error(p, fmb_find_key(p, node, "integrator"),
-                           "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
-                           "integrator (CVODE): drop one of the two keys");
-  /* radau5's systems are complex as well as real; SUNDIALS' dense LU is real only */
-  if (integrator == FMB_INTEG_RADAU5 && linear_solver == FMB_LS_DENSE)
-    return fmb_parse_error(p, fmb_find_key(p, node, "linear_solver"),
-                           "integrator: radau5 solves with KLU: linear_solver klu (the position rows eliminated, "
-                           "default) or klu_full (the whole matrix); dense is IDA's only");
+  s->integrator = integrator_ops[integrator];
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->atol_given = !atol_is_auto && fmb_find_key(p, node, "atol") >= 0;
   if (!s->atol_given) s->atol = FMB_ATOL_PER_RTOL * s->rtol; /* a metre of a 1 m body (tolerance.c) */
@@ -189,6 +194,8 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   *self = NULL;
   if (!fmbp_is_map(p, item)) return fmb_parse_error(p, item, "expected a mapping for a %s (with name and type)", kind);
   fmbp_begin_item(p);
+  static const char* const item_keys[] = {"name", "type", NULL};
+  fmbp_expect(p, kind, item_keys, NULL, 0); /* its type's keys are known once `type` is read */
   if (fmbp_get_name(p, item, "name", name)) return -1;
   if (name_taken(m, name))
     return fmb_parse_error(p, fmb_find_key(p, item, "name"),
@@ -208,8 +215,11 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : bt->destroy;
   char what[FMB_NAME_MAX + 40];
   snprintf(what, sizeof what, "%s '%s' (type %s)", kind, name, type_name);
+  const fmbParam* params = joints ? p->reg->joints[*t]->params : bt->params;
+  fmbp_expect(p, what, item_keys, params, params != NULL);
   const int failed = parse(p, item, self) || fmbp_check_unknown(p, item, what);
   p->item = p->inherited[0] = p->inherited[1] = -1;
+  fmbp_expect(p, NULL, NULL, NULL, 0); /* `what` ends with this function */
   if (failed) {
     if (*self) destroy(*self); /* also a parse that failed after setting *self */
     *self = NULL;
@@ -272,6 +282,9 @@ static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
     int t = 0;
     if (parse_item(p, m, item, 1, names, j->name, &t, NULL, &j->self)) return -1;
     j->type = p->reg->joints[t];
+    const yaml_node_t* at = fmbp_node(p, item);
+    j->line = (int)at->start_mark.line + 1;
+    j->col = (int)at->start_mark.column + 1;
     m->njoint++;
     j->type->bodies(j->self, j->body);
     if (j->body[0] == j->body[1])
@@ -360,9 +373,15 @@ static int check_resources(fmbParser* p, fmbModel* m) {
   return 0;
 }
 
+/* the top-level keys, in the order parse_scene reads them (solver and bodies, the required ones,
+   first: yaml_get.c's messages rely on it) */
+const char* const fmb_scene_keys[] = {"solver", "bodies", "joints", "outputs", "plugins", "gravity",
+                                      "initial", "vtk",    "materials", "sections", NULL};
+
 static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode root = fmbp_root(p);
   fmbp_begin_item(p);
+  fmbp_expect(p, "the scene's top level", fmb_scene_keys, NULL, 1);
   fmbNode solver = fmb_find_key(p, root, "solver");
   fmbNode bodies = fmb_find_key(p, root, "bodies");
   fmbNode joints = fmb_find_key(p, root, "joints");
@@ -378,11 +397,8 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
     return -1;
   m->assemble = initial == 1;
   m->initial_static = initial == 2;
-  /* optional conveniences, not listed among the expected top-level keys (docs/scenes.md has them) */
-  const int looked = p->nlooked;
   fmbNode vtk = fmb_find_key(p, root, "vtk"); /* a directory for the ParaView animation (engine/vtk.c) */
   fmbNode library[2] = {fmb_find_key(p, root, library_keys[0]), fmb_find_key(p, root, library_keys[1])};
-  p->nlooked = looked;
   if (fmbp_check_unknown(p, root, "the scene's top level")) return -1;
   if (vtk >= 0) {
     const char* dir = fmbp_scalar(p, vtk);
@@ -406,14 +422,17 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   if (m->solver.positions_only < 0) m->solver.positions_only = m->bodies_prefer_positions;
   if (outputs >= 0) {
     if (fmb_outputs_resolve(p, m, outputs)) return -1;
-  } else {
-    fmb_outputs_default(m);
+  } else if (fmb_outputs_default(p, m)) {
+    return fmb_parse_error(p, root, "out of memory");
   }
-  /* the projected formulation works on q and v alone, with the bodies' mass matrices */
-  if (m->solver.formulation == FMB_FORM_PROJECTED && m->nz > 0)
-    return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
-                           "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
-                           "its assembly: dense, or use formulation: ggl)");
+  /* a CSV of times alone says nothing: refused rather than written silently */
+  if (m->noutput <= 1)
+    return fmb_parse_error(p, outputs >= 0 ? outputs : root,
+                           "the run would write only the time column t: %s; list what to write, e.g. "
+                           "outputs: [energy.total] (`flexmbd types` lists each type's outputs)",
+                           outputs >= 0 ? "'outputs' is empty" : "the scene has no 'outputs' and no body with a frame");
+  /* each backend's cross-key rules (e.g. radau5 refuses formulation: projected) */
+  if (fmb_integrator_check(m, p, solver)) return -1;
   m->nredundant = fmb_count_redundant(m);
   if (fmb_pattern_build(m)) return fmb_parse_error(p, root, "out of memory building the sparsity pattern");
   return check_resources(p, m);

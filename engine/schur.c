@@ -22,18 +22,19 @@
  * model's pattern only and are built here once per fmbSchur.
  *
  * S's pattern and KLU's symbolic analysis are made once, at fmb_schur_new; the numeric
- * factorization is refreshed with klu_l_refactor (a new pivot order only when the condition
+ * factorization follows the one KLU policy (klu.c: a new pivot order only when the condition
  * estimate degrades), as SUNDIALS' own KLU module does. Factor and solve allocate nothing but
  * that new pivot order. */
 #include <complex.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <klu.h>
 #include <sundials/sundials_linearsolver.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include "internal.h"
+#include "klu_policy.h"
+#include "schur.h"
 
 struct fmbSchur {
   const fmbModel* m;
@@ -57,9 +58,7 @@ struct fmbSchur {
   double* qr_val;
   double* acc;         /* dense column / vector scratch, nr, kept zero between uses */
   double* dq;
-  klu_l_common common;
-  klu_l_symbolic* symbolic;
-  klu_l_numeric* numeric;
+  fmbKlu* klu; /* S's LU (klu.c), complex when nc == 2 */
   /* small, dense S (schur_use_dense): a dense LU instead of KLU; lu is S column-major (nr x nr,
      nc doubles each), NULL when KLU is used */
   double* lu;
@@ -73,7 +72,6 @@ struct fmbSchur {
 #define SCHUR_T double
 #define SCHUR_FINITE(x) isfinite(x)
 #define SCHUR_FN(name) SCHUR_CAT(name, _real)
-#define SCHUR_KLU(name) SCHUR_CAT(klu_l_, name)
 #define SCHUR_ABS1(x) fabs(x)
 #define SCHUR_IS_COMPLEX 0
 #include "schur_kernels.h"
@@ -81,7 +79,6 @@ struct fmbSchur {
 #define SCHUR_T double complex
 #define SCHUR_FINITE(x) (isfinite(creal(x)) && isfinite(cimag(x)))
 #define SCHUR_FN(name) SCHUR_CAT(name, _complex)
-#define SCHUR_KLU(name) SCHUR_CAT(klu_zl_, name)
 #define SCHUR_ABS1(x) (fabs(creal(x)) + fabs(cimag(x)))
 #define SCHUR_IS_COMPLEX 1
 #include "schur_kernels.h"
@@ -94,17 +91,13 @@ int fmb_schur_solve(fmbSchur* s, double* x) { return s->nc == 2 ? schur_solve_co
 
 void fmb_schur_forget(fmbSchur* s) {
   s->factored = 0;
-  if (!s->numeric) return;
-  if (s->nc == 2)
-    klu_zl_free_numeric(&s->numeric, &s->common);
-  else
-    klu_l_free_numeric(&s->numeric, &s->common);
+  fmb_klu_forget(s->klu);
 }
 
 void fmb_schur_free(fmbSchur* s) {
   if (!s) return;
   fmb_schur_forget(s);
-  if (s->symbolic) klu_l_free_symbolic(&s->symbolic, &s->common);
+  fmb_klu_free(s->klu);
   free(s->first_kept);
   free(s->diag_pos);
   free(s->dinv);
@@ -285,9 +278,8 @@ fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
     if (!s->lu || !s->ipiv) goto fail;
     return s;
   }
-  klu_l_defaults(&s->common);
-  s->symbolic = klu_l_analyze(s->nr, s->colptr, s->rowind, &s->common);
-  if (!s->symbolic) goto fail;
+  s->klu = fmb_klu_new(s->nr, s->colptr, s->rowind, nc == 2 ? FMB_KLU_COMPLEX : 0);
+  if (!s->klu) goto fail;
   return s;
 fail:
   fmb_schur_free(s);

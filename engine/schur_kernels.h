@@ -5,7 +5,7 @@
  * complex (6.2.5) and what KLU's klu_zl_* routines take. Not a header for anyone else.
  *
  * Expects: SCHUR_T, SCHUR_FINITE(x), SCHUR_FN(name) (the name with the type's suffix),
- * SCHUR_KLU(name) (klu_l_name or klu_zl_name), SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
+ * SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
  * SCHUR_IS_COMPLEX (0 or 1); undefines them at its end. */
 
 /* S = J_RR - J_Rq D^-1 J_qR, column by column through a dense scratch column (schur.c's head
@@ -125,31 +125,19 @@ static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* r
   }
 }
 
-/* S formed from J and factorized: a refactorization with the old pivot order, from scratch when a
-   cheap estimate, then the accurate one, say the condition has degraded (as SUNDIALS' KLU module
-   does). 0 ok, 1 recoverable (D or S singular), -1 KLU could not factorize at all. */
+/* S formed from J and factorized (klu.c's policy: the old pivot order while the condition
+   estimates allow). 0 ok, 1 recoverable (D singular, or a small dense S), -1 KLU could not
+   factorize S, not even from scratch with new pivots. */
 static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
   if (SCHUR_FN(schur_form)(s, J)) return 1;
   if (s->lu) { /* partial pivoting afresh each time: a dense LU has no refactorization to reuse */
     s->factored = !SCHUR_FN(dense_lu)((SCHUR_T*)s->lu, s->nr, s->ipiv);
     return s->factored ? 0 : 1;
   }
-  if (!s->numeric) {
-    s->numeric = SCHUR_KLU(factor)(s->colptr, s->rowind, s->data, s->symbolic, &s->common);
-    return s->numeric ? 0 : -1;
-  }
-  if (!SCHUR_KLU(refactor)(s->colptr, s->rowind, s->data, s->symbolic, s->numeric, &s->common) ||
-      !SCHUR_KLU(rcond)(s->symbolic, s->numeric, &s->common))
-    return 1;
-  if (s->common.rcond < FMB_KLU_RCOND_TINY) {
-    if (!SCHUR_KLU(condest)(s->colptr, s->data, s->symbolic, s->numeric, &s->common)) return 1;
-    if (s->common.condest > 1.0 / FMB_KLU_RCOND_TINY) {
-      SCHUR_KLU(free_numeric)(&s->numeric, &s->common);
-      s->numeric = SCHUR_KLU(factor)(s->colptr, s->rowind, s->data, s->symbolic, &s->common);
-      if (!s->numeric) return -1;
-    }
-  }
-  return 0;
+  /* the one KLU policy (klu.c). No factorization at all, even from scratch, is a failure the step
+     size cannot mend (as SUNDIALS' KLU module says of a failed klu_factor): the caller falls back
+     to the whole matrix (klu_full) */
+  return fmb_klu_factor(s->klu, s->data) == FMB_KLU_OK ? 0 : -1;
 }
 
 /* x = J^-1 x in place with the last factorization: dR from S dR = b_R - J_Rq D^-1 b_q, then
@@ -183,7 +171,7 @@ static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
     ok = s->factored;
     if (ok) SCHUR_FN(dense_solve)((const SCHUR_T*)s->lu, nr, s->ipiv, rhs);
   } else {
-    ok = SCHUR_KLU(solve)(s->symbolic, s->numeric, nr, 1, (double*)rhs, &s->common) != 0;
+    ok = fmb_klu_solve(s->klu, (double*)rhs) == 0;
   }
   if (!ok) {
     memset(rhs, 0, sizeof(SCHUR_T) * (size_t)nr);
@@ -206,6 +194,5 @@ static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
 #undef SCHUR_T
 #undef SCHUR_FINITE
 #undef SCHUR_FN
-#undef SCHUR_KLU
 #undef SCHUR_ABS1
 #undef SCHUR_IS_COMPLEX

@@ -228,7 +228,8 @@ static int eval_F(Newton* s, const double* x, double* Fx) {
   return 0;
 }
 
-/* dense [dF_v/dq (S1), Phi_q^T; Phi_q, 0] at x, LU-factored into s->A */
+/* dense [dF_v/dq (S1), Phi_q^T; Phi_q, 0] at x, LU-factored into s->A; 0, 2 when the LU meets an
+   exactly zero pivot, else the Jacobian's own failure code */
 static int factor_jacobian(Newton* s, const double* x) {
   const fmbModel* m = s->m;
   const int nq = m->nq, nc = m->nc, ny = m->ny, n = s->n;
@@ -253,8 +254,8 @@ static int factor_jacobian(Newton* s, const double* x) {
     double* Ctmp = s->J0 + (size_t)nq * ny + nq;
     double* Mtmp = s->J1 + (size_t)nq * ny + nq;
     double* K = malloc((size_t)nq * nq * sizeof(double));
-    double* Cc = malloc((size_t)nq * nq * sizeof(double));
-    double* Mc = malloc((size_t)nq * nq * sizeof(double));
+    double* Cc = calloc((size_t)nq * nq, sizeof(double)); /* calloc: -Wmaybe-uninitialized under LTO */
+    double* Mc = calloc((size_t)nq * nq, sizeof(double));
     if (!K || !Cc || !Mc) {
       free(K);
       free(Cc);
@@ -274,7 +275,7 @@ static int factor_jacobian(Newton* s, const double* x) {
     free(Cc);
     free(Mc);
   }
-  return fmb_lu_factor(n, s->A, s->piv) ? -1 : 0;
+  return fmb_lu_factor(n, s->A, s->piv) ? 2 : 0; /* 2: an exactly zero pivot */
 }
 
 /* A steady rotation read at T = 20 s after a spin-up finds the drives 50 rad ahead of the bodies'
@@ -318,6 +319,24 @@ static void turn_to_drives(Newton* s, double* x) {
   free(phi);
   free(PhiQ);
   free(zero);
+}
+
+/* an out-of-balance load below this (N, N m) is roundoff: nothing loads the system */
+#define FMB_STATIC_NO_LOAD 1e-9
+
+/* 1 when the equilibrium Jacobian at x is singular (a pivot of its LU at most 1e-12 of the
+   largest, or exactly zero), 0 when not, -1 when it cannot be evaluated */
+static int singular_stiffness(Newton* s, const double* x) {
+  const int rc = factor_jacobian(s, x);
+  if (rc == 2) return 1; /* an exactly zero pivot */
+  if (rc) return -1;
+  double lo = INFINITY, hi = 0.0;
+  for (int i = 0; i < s->n; ++i) {
+    const double d = fabs(s->A[(size_t)i * s->n + i]);
+    lo = fmin(lo, d);
+    hi = fmax(hi, d);
+  }
+  return lo <= 1e-12 * hi ? 1 : 0;
 }
 
 /* rad: the largest turn of a frame in one Newton iteration */
@@ -398,6 +417,12 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
     const fmbBodyInst* bi = &m->body[b];
     bi->type->initial(bi->self, x + bi->qadr, v0 + bi->qadr);
   }
+  /* the poses as given must satisfy the joints at t0, as for a run (statics once moved bodies
+     onto their joints silently, or failed with exit 3 "no equilibrium" on joints that cannot all
+     hold, where `run` refuses the same scene); checked on a copy: the drives may stand elsewhere
+     at opt.t, which Newton reaches from the poses given */
+  memcpy(xt, x, (size_t)nq * sizeof(double));
+  if ((rc = fmb_pose_check(m, w, m->solver.t0, xt, diag))) goto done;
   if ((rc = fit_rotation(m, w, opt.t, x, &s.speed, s.center, diag))) goto done;
   res->speed = s.speed;
   res->center[0] = s.center[0];
@@ -410,6 +435,30 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
     goto done;
   }
   res->residual_start = norm2(F0, n);
+  /* No load (a mechanism without gravity, springs or applied forces: the out-of-balance load is
+     roundoff, 2e-15 on a pendulum without gravity) and a singular stiffness: every pose along the
+     free motion is an equilibrium. Newton then succeeded on a residual of exactly 0 and failed on
+     one of 1e-16 ("no equilibrium found"), both answers wrong: say what holds. The test is on the
+     pivots of the equilibrium Jacobian (smallest / largest below 1e-12: a roundoff-level pivot
+     against the stiffest entry; a 1.8 m aluminium blade's softest pivot is 1e-8 of its stiffest). */
+  if (s.speed == 0.0 && res->residual_start <= FMB_STATIC_NO_LOAD) {
+    const int free_motions = singular_stiffness(&s, x);
+    if (free_motions < 0) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equilibrium equations cannot be evaluated (t = %g)", opt.t);
+      rc = FMB_EXIT_SOLVER;
+      goto done;
+    }
+    if (free_motions > 0) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                   "no unique equilibrium: nothing loads the system (no gravity, spring or applied force; out-of-balance "
+                   "load %.3g) and its stiffness is singular, so every pose along its free motion (a mechanism's degree "
+                   "of freedom, a free body) is in equilibrium. Add the load or the spring that holds it, or fix that "
+                   "motion with a joint or a drive",
+                   res->residual_start);
+      rc = FMB_EXIT_BAD_INPUT;
+      goto done;
+    }
+  }
   /* already balanced (a structure at rest without loads, free bodies): nothing to solve, and
      nothing to factor where nothing holds a body */
   double done_s = norm2(F0, n) == 0.0 ? 1.0 : 0.0, ds = 1.0;
@@ -509,6 +558,11 @@ int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double
   memset(diag, 0, sizeof *diag);
   if (!m || !y || !yp || !res) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_static: NULL model, state or result");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (opt && opt->has_t && !isfinite(opt->t)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_static: the time (fmbStaticOptions.t) is %g, not finite",
+                 opt->t);
     return FMB_EXIT_BAD_INPUT;
   }
   fmbWorkspace* w = fmb_workspace_new(m);

@@ -42,8 +42,10 @@ static int live(const fmbData* d) { return d && d->magic == FMB_DATA_LIVE; }
 /* the misuse every call on (m, d) refuses; 0 when usable */
 static int misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDiag* diag) {
   const char* path = m ? m->path : "";
-  if (!m) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no model (NULL)", fn);
-  else if (!d) fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no data object (NULL)", fn);
+  if (!m)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no model (NULL)", fn);
+  else if (!d)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: no data object (NULL)", fn);
   else if (d->magic == FMB_DATA_FREED)
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s: the data object was freed (fmb_data_free)", fn);
   else if (d->magic != FMB_DATA_LIVE)
@@ -80,6 +82,7 @@ static void release(fmbData* d) {
   d->integ = NULL;
   double* bufs[] = {d->y, d->yp, d->atol, d->row, d->work_before, d->redundant_phi, d->start.y, d->start.yp};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
+  free(d->range_warned);
   fmb_workspace_free(d->w);
   d->w = NULL;
 }
@@ -106,12 +109,13 @@ fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
   d->row = calloc((size_t)m->noutput + 1, sizeof(double));
   d->work_before = calloc((size_t)m->njoint + 1, sizeof(double));
   d->redundant_phi = calloc((size_t)m->nc + 1, sizeof(double));
+  d->range_warned = calloc((size_t)m->nbody + 1, 1);
   d->may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
   if (d->may_switch) {
     d->start.y = calloc(ny, sizeof(double));
     d->start.yp = calloc(ny, sizeof(double));
   }
-  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi ||
+  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi || !d->range_warned ||
       (d->may_switch && (!d->start.y || !d->start.yp))) {
     release(d);
     free(d);
@@ -119,7 +123,6 @@ fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
     return NULL;
   }
   fmb_absolute_tolerances(m, d->atol);
-  d->ops = fmb_integrator_for(m);
   d->stop = &d->cancel;
   d->t = NAN;
   d->magic = FMB_DATA_LIVE;
@@ -148,7 +151,8 @@ void fmb_data_free(fmbData* d) {
 #if defined(__GNUC__)
 __attribute__((destructor))
 #endif
-static void quarantine_release(void) {
+static void
+quarantine_release(void) {
   pthread_mutex_lock(&quarantine_lock);
   for (int i = 0; i < FMB_DATA_QUARANTINE; ++i) {
     free(quarantine[i]);
@@ -169,7 +173,7 @@ void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop) {
 }
 
 void fmb_data_cancel(fmbData* d) {
-  if (d) d->cancel = 1; /* only a store: a signal handler may call it */
+  if (d) fmb_stop_set(&d->cancel, 1); /* one atomic store: another thread or a signal handler may call it */
 }
 
 void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user) {
@@ -219,7 +223,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   d->ops = fmb_integrator_for(m);
   d->restart = 0;
   d->initialised = d->ic_done = d->interrupted = 0;
-  d->cancel = 0;
+  fmb_stop_set(&d->cancel, 0);
   d->cpu_s = 0.0;
   memset(&d->before, 0, sizeof d->before);
   memset(&d->ic, 0, sizeof d->ic);
@@ -239,6 +243,8 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
       rc = FMB_EXIT_SOLVER;
     }
   }
+  memset(d->range_warned, 0, (size_t)m->nbody + 1);
+  if (!rc) fmb_warn_model_range(m, d->w, d->t, d->y, d->range_warned);
   if (!rc && m->need_work) { /* the force elements' potential at t0 enters energy.balance */
     fmbEnergy e0;
     fmb_energy(m, w, d->t, d->y, d->y + m->nq, &e0);
@@ -253,7 +259,8 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
 /* A row left out as redundant must keep holding: if it stops (the joints were dependent only at
    t0, or only on part of the motion) the run would silently lose a joint. Checked after every
    advance. */
-static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, const double* y, double* phi, fmbDiag* diag) {
+static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, const double* y, double* phi,
+                                fmbDiag* diag) {
   int count = 0;
   const unsigned char* drop = fmb_workspace_redundant(w, &count);
   if (!count || fmb_constraints_all(m, w, t, y, y + m->nq, phi, NULL, NULL, NULL)) return 0;
@@ -269,7 +276,8 @@ static int redundant_row_broken(const fmbModel* m, fmbWorkspace* w, double t, co
       }
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                    "stopped at t = %.6g: %s, left out as redundant at the start, no longer holds (residual %.3g): the "
-                   "joints repeat each other only on part of the motion; remove the repeated joint", t, name, phi[r]);
+                   "joints repeat each other only on part of the motion; remove the repeated joint",
+                   t, name, phi[r]);
       return 1;
     }
   return 0;
@@ -314,7 +322,7 @@ static void update_work(const fmbModel* m, fmbData* d) {
 static int interrupted(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   update_work(m, d); /* up to where it stopped: a run that goes on keeps its energy balance */
   d->interrupted = 1;
-  if (d->stop == &d->cancel) d->cancel = 0; /* used up; fmb_run's own flag stays as its signal set it */
+  if (d->stop == &d->cancel) fmb_stop_set(&d->cancel, 0); /* used up; fmb_run's flag stays as its signal set it */
   retire_backend(d, 1);
   fmb_diag_set(diag, FMB_EXIT_INTERRUPTED, m->path, 0, 0, "interrupted at t = %.6g", d->t);
   return FMB_EXIT_INTERRUPTED;
@@ -325,7 +333,7 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   const size_t ny = (size_t)m->ny;
   int rc = ensure_backend(m, d, diag);
   if (rc) return rc;
-  if (d->may_switch && d->ops != &fmb_integrator_projected) {
+  if (d->may_switch && !d->ops->projected) {
     d->start.t = d->t;
     memcpy(d->start.y, d->y, sizeof(double) * ny);
     memcpy(d->start.yp, d->yp, sizeof(double) * ny);
@@ -335,8 +343,9 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
     char why[1200] = "";
     const int flag = d->ops->advance(d->integ, t_out, &tret, d->y, d->yp, &h, why, sizeof why);
     d->t = tret;
-    if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && *d->stop)) return interrupted(m, d, diag);
-    if (flag == FMB_ADVANCE_FAILED && d->ops != &fmb_integrator_projected && d->may_switch &&
+    if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && fmb_stop_requested(d->stop)))
+      return interrupted(m, d, diag);
+    if (flag == FMB_ADVANCE_FAILED && !d->ops->projected && d->may_switch &&
         fmb_rank_deficient_at(m, w, tret, d->y, d->y + m->nq, FMB_AUTO_SWITCH_RANK_TOL)) {
       /* a singular configuration: the GGL system's Newton matrix (IDA's or radau5's) is singular
          here; the projected formulation (minimum-norm multipliers) passes it, for the rest of the
@@ -346,9 +355,11 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
          before the flat position, CVODE started there stopped at it). The work integrals go on
          from their values there. */
       if (!d->quiet)
-        fmb_warn(w, "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
+        fmb_warn(w,
+                 "note: t = %.6g: the constraint Jacobian is rank-deficient here (a singular configuration, where "
                  "the mechanism can change branch); continuing with the projected formulation (set solver.formulation: "
-                 "ggl to stop instead)", tret);
+                 "ggl to stop instead)",
+                 tret);
       retire_backend(d, 0);
       d->ops = &fmb_integrator_projected;
       d->t = d->start.t;
@@ -365,11 +376,13 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
       if (bad)
         mass_failure(m, bad, tret, diag);
       else if (d->switched.t >= 0 && tret - d->switched.t < m->solver.output_step) /* no further: IDA's reason */
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s (the projected "
-                     "formulation, tried from t = %.6g, did not get further)", tret, d->switched.h, d->switched.why,
-                     d->switched.t);
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                     "solver failed at t = %.6g (step size %.3g): %s (the projected "
+                     "formulation, tried from t = %.6g, did not get further)",
+                     tret, d->switched.h, d->switched.why, d->switched.t);
       else
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h, why);
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h,
+                     why);
       update_work(m, d);
       retire_backend(d, 1);
       return FMB_EXIT_SOLVER;
@@ -384,6 +397,7 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
       mass_failure(m, bad, d->t, diag);
       return FMB_EXIT_SOLVER;
     }
+    fmb_warn_model_range(m, d->w, d->t, d->y, d->range_warned);
     if (d->ops->after_row) d->ops->after_row(d->integ, d->t);
     return 0;
   }
@@ -400,9 +414,10 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
     return FMB_EXIT_BAD_INPUT;
   }
   if (isnan(t_out) || t_out < d->t) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "fmb_advance: t_out = %g is before the run's time %.17g: a run goes forward (fmb_init starts it again)",
-                 t_out, d->t);
+    fmb_diag_set(
+        diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+        "fmb_advance: t_out = %g is before the run's time %.17g: a run goes forward (fmb_init starts it again)", t_out,
+        d->t);
     return FMB_EXIT_BAD_INPUT;
   }
   if (t_out > m->solver.t_end) {
@@ -411,7 +426,7 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
                  t_out, m->solver.t_end);
     return FMB_EXIT_BAD_INPUT;
   }
-  if (*d->stop) { /* cancelled between two advances */
+  if (fmb_stop_requested(d->stop)) { /* cancelled between two advances */
     d->failed = 1;
     return interrupted(m, d, diag);
   }
@@ -483,8 +498,10 @@ int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value)
   const int i = input_index(m, name);
   if (i < 0 || !isfinite(value)) {
     if (i < 0)
-      fmb_warn(d->w, "fmb_set_input: no input named '%s' (%d inputs: a drive with `profile: input` or a load with "
-               "`law: input` is one, named by its joint)", name ? name : "(NULL)", m->ninput);
+      fmb_warn(d->w,
+               "fmb_set_input: no input named '%s' (%d inputs: a drive with `profile: input` or a load with "
+               "`law: input` is one, named by its joint)",
+               name ? name : "(NULL)", m->ninput);
     else
       fmb_warn(d->w, "fmb_set_input: input '%s' = %g: not a finite number", name, value);
     return FMB_EXIT_BAD_INPUT;

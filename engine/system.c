@@ -16,7 +16,7 @@
  * two pins that say the same thing; found by ic.c) are taken out of the equations: their rows
  * become F_lambda = lambda_r, F_mu = mu_r, so the Newton matrix stays regular while the
  * independent rows still fix the same motion (docs/mechanisms.md). Their share of the reactions
- * is restored in the outputs by the minimum-norm rule (ic.c's fmb_augmented_solve). */
+ * is restored in the outputs by the minimum-norm rule (output.c, with augmented.c's minimum-norm solve). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -44,8 +44,10 @@ struct fmbWorkspace {
   double* work_done; /* njoint: accumulated work of each joint (step.c fills it) */
   unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
   int nredundant_cap; /* nc */
-  struct fmbAugmented* aug; /* outputs' multipliers (need_multipliers only) */
-  double* lambda;
+  /* an object a layer above keeps with the workspace and frees with it (output.c: the augmented
+     system of the multipliers the outputs show), so that this file calls nothing above it */
+  void* attached;
+  void (*attached_free)(void*);
   double spring_energy0;
   double* input;    /* m->ninput: the inputs' current values */
   fmbWarnSink warn; /* where this run's messages go */
@@ -113,16 +115,6 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
     fmb_workspace_free(w);
     return NULL;
   }
-  /* reactions from multipliers recomputed by the dense augmented system, except with a body that
-     declared a sparse pattern (a banded beam: (nq + nc)^2 memory), where IDA's own are used */
-  if (m->need_multipliers && !fmb_model_has_sparse_body(m)) {
-    w->aug = fmb_augmented_new(m);
-    w->lambda = calloc((size_t)m->nc + 1, sizeof(double));
-    if (!w->aug || !w->lambda) {
-      fmb_workspace_free(w);
-      return NULL;
-    }
-  }
   if (!w->work_done || !w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
       !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fdcol || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
     fmb_workspace_free(w);
@@ -160,8 +152,7 @@ void fmb_workspace_free(fmbWorkspace* w) {
   free(w->work_done);
   free(w->redundant);
   free(w->input);
-  fmb_augmented_free(w->aug);
-  free(w->lambda);
+  if (w->attached_free) w->attached_free(w->attached);
   double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
                     w->K, w->C, w->M, w->fdcol, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
@@ -187,16 +178,11 @@ unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
   return w->redundant;
 }
 
-const double* fmb_output_multipliers(const fmbModel* m, fmbWorkspace* w, double t, const double* y) {
-  int nred = 0;
-  fmb_workspace_redundant(w, &nred);
-  /* with redundant rows the multipliers are not unique: the minimum-norm ones, the limit of the
-     Tikhonov-regularized system as its shift -> 0 */
-  if (!w->aug || fmb_augmented_solve(m, w, w->aug, t, y, y + m->nq, NULL, nred ? FMB_MIN_NORM_SHIFT : 0.0, NULL, w->lambda))
-    return y + 2 * m->nq;
-  return w->lambda;
-}
 double* fmb_workspace_spring_energy0(fmbWorkspace* w) { return &w->spring_energy0; }
+void** fmb_workspace_attached(fmbWorkspace* w, void (*free_fn)(void*)) {
+  if (free_fn) w->attached_free = free_fn;
+  return &w->attached;
+}
 
 /* ---------------------------------------------------------------------------------------------
  * joints' view of the bodies */
@@ -224,7 +210,10 @@ const double* fmb_eval_v(const fmbJointEval* ev, int k) {
 
 double* fmb_eval_scratch(const fmbJointEval* ev) { return ev ? ev->js : NULL; }
 
-int fmb_eval_col0(const fmbJointEval* ev, int k) { return k == 1 ? fmb_eval_ncoord(ev, 0) : 0; }
+int fmb_eval_col0(const fmbJointEval* ev, int k) {
+  if (!ev || (k != 0 && k != 1)) return -1; /* 0 would send a plugin to body 0's columns */
+  return k == 1 ? fmb_eval_ncoord(ev, 0) : 0;
+}
 double fmb_eval_input(const fmbJointEval* ev) {
   return (ev && ev->j->input >= 0 && ev->input) ? ev->input[ev->j->input] : NAN;
 }
@@ -333,13 +322,40 @@ int fmb_joint_support(const fmbModel* m, fmbWorkspace* w, int j, int* sup) {
 }
 
 /* ---------------------------------------------------------------------------------------------
- * residual */
+ * adding into the Newton matrix's values on the model's CSC pattern (pattern.c built it) */
 
-int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                  const double* z, double* R, double* work) {
-  if (b->nz > 0) return b->type->residual_aux(b->self, env, q, v, a, z, R, R + b->nq, work);
-  return b->type->residual(b->self, env, q, v, a, R, work);
+/* position of (r, c) in the data array; the entry must be in the pattern */
+static long find_entry(const fmbModel* m, int r, int c) {
+  long lo = m->colptr[c], hi = m->colptr[c + 1] - 1;
+  while (lo <= hi) {
+    long mid = (lo + hi) / 2;
+    if (m->rowind[mid] < r)
+      lo = mid + 1;
+    else if (m->rowind[mid] > r)
+      hi = mid - 1;
+    else
+      return mid;
+  }
+  return -1;
 }
+
+static void csc_add(const fmbModel* m, double* data, int r, int c, double v) {
+  long k = find_entry(m, r, c);
+  if (k >= 0) data[k] += v;
+}
+
+static void csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c0, int nc, const double* vals, int ld,
+                          double scale) {
+  for (int j = 0; j < nc; ++j) {
+    long k = find_entry(m, r0, c0 + j);
+    if (k < 0) continue; /* not in the pattern: a programming error caught by the FD tests */
+    const double* col = vals + (size_t)j * (size_t)ld;
+    for (int i = 0; i < nr; ++i) data[k + i] += scale * col[i];
+  }
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * residual */
 
 static int all_finite(const double* x, int n) {
   for (int i = 0; i < n; ++i)
@@ -409,12 +425,12 @@ static void sink_add(const Sink* s, int r, int c, double v) {
   if (s->dense)
     s->dense[(size_t)c * (size_t)s->m->ny + (size_t)r] += v;
   else
-    fmb_csc_add(s->m, s->csc, r, c, v);
+    csc_add(s->m, s->csc, r, c, v);
 }
 
 static void sink_block(const Sink* s, int r0, int nr, int c0, int nc, const double* vals, int ld, double scale) {
   if (!s->dense) {
-    fmb_csc_add_block(s->m, s->csc, r0, nr, c0, nc, vals, ld, scale);
+    csc_add_block(s->m, s->csc, r0, nr, c0, nc, vals, ld, scale);
     return;
   }
   for (int j = 0; j < nc; ++j)

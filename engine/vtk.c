@@ -206,6 +206,19 @@ void fmb_vtk_close(fmbVtk* v) {
   free(v);
 }
 
+/* `text` as an XML attribute value: a scene named `a&b.yaml` or `"q".yaml` must not break the
+   collection file (its frames' names carry the scene's) */
+static void fputs_xml_attribute(const char* text, FILE* f) {
+  for (const char* c = text; *c; ++c) switch (*c) {
+      case '&': fputs("&amp;", f); break;
+      case '<': fputs("&lt;", f); break;
+      case '>': fputs("&gt;", f); break;
+      case '"': fputs("&quot;", f); break;
+      case '\'': fputs("&apos;", f); break;
+      default: fputc(*c, f);
+    }
+}
+
 fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag) {
   if (mkdir(dir, 0777) != 0 && errno != EEXIST) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, dir, 0, 0, "cannot create the VTK directory: %s", strerror(errno));
@@ -322,7 +335,9 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   if (fmb_safe_close(sf, !bad) != 0 || bad) return -1;
   /* the new entry replaces the collection's closing tags, which follow it again */
   if (fseek(v->pvd, -(long)(sizeof pvd_tail - 1), SEEK_END) != 0) return -1;
-  fprintf(v->pvd, "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"%s\"/>\n%s", t, name, pvd_tail);
+  fprintf(v->pvd, "    <DataSet timestep=\"%.12g\" group=\"\" part=\"0\" file=\"", t);
+  fputs_xml_attribute(name, v->pvd);
+  fprintf(v->pvd, "\"/>\n%s", pvd_tail);
   if (fflush(v->pvd) != 0 || ferror(v->pvd)) return -1;
   v->step++;
   return 0;

@@ -9,7 +9,6 @@
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,18 +22,6 @@
    bounds what libyaml is asked to hold (its document takes ~20x the text) */
 #define FMB_SCENE_BYTES_MAX (64 * 1024 * 1024)
 
-void fmb_diag_set(fmbDiag* d, int code, const char* file, int line, int col, const char* fmt, ...) {
-  if (!d || d->code) return; /* the first error wins */
-  d->code = code;
-  snprintf(d->file, sizeof d->file, "%s", file ? file : "");
-  d->line = line;
-  d->col = col;
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(d->msg, sizeof d->msg, fmt, ap);
-  va_end(ap);
-}
-
 yaml_node_t* fmbp_node(fmbParser* p, fmbNode n) {
   if (n <= 0) return NULL;
   return yaml_document_get_node(&p->doc, n);
@@ -46,65 +33,6 @@ fmbNode fmbp_root(fmbParser* p) {
 }
 
 static int node_count(fmbParser* p) { return (int)(p->doc.nodes.top - p->doc.nodes.start); }
-
-/* an override as messages show it, on one line (control characters as \n, \t, \xNN) and cut
-   after FMB_OVERRIDE_SHOWN characters so the reason that follows is never lost */
-#define FMB_OVERRIDE_SHOWN 80
-static const char* shown_override(const char* text, char buf[FMB_OVERRIDE_SHOWN + 32]) {
-  size_t used = 0, i = 0;
-  const size_t len = strlen(text);
-  for (; text[i] && used < FMB_OVERRIDE_SHOWN - 20; ++i) {
-    const unsigned char ch = (unsigned char)text[i];
-    if (ch == '\n' || ch == '\t')
-      used += (size_t)snprintf(buf + used, 8, "\\%c", ch == '\n' ? 'n' : 't');
-    else if (ch < 0x20 || ch == 0x7f)
-      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
-    else
-      buf[used++] = (char)ch;
-  }
-  if (text[i] && len > FMB_OVERRIDE_SHOWN) {
-    snprintf(buf + used, FMB_OVERRIDE_SHOWN + 32 - used, "...(%zu characters)", len);
-    return buf;
-  }
-  for (; text[i] && used < FMB_OVERRIDE_SHOWN + 24; ++i) {
-    const unsigned char ch = (unsigned char)text[i];
-    if (ch < 0x20 || ch == 0x7f)
-      used += (size_t)snprintf(buf + used, 8, "\\x%02x", ch);
-    else
-      buf[used++] = (char)ch;
-  }
-  buf[used] = '\0';
-  return buf;
-}
-
-/* where `node` is: file:line:column, or the override that made it */
-static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
-  yaml_node_t* nd = fmbp_node(p, node);
-  int ov = (node > 0 && p->override_of && node <= p->nnodes_cap) ? p->override_of[node] : -1;
-  char shown[FMB_OVERRIDE_SHOWN + 32];
-  if (ov >= 0)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", shown_override(p->overrides[ov], shown), msg);
-  else if (nd)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s", msg);
-  else
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "%s", msg);
-}
-
-static int verror_at(fmbParser* p, fmbNode node, const char* fmt, va_list ap) {
-  char msg[900];
-  vsnprintf(msg, sizeof msg, fmt, ap);
-  diag_at(p, node, p->diag, msg);
-  return -1;
-}
-
-int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...) {
-  if (!p || !fmt) return -1;
-  va_list ap;
-  va_start(ap, fmt);
-  verror_at(p, node, fmt, ap);
-  va_end(ap);
-  return -1;
-}
 
 int fmbp_is_map(fmbParser* p, fmbNode n) {
   yaml_node_t* nd = fmbp_node(p, n);
@@ -146,7 +74,20 @@ static const char* node_kind(yaml_node_t* nd) {
 /* ------------------------------------------------------------------------------------------ */
 /* keys */
 
-void fmbp_begin_item(fmbParser* p) { p->nlooked = 0; }
+void fmbp_begin_item(fmbParser* p) {
+  p->nlooked = 0;
+  p->valid = NULL;
+  p->params = NULL;
+  p->expect_complete = 0;
+  p->what = NULL;
+}
+
+void fmbp_expect(fmbParser* p, const char* what, const char* const* keys, const fmbParam* params, int complete) {
+  p->what = what;
+  p->valid = keys;
+  p->params = params;
+  p->expect_complete = complete;
+}
 
 static void remember_key(fmbParser* p, const char* key) {
   for (int i = 0; i < p->nlooked; ++i)
@@ -181,20 +122,124 @@ fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
   return v;
 }
 
+/* The keys the current mapping may have, in one list: those looked up so far (in the order the
+   loader reads them), then the declared ones (fmbp_expect) not yet among them. `material` and
+   `section` stay out (every item takes them; docs/scenes.md lists them). Returns the count. */
+#define FMB_EXPECTED_MAX 96
+static int expected_keys(const fmbParser* p, const char* out[FMB_EXPECTED_MAX]) {
+  int n = 0;
+  const char* const* lists[2] = {p->looked, p->valid};
+  const int counts[2] = {p->nlooked, 1 << 20};
+  for (int l = 0; l < 3; ++l)
+    for (int i = 0; n < FMB_EXPECTED_MAX; ++i) {
+      const char* k = l < 2 ? (lists[l] && i < counts[l] ? lists[l][i] : NULL) : (p->params ? p->params[i].key : NULL);
+      if (!k) break;
+      int dup = strcmp(k, "material") == 0 || strcmp(k, "section") == 0;
+      for (int j = 0; j < n && !dup; ++j) dup = strcmp(out[j], k) == 0;
+      if (!dup) out[n++] = k;
+    }
+  return n;
+}
+
+/* optimal string alignment distance (Levenshtein with adjacent transpositions: lenght -> length
+   is 1), bounded: keys are short, longer words just count as far */
+static int key_distance(const char* a, const char* b) {
+  enum { W = 40 };
+  const int la = (int)strlen(a), lb = (int)strlen(b);
+  if (la >= W || lb >= W) return W;
+  int d[W + 1][W + 1];
+  for (int i = 0; i <= la; ++i) d[i][0] = i;
+  for (int j = 0; j <= lb; ++j) d[0][j] = j;
+  for (int i = 1; i <= la; ++i)
+    for (int j = 1; j <= lb; ++j) {
+      const int cost = a[i - 1] != b[j - 1];
+      int v = d[i - 1][j] + 1;
+      if (d[i][j - 1] + 1 < v) v = d[i][j - 1] + 1;
+      if (d[i - 1][j - 1] + cost < v) v = d[i - 1][j - 1] + cost;
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && d[i - 2][j - 2] + 1 < v) v = d[i - 2][j - 2] + 1;
+      d[i][j] = v;
+    }
+  return d[la][lb];
+}
+
+/* a typo: at most 1 edit in a short word, 2 from 5 letters on (t_ned, ramp_tme, lenght, omega) */
+static int is_typo_of(const char* typed, const char* key) {
+  const int d = key_distance(typed, key), len = (int)strlen(key);
+  return d > 0 && d <= (len >= 5 ? 2 : 1);
+}
+
+/* the unknown-key message, with the nearest expected key when it is a typo of it */
+static int unknown_key_error(fmbParser* p, fmbNode key, const char* k, const char* what) {
+  const char* exp[FMB_EXPECTED_MAX];
+  const int n = expected_keys(p, exp);
+  char expected[900] = "";
+  size_t used = 0;
+  const char* nearest = NULL;
+  int best = 1 << 20;
+  for (int i = 0; i < n; ++i) {
+    if (used + 40 < sizeof expected)
+      used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s", i ? ", " : "", exp[i]);
+    const int d = key_distance(k, exp[i]);
+    if (is_typo_of(k, exp[i]) && d < best) best = d, nearest = exp[i];
+  }
+  if (nearest)
+    return fmb_parse_error(p, key, "unknown key '%s' in %s: did you mean '%s'? (expected one of: %s)", k, what, nearest,
+                           expected);
+  return fmb_parse_error(p, key, "unknown key '%s' in %s (expected one of: %s)", k, what, expected);
+}
+
+/* whether `k` may stand in the current mapping: read already, or declared (fmbp_expect) */
+static int key_expected(const fmbParser* p, const char* k) {
+  const char* exp[FMB_EXPECTED_MAX];
+  const int n = expected_keys(p, exp);
+  for (int i = 0; i < n; ++i)
+    if (strcmp(exp[i], k) == 0) return 1;
+  return strcmp(k, "material") == 0 || strcmp(k, "section") == 0;
+}
+
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
   yaml_node_t* nd = fmbp_node(p, map);
   if (!nd || nd->type != YAML_MAPPING_NODE) return 0;
   for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr) {
     if (pr->key <= p->nnodes_cap && p->known[pr->key]) continue;
     const char* k = fmbp_scalar(p, pr->key);
-    char expected[600] = "";
-    size_t used = 0;
-    for (int i = 0; i < p->nlooked && used + 40 < sizeof expected; ++i)
-      used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s", i ? ", " : "", p->looked[i]);
     if (!k) return fmb_parse_error(p, pr->key, "keys must be plain words in %s", what);
-    return fmb_parse_error(p, pr->key, "unknown key '%s' in %s (expected one of: %s)", k, what, expected);
+    if (p->expect_complete && key_expected(p, k)) { /* a key of the type that these settings do not read */
+      char read[600] = "";
+      for (int i = 0, used = 0; i < p->nlooked && used + 40 < (int)sizeof read; ++i)
+        used += snprintf(read + used, sizeof read - used, "%s%s", i ? ", " : "", p->looked[i]);
+      return fmb_parse_error(p, pr->key, "key '%s' does not apply to %s as written: it is read only with other "
+                             "settings (keys read here: %s)", k, what, read);
+    }
+    return unknown_key_error(p, pr->key, k, what);
   }
   return 0;
+}
+
+/* A required key is missing. A key beside it that the mapping may not have is reported first:
+   it is most often the required key misspelt (`lenght:`), and "missing 'length'" at the item
+   would name the consequence, not the mistake. With the mapping's keys declared (fmbp_expect)
+   any unknown key counts, the nearest to the missing one first; without, only a typo of it. */
+static int missing_key(fmbParser* p, fmbNode map, const char* key, const char* what) {
+  yaml_node_t* nd = fmbp_node(p, map);
+  fmbNode culprit = -1;
+  const char* ck = NULL;
+  int best = 1 << 20;
+  const int declared = p->expect_complete;
+  for (yaml_node_pair_t* pr = nd && nd->type == YAML_MAPPING_NODE ? nd->data.mapping.pairs.start : NULL;
+       pr && pr < nd->data.mapping.pairs.top; ++pr) {
+    if (pr->key <= p->nnodes_cap && p->known[pr->key]) continue;
+    const char* k = fmbp_scalar(p, pr->key);
+    if (!k || key_expected(p, k)) continue;
+    const int d = key_distance(k, key);
+    if ((declared || is_typo_of(k, key)) && d < best) best = d, culprit = pr->key, ck = k;
+  }
+  if (culprit >= 0) {
+    char where[300];
+    snprintf(where, sizeof where, "%s, which lacks the required '%s'", p->what ? p->what : "this mapping", key);
+    return unknown_key_error(p, culprit, ck, where);
+  }
+  return fmb_parse_error(p, map, "missing required key '%s' (%s)", key, what);
 }
 
 /* FNV-1a: the duplicate-key check's hash */
@@ -287,37 +332,55 @@ static int number_at(fmbParser* p, fmbNode n, const char* key, unsigned flags, d
 }
 
 static int absent(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* what) {
-  if (flags & FMB_REQUIRED) return fmb_parse_error(p, map, "missing required key '%s' (%s)", key, what);
+  if (flags & FMB_REQUIRED) return missing_key(p, map, key, what);
   return 0;
+}
+
+/* Values far outside what their unit means for any real material or part: most often a number
+   written in another unit (Young's modulus in GPa, a density in g/cm^3, a length in mm), which
+   runs (or fails much later, at t = 0.11 s with a generic solver message) without a word. Each
+   rule applies to a key by the SI unit its type declares (fmbParam.unit; `key` NULL = any key of
+   that unit) and warns once per scene. The bounds leave every structural solid inside: moduli from
+   soft rubber (~1e6 Pa) to diamond (1.2e12 Pa), densities from balsa (~100 kg/m^3) to osmium
+   (22,590 kg/m^3), beams from 0.1 mm to 100 m. The density's lower bound is 100, not 1 kg/m^3:
+   in g/cm^3 every metal lies between 1.7 and 22.6, so a bound of 1 would catch none of them;
+   a foam or an aerogel below 100 kg/m^3 still runs, with the warning. */
+static const struct {
+  const char* unit;
+  const char* key;
+  double lo, hi;
+  const char *below, *above; /* the likely mistake */
+} plausibility[] = {
+    {"Pa", NULL, 1e5, 1e13, "GPa or MPa given as Pa? 70 GPa is 70e9", "an exponent too large? diamond is 1.2e12 Pa"},
+    {"kg/m^3", NULL, 100.0, 1e5, "g/cm^3 or t/m^3 given as kg/m^3? aluminium is 2767 kg/m^3 = 2.767 g/cm^3",
+     "g/m^3 or an exponent too large? osmium, the densest element, is 22590 kg/m^3"},
+    {"m", "length", 1e-4, 100.0, "km given as m?", "mm given as m? 1000 mm is 1 m"},
+};
+
+static void check_plausible(fmbParser* p, fmbNode n, const char* key, double value) {
+  const fmbParam* par = NULL;
+  for (int i = 0; p->params && p->params[i].key && !par; ++i)
+    if (strcmp(p->params[i].key, key) == 0) par = &p->params[i];
+  if (!par || !par->unit) return;
+  for (unsigned r = 0; r < sizeof plausibility / sizeof plausibility[0]; ++r) {
+    if (strcmp(par->unit, plausibility[r].unit) != 0 || (plausibility[r].key && strcmp(plausibility[r].key, key) != 0))
+      continue;
+    const int low = value < plausibility[r].lo, high = value > plausibility[r].hi;
+    if ((!low && !high) || (p->plausibility_warned & (1u << r))) continue;
+    p->plausibility_warned |= 1u << r;
+    fmbp_warning_at(p, n, "'%s: %g' %s %g %s, outside the range of real parts and materials (%g to %g %s): %s", key, value,
+               low ? "is below" : "is above", low ? plausibility[r].lo : plausibility[r].hi, par->unit,
+               plausibility[r].lo, plausibility[r].hi, par->unit, low ? plausibility[r].below : plausibility[r].above);
+  }
 }
 
 int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out) {
   if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
   if (n < 0) return absent(p, map, key, flags, "a number");
-  return number_at(p, n, key, flags, out);
-}
-
-/* a warning does not stop the load: FILE:LINE:COL: warning: ... (or the override) to the thread's
-   warn handler (warn.c) */
-static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-static void warning_at(fmbParser* p, fmbNode node, const char* fmt, ...) {
-  char msg[600];
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(msg, sizeof msg, fmt, ap);
-  va_end(ap);
-  fmbDiag w;
-  memset(&w, 0, sizeof w);
-  diag_at(p, node, &w, msg);
-  if (w.line > 0)
-    fmb_warn(NULL, "%s:%d:%d: warning: %s", w.file, w.line, w.col, w.msg);
-  else
-    fmb_warn(NULL, "%s: warning: %s", w.file, w.msg);
+  const int rc = number_at(p, n, key, flags, out);
+  if (rc == 0) check_plausible(p, n, key, *out);
+  return rc;
 }
 
 /* `1.2` (radians), `1.2 rad`, `120 deg` (or without the space) */
@@ -351,7 +414,7 @@ int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
   if ((flags & FMB_NONNEGATIVE) && !(v >= 0))
     return fmb_parse_error(p, n, "expected a non-negative angle for '%s', got %s", key, s);
   if ((flags & FMB_POSE) && !*unit && fabs(v) > two_pi)
-    warning_at(p, n, "'%s: %s' is taken as radians (%.3g turns); write '%s deg' if degrees were meant", key, s,
+    fmbp_warning_at(p, n, "'%s: %s' is taken as radians (%.3g turns); write '%s deg' if degrees were meant", key, s,
                fabs(v) / two_pi, s);
   *out = v * scale;
   return 0;
@@ -446,13 +509,26 @@ static int table_rows(fmbParser* p, fmbNode n, const char* key, double* x, doubl
     return 0;
   }
   const char* name = fmbp_scalar(p, n);
-  char path[1024], line[512];
+  char path[1024], line[4096];
   sibling_path(p->path, name, path, sizeof path);
   FILE* f = fopen(path, "r");
   if (!f) return fmb_parse_error(p, n, "cannot read the table file '%s' for '%s': %s", path, key, strerror(errno));
   int lineno = 0, header_ok = 1;
   while (fgets(line, sizeof line, f)) {
     ++lineno;
+    /* a line longer than the buffer must not become two rows (its tail read as the next line):
+       a long comment is skipped whole, a long row refused */
+    const size_t len = strlen(line);
+    if (len == sizeof line - 1 && line[len - 1] != '\n') {
+      const int comment = line[strspn(line, " \t")] == '#';
+      int c;
+      while ((c = getc(f)) != EOF && c != '\n') {
+      }
+      if (comment) continue;
+      fclose(f);
+      return fmb_parse_error(p, n, "table file '%s' line %d: longer than %d characters; a row is 't,value'", path,
+                             lineno, (int)sizeof line - 2);
+    }
     double v[2];
     int r = table_file_row(line, v);
     if (r == 1) continue;
@@ -503,7 +579,11 @@ int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, c
   for (int i = 0; choices[i] && used + 40 < sizeof list; ++i)
     used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", choices[i]);
   if (n < 0) {
-    if (flags & FMB_REQUIRED) return fmb_parse_error(p, map, "missing required key '%s' (one of: %s)", key, list);
+    if (flags & FMB_REQUIRED) {
+      char what[420];
+      snprintf(what, sizeof what, "one of: %s", list);
+      return missing_key(p, map, key, what);
+    }
     return 0;
   }
   const char* s = fmbp_scalar(p, n);
@@ -519,7 +599,7 @@ int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, c
 
 int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]) {
   fmbNode n = fmb_find_key(p, map, key);
-  if (n < 0) return fmb_parse_error(p, map, "missing required key '%s' (a name)", key);
+  if (n < 0) return missing_key(p, map, key, "a name");
   const char* s = fmbp_scalar(p, n);
   if (!s || !*s) return fmb_parse_error(p, n, "expected a name for '%s', found %s", key, node_kind(fmbp_node(p, n)));
   size_t len = strlen(s);
@@ -649,7 +729,7 @@ static void mark_override(fmbParser* p, int first_new, int ov) {
 static int apply_override(fmbParser* p, int ov) {
   const char* full = p->overrides[ov];
   char shown[FMB_OVERRIDE_SHOWN + 32];
-  const char* text = shown_override(full, shown);
+  const char* text = fmbp_shown_override(full, shown);
   const char* eq = strchr(full, '=');
   if (!eq || eq == full) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected PATH=VALUE, e.g. solver.rtol=1e-8", text);
@@ -804,6 +884,41 @@ static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* p
     return;
   }
   yaml_mark_t mk = parser->problem_mark, cm = parser->context_mark;
+  /* libyaml's wording describes its own state; the usual causes get a sentence a person can act
+     on, with libyaml's text after it for the rest */
+  int at = -1; /* the character at the problem's line and column (columns count characters) */
+  rewind(f);
+  for (size_t line = 0, col = 0; (at = getc(f)) != EOF;) {
+    if (line == mk.line && col == mk.column && (at & 0xC0) != 0x80) break;
+    if (at == '\n') ++line, col = 0;
+    else if ((at & 0xC0) != 0x80) ++col;
+    if (line > mk.line) {
+      at = -1;
+      break;
+    }
+  }
+  const char* plain = NULL;
+  char plain_buf[300];
+  if (strstr(problem, "cannot start any token") && at == '\t')
+    plain = "tabs are not allowed for indentation; use spaces";
+  else if (strstr(problem, "cannot start any token") && at > ' ' && at < 127) {
+    snprintf(plain_buf, sizeof plain_buf, "'%c' cannot start a value; put the value in quotes (\"%c...\")", at, at);
+    plain = plain_buf;
+  } else if (strstr(problem, "did not find expected key") || strstr(problem, "did not find expected '-' indicator")) {
+    snprintf(plain_buf, sizeof plain_buf,
+             "bad indentation at line %d: the keys of one mapping, and the '- ' items of one list, must start in the "
+             "same column as the others (the block began at line %d, column %d)",
+             (int)mk.line + 1, (int)cm.line + 1, (int)cm.column + 1);
+    plain = plain_buf;
+  } else if (strstr(problem, "mapping values are not allowed")) {
+    plain = "a ':' where no key may start: a line indented deeper than the key above it, or a value with ': ' in "
+            "it that needs quotes";
+  }
+  if (plain) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1, "%s (YAML: %s%s%s)", plain,
+                 problem, parser->context ? " " : "", parser->context ? parser->context : "");
+    return;
+  }
   if (parser->context && (cm.line != mk.line || cm.column != mk.column))
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, (int)mk.line + 1, (int)mk.column + 1,
                  "YAML syntax error: %s %s (which began at line %d, column %d)", problem, parser->context,
@@ -1126,15 +1241,18 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   fclose(f);
   if (rc) return -1;
 
+  /* the top-level keys as the loader reads them (engine/scene.c): the first two are required */
+  char top[400] = "";
+  for (size_t i = 0, used = 0; fmb_scene_keys[i] && used + 40 < sizeof top; ++i)
+    used += (size_t)snprintf(top + used, sizeof top - used, "%s%s", i == 0 ? "" : i == 2 ? " (and optionally " : ", ",
+                             fmb_scene_keys[i]);
   if (!yaml_document_get_root_node(&p->doc)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1,
-                 "the scene file is empty: expected a mapping with keys solver, bodies (and optionally gravity, joints, outputs)");
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1, "the scene file is empty: expected a mapping with keys %s)", top);
     return -1;
   }
   if (!fmbp_is_map(p, fmbp_root(p)))
-    return fmb_parse_error(p, fmbp_root(p),
-                         "expected a mapping with keys solver, bodies, gravity, joints, outputs at the top, found %s",
-                         node_kind(fmbp_node(p, fmbp_root(p))));
+    return fmb_parse_error(p, fmbp_root(p), "expected a mapping with keys %s) at the top, found %s", top,
+                           node_kind(fmbp_node(p, fmbp_root(p))));
   grow_override_marks(p);
   if (check_duplicates(p)) return -1;
   for (int i = 0; i < noverrides; ++i)

@@ -57,4 +57,5 @@ const fmbJointType fmb_joint_revolute = {
     .output = revolute_output,
     .params = revolute_params,
     .example = "body1: a\nbody2: b\npoint1: [0.5, 0]\npoint2: [-0.5, 0]\n",
+    .flags = FMB_TYPE_CONFORM_FIXTURE, /* conform's pin of body a to ground */
 };

@@ -7,8 +7,32 @@
 
 const char* const fmbj_law_names[] = {"constant", "ramp", "harmonic", "spinup", "table", "input", NULL};
 
-static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
+/* The slope at each row of a position table: the derivative of the parabola through the row and
+   its two neighbours (at the ends, the parabola through the first or last three rows), exact
+   when f is quadratic in t, whatever the spacing; with two rows, the line's slope. */
+static void table_slopes(const double* t, const double* s, int n, double* d) {
+  if (n == 2) {
+    d[0] = d[1] = (s[1] - s[0]) / (t[1] - t[0]);
+    return;
+  }
+  for (int i = 0; i < n; ++i) {
+    const int k = i == 0 ? 1 : i == n - 1 ? n - 2 : i; /* the middle row of the three */
+    const double h0 = t[k] - t[k - 1], h1 = t[k + 1] - t[k];
+    const double d0 = (s[k] - s[k - 1]) / h0, d1 = (s[k + 1] - s[k]) / h1, c = (d1 - d0) / (h0 + h1);
+    /* the parabola s[k] + b (x - t[k]) + c (x - t[k])^2, b from the two secants */
+    const double b = (h1 * d0 + h0 * d1) / (h0 + h1);
+    const double x = t[i] - t[k];
+    d[i] = b + 2.0 * c * x;
+  }
+}
+
+static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law, int smooth) {
   if (fmb_get_table(p, item, "table", FMB_REQUIRED, &law->t, &law->s, &law->n)) return -1;
+  if (smooth) {
+    law->slope = calloc((size_t)law->n, sizeof(double));
+    if (!law->slope) return fmb_parse_error(p, item, "out of memory");
+    table_slopes(law->t, law->s, law->n, law->slope);
+  }
   law->integral = calloc((size_t)law->n, sizeof(double));
   if (!law->integral) return fmb_parse_error(p, item, "out of memory");
   for (int i = 1; i < law->n; ++i) /* trapezoid rule: exact for a piecewise-linear s */
@@ -18,7 +42,8 @@ static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
   return 0;
 }
 
-static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law, int angular) {
+/* the law's own keys; smooth: a position table (a prescribed motion); angular: an angle (a drive) */
+static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law, int smooth, int angular) {
   switch (law->kind) {
     case FMB_LAW_INPUT:
       return angular ? fmb_get_angle(p, item, "value", 0, &law->value) : fmb_get_double(p, item, "value", 0, &law->value);
@@ -29,7 +54,7 @@ static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law, int angular) 
                      fmb_get_angle(p, item, "phase", 0, &law->phase)
                  ? -1
                  : 0;
-    case FMB_LAW_TABLE: return table_setup(p, item, law);
+    case FMB_LAW_TABLE: return table_setup(p, item, law, smooth);
     default: return 0;
   }
 }
@@ -39,20 +64,57 @@ int fmbj_law_parse(fmbParser* p, fmbNode item, fmbTimeLaw* law) {
   int kind = FMB_LAW_CONSTANT;
   if (fmb_get_choice(p, item, "law", 0, fmbj_law_names, &kind)) return -1;
   law->kind = (fmbLawKind)kind;
-  return parse_kind(p, item, law, 0);
+  return parse_kind(p, item, law, 0, 0);
 }
 
 void fmbj_law_free(fmbTimeLaw* law) {
   free(law->t);
   free(law->s);
   free(law->integral);
-  law->t = law->s = law->integral = NULL;
+  free(law->slope);
+  law->t = law->s = law->integral = law->slope = NULL;
 }
 
 const char* fmbj_law_name(const fmbTimeLaw* law) { return fmbj_law_names[law->kind]; }
 
+/* the row lo with t[lo] <= t < t[lo + 1], for t[0] < t < t[n - 1] (bisection) */
+static int table_segment(const fmbTimeLaw* law, double t) {
+  int lo = 0, hi = law->n - 1;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    if (law->t[mid] <= t)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return lo;
+}
+
+/* a position table: the cubic Hermite through the rows with their slopes, straight on along the
+   end slopes outside (s, rate, accel; no integral: a position law is not integrated) */
+static fmbLawValue smooth_table_eval(const fmbTimeLaw* law, double t) {
+  fmbLawValue v = {0, 0, 0, 0};
+  const int n = law->n;
+  if (t <= law->t[0] || t >= law->t[n - 1]) {
+    const int e = t <= law->t[0] ? 0 : n - 1;
+    v.rate = law->slope[e];
+    v.s = law->s[e] + v.rate * (t - law->t[e]);
+    return v;
+  }
+  const int lo = table_segment(law, t), hi = lo + 1;
+  const double h = law->t[hi] - law->t[lo], x = (t - law->t[lo]) / h;
+  const double s0 = law->s[lo], s1 = law->s[hi], d0 = law->slope[lo] * h, d1 = law->slope[hi] * h;
+  /* Hermite basis on x in [0, 1]; d/dt = (d/dx) / h */
+  const double x2 = x * x, x3 = x2 * x;
+  v.s = (2 * x3 - 3 * x2 + 1) * s0 + (x3 - 2 * x2 + x) * d0 + (-2 * x3 + 3 * x2) * s1 + (x3 - x2) * d1;
+  v.rate = ((6 * x2 - 6 * x) * s0 + (3 * x2 - 4 * x + 1) * d0 + (-6 * x2 + 6 * x) * s1 + (3 * x2 - 2 * x) * d1) / h;
+  v.accel = ((12 * x - 6) * s0 + (6 * x - 4) * d0 + (-12 * x + 6) * s1 + (6 * x - 2) * d1) / (h * h);
+  return v;
+}
+
 /* piecewise-linear table: s, slope and the integral from t[0] (s held at the end values) */
 static fmbLawValue table_eval(const fmbTimeLaw* law, double t) {
+  if (law->slope) return smooth_table_eval(law, t);
   fmbLawValue v = {0, 0, 0, 0};
   const int n = law->n;
   if (t <= law->t[0]) {
@@ -62,14 +124,7 @@ static fmbLawValue table_eval(const fmbTimeLaw* law, double t) {
     v.s = law->s[n - 1];
     v.integral = law->integral[n - 1] + law->s[n - 1] * (t - law->t[n - 1]);
   } else {
-    int lo = 0, hi = n - 1; /* bisection: t[lo] <= t < t[hi] */
-    while (hi - lo > 1) {
-      const int mid = (lo + hi) / 2;
-      if (law->t[mid] <= t)
-        lo = mid;
-      else
-        hi = mid;
-    }
+    const int lo = table_segment(law, t), hi = lo + 1;
     const double h = t - law->t[lo];
     v.rate = (law->s[hi] - law->s[lo]) / (law->t[hi] - law->t[lo]);
     v.s = law->s[lo] + v.rate * h;
@@ -156,7 +211,7 @@ int fmbj_motion_parse(fmbParser* p, fmbNode item, int angular, fmbMotion* mo) {
     case FMB_LAW_TABLE:
     case FMB_LAW_INPUT: break;
   }
-  return rc || parse_kind(p, item, &mo->law, angular) ? -1 : 0;
+  return rc || parse_kind(p, item, &mo->law, 1, angular) ? -1 : 0;
 }
 
 void fmbj_motion_eval(const fmbMotion* mo, const fmbJointEval* ev, double f[3]) {

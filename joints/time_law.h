@@ -7,6 +7,7 @@
  *   spinup    s = t/Tn - sin(2 pi t/Tn)/(2 pi) for t <= Tn, 1 after: the speed profile of
  *             Liu, Hong & Liu (2009), Eq. 41 (its integral is the paper's spin-up angle)
  *   table     s piecewise linear through [t, value] rows, held at the end values outside
+ *             (a load's); a prescribed motion's table is smooth instead (see fmbMotion)
  *   input     s set by a program between steps (fmb_set_input; the joint's `input` op), constant
  *             between two settings; `value:` is its value until then (issue 24, docs/api.md)
  * A load multiplies its force and torque by s(t); a prescribed motion (fmbMotion) is either a
@@ -24,7 +25,10 @@ typedef struct {
   int n;                        /* table rows */
   double *t, *s, *integral;     /* table points; integral of s from t[0] to t[i] */
   double integral_at_zero;      /* of s from t[0] to 0 (tables may start before or after 0) */
-  double value;                 /* input: the initial value (`value:`) */
+  /* a position table (a prescribed motion): C1 cubic Hermite through the rows, continued along the
+     end slopes, with the slope at each row (NULL for a load's piecewise-linear table) */
+  double* slope;
+  double value; /* input: the initial value (`value:`) */
 } fmbTimeLaw;
 
 /* s, ds/dt, d2s/dt2 and the integral of s from 0 to t */
@@ -50,7 +54,12 @@ const char* fmbj_law_name(const fmbTimeLaw* law);
      ramp     (speed, ramp_time):   the speed ramps linearly to `speed` over ramp_time
      spinup   (omega0, ramp_time):  Eq. 41, the speed rises smoothly to omega0 over ramp_time
      harmonic (amplitude, frequency, phase):  f = amplitude sin(frequency t + phase)
-     table    (table):              f piecewise linear through the [t, f] rows
+     table    (table):              f through the [t, f] rows, cubic between them with the slope
+                                    of the parabola through each row and its neighbours, and
+                                    straight on along the end slopes outside: continuous speed,
+                                    so a rigid drive can follow it (a piecewise-linear angle
+                                    jumps in speed at every row: an impulse no solver steps over);
+                                    exact for f quadratic in t
      input    (value):              f set by a program between steps, held between settings */
 typedef struct {
   fmbTimeLaw law;

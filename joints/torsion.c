@@ -79,15 +79,28 @@ static int torsion_output(const void* self, int id, const fmbJointEval* ev, doub
 
 static void torsion_describe(const void* self, FILE* out) {
   const Torsion* s = self;
-  fprintf(out, "rotational spring-damper k = %g N m/rad, c = %g N m s/rad, set point %g rad\n", s->stiffness, s->damping,
-          s->angle0);
+  fprintf(out, "rotational spring-damper k = %g N m/rad, c = %g N m s/rad, set point %g rad\n", s->stiffness,
+          s->damping, s->angle0);
 }
 
 static const fmbParam torsion_params[] = {
     FMBJ_TWO_POINT_PARAMS,
-    {.key = "stiffness", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_NONNEGATIVE, .unit = "N m/rad", .doc = "rate k"},
-    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "N m s/rad", .fallback = "0", .doc = "rate c"},
-    {.key = "angle0", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "relative angle where it is relaxed (set point)"},
+    {.key = "stiffness",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_REQUIRED | FMB_NONNEGATIVE,
+     .unit = "N m/rad",
+     .doc = "rate k"},
+    {.key = "damping",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_NONNEGATIVE,
+     .unit = "N m s/rad",
+     .fallback = "0",
+     .doc = "rate c"},
+    {.key = "angle0",
+     .kind = FMB_PARAM_NUMBER,
+     .unit = "rad",
+     .fallback = "0",
+     .doc = "relative angle where it is relaxed (set point)"},
     {.key = NULL},
 };
 

@@ -31,13 +31,19 @@ fmbRegistry* fmb_cli_registry(void) {
   return cli_registry;
 }
 
-void fmb_cli_print_diag(const fmbDiag* d) {
+void fmb_cli_format_diag(const fmbDiag* d, char* buf, size_t len) {
   if (d->line > 0)
-    fprintf(stderr, "%s:%d:%d: error: %s\n", d->file, d->line, d->col, d->msg);
+    snprintf(buf, len, "%s:%d:%d: error: %s", d->file, d->line, d->col, d->msg);
   else if (d->file[0])
-    fprintf(stderr, "%s: error: %s\n", d->file, d->msg);
+    snprintf(buf, len, "%s: error: %s", d->file, d->msg);
   else
-    fprintf(stderr, "error: %s\n", d->msg);
+    snprintf(buf, len, "error: %s", d->msg);
+}
+
+void fmb_cli_print_diag(const fmbDiag* d) {
+  char text[sizeof d->file + sizeof d->msg + 64];
+  fmb_cli_format_diag(d, text, sizeof text);
+  fprintf(stderr, "%s\n", text);
 }
 
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what) {

@@ -7,6 +7,15 @@
 
 #define FMB_CLI_MAX_OVERRIDES 256
 
+/* what a result records as the build that made it (CMakeLists.txt defines both for the files
+   that write them: regression references, sweep run ids, sweep.h5) */
+#ifndef FLEXMBD_VERSION
+#define FLEXMBD_VERSION "unknown"
+#endif
+#ifndef FLEXMBD_COMMIT
+#define FLEXMBD_COMMIT "unknown"
+#endif
+
 /* a scene and its --set overrides, as `run`, `check` and the analysis commands take them */
 typedef struct fmbCliScene {
   const char* scene;
@@ -22,8 +31,11 @@ typedef struct fmbCliScene {
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
 /* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
-/* file:line:col: error: msg (or the shorter forms when no location is known) */
+/* file:line:col: error: msg (or the shorter forms when no location is known), on stderr or in buf */
 void fmb_cli_print_diag(const fmbDiag* d);
+void fmb_cli_format_diag(const fmbDiag* d, char* buf, size_t len);
+/* `run SCENE --serve`: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
+int fmb_run_serve(const fmbCliScene* s);
 /* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
    else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
 int fmb_cli_check_input(const char* path, const char* what);
@@ -39,8 +51,21 @@ void fmb_cli_warn_end(void);
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
 
-/* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c) */
-int fmb_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet);
+/* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c
+   over the library's fmb_run_models) */
+int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet);
+
+/* `compare`'s work on parsed options (tools/cmd_compare.c), also `run --reference`'s: one line per
+   column on stdout; returns compare's exit code */
+typedef struct fmbCliCompare {
+  const char *out, *ref; /* the run's CSV and the reference's */
+  const char* columns;   /* "a,b,..." or NULL: every column (both files must have the same) */
+  const char* tag;       /* appended to every line (run --reference: the run's cost), or NULL */
+  double rtol, atol;
+  int check;             /* apply rtol/atol: status=ok|beyond, exit 1 beyond */
+  int common;            /* the columns both files have; a missing or extra one is no failure */
+} fmbCliCompare;
+int fmb_cli_compare(const fmbCliCompare* c);
 
 /* the commands */
 int fmb_cmd_run(int argc, char** argv);
@@ -54,6 +79,7 @@ int fmb_cmd_new(int argc, char** argv);
 int fmb_cmd_static(int argc, char** argv);
 int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
+int fmb_cmd_sweep(int argc, char** argv);
 /* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
 typedef struct fmbCliAnalysis {
   fmbStaticOptions opt; /* --at T, --quiet */
@@ -69,4 +95,10 @@ int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fm
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
                          double** yp, fmbStaticResult* res, fmbDiag* diag);
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
+/* the modes at one speed (steady state, then modes): 0 with *out, or an exit code with *diag */
+typedef int (*fmbCliModesAt)(void* ctx, double speed, fmbModes** out, fmbDiag* diag);
+/* at(ctx, speeds[i]) for every i in child processes, `jobs` at once (tools/modes_pool.c): out[i]
+   for i < *done (the speeds before the first that failed, whose code and *diag are returned) */
+int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx, fmbModes** out,
+                              int* done, fmbDiag* diag);
 #endif

@@ -1,11 +1,12 @@
-/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K]
+/* cmd_campbell.c — `flexmbd campbell SCENE --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j J]
  *                    [--at T] [-o campbell.csv] [--plot campbell.png] [--eigen dense|sparse|auto]
  *                    [--set PATH=VALUE]...`
  * For each hub speed (PATH: the scene key that sets it, e.g. joints.spin.speed): the steady state,
  * then its modes. CSV columns: speed, mode1 ... modeK (rad/s; negative = divergent), the modes
  * followed from speed to speed by shape (greatest modal assurance criterion, MAC), not by order.
  * With -o FILE.csv a PNG is drawn beside it (FILE.png, or --plot) with gnuplot. On a failure the
- * speeds done so far are written and the exit code is run's (2 bad input, 3 solver). */
+ * speeds done so far are written and the exit code is run's (2 bad input, 3 solver). The diagram
+ * itself is the library's (fmb_campbell, engine/campbell.c); this file parses, writes and plots. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -14,9 +15,16 @@
 #include "cli.h"
 
 #define MAX_SPEEDS 10000
-#define MAX_TRACKED 64
-#define EXTRA_MODES 6 /* computed beyond K so that a mode crossing from above can be followed */
 
+/* one speed's modes, for the child processes of -j J (tools/modes_pool.c) */
+typedef struct {
+  const fmbSceneSource* scene;
+  const fmbCampbellOptions* opt;
+} Speed;
+static int modes_at(void* ctx, double speed, fmbModes** out, fmbDiag* diag) {
+  const Speed* c = ctx;
+  return fmb_campbell_modes_at(c->scene, c->opt, speed, out, diag);
+}
 
 /* "A:B:N" (N values from A to B) or "S1,S2,..."; returns the count or -1 */
 static int parse_speeds(const char* text, double* out) {
@@ -24,7 +32,7 @@ static int parse_speeds(const char* text, double* out) {
   int n;
   char tail;
   if (sscanf(text, "%lf:%lf:%d%c", &a, &b, &n, &tail) == 3) {
-    if (n < 1 || n > MAX_SPEEDS) return -1;
+    if (n < 1 || n > MAX_SPEEDS || !isfinite(a) || !isfinite(b)) return -1; /* nan, inf: bad input */
     for (int i = 0; i < n; ++i) out[i] = n == 1 ? a : a + (b - a) * i / (n - 1);
     return n;
   }
@@ -33,7 +41,7 @@ static int parse_speeds(const char* text, double* out) {
   while (*p && n < MAX_SPEEDS) {
     char* end;
     out[n++] = strtod(p, &end);
-    if (end == p || (*end != ',' && *end != '\0')) return -1;
+    if (end == p || (*end != ',' && *end != '\0') || !isfinite(out[n - 1])) return -1;
     p = *end ? end + 1 : end;
   }
   return *p ? -1 : n;
@@ -62,15 +70,44 @@ static void plot(const char* csv, const char* png, int count, const char* title)
   if (fmb_safe_close(fig, ok) != 0 || !ok) fprintf(stderr, "flexmbd campbell: gnuplot failed, no plot (%s)\n", png);
 }
 
+/* the diagram's rows as the CSV has them: speed, then mode1 ... modeK */
+static int write_csv(const char* out, const fmbCampbell* c) {
+  const int ncol = c->count + 1;
+  double* rows = calloc((size_t)(c->done > 0 ? c->done : 1) * (size_t)ncol, sizeof(double));
+  char** names = calloc((size_t)ncol, sizeof(char*));
+  char* text = calloc((size_t)ncol, 16);
+  fmbDiag wd;
+  memset(&wd, 0, sizeof wd);
+  int rc = rows && names && text ? 0 : FMB_EXIT_SOLVER;
+  if (!rc) {
+    names[0] = "speed";
+    for (int k = 0; k < c->count; ++k) {
+      names[k + 1] = text + 16 * (size_t)(k + 1);
+      snprintf(names[k + 1], 16, "mode%d", k + 1);
+    }
+    for (int i = 0; i < c->done; ++i) {
+      rows[(size_t)i * ncol] = c->speed[i];
+      memcpy(rows + (size_t)i * ncol + 1, c->frequency + (size_t)i * c->count, sizeof(double) * (size_t)c->count);
+    }
+    rc = fmb_write_table(out, ncol, (const char* const*)names, c->done, rows, &wd);
+    if (rc) fmb_cli_print_diag(&wd);
+  }
+  free(text);
+  free(names);
+  free(rows);
+  return rc;
+}
+
 int fmb_cmd_campbell(int argc, char** argv) {
   fmbCliScene s;
   memset(&s, 0, sizeof s);
   fmbCliAnalysis an;
   memset(&an, 0, sizeof an);
   an.count = 4;
-  an.count_max = MAX_TRACKED;
+  an.count_max = FMB_CAMPBELL_MAX_MODES;
   an.opt.quiet = 1;
   const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
+  int jobs = 1; /* -j J: the speeds' modes computed in J child processes (tools/modes_pool.c) */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("campbell", argc, argv, &i, &s);
@@ -83,6 +120,14 @@ int fmb_cmd_campbell(int argc, char** argv) {
       if (!(png = fmb_cli_value("campbell", argc, argv, &i, "a PNG file name"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--speed") == 0) {
       if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
+      const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of processes");
+      char* end;
+      jobs = v ? (int)strtol(v, &end, 10) : 0;
+      if (!v || *end || jobs < 1 || jobs > 1024) {
+        fprintf(stderr, "flexmbd campbell: -j expects 1 to 1024 processes\n");
+        return FMB_EXIT_BAD_INPUT;
+      }
     } else if (strcmp(a, "--speeds") == 0) {
       if (!(speeds_text = fmb_cli_value("campbell", argc, argv, &i, "A:B:N or S1,S2,..."))) return FMB_EXIT_BAD_INPUT;
     } else {
@@ -102,90 +147,51 @@ int fmb_cmd_campbell(int argc, char** argv) {
   double* speeds = malloc(MAX_SPEEDS * sizeof(double));
   const int nspeed = speeds ? parse_speeds(speeds_text, speeds) : -1;
   if (nspeed < 1) {
-    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,..., got '%s'\n",
+    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,... of finite speeds, got '%s'\n",
             MAX_SPEEDS, speeds_text);
     free(speeds);
     return FMB_EXIT_BAD_INPUT;
   }
-  const int ncol = count + 1;
-  double* rows = calloc((size_t)nspeed * ncol, sizeof(double));
-  char** names = calloc((size_t)ncol, sizeof(char*));
-  char override[600];
-  int rc = rows && names ? 0 : FMB_EXIT_SOLVER, done = 0;
+  const fmbSceneSource scene = {s.scene, s.overrides, s.nover, fmb_cli_registry()};
+  const fmbCampbellOptions opt = {path, count, an.method, an.opt};
+  /* fmb_campbell in its steps: each speed's modes (computable anywhere, e.g. in other processes),
+     then followed in order */
+  fmbCampbell* c = fmb_campbell_new(speeds, nspeed, count);
   fmbDiag diag;
   memset(&diag, 0, sizeof diag);
-  fmbModes* prev = NULL;
-  int track[MAX_TRACKED]; /* tracked mode k is mode track[k] of prev */
-  for (int i = 0; rc == 0 && i < nspeed; ++i) {
-    snprintf(override, sizeof override, "%s=%.17g", path, speeds[i]);
-    s.overrides[s.nover] = override;
-    fmbModel* m;
-    double *y, *yp;
-    fmbStaticResult res;
-    fmbModes* cur = NULL;
-    rc = fmb_cli_steady_state(&s, s.nover + 1, &an.opt, &m, &y, &yp, &res, &diag);
-    if (!rc) rc = fmb_modes(m, res.t, y, yp, count + EXTRA_MODES, an.method, &cur, &diag);
-    if (!rc && cur->count < count) {
-      fprintf(stderr, "flexmbd campbell: the scene has only %d modes; --count %d asks for more\n", cur->count, count);
-      rc = FMB_EXIT_BAD_INPUT;
+  int rc = c ? 0 : FMB_EXIT_SOLVER;
+  if (!c) snprintf(diag.msg, sizeof diag.msg, "out of memory");
+  /* -j J: every speed's modes at once in child processes, then followed in order as below */
+  Speed ctx = {&scene, &opt};
+  fmbModes** pre = jobs > 1 && !rc ? calloc((size_t)nspeed, sizeof *pre) : NULL;
+  int pre_done = 0, pre_rc = 0;
+  fmbDiag pre_diag;
+  memset(&pre_diag, 0, sizeof pre_diag);
+  if (pre) pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, pre, &pre_done, &pre_diag);
+  for (int i = 0; !rc && i < nspeed; ++i) {
+    fmbModes* modes = NULL;
+    if (!pre) {
+      rc = modes_at(&ctx, speeds[i], &modes, &diag);
+    } else if (i < pre_done) {
+      modes = pre[i];
+      pre[i] = NULL;
+    } else {
+      rc = pre_rc;
+      diag = pre_diag;
     }
-    if (!rc) {
-      /* follow the modes: greedy assignment by the largest MAC with the previous speed's shapes */
-      int next[MAX_TRACKED];
-      if (!prev) {
-        for (int k = 0; k < count; ++k) next[k] = k;
-      } else {
-        unsigned char taken_k[MAX_TRACKED] = {0}, taken_j[MAX_TRACKED + EXTRA_MODES] = {0};
-        for (int n = 0; n < count; ++n) {
-          double best = -1.0;
-          int bk = 0, bj = 0;
-          for (int k = 0; k < count; ++k)
-            for (int j = 0; j < cur->count && !taken_k[k]; ++j) {
-              if (taken_j[j]) continue;
-              const double mac = fmb_modes_mac(prev, track[k], cur, j);
-              if (mac > best) {
-                best = mac;
-                bk = k;
-                bj = j;
-              }
-            }
-          taken_k[bk] = taken_j[bj] = 1;
-          next[bk] = bj;
-          if (best < 0.5)
-            fprintf(stderr, "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
-                            "take finer speed steps\n", speeds[i], bk + 1, best);
-        }
-      }
-      rows[(size_t)i * ncol] = speeds[i];
-      for (int k = 0; k < count; ++k) {
-        track[k] = next[k];
-        rows[(size_t)i * ncol + 1 + k] = cur->frequency[next[k]];
-      }
-      fmb_modes_free(prev);
-      prev = cur;
-      cur = NULL;
-      done = i + 1;
-    }
-    fmb_modes_free(cur);
-    free(y);
-    free(yp);
-    fmb_free(m);
+    if (!rc && (rc = fmb_campbell_add(c, modes, &diag)) != 0)
+      snprintf(diag.file, sizeof diag.file, "%s", s.scene); /* too few modes: the scene's */
   }
-  fmb_modes_free(prev);
+  for (int i = 0; pre && i < nspeed; ++i) fmb_modes_free(pre[i]);
+  free(pre);
+  const int done = c ? c->done : 0;
+  for (int i = 1; i < done; ++i)
+    for (int k = 0; k < count; ++k)
+      if (c->mac[(size_t)i * count + k] < 0.5)
+        fprintf(stderr, "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
+                        "take finer speed steps\n", speeds[i], k + 1, c->mac[(size_t)i * count + k]);
   if (rc) fmb_cli_print_diag(&diag);
-  int wrc = 0;
-  if (names) {
-    names[0] = "speed";
-    for (int k = 0; k < count; ++k) {
-      names[k + 1] = malloc(16);
-      if (names[k + 1]) snprintf(names[k + 1], 16, "mode%d", k + 1);
-    }
-    fmbDiag wd;
-    memset(&wd, 0, sizeof wd);
-    wrc = fmb_write_table(out, ncol, (const char* const*)names, done, rows, &wd);
-    if (wrc) fmb_cli_print_diag(&wd);
-    for (int k = 0; k < count; ++k) free(names[k + 1]);
-  }
+  const int wrc = c ? write_csv(out, c) : 0;
   char pngbuf[1024];
   if (!png && out && strcmp(out, "-") != 0) {
     const size_t len = strlen(out);
@@ -199,8 +205,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
     plot(out, png, count, title);
   }
   fprintf(stderr, "stats: status=%s speeds=%d of %d modes=%d\n", rc ? "failed" : "ok", done, nspeed, count);
-  free(names);
-  free(rows);
+  fmb_campbell_free(c);
   free(speeds);
   return rc ? rc : wrc;
 }

@@ -59,25 +59,23 @@ static int column_set_differences(const fmbTable* out, const fmbTable* ref, cons
 }
 
 int fmb_cmd_compare(int argc, char** argv) {
-  const char* files[2] = {NULL, NULL};
-  const char* cols = NULL;
-  const char* tag = NULL; /* appended to every line: `flexmbd run --reference` adds the run's cost */
-  double rtol = 0.0, atol = 0.0;
-  int check = 0, common = 0, nf = 0;
+  fmbCliCompare c;
+  memset(&c, 0, sizeof c);
+  int nf = 0;
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     if (strcmp(a, "--tag") == 0 && i + 1 < argc) {
-      tag = argv[++i];
+      c.tag = argv[++i];
     } else if (strcmp(a, "--columns") == 0 || strcmp(a, "-c") == 0) {
-      if (!(cols = fmb_cli_value("compare", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
+      if (!(c.columns = fmb_cli_value("compare", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
     } else if (strncmp(a, "--columns=", 10) == 0) {
-      cols = a + 10;
+      c.columns = a + 10;
     } else if (strcmp(a, "--rtol") == 0 || strcmp(a, "--atol") == 0) {
       const char* v = fmb_cli_value("compare", argc, argv, &i, "a number");
-      if (!v || tolerance_arg(a, v, a[2] == 'r' ? &rtol : &atol)) return FMB_EXIT_BAD_INPUT;
-      check = 1;
+      if (!v || tolerance_arg(a, v, a[2] == 'r' ? &c.rtol : &c.atol)) return FMB_EXIT_BAD_INPUT;
+      c.check = 1;
     } else if (strcmp(a, "--common") == 0) {
-      common = 1;
+      c.common = 1;
     } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       usage(stdout);
       return 0;
@@ -86,7 +84,7 @@ int fmb_cmd_compare(int argc, char** argv) {
       usage(stderr);
       return FMB_EXIT_BAD_INPUT;
     } else if (nf < 2) {
-      files[nf++] = a;
+      *(nf++ ? &c.ref : &c.out) = a;
     } else {
       fprintf(stderr, "flexmbd compare: two CSV files, OUT and REF (got a third, '%s')\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -96,6 +94,15 @@ int fmb_cmd_compare(int argc, char** argv) {
     usage(stderr);
     return FMB_EXIT_BAD_INPUT;
   }
+  return fmb_cli_compare(&c);
+}
+
+int fmb_cli_compare(const fmbCliCompare* c) {
+  const char* files[2] = {c->out, c->ref};
+  const char* cols = c->columns;
+  const char* tag = c->tag;
+  const double rtol = c->rtol, atol = c->atol;
+  const int check = c->check, common = c->common;
   fmbTable out, ref;
   char err[600];
   if (fmb_table_load(files[0], &out, err, sizeof err)) {

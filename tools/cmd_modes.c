@@ -111,7 +111,7 @@ int fmb_cmd_modes(int argc, char** argv) {
       fprintf(stderr, "  %4d %16.8g %14.8g %14.6g%s\n", k + 1, md->frequency[k], md->frequency[k] / (2.0 * M_PI),
               md->damping_ratio[k], md->frequency[k] < 0 ? "   divergent (unstable)" : "");
   }
-  fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);
+  if (rc != FMB_EXIT_BAD_INPUT) fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);
   fmb_modes_free(md);
   free(y);
   free(yp);

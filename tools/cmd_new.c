@@ -77,7 +77,6 @@ static const Starter starters[] = {
      "solver:\n"
      "  t_end: 8.0               # s\n"
      "  output_step: 0.02        # s\n"
-     "  error_control: full      # a smooth prescribed motion: docs/scenes.md\n"
      "materials:\n"
      "  aluminium: {density: 2767.0, youngs_modulus: 68.95e9}\n"
      "sections:\n"

@@ -36,6 +36,7 @@ int fmb_cmd_run(int argc, char** argv) {
   int quiet = 0, progress = 0;
   const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
   const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
+  int serve = 0;             /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("run", argc, argv, &i, &s);
@@ -51,6 +52,8 @@ int fmb_cmd_run(int argc, char** argv) {
       if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = 1;
+    } else if (strcmp(a, "--serve") == 0) {
+      serve = 1;
     } else if (strcmp(a, "--progress") == 0) {
       progress = 1;
     } else if (strcmp(a, "--vtk") == 0) {
@@ -72,7 +75,8 @@ int fmb_cmd_run(int argc, char** argv) {
     fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
     return FMB_EXIT_BAD_INPUT;
   }
-  if (models) return fmb_run_models(&s, models, out, quiet);
+  if (models) return fmb_cli_run_models(&s, models, out, quiet);
+  if (serve) return fmb_run_serve(&s);
   fmbDiag diag;
   fmbStats stats;
   memset(&stats, 0, sizeof stats);
@@ -83,15 +87,11 @@ int fmb_cmd_run(int argc, char** argv) {
   for (int k = 0; k < s.nplugins; ++k) inputs[ninputs++] = s.plugins[k];
   int bad = reference ? fmb_cli_check_input(reference, "reference") : 0;
   if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
-  if (bad) {
-    fmb_print_stats(&stats, stderr);
-    return bad;
-  }
+  if (bad) return bad; /* nothing ran: no stats line */
   catch_stop_signals();
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
-    fmb_print_stats(&stats, stderr);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   /* the progress line: on a terminal once a run has taken 2 s; --progress asks for it anywhere
@@ -109,16 +109,13 @@ int fmb_cmd_run(int argc, char** argv) {
     /* one line per column on stdout: the error against the reference and what the run cost */
     char tag[160];
     snprintf(tag, sizeof tag, "status=%s cpu_s=%.4f steps=%ld", rc ? "failed" : "ok", stats.cpu_s, stats.steps);
-    char* cargv[10] = {argv[0], "compare", (char*)out, (char*)reference, "--tag", tag, "--common", NULL, NULL};
-    int cargc = 7;
-    if (columns) {
-      cargv[cargc++] = "--columns";
-      cargv[cargc++] = (char*)columns;
-    }
-    int crc = fmb_cmd_compare(cargc, cargv);
+    const fmbCliCompare c = {.out = out, .ref = reference, .columns = columns, .tag = tag, .common = 1};
+    int crc = fmb_cli_compare(&c);
     if (crc && !rc) rc = crc;
   }
-  fmb_print_stats(&stats, stderr);
+  /* the stats line tells what a run did; bad input (found in the initial pose, or an output that
+     cannot be written) ran nothing, and the error line is the last word */
+  if (rc != FMB_EXIT_BAD_INPUT) fmb_print_stats(&stats, stderr);
   fmb_free(m);
   return rc;
 }

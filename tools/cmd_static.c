@@ -2,6 +2,7 @@
  * The static equilibrium (or, under a constant-speed drive, the steady rotation) of the scene
  * with its drives held at t0 or T: the scene's outputs as one CSV row; the last stderr line is
  * `stats: status=... t=... speed=... iterations=... load_steps=... residual=... cpu_s=...`. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -12,8 +13,9 @@
 static int parse_time(const char* cmd, const char* text, double* t) {
   char* end;
   *t = strtod(text, &end);
-  if (end == text || *end != '\0') {
-    fprintf(stderr, "flexmbd %s: --at needs a time in seconds, got '%s'\n", cmd, text);
+  /* nan and inf parse as numbers; they are bad input, not a solver failure at t = nan */
+  if (end == text || *end != '\0' || !isfinite(*t)) {
+    fprintf(stderr, "flexmbd %s: --at needs a finite time in seconds, got '%s'\n", cmd, text);
     return FMB_EXIT_BAD_INPUT;
   }
   return 0;
@@ -56,14 +58,8 @@ int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fm
 
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
                          double** yp, fmbStaticResult* res, fmbDiag* diag) {
-  memset(res, 0, sizeof *res);
-  *y = *yp = NULL;
-  *m = fmb_load(s->scene, s->overrides, nover, fmb_cli_registry(), diag);
-  if (!*m) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
-  const int ny = fmb_state_size(*m);
-  *y = calloc((size_t)ny, sizeof(double));
-  *yp = calloc((size_t)ny, sizeof(double));
-  return *y && *yp ? fmb_static(*m, opt, *y, *yp, res, diag) : FMB_EXIT_SOLVER;
+  const fmbSceneSource scene = {s->scene, s->overrides, nover, fmb_cli_registry()};
+  return fmb_load_steady(&scene, NULL, opt, m, y, yp, res, diag);
 }
 
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f) {
@@ -105,7 +101,8 @@ int fmb_cmd_static(int argc, char** argv) {
   int rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
   if (!rc) rc = fmb_write_state_row(m, out, res.t, y, yp, &diag);
   if (rc) fmb_cli_print_diag(&diag);
-  fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);
+  /* bad input ran nothing: the error line is the last word, as for `run` */
+  if (rc != FMB_EXIT_BAD_INPUT) fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);
   free(y);
   free(yp);
   fmb_free(m);

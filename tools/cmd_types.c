@@ -38,8 +38,13 @@ static void print_params(const fmbParam* params) {
   }
 }
 
-static void print_outputs(const char* engine_given, const char* const* own) {
-  printf("    outputs: %s", engine_given);
+/* every output a scene may ask of an item of this type, as NAME.quantity: the engine's groups
+   (fmb_engine_outputs, the lists the loader resolves against) that apply, then the type's own */
+static void print_outputs(const char* const* const* groups, int ngroups, const char* extra, const char* const* own) {
+  printf("    outputs:");
+  for (int g = 0; g < ngroups; ++g)
+    for (const char* const* n = groups[g]; n && *n; ++n) printf(" %s", *n);
+  if (extra) printf(" %s", extra);
   for (; own && *own; ++own) printf(" %s", *own);
   printf("\n");
 }
@@ -56,20 +61,31 @@ int fmb_cmd_types(int argc, char** argv) {
   }
   const fmbRegistry* reg = fmb_cli_registry();
   if (!reg) return FMB_EXIT_BAD_INPUT;
-  printf("bodies (the frame outputs come with every body that has coordinates):\n");
+  const char* const* frame[] = {fmb_engine_outputs("frame")};
+  printf("bodies (x y theta omega vx vy: the frame, for every body whose marker places its origin; nodeK_*: "
+         "K = 0 .. elements; shape_N: N stations):\n");
   for (int i = 0; i < fmb_registry_nbodies(reg); ++i) {
     const fmbBodyType* t = fmb_registry_body(reg, i);
     printf("  %s  (%s)\n", t->name, fmb_registry_body_origin(reg, i));
     print_params(t->params);
-    print_outputs("[x y theta omega vx vy]", t->output_names);
+    print_outputs(frame, 1, t->centreline ? "shape shape_N" : NULL, t->output_names);
   }
-  printf("joints and forces (power comes with every joint that has constraint rows):\n");
+  printf("joints and forces (power and work: a joint with constraint rows or a force; reaction_*: with "
+         "constraint rows):\n");
   for (int i = 0; i < fmb_registry_njoints(reg); ++i) {
     const fmbJointType* t = fmb_registry_joint(reg, i);
     printf("  %s  (%s)%s\n", t->name, fmb_registry_joint_origin(reg, i),
            t->flags & FMB_TYPE_DOES_WORK ? ", feeds energy in" : "");
     print_params(t->params);
-    print_outputs(t->nrows ? "[power]" : "", t->output_names);
+    const char* const* engine_given[2];
+    int n = 0;
+    if (t->nrows || t->force) engine_given[n++] = fmb_engine_outputs("power");
+    if (t->nrows) engine_given[n++] = fmb_engine_outputs("reaction");
+    print_outputs(engine_given, n, NULL, t->output_names);
   }
+  printf("scene-wide:\n    outputs:");
+  for (const char* const* n = fmb_engine_outputs("energy"); *n; ++n) printf(" energy.%s", *n);
+  for (const char* const* n = fmb_engine_outputs("constraint"); *n; ++n) printf(" constraint.%s", *n);
+  printf("\n");
   return 0;
 }

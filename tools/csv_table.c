@@ -62,6 +62,10 @@ static int push_string(char*** list, int* n, const char* s) {
 }
 
 int fmb_table_load(const char* path, fmbTable* tb, char* err, size_t errlen) {
+  return fmb_table_load_keyed(path, tb, "t", err, errlen);
+}
+
+int fmb_table_load_keyed(const char* path, fmbTable* tb, const char* first, char* err, size_t errlen) {
   memset(tb, 0, sizeof *tb);
   struct stat st;
   if (stat(path, &st) != 0) {
@@ -103,8 +107,9 @@ int fmb_table_load(const char* path, fmbTable* tb, char* err, size_t errlen) {
     }
     if (push_string(&tb->name, &tb->ncol, tok)) goto nomem;
   }
-  if (strcmp(tb->name[0], "t") != 0) {
-    say(err, errlen, "%s:%ld: the first column must be 't' (a flexmbd CSV), got '%.40s'", path, lineno, tb->name[0]);
+  if (first && strcmp(tb->name[0], first) != 0) {
+    say(err, errlen, "%s:%ld: the first column must be '%s' (a flexmbd CSV), got '%.40s'", path, lineno, first,
+        tb->name[0]);
     goto out;
   }
   for (int i = 1; i < tb->ncol; ++i)

@@ -19,6 +19,8 @@ typedef struct fmbTable {
 
 /* 0, or -1 with a message "PATH:LINE: what was expected" in err. Refuses non-regular files. */
 int fmb_table_load(const char* path, fmbTable* tb, char* err, size_t errlen);
+/* the same with another first column (`modes -o` writes `mode` first), or any when first is NULL */
+int fmb_table_load_keyed(const char* path, fmbTable* tb, const char* first, char* err, size_t errlen);
 void fmb_table_free(fmbTable* tb);
 /* column index (>= 1) or -1 */
 int fmb_table_col(const fmbTable* tb, const char* name);

@@ -37,8 +37,12 @@ static const Command commands[] = {
      "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv] [--animate DIR]\n"
      "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state", 0},
     {"campbell", fmb_cmd_campbell,
-     "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-o campbell.csv] [--plot campbell.png]\n"
+     "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j K] [-o campbell.csv] [--plot campbell.png]\n"
      "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC)", 0},
+    {"sweep", fmb_cmd_sweep,
+     "sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log]|PATH=v1,v2,...]... [--zip ...] [--samples F.csv] [--random ...]\n"
+     "      [-j K] [--metric COL:max] [--timeout SEC|Nx] ...   many runs, each a child process; resumable (docs/sweep.md)\n"
+     "sweep --status DIR   what a sweep has done", 1},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

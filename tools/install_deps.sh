@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # Install what flexmbd needs on Debian 12, only if something is missing.
-#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; and
+#   --ci  also what CI's robustness step uses: clang and libFuzzer's runtime, valgrind; clang-format-14
+#         (tools/format.sh: the committed .clang-format); and
 #         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
 #         VTK itself (skipped without it)
 # python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux; python3-numpy is
@@ -9,10 +10,13 @@
 set -euo pipefail
 # liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
 # libarpack2-dev: its sparse shift-invert path (Arnoldi) for large systems
+# libopenmpi-dev, openmpi-bin: `flexmbd sweep` over MPI ranks (mpirun); libhdf5-dev, hdf5-tools: its
+# DIR/sweep.h5 and the h5dump that the sweep test reads it with (docs/sweep.md; both optional to build)
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
-      liblapack-dev libblas-dev libarpack2-dev python3-numpy python3-matplotlib python3-pytest)
+      liblapack-dev libblas-dev libarpack2-dev libopenmpi-dev openmpi-bin libhdf5-dev hdf5-tools python3-numpy
+      python3-matplotlib python3-pytest)
 if [ "${1:-}" = "--ci" ]; then
-  pkgs+=(clang-14 libclang-rt-14-dev valgrind util-linux python3-vtk9)
+  pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9)
 fi
 missing=()
 for p in "${pkgs[@]}"; do

@@ -64,7 +64,8 @@ static void load_steps(void) {
     th += om * h + 0.5 * alpha * h * h;
     om += alpha * h;
     ENSURE(fmb_outputs(m, d, out) == 0);
-    const double err = fmax(fmax(fabs(out[ix] - x), fabs(out[ivx] - vx)), fmax(fabs(out[ith] - th), fabs(out[iom] - om)));
+    const double err =
+        fmax(fmax(fabs(out[ix] - x), fabs(out[ivx] - vx)), fmax(fabs(out[ith] - th), fabs(out[iom] - om)));
     worst = fmax(worst, err);
     worst_balance = fmax(worst_balance, fabs(out[ib]));
     ENSURE_NEAR(out[iw], out[ike], 1e-7 * fmax(1.0, out[ike]));
@@ -103,8 +104,9 @@ static void drive_steps(void) {
   ENSURE(worst_rest < 1e-8);
   ENSURE(worst_phi < 1e-9);
   ENSURE(worst_weight < 1e-6);
-  printf("drive input, 20 jumps: angle off the set one by %.3g, |omega| %.3g, constraint %.3g, pin load off m g by %.3g\n",
-         worst_angle, worst_rest, worst_phi, worst_weight);
+  printf(
+      "drive input, 20 jumps: angle off the set one by %.3g, |omega| %.3g, constraint %.3g, pin load off m g by %.3g\n",
+      worst_angle, worst_rest, worst_phi, worst_weight);
   fmb_data_free(d);
   fmb_free(m);
 }
@@ -195,8 +197,8 @@ static void cancelling(void) {
   /* from another thread, during an advance over the whole run */
   char fourbar[1024];
   const char* longer[] = {"solver.t_end=100", "outputs=[crank.theta, rocker.theta, motor.work, energy.balance]"};
-  fmbModel* slow = fmb_load(fmbt_path("scenes/fourbar.yaml", fourbar, sizeof fourbar), longer, 2, fmb_builtin_registry(),
-                            &diag);
+  fmbModel* slow =
+      fmb_load(fmbt_path("scenes/fourbar.yaml", fourbar, sizeof fourbar), longer, 2, fmb_builtin_registry(), &diag);
   ENSURE(slow != NULL);
   if (slow) {
     fmbData* e = fmb_data_new(slow, &diag);

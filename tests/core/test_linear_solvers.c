@@ -14,6 +14,7 @@
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include "internal.h"
+#include "schur.h"
 #include "testlib.h"
 
 static double urand(unsigned* s) {

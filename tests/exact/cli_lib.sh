@@ -1,4 +1,4 @@
-# cli_lib.sh — sourced by the command-line tests of tests/exact with the arguments
+# cli_lib.sh — sourced by the command-line tests (tests/exact, and static_messages, plausibility) with the arguments
 # FLEXMBD SOURCE_DIR OUT_DIR: sets F, SRC, OUT, enters SOURCE_DIR, and offers
 #   check WHAT CONDITION   prints ok/FAIL and records a failure in $fail
 #   near A B TOL           true when |A - B| <= TOL

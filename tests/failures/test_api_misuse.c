@@ -34,6 +34,45 @@ static void write_file(const char* path, const char* text) {
   fclose(f);
 }
 
+/* Five calls that answered edge inputs with a plausible wrong result instead of an error: the
+   MAC of modes out of range (0.0, "orthogonal"), a table of -1 rows (an empty table, exit 0), a
+   mode animation of amplitude 0, -1 or nan (a still or inverted mode), an unknown eigen-solver
+   (the dense one, silently), a time of nan for the linearization; and fmb_eval_col0 of body 2
+   (0: body 0's column; see parser_misuse). The writers also left a caller's earlier error in
+   *diag (the first error wins) instead of their own. */
+static void wrong_results(const fmbModel* m, const char* csv) {
+  fmbDiag d = {.code = FMB_EXIT_SOLVER, .msg = "an earlier error"}; /* each call reports its own */
+  double shape[2] = {1.0, 0.0}, freq = 1.0, zeta = 0.0;
+  fmbModes one = {.count = 1, .nq = 1, .frequency = &freq, .damping_ratio = &zeta, .shape_re = shape,
+                  .shape_im = shape + 1};
+  ENSURE(fmb_modes_mac(&one, 0, &one, 0) == 1.0);
+  ENSURE(isnan(fmb_modes_mac(&one, 1, &one, 0)) && isnan(fmb_modes_mac(&one, 0, &one, -1)));
+  ENSURE(isnan(fmb_modes_mac(NULL, 0, &one, 0)));
+  const char* names[1] = {"a"};
+  const double values[1] = {1.0};
+  ENSURE(fmb_write_table(csv, 1, names, -1, values, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "negative row count"));
+  ENSURE(fmb_write_table(csv, 1, names, 1, values, &d) == 0);
+  const int ny = fmb_state_size(m);
+  double* y = calloc((size_t)ny, sizeof(double));
+  double* yp = calloc((size_t)ny, sizeof(double));
+  fmbModes* md = NULL;
+  ENSURE(y && yp);
+  if (!y || !yp) return;
+  ENSURE(fmb_modes(m, 0.0, y, yp, 0, 7, &md, &d) == FMB_EXIT_BAD_INPUT && md == NULL && strstr(d.msg, "method 7"));
+  ENSURE(fmb_modes(m, NAN, y, yp, 0, FMB_EIGEN_DENSE, &md, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "not finite"));
+  double mshape[3] = {0.0, 0.0, 1.0}, mim[3] = {0.0, 0.0, 0.0};
+  fmbModes mode = {.count = 1, .nq = m->nq, .frequency = &freq, .damping_ratio = &zeta, .shape_re = mshape,
+                   .shape_im = mim};
+  ENSURE(m->nq == 3);
+  char dir[1100];
+  snprintf(dir, sizeof dir, "%s.anim", csv);
+  const double bad_amplitude[3] = {0.0, -1.0, NAN};
+  for (int k = 0; k < 3 && m->nq == 3; ++k)
+    ENSURE(fmb_write_mode_animation(m, 0.0, y, &mode, 0, bad_amplitude[k], 4, dir, &d) == FMB_EXIT_BAD_INPUT);
+  free(y);
+  free(yp);
+}
+
 static void load_and_run_misuse(const char* scene, const char* csv) {
   const fmbRegistry* reg = fmb_builtin_registry();
   fmbDiag d;
@@ -97,6 +136,7 @@ static void load_and_run_misuse(const char* scene, const char* csv) {
     opt.stop = &stop;
     ENSURE(fmb_run(m, &opt, &st, &d) == FMB_EXIT_INTERRUPTED && st.interrupted && st.rows_written == 0);
     fmb_describe(m, NULL);
+    wrong_results(m, csv);
   }
   fmb_describe(NULL, stdout);
   fmb_print_stats(NULL, stdout);
@@ -170,7 +210,7 @@ static void parser_misuse(const char* scene) {
   ENSURE(fmb_eval_ncoord(NULL, 0) == 0);
   ENSURE(fmb_eval_q(NULL, 0) == NULL && fmb_eval_v(NULL, 1) == NULL);
   ENSURE(fmb_eval_scratch(NULL) == NULL);
-  ENSURE(fmb_eval_col0(NULL, 1) == 0);
+  ENSURE(fmb_eval_col0(NULL, 1) == -1 && fmb_eval_col0(NULL, 0) == -1); /* not 0: body 0's column */
   double pos[2], ang;
   ENSURE(fmb_marker(NULL, 0, v, pos, &ang, NULL, 0, NULL) == -1);
 

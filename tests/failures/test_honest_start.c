@@ -22,7 +22,8 @@ static void off_joint_pose(void) {
   fmbDiag d;
   int rc = fmbt_run("tests/bad_scenes/107-pose-off-joints.yaml", NULL, 0, "honest_off.csv", &st, &d);
   ENSURE(rc == FMB_EXIT_BAD_INPUT);
-  ENSURE(strstr(d.msg, "they move body 'bob' by 0.5 ") != NULL);
+  ENSURE(strstr(d.msg, "the joints move body 'bob' by 0.5 ") != NULL);
+  ENSURE(strstr(d.msg, "joint 'pin' is not satisfied") == d.msg && d.line == 7 && d.col == 5); /* named, located */
   ENSURE(strstr(d.msg, "initial: assemble") != NULL);
   const char* ov[] = {"initial=assemble", "outputs=[bob.x, bob.y, constraint.position]"};
   fmbtCsv c;

@@ -36,17 +36,16 @@ static fmbModel* load_text(const char* name, const char* text) {
 
 int main(void) {
   fmb_set_warn(count_warning, NULL);
-  fmbModel* m = load_text("step_misuse_a.yaml",
-                          "solver: {t_end: 1, output_step: 0.1}\n"
-                          "gravity: [0, -9.81]\n"
-                          "bodies: [{name: bob, type: rigid, mass: 1, inertia: 0.1, position: [1, 0]}]\n"
-                          "joints:\n"
-                          "  - {name: pin, type: revolute, body1: ground, body2: bob, point2: [-1, 0]}\n"
-                          "  - {name: kick, type: force, body: bob, force: [0, 1], law: input, value: 0}\n"
-                          "outputs: [bob.theta, bob.omega]\n");
-  fmbModel* other = load_text("step_misuse_b.yaml",
-                              "solver: {t_end: 1}\n"
-                              "bodies: [{name: bob, type: rigid, mass: 1, inertia: 0.1}]\n");
+  fmbModel* m =
+      load_text("step_misuse_a.yaml", "solver: {t_end: 1, output_step: 0.1}\n"
+                                      "gravity: [0, -9.81]\n"
+                                      "bodies: [{name: bob, type: rigid, mass: 1, inertia: 0.1, position: [1, 0]}]\n"
+                                      "joints:\n"
+                                      "  - {name: pin, type: revolute, body1: ground, body2: bob, point2: [-1, 0]}\n"
+                                      "  - {name: kick, type: force, body: bob, force: [0, 1], law: input, value: 0}\n"
+                                      "outputs: [bob.theta, bob.omega]\n");
+  fmbModel* other = load_text("step_misuse_b.yaml", "solver: {t_end: 1}\n"
+                                                    "bodies: [{name: bob, type: rigid, mass: 1, inertia: 0.1}]\n");
   ENSURE(m && other);
   if (!m || !other) return fmbt_finish("test_step_misuse");
   fmbDiag diag;
@@ -136,11 +135,11 @@ int main(void) {
 
   /* a failed init (joints 4 m off the poses given: exit 2) leaves no state to advance, and the
      object stays usable */
-  fmbModel* bad = load_text("step_misuse_c.yaml",
-                            "solver: {t_end: 1}\n"
-                            "bodies: [{name: a, type: rigid, mass: 1, inertia: 0.1, position: [1, 0]},\n"
-                            "         {name: b, type: rigid, mass: 1, inertia: 0.1, position: [5, 0]}]\n"
-                            "joints: [{name: p, type: revolute, body1: a, body2: b}]\n");
+  fmbModel* bad =
+      load_text("step_misuse_c.yaml", "solver: {t_end: 1}\n"
+                                      "bodies: [{name: a, type: rigid, mass: 1, inertia: 0.1, position: [1, 0]},\n"
+                                      "         {name: b, type: rigid, mass: 1, inertia: 0.1, position: [5, 0]}]\n"
+                                      "joints: [{name: p, type: revolute, body1: a, body2: b}]\n");
   ENSURE(bad != NULL);
   if (bad) {
     fmbData* bd = fmb_data_new(bad, &diag);

@@ -2,7 +2,10 @@
  * F0 s(t) and a torque tau0 s(t) has vx = F0 S(t) / m and omega = tau0 S(t) / J, S = the integral
  * of s, computed here independently for each law (constant, ramp, harmonic, spinup, a table inline
  * and from a CSV file). The load's work equals the kinetic energy gained (energy.balance constant).
- * A follower load (frame: body) on a spinning puck turns with it: v = F/(m w) (sin wt, 1 - cos wt). */
+ * A follower load (frame: body) on a spinning puck turns with it: v = F/(m w) (sin wt, 1 - cos wt).
+ * A drive whose table begins at t0 follows the prescribed angle through every row (drive_table:
+ * the rows of a quadratic f, which a drive's C1 table reproduces exactly; before, the run failed
+ * at t = 0 with the error test, the speed jumping at every row of a piecewise-linear angle). */
 #include <string.h>
 
 #include "testlib.h"
@@ -67,7 +70,38 @@ static void follower(int body_frame) {
   fmbt_csv_free(&c);
 }
 
+/* f(t) = 0.5 t - 0.8 t^2 up to 3 s, then straight on along f'(3) = -4.3 (scenes/table_drive.yaml) */
+static void drive_table(const char* name, const char* const* ov, int nov) {
+  fmbtCsv c;
+  fmbStats st;
+  char out[64];
+  snprintf(out, sizeof out, "drive_%s.csv", name);
+  ENSURE(fmbt_run_read("tests/mechanisms/scenes/table_drive.yaml", ov, nov, out, &c, &st) == 0);
+  const double *t = fmbt_col(&c, "t"), *th = fmbt_col(&c, "bar.theta"), *om = fmbt_col(&c, "bar.omega"),
+               *ang = fmbt_col(&c, "motor.angle"), *bal = fmbt_col(&c, "energy.balance");
+  if (!t || !th || !om || !ang || !bal) return;
+  double ea = 0.0, ew = 0.0, eb = 0.0; /* angle, speed, energy.balance drift */
+  for (int i = 0; i < c.nrow; ++i) {
+    const double ti = t[i], f = ti <= 3.0 ? 0.5 * ti - 0.8 * ti * ti : -5.7 - 4.3 * (ti - 3.0),
+                 df = ti <= 3.0 ? 0.5 - 1.6 * ti : -4.3;
+    ea = fmax(ea, fmax(fabs(th[i] - f), fabs(ang[i] - f)));
+    ew = fmax(ew, fabs(om[i] - df));
+    eb = fmax(eb, fabs(bal[i] - bal[0]));
+  }
+  printf("drive table %-6s: %d rows to t = %g, %ld steps, |theta - f| %.2e rad, |omega - f'| %.2e rad/s, balance %.2e J\n",
+         name, c.nrow, c.nrow ? t[c.nrow - 1] : 0.0, st.steps, ea, ew, eb);
+  ENSURE(c.nrow == 401);
+  ENSURE(ea < 1e-7 && ew < 1e-6);
+  /* energy.balance is printed, not checked: the constraint's work is outside the error test and
+     drifts by up to 0.1 J here after the last row (IDA's steps grow on the straight motion), 1e-4 J
+     with max_step 1e-3; a constant drive on the same motion keeps 1e-6 J (left to issue 23 item 2) */
+  fmbt_csv_free(&c);
+}
+
 int main(void) {
+  drive_table("inline", NULL, 0);
+  const char* tfile[] = {"joints.motor.table=table_drive.csv"};
+  drive_table("file", tfile, 1);
   law_case("constant", NULL, 0, S_constant);
   const char* ramp[] = {"joints.push.law=ramp", "joints.push.ramp_time=1.5"};
   law_case("ramp", ramp, 2, S_ramp);
@@ -79,6 +113,10 @@ int main(void) {
   law_case("table", tab, 2, S_table);
   const char* file[] = {"joints.push.law=table", "joints.push.table=load_table.csv"};
   law_case("tablefile", file, 2, S_table);
+  /* the same rows, one padded to 700 characters and a 7000-character comment: one row each (a
+     512-byte line buffer once split them into two rows) */
+  const char* longfile[] = {"joints.push.law=table", "joints.push.table=load_table_long.csv"};
+  law_case("tablelong", longfile, 2, S_table);
   follower(1);
   follower(0);
   return fmbt_finish("test_loads");

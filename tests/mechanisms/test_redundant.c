@@ -50,6 +50,8 @@ static void check_command(void) {
   fmbDiag d;
   ENSURE(fmbt_run("scenes/parallelogram.yaml", flat, 5, "flat.csv", &st, &d) == FMB_EXIT_BAD_INPUT);
   ENSURE(strstr(d.msg, "singular configuration") != NULL);
+  printf("run on it: %s:%d:%d: %s\n", d.file, d.line, d.col, d.msg);
+  ENSURE(d.line > 0 && d.col > 0); /* at the joint named first */
 }
 
 static void two_pins(void) {

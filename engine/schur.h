@@ -1,0 +1,24 @@
+/* schur.h — schur.c: KLU on the GGL Newton systems with the position rows eliminated, for the
+ * integrator backends (integrator.h includes it) and their tests; out of internal.h, which every
+ * engine file includes, because only the backends use it. */
+#ifndef FMB_SCHUR_H
+#define FMB_SCHUR_H
+
+#include "internal.h"
+
+/* One Newton matrix on the model's pattern, real or complex (values interleaved (re, im)), solved
+   through the Schur complement of its position rows. Factor: 0 ok, 1 recoverable (singular),
+   -1 KLU failed outright; solve in place: 0 ok, 1 failed. Allocates in new only (and when KLU
+   picks a new pivot order). */
+typedef struct fmbSchur fmbSchur;
+fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values);
+int fmb_schur_factor(fmbSchur* s, const double* J);
+int fmb_schur_solve(fmbSchur* s, double* x);
+void fmb_schur_forget(fmbSchur* s); /* drop the factorization: the next one chooses pivots afresh */
+void fmb_schur_free(fmbSchur* s);
+/* the real one as IDA's SUNLinearSolver */
+struct _generic_SUNLinearSolver;
+struct _SUNContext;
+struct _generic_SUNLinearSolver* fmb_schur_klu_new(const fmbModel* m, struct _SUNContext* sun);
+
+#endif

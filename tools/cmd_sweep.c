@@ -1,0 +1,428 @@
+/* cmd_sweep.c — `flexmbd sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log] | --grid PATH=v1,v2,...]...
+ *                 [--zip PATH=v1,v2,...]... [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|
+ *                 lognormal(m,s)]... [--count N] [--seed S] [--design mc|lhs] [--set PATH=VALUE]...
+ *                 [--verb run|static|modes] [--metric COL:max,min,end,rms]... [--reference REF.csv
+ *                 [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...] [--keep summary|series]
+ *                 [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...`
+ *               `flexmbd sweep --status DIR`
+ * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
+ * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
+ * index) and, when built with HDF5, DIR/sweep.h5. Under mpirun/srun the ranks share the runs
+ * (sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
+ * 4 interrupted (SIGINT/SIGTERM: every child killed, the journal flushed; run again to resume). */
+#define _GNU_SOURCE /* sched_getaffinity */
+#include <errno.h>
+#include <sched.h>
+#include <math.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "sweep.h"
+
+#define YES_LIMIT 1e6 /* a larger plan needs --yes */
+#define MAX_PLAN 1e9  /* a larger plan is refused */
+
+static volatile sig_atomic_t stop_requested;
+static void on_stop(int sig) {
+  (void)sig;
+  stop_requested = 1;
+}
+
+static int bad(const char* fmt, const char* what) {
+  fprintf(stderr, "flexmbd sweep: ");
+  fprintf(stderr, fmt, what);
+  fputc('\n', stderr);
+  return FMB_EXIT_BAD_INPUT;
+}
+
+/* COL:max,min,end,rms -> one metric per statistic */
+static int add_metrics(fmbSweep* sw, const char* spec) {
+  static const char* const kinds[4] = {"max", "min", "end", "rms"};
+  const char* colon = strrchr(spec, ':');
+  if (!colon || colon == spec || !colon[1]) return bad("--metric expects COLUMN:max|min|end|rms (several: max,rms), got '%s'", spec);
+  const char* s = colon + 1;
+  while (*s) {
+    size_t n = strcspn(s, ",");
+    int kind = -1;
+    for (int k = 0; k < 4; ++k)
+      if (strlen(kinds[k]) == n && strncmp(s, kinds[k], n) == 0) kind = k;
+    if (kind < 0 || sw->nmetric == FMB_SWEEP_MAX_METRICS)
+      return bad("--metric expects COLUMN:max|min|end|rms (several: max,rms), got '%s'", spec);
+    fmbSweepMetric* m = &sw->metric[sw->nmetric++];
+    snprintf(m->column, sizeof m->column, "%.*s", (int)(colon - spec), spec);
+    m->kind = kind;
+    s += n + (s[n] == ',');
+  }
+  return 0;
+}
+
+/* the id of every run: FNV-1a 64 over the scene's bytes, the verb, the engine version, the plugins
+   and the run's overrides (fixed and swept), sorted, numbers printed %.17g; identical runs share
+   one id and run once */
+static int by_text(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
+static uint64_t hash_file(uint64_t h, const char* path) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return h;
+  char buf[1 << 15];
+  size_t n;
+  while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = fmb_fnv1a(h, buf, n);
+  fclose(f);
+  return h;
+}
+typedef struct {
+  uint64_t id;
+  long i;
+} IdIndex;
+static int by_id(const void* a, const void* b) {
+  const IdIndex *x = a, *y = b;
+  return x->id < y->id ? -1 : x->id > y->id ? 1 : (x->i > y->i) - (x->i < y->i);
+}
+static int make_ids(fmbSweep* sw) {
+  sw->id = malloc((size_t)sw->nrun * sizeof *sw->id);
+  sw->first = malloc((size_t)sw->nrun * sizeof *sw->first);
+  if (!sw->id || !sw->first) return -1;
+  uint64_t base = fmb_fnv1a(FMB_FNV_OFFSET, "flexmbd sweep run 1", 20);
+  base = hash_file(base, sw->scene);
+  const char* version = FLEXMBD_VERSION " " FLEXMBD_COMMIT;
+  base = fmb_fnv1a(base, sw->verb, strlen(sw->verb) + 1);
+  base = fmb_fnv1a(base, version, strlen(version) + 1);
+  for (int k = 0; k < sw->nplugins; ++k) base = hash_file(base, sw->plugins[k]);
+  const int nset = sw->nfixed + sw->plan.npath;
+  char** sets = malloc((size_t)nset * sizeof *sets);
+  char* text = malloc((size_t)sw->plan.npath * 600);
+  if (!sets || !text) return free(sets), free(text), -1;
+  sw->digest = FMB_FNV_OFFSET;
+  for (long i = 0; i < sw->nrun; ++i) {
+    int n = 0;
+    for (int k = 0; k < sw->nfixed; ++k) sets[n++] = (char*)sw->fixed[k];
+    for (int k = 0; k < sw->plan.npath; ++k) {
+      snprintf(text + 600 * k, 600, "%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, i, k));
+      sets[n++] = text + 600 * k;
+    }
+    qsort(sets, (size_t)n, sizeof *sets, by_text);
+    uint64_t h = base;
+    for (int k = 0; k < n; ++k) h = fmb_fnv1a(h, sets[k], strlen(sets[k]) + 1);
+    sw->id[i] = fmb_mix64(h); /* FNV-1a alone leaves ids of runs that differ in a last digit alike */
+    sw->digest = fmb_fnv1a(sw->digest, &h, sizeof h);
+  }
+  free(sets), free(text);
+  /* identical runs: the first index of each id (a sorted copy keeps this O(n log n)) */
+  IdIndex* p = malloc((size_t)sw->nrun * sizeof *p);
+  if (!p) return -1;
+  for (long i = 0; i < sw->nrun; ++i) p[i] = (IdIndex){sw->id[i], i};
+  qsort(p, (size_t)sw->nrun, sizeof *p, by_id);
+  for (long k = 0; k < sw->nrun; ++k) sw->first[p[k].i] = k > 0 && p[k].id == p[k - 1].id ? sw->first[p[k - 1].i] : p[k].i;
+  free(p);
+  return 0;
+}
+
+/* `flexmbd check` of run `index` in a child: its exit code (its messages on stderr when it fails) */
+static int check_run(fmbSweep* sw, long index, int verbose) {
+  char err[4300];
+  snprintf(err, sizeof err, "%s/logs/check.err", sw->dir);
+  char* argv[FMB_SWEEP_MAX_ARGS];
+  char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
+  fmb_sweep_argv(sw, index, "check", NULL, argv, sets);
+  fmbPool* pool = fmb_pool_new(1);
+  /* a check that crashes or hangs is left to the runs to record; only refused input stops the sweep */
+  fmbChildSpec spec = {.argv = argv, .stderr_path = err, .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,
+                       .mem_limit_mb = sw->mem_limit_mb};
+  fmbChildResult r = {.status = FMB_CHILD_CRASHED};
+  if (pool && fmb_pool_start(pool, &spec) == 0)
+    while (fmb_pool_wait(pool, 1.0, &r) == 0) {
+    }
+  fmb_pool_free(pool);
+  const int rc = r.status == FMB_CHILD_OK ? 0 : r.status == FMB_CHILD_BAD_INPUT ? 2 : 3;
+  if (verbose || rc) {
+    fprintf(stderr, "check of run %ld:", index);
+    for (int k = 0; k < sw->plan.npath; ++k) fprintf(stderr, " %s", sets[k]);
+    fprintf(stderr, ": %s\n", rc == 0 ? "loads" : fmb_child_status_name(r.status));
+    FILE* f = rc ? fopen(err, "r") : NULL;
+    char line[2048];
+    while (f && fgets(line, sizeof line, f))
+      if (strncmp(line, "stats:", 6) != 0) fprintf(stderr, "  %s", line);
+    if (f) fclose(f);
+  }
+  unlink(err);
+  return rc;
+}
+
+static int make_dirs(const char* dir) {
+  char p[4300];
+  const char* sub[3] = {"", "/series", "/logs"};
+  for (int k = 0; k < 3; ++k) {
+    snprintf(p, sizeof p, "%s%s", dir, sub[k]);
+    if (mkdir(p, 0755) != 0 && errno != EEXIST) {
+      fprintf(stderr, "flexmbd sweep: cannot create %s: %s\n", p, strerror(errno));
+      return FMB_EXIT_BAD_INPUT;
+    }
+  }
+  return 0;
+}
+
+static void usage(FILE* f) {
+  fprintf(f,
+          "usage: flexmbd sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log] | --grid PATH=v1,v2,...]... [--zip PATH=v1,v2,...]...\n"
+          "         [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)]... --count N [--seed S]\n"
+          "         [--design mc|lhs] [--set PATH=VALUE]... [--verb run|static|modes] [--metric COL:max,min,end,rms]...\n"
+          "         [--reference REF.csv [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...]\n"
+          "         [--keep summary|series] [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes]\n"
+          "         [--quiet] [--plugin x.so]...\n"
+          "       flexmbd sweep --status DIR\n"
+          "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
+          "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
+          "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
+          "spec, 4 interrupted (resumable). docs/sweep.md\n");
+}
+
+int fmb_cmd_sweep(int argc, char** argv) {
+  static fmbSweep sw0;
+  fmbSweep* sw = &sw0;
+  memset(sw, 0, sizeof *sw);
+  sw->verb = "run";
+  sw->jobs = 0;
+  sw->timeout_s = 600.0;
+  sw->journal_fd = sw->inflight_fd = -1;
+  sw->stop = &stop_requested;
+  const char* columns = NULL;
+  const char* status_dir = NULL;
+  int dry = 0, resume = 0, fresh = 0, yes = 0, design_lhs = -1;
+  long count = 0;
+  int seed_given = 0;
+  char err[1200];
+  for (int i = 2; i < argc; ++i) {
+    const char* a = argv[i];
+#define VALUE(what) (fmb_cli_value("sweep", argc, argv, &i, what))
+    const char* v = NULL;
+    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
+      usage(stdout);
+      return 0;
+    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
+      if (!(sw->dir = VALUE("a folder"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--grid") == 0 || strcmp(a, "--zip") == 0 || strcmp(a, "--random") == 0) {
+      if (!(v = VALUE("PATH=VALUES"))) return FMB_EXIT_BAD_INPUT;
+      int r = a[2] == 'g' ? fmb_plan_add_grid(&sw->plan, v, err, sizeof err)
+              : a[2] == 'z' ? fmb_plan_add_zip(&sw->plan, v, err, sizeof err)
+                            : fmb_plan_add_random(&sw->plan, v, err, sizeof err);
+      if (r) return bad("%s", err);
+    } else if (strcmp(a, "--samples") == 0) {
+      if (!(v = VALUE("a CSV file")) || fmb_plan_add_samples(&sw->plan, v, err, sizeof err))
+        return v ? bad("%s", err) : FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--count") == 0) {
+      char* end;
+      if (!(v = VALUE("N"))) return FMB_EXIT_BAD_INPUT;
+      double c = strtod(v, &end);
+      if (*end || !(c >= 1) || c > MAX_PLAN || c != floor(c)) return bad("--count expects a whole number from 1 to 1e9, got '%s'", v);
+      count = (long)c;
+    } else if (strcmp(a, "--seed") == 0) {
+      char* end;
+      if (!(v = VALUE("a whole number"))) return FMB_EXIT_BAD_INPUT;
+      sw->plan.seed = strtoull(v, &end, 10);
+      if (*end || !*v || v[0] == '-') return bad("--seed expects a whole number >= 0, got '%s'", v);
+      seed_given = 1;
+    } else if (strcmp(a, "--design") == 0) {
+      if (!(v = VALUE("mc or lhs"))) return FMB_EXIT_BAD_INPUT;
+      if (strcmp(v, "mc") && strcmp(v, "lhs")) return bad("--design expects mc or lhs, got '%s'", v);
+      design_lhs = strcmp(v, "lhs") == 0;
+    } else if (strcmp(a, "--set") == 0 || strncmp(a, "--set=", 6) == 0) {
+      if (!(v = a[5] == '=' ? a + 6 : VALUE("PATH=VALUE"))) return FMB_EXIT_BAD_INPUT;
+      if (!strchr(v, '=') || sw->nfixed == FMB_SWEEP_MAX_FIXED) return bad("--set expects PATH=VALUE, got '%s'", v);
+      /* numbers as every run gets them: %.17g (so the run id does not depend on how they were typed) */
+      char* end;
+      const char* val = strchr(v, '=') + 1;
+      double x = strtod(val, &end);
+      char* t = malloc(strlen(v) + 40);
+      if (!t) return FMB_EXIT_BAD_INPUT;
+      if (end != val && !*end && isfinite(x))
+        sprintf(t, "%.*s=%.17g", (int)(val - 1 - v), v, x);
+      else
+        strcpy(t, v);
+      sw->fixed[sw->nfixed++] = t;
+    } else if (strcmp(a, "--plugin") == 0) {
+      if (!(v = VALUE("a plugin file"))) return FMB_EXIT_BAD_INPUT;
+      if (sw->nplugins == 16) return bad("at most 16 --plugin files%s", "");
+      char* real = realpath(v, NULL);
+      if (!real) return bad("--plugin: cannot find '%s'", v);
+      sw->plugins[sw->nplugins++] = real;
+    } else if (strcmp(a, "--verb") == 0) {
+      if (!(v = VALUE("run, static or modes"))) return FMB_EXIT_BAD_INPUT;
+      if (strcmp(v, "run") && strcmp(v, "static") && strcmp(v, "modes")) return bad("--verb expects run, static or modes, got '%s'", v);
+      sw->verb = v;
+    } else if (strcmp(a, "--metric") == 0) {
+      if (!(v = VALUE("COLUMN:max|min|end|rms")) || add_metrics(sw, v)) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--reference") == 0) {
+      if (!(sw->reference = VALUE("a CSV file"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--columns") == 0) {
+      if (!(columns = VALUE("a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
+      char* end;
+      if (!(v = VALUE("a number of children"))) return FMB_EXIT_BAD_INPUT;
+      long j = strtol(v, &end, 10);
+      if (*end || j < 1 || j > 1024) return bad("-j expects 1 to 1024 children, got '%s'", v);
+      sw->jobs = (int)j;
+    } else if (strcmp(a, "--timeout") == 0) {
+      char* end;
+      if (!(v = VALUE("SEC or Nx"))) return FMB_EXIT_BAD_INPUT;
+      double t = strtod(v, &end);
+      const int rel = *end == 'x' && !end[1];
+      if (end == v || (*end && !rel) || !(t > 0) || !isfinite(t)) return bad("--timeout expects SEC (> 0) or Nx (N times the median of ok runs), got '%s'", v);
+      if (rel)
+        sw->timeout_factor = t;
+      else
+        sw->timeout_s = t;
+    } else if (strcmp(a, "--retry") == 0) {
+      if (!(v = VALUE("a list of statuses"))) return FMB_EXIT_BAD_INPUT;
+      for (const char* s = v; *s;) {
+        char name[32];
+        size_t n = strcspn(s, ",");
+        snprintf(name, sizeof name, "%.*s", (int)(n < 31 ? n : 31), s);
+        int st = fmb_child_status_of(name);
+        if (st < 0 || st == FMB_CHILD_OK)
+          return bad("--retry expects statuses among solver_stopped,bad_input,timeout,crashed,lost, got '%s'", v);
+        sw->retry_mask |= 1u << st;
+        s += n + (s[n] == ',');
+      }
+    } else if (strcmp(a, "--keep") == 0) {
+      if (!(v = VALUE("summary or series"))) return FMB_EXIT_BAD_INPUT;
+      if (strcmp(v, "summary") && strcmp(v, "series")) return bad("--keep expects summary or series, got '%s'", v);
+      sw->keep_series = strcmp(v, "series") == 0;
+    } else if (strcmp(a, "--runner") == 0) {
+      if (!(v = VALUE("spawn or serve"))) return FMB_EXIT_BAD_INPUT;
+      if (strcmp(v, "spawn") && strcmp(v, "serve")) return bad("--runner expects spawn or serve, got '%s'", v);
+      sw->serve = strcmp(v, "serve") == 0;
+    } else if (strcmp(a, "--mem-limit") == 0) {
+      char* end;
+      if (!(v = VALUE("megabytes"))) return FMB_EXIT_BAD_INPUT;
+      sw->mem_limit_mb = strtod(v, &end);
+      if (*end || !(sw->mem_limit_mb >= 16)) return bad("--mem-limit expects megabytes (>= 16) per run, got '%s'", v);
+    } else if (strcmp(a, "--status") == 0) {
+      if (!(status_dir = VALUE("a sweep folder"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--dry-run") == 0) {
+      dry = 1;
+    } else if (strcmp(a, "--resume") == 0) {
+      resume = 1;
+    } else if (strcmp(a, "--fresh") == 0) {
+      fresh = 1;
+    } else if (strcmp(a, "--yes") == 0) {
+      yes = 1;
+    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
+      sw->quiet = 1;
+    } else if (a[0] != '-' && !sw->scene) {
+      sw->scene = a;
+    } else {
+      usage(stderr);
+      return bad("unknown option or extra argument '%s'", a);
+    }
+#undef VALUE
+  }
+  if (status_dir) return fmb_journal_status(status_dir);
+  if (!sw->scene) return usage(stderr), bad("no scene file given%s", "");
+  if (!sw->dir) return bad("no output folder given (-o DIR)%s", "");
+  if (resume && fresh) return bad("--resume and --fresh exclude each other%s", "");
+  if (fmb_cli_check_input(sw->scene, "scene")) return FMB_EXIT_BAD_INPUT;
+  if (sw->serve && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
+  if (design_lhs >= 0 && !sw->plan.nrandom) return bad("--design goes with --random%s", "");
+  if (seed_given && !sw->plan.nrandom) return bad("--seed goes with --random%s", "");
+  sw->plan.count = count;
+  sw->plan.lhs = design_lhs == 1;
+  const double size = fmb_plan_size(&sw->plan);
+  if (fmb_plan_finish(&sw->plan, err, sizeof err) && !(size > MAX_PLAN)) return bad("%s", err);
+  if (size > MAX_PLAN) return fprintf(stderr, "flexmbd sweep: a plan of %.4g runs is beyond the limit of 1e9\n", size), FMB_EXIT_BAD_INPUT;
+  if (size > YES_LIMIT && !yes && !dry)
+    return fprintf(stderr, "flexmbd sweep: the plan has %.4g runs (more than 1e6): check it with --dry-run, then add --yes\n", size),
+           FMB_EXIT_BAD_INPUT;
+  sw->nrun = (long)size;
+  for (int k = 0; k < sw->nfixed; ++k)
+    for (int p = 0; p < sw->plan.npath; ++p)
+      if (strncmp(sw->fixed[k], sw->plan.path[p], strlen(sw->plan.path[p])) == 0 && sw->fixed[k][strlen(sw->plan.path[p])] == '=')
+        return bad("'%s' is both swept and fixed by --set", sw->plan.path[p]);
+  if (sw->reference) { /* the error per run against a reference, per column */
+    if (fmb_cli_check_input(sw->reference, "reference")) return FMB_EXIT_BAD_INPUT;
+    if (fmb_table_load(sw->reference, &sw->ref, err, sizeof err)) return bad("%s", err);
+    for (int c = 1; c < sw->ref.ncol && !columns && sw->nrefcol < FMB_SWEEP_MAX_METRICS; ++c) sw->refcol[sw->nrefcol++] = c;
+    for (const char* s = columns; s && *s && sw->nrefcol < FMB_SWEEP_MAX_METRICS;) {
+      char name[200];
+      size_t n = strcspn(s, ",");
+      snprintf(name, sizeof name, "%.*s", (int)(n < 199 ? n : 199), s);
+      int c = fmb_table_col(&sw->ref, name);
+      if (c < 0) return fprintf(stderr, "flexmbd sweep: --columns: no column '%s' in %s\n", name, sw->reference), FMB_EXIT_BAD_INPUT;
+      sw->refcol[sw->nrefcol++] = c;
+      s += n + (s[n] == ',');
+    }
+  } else if (columns) {
+    return bad("--columns goes with --reference%s", "");
+  }
+  ssize_t el = readlink("/proc/self/exe", sw->exe, sizeof sw->exe - 1);
+  if (el <= 0) return bad("cannot find this program (/proc/self/exe)%s", "");
+  sw->exe[el] = '\0';
+  if (sw->jobs == 0) { /* the CPUs this process may use (a rank bound to cores gets its share) */
+    long n = sysconf(_SC_NPROCESSORS_ONLN);
+#ifdef __linux__
+    cpu_set_t set;
+    if (sched_getaffinity(0, sizeof set, &set) == 0) n = CPU_COUNT(&set);
+#endif
+    sw->jobs = n > 0 ? (int)n : 1;
+  }
+  if (make_ids(sw)) return bad("out of memory for %s runs", "the");
+  /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
+     libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
+  const int launched = fmb_sweep_launched_by_mpi();
+  const fmbSweepExtension* ext = fmb_sweep_extension_load(launched);
+  if (!launched || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
+
+  int rc = 0;
+  if (sw->rank != 0 && dry) { /* rank 0 alone checks the plan */
+    ext->mpi_finalize(0);
+    return 0;
+  }
+  if (sw->rank == 0) {
+    rc = make_dirs(sw->dir);
+    if (!rc && dry) {
+      long distinct = 0;
+      for (long i = 0; i < sw->nrun; ++i) distinct += sw->first[i] == i;
+      printf("sweep plan: %ld runs (%ld distinct) of %s %s, %d swept paths:", sw->nrun, distinct, sw->verb, sw->scene,
+             sw->plan.npath);
+      for (int k = 0; k < sw->plan.npath; ++k) printf(" %s", sw->plan.path[k]);
+      printf("\n");
+      if (fmb_journal_write_plan(sw) == 0) printf("sweep plan: written to %s/plan.csv\n", sw->dir);
+      fflush(stdout);
+      long pick[3] = {0, sw->nrun - 1, (long)(fmb_plan_uniform(sw->plan.seed, 0, 1u << 20) * (double)sw->nrun)};
+      for (int k = 0; k < 3 && !rc; ++k)
+        if (k == 0 || pick[k] != pick[0]) rc = check_run(sw, pick[k], 1);
+      if (!rc && size > YES_LIMIT && !yes) printf("sweep plan: more than 1e6 runs: run it with --yes\n");
+      ext->mpi_finalize(0);
+      return rc ? FMB_EXIT_BAD_INPUT : 0;
+    }
+    if (!rc) rc = check_run(sw, 0, 0) == 2 ? FMB_EXIT_BAD_INPUT : 0; /* an unknown path: refused before anything runs */
+    if (!rc) rc = fmb_journal_open(sw, resume, fresh);
+    if (!rc) rc = fmb_journal_write_plan(sw) ? FMB_EXIT_BAD_INPUT : 0;
+  }
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_stop; /* no SA_RESTART: the pool's wait returns at once */
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  sw->progress = !sw->quiet && isatty(STDERR_FILENO);
+  sw->t_start = fmb_pool_now();
+  if (sw->nranks > 1)
+    rc = ext->mpi_run(sw, rc);
+  else if (!rc)
+    rc = sw->serve ? fmb_sweep_serve(sw) : fmb_sweep_local(sw);
+  if (sw->rank == 0 && sw->journal_fd >= 0) {
+    fmb_sweep_progress(sw, 1);
+    if (fmb_journal_write_table(sw)) fprintf(stderr, "flexmbd sweep: cannot write %s/table.csv\n", sw->dir);
+    ext = fmb_sweep_extension_load(1);
+    if (rc == 0 && ext->write_h5(sw) < 0) fprintf(stderr, "flexmbd sweep: cannot write %s/sweep.h5\n", sw->dir);
+    if (rc == FMB_EXIT_INTERRUPTED)
+      fprintf(stderr, "sweep: interrupted; every child stopped, %s/runs.csv is complete: run the same command to resume\n", sw->dir);
+    fmb_journal_close(sw);
+  }
+  ext->mpi_finalize(rc);
+  return rc;
+}

@@ -1,0 +1,158 @@
+/* sweep.h — what the parts of `flexmbd sweep` share (docs/sweep.md):
+ *   cmd_sweep.c      options -> plan -> the engine; --status, --dry-run
+ *   sweep_plan.c     grids, zip, samples, random designs
+ *   sweep_journal.c  DIR/runs.csv (append-only, one row per finished run), resume, DIR/table.csv
+ *   sweep_exec.c     one run as a child (child_pool.c) and its row; the local loop
+ *   sweep_mpi.c      rank 0 hands out runs one at a time to whichever rank asks (FLEXMBD_HAVE_MPI)
+ *   sweep_h5.c       DIR/sweep.h5 from the journal at the end (FLEXMBD_HAVE_HDF5) */
+#ifndef FLEXMBD_SWEEP_H
+#define FLEXMBD_SWEEP_H
+#include <signal.h>
+#include <stdint.h>
+
+#include "child_pool.h"
+#include "csv_table.h"
+#include "sweep_plan.h"
+
+#define FMB_SWEEP_MAX_METRICS 64
+#define FMB_SWEEP_MAX_FIXED 256
+#define FMB_SWEEP_MAX_RETRIES 3 /* starts without a row before a run is marked lost */
+#define FMB_SWEEP_SYNC_S 1.0    /* the journal goes to the disk at most this often (sweep_journal.c) */
+/* the stats fields every row carries, in the order of the stats line */
+#define FMB_SWEEP_NSTATS 9
+extern const char* const fmb_sweep_stat_names[FMB_SWEEP_NSTATS];
+/* leading columns of a row, before the swept paths */
+#define FMB_SWEEP_LEAD "index,run_id,attempt,status,exit_code,signal,wall_s,rank"
+
+typedef struct fmbSweepMetric {
+  char column[160];
+  int kind; /* 0 max, 1 min, 2 end, 3 rms */
+} fmbSweepMetric;
+
+typedef struct fmbSweep {
+  /* options */
+  const char* scene;
+  const char* dir;
+  const char* verb; /* run, static, modes */
+  const char* fixed[FMB_SWEEP_MAX_FIXED]; /* --set, numbers normalized */
+  int nfixed;
+  const char* plugins[16];
+  int nplugins;
+  fmbSweepMetric metric[FMB_SWEEP_MAX_METRICS];
+  int nmetric;
+  const char* reference; /* --reference REF.csv */
+  fmbTable ref;
+  int nrefcol;
+  int refcol[FMB_SWEEP_MAX_METRICS]; /* columns of ref compared (--columns, or all) */
+  int jobs;
+  double timeout_s;      /* absolute, or ... */
+  double timeout_factor; /* ... N x the median wall of ok runs (after 5 of them) */
+  double mem_limit_mb;
+  unsigned retry_mask; /* bit per fmbChildStatus re-run on resume */
+  int keep_series, quiet, progress;
+  int serve; /* --runner serve: one `flexmbd run --serve` per slot instead of a process per run */
+  char exe[4096]; /* this program, for the children */
+  /* the plan and its identities */
+  fmbSweepPlan plan;
+  long nrun;
+  uint64_t* id;    /* run id per index */
+  long* first;     /* index of the first run with the same id (identical runs run once) */
+  uint64_t digest; /* of the whole plan: every id in order */
+  /* MPI */
+  int rank, nranks;
+  /* the journal (rank 0) */
+  int journal_fd;
+  long* row_at;   /* per index: file offset of its latest row in runs.csv, -1 none */
+  int* status;    /* per index: its latest status, -1 none */
+  int* starts;    /* per index: dispatches recorded in DIR/inflight.log */
+  int inflight_fd;
+  double last_sync; /* when the journal last went to the disk */
+  long count[FMB_CHILD_NSTATUS];
+  long done, failed, running, total_todo;
+  double t_start, last_progress;
+  /* timeouts relative to the median */
+  double* ok_wall;
+  long nok, okcap;
+  double median_wall;
+  long median_at;
+  volatile sig_atomic_t* stop;
+} fmbSweep;
+
+/* sweep_journal.c */
+/* the header line of runs.csv / table.csv (no newline) into buf; its length or -1 */
+int fmb_sweep_header(const fmbSweep* sw, char* buf, size_t len);
+/* opens DIR/runs.csv and DIR/inflight.log: resumes (the same plan, or `resume` given), sets aside
+   (`fresh`) or refuses another plan (2); fills row_at/status/starts. 0 or an exit code. */
+int fmb_journal_open(fmbSweep* sw, int resume, int fresh);
+/* appends one row (ending in '\n') to runs.csv with one write (to the disk once a second); 0 or -1 */
+int fmb_journal_append(fmbSweep* sw, long index, const char* row);
+/* records the dispatch of run `index` in inflight.log before it starts */
+void fmb_journal_started(fmbSweep* sw, long index);
+/* DIR/table.csv: the latest row of every planned run, sorted by index (indices of this plan) */
+int fmb_journal_write_table(const fmbSweep* sw);
+/* DIR/plan.csv: index, run_id and the swept values */
+int fmb_journal_write_plan(const fmbSweep* sw);
+/* takes a start back: run `index` was killed because the sweep was interrupted, not lost */
+void fmb_journal_cancelled(fmbSweep* sw, long index);
+void fmb_journal_close(fmbSweep* sw);
+/* `flexmbd sweep --status DIR` */
+int fmb_journal_status(const char* dir);
+
+/* sweep_exec.c */
+#define FMB_SWEEP_SET_LEN 600 /* one "--set PATH=VALUE" of a swept path */
+#define FMB_SWEEP_MAX_ARGS (8 + 2 * (FMB_SWEEP_MAX_FIXED + FMB_SWEEP_MAX_PATHS + 16))
+/* argv of `flexmbd VERB SCENE [-o OUT --quiet] --set ... --plugin ...` for run `index` (sets: the
+   swept paths' texts, FMB_SWEEP_MAX_PATHS of them); argv has FMB_SWEEP_MAX_ARGS places; argc */
+int fmb_sweep_argv(const fmbSweep* sw, long index, const char* verb, const char* out, char** argv,
+                   char (*sets)[FMB_SWEEP_SET_LEN]);
+/* kills the pool's children on an interrupt and takes their starts back (they are not lost) */
+void fmb_sweep_cancel(fmbSweep* sw, fmbPool* pool);
+/* the child for run `index` (attempt `attempt`) started in the pool; 0 or -1 */
+int fmb_sweep_start(fmbSweep* sw, fmbPool* pool, long index, double timeout_s);
+/* the journal row of a finished child (metrics, stats, message), '\n'-terminated, malloc'd */
+char* fmb_sweep_row(fmbSweep* sw, const fmbChildResult* r, int attempt);
+/* the same from a runner's answer (sweep_serve.c): its stats line and message */
+char* fmb_sweep_row_served(fmbSweep* sw, const fmbChildResult* r, int attempt, const char* stats_line,
+                           const char* message);
+/* a row for a run that never ran to a result (lost after three starts) */
+char* fmb_sweep_row_lost(fmbSweep* sw, long index, int attempt);
+/* the deadline of the next run (absolute, or N x median) */
+double fmb_sweep_timeout(fmbSweep* sw);
+/* after a row: counts, the median of ok walls, the progress line */
+void fmb_sweep_account(fmbSweep* sw, int status, double wall_s);
+void fmb_sweep_progress(fmbSweep* sw, int final);
+/* the runs still to do, in-flight ones (started, no row) first: *n_inflight of them; malloc'd */
+long* fmb_sweep_todo(fmbSweep* sw, long* n, long* n_inflight);
+/* the whole sweep in this process; 0, or FMB_EXIT_INTERRUPTED (resumable) */
+int fmb_sweep_local(fmbSweep* sw);
+/* the same with persistent runners (`--runner serve`, sweep_serve.c) */
+int fmb_sweep_serve(fmbSweep* sw);
+/* runs the in-flight runs of a crash one at a time (each alone: one may be what crashed) */
+int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n);
+
+/* MPI and HDF5 live in a module loaded only by `flexmbd sweep` (libflexmbd_sweep.so, built from
+   sweep_mpi.c, sweep_h5.c and sweep_extension.c when the libraries are found): linked into the
+   program, their 40 libraries would be loaded by every child `flexmbd run` too, 12 ms each (the
+   four-bar runs in 4 ms). sweep_load.c finds it beside the program (build tree) or in
+   LIBDIR/flexmbd (installed); without it the sweep is the local pool and writes no sweep.h5. */
+typedef struct fmbSweepExtension {
+  int has_mpi, has_hdf5;
+  int (*mpi_init)(fmbSweep* sw); /* MPI_Init, rank and size; 0 or -1 */
+  /* the sweep over the ranks; rc0: rank 0's verdict on the spec and journal (0 go, else every
+     rank returns it); rank 0 returns what fmb_sweep_local would */
+  int (*mpi_run)(fmbSweep* sw, int rc0);
+  void (*mpi_finalize)(int rc); /* MPI_Finalize, or MPI_Abort when interrupted */
+  /* DIR/sweep.h5 from DIR/plan.csv, DIR/table.csv and (--keep series) the series; 0 or -1 */
+  int (*write_h5)(const fmbSweep* sw);
+} fmbSweepExtension;
+/* started by mpirun or srun (their environment variables: OMPI_COMM_WORLD_SIZE, PMIX_RANK, ...) */
+int fmb_sweep_launched_by_mpi(void);
+/* with `load`, the module's table (loaded once), or fallbacks (local pool, no HDF5) when it cannot
+   be loaded; without, the fallbacks until it is */
+const fmbSweepExtension* fmb_sweep_extension_load(int load);
+/* in the module (sweep_mpi.c, sweep_h5.c) */
+int fmb_sweep_mpi_init(fmbSweep* sw);
+int fmb_sweep_mpi(fmbSweep* sw, int rc0);
+void fmb_sweep_mpi_finalize(int rc);
+int fmb_sweep_write_h5(const fmbSweep* sw);
+#endif

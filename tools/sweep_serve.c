@@ -1,0 +1,208 @@
+/* sweep_serve.c — `flexmbd sweep --runner serve`: one persistent `flexmbd run SCENE --serve` per
+ * slot (tools/run_serve.c) instead of a process per run. A run costs what it computes plus a line
+ * each way through a pipe, not a process start (exec and linking, ~3 ms of CPU: as much as a
+ * four-bar run). Isolation is per runner: a crash or a hang (killed at the run's deadline) ends
+ * the runner, the run in flight gets its row (`crashed`, `timeout`), and a fresh runner takes the
+ * slot. The rows are those of the spawned runs, bit for bit (the same fmb_load and fmb_run; tested).
+ * Runners are children of the pool (child_pool.c: process group, PDEATHSIG, RLIMIT_AS), talked to
+ * through pipes; the wait is poll(2) on their answers, which SIGINT/SIGTERM interrupt. */
+#define _GNU_SOURCE /* pipe2 */
+#include <errno.h>
+#include <fcntl.h>
+#include <poll.h>
+#include <signal.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "cli.h"
+#include "sweep.h"
+
+typedef struct {
+  int alive;
+  int in, out;     /* the runner's stdin (we write) and stdout (we read) */
+  long index;      /* the run in flight, -1 none */
+  double start, deadline;
+  int timed_out;
+  int reaped;           /* its process ended and was collected (res) */
+  fmbChildResult res;
+  char buf[8192];  /* its answer so far */
+  size_t n;
+} Runner;
+
+static int start_runner(fmbSweep* sw, fmbPool* pool, Runner* r, int slot) {
+  int to[2], from[2];
+  if (pipe2(to, O_CLOEXEC) != 0) return -1;
+  if (pipe2(from, O_CLOEXEC) != 0) {
+    close(to[0]), close(to[1]);
+    return -1;
+  }
+  char err[4300];
+  snprintf(err, sizeof err, "%s/logs/runner-%d.err", sw->dir, slot);
+  char* argv[FMB_SWEEP_MAX_ARGS];
+  char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
+  const int npath = sw->plan.npath;
+  sw->plan.npath = 0; /* the fixed --set and plugins only: the swept values come per run */
+  int n = fmb_sweep_argv(sw, 0, "run", NULL, argv, sets);
+  sw->plan.npath = npath;
+  memmove(argv + 4, argv + 3, (size_t)(n - 2) * sizeof *argv); /* ... SCENE --serve --set ... */
+  argv[3] = "--serve";
+  fmbChildSpec spec = {.argv = argv,
+                       .stderr_path = err,
+                       .use_fds = 1,
+                       .stdin_fd = to[0],
+                       .stdout_fd = from[1],
+                       .mem_limit_mb = sw->mem_limit_mb,
+                       .tag = slot};
+  const int rc = fmb_pool_start(pool, &spec);
+  close(to[0]), close(from[1]);
+  if (rc != 0) {
+    close(to[1]), close(from[0]);
+    return -1;
+  }
+  *r = (Runner){.alive = 1, .in = to[1], .out = from[0], .index = -1};
+  fcntl(r->out, F_SETFL, O_NONBLOCK); /* read whatever each runner has, never wait on one */
+  return 0;
+}
+
+/* hands run `index` to an idle runner: 0, or -1 (its pipe is gone: it died) */
+static int dispatch(fmbSweep* sw, Runner* r, long index) {
+  char line[FMB_SWEEP_MAX_PATHS * FMB_SWEEP_SET_LEN + 4400];
+  int n = snprintf(line, sizeof line, "%s/series/%016llx.csv", sw->dir, (unsigned long long)sw->id[index]);
+  for (int k = 0; k < sw->plan.npath && n < (int)sizeof line; ++k)
+    n += snprintf(line + n, sizeof line - (size_t)n, "\t%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
+  if (n >= (int)sizeof line - 1) return -1;
+  line[n++] = '\n';
+  fmb_journal_started(sw, index);
+  r->index = index;
+  r->start = fmb_pool_now();
+  const double t = fmb_sweep_timeout(sw);
+  r->deadline = t > 0 ? r->start + t : 0.0;
+  r->timed_out = 0;
+  r->n = 0;
+  for (const char* p = line; n > 0;) {
+    ssize_t w = write(r->in, p, (size_t)n);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) return -1;
+    p += w, n -= (int)w;
+  }
+  return 0;
+}
+
+static void record(fmbSweep* sw, const fmbChildResult* res, const char* stats, const char* msg) {
+  char* row = fmb_sweep_row_served(sw, res, sw->starts[sw->first[res->tag]], stats, msg);
+  if (row && fmb_journal_append(sw, res->tag, row) == 0) fmb_sweep_account(sw, (int)res->status, res->wall_s);
+  free(row);
+}
+
+/* a runner's answer "EXIT<TAB>stats: ...<TAB>message" for its run */
+static void answered(fmbSweep* sw, Runner* r, char* line) {
+  char* save = NULL;
+  const char* code = strtok_r(line, "\t", &save);
+  const char* stats = strtok_r(NULL, "\t", &save);
+  const char* msg = strtok_r(NULL, "", &save);
+  const int rc = code ? atoi(code) : -1;
+  fmbChildResult res = {.tag = r->index, .exit_code = rc, .wall_s = fmb_pool_now() - r->start};
+  res.status = rc == 0 ? FMB_CHILD_OK : rc == 2 ? FMB_CHILD_BAD_INPUT : rc == 3 ? FMB_CHILD_SOLVER_STOPPED : FMB_CHILD_CRASHED;
+  record(sw, &res, stats ? stats : "", msg ? msg : "");
+  r->index = -1;
+}
+
+/* a runner ended (crash, kill at a deadline): reaped, its run in flight recorded */
+static void ended(fmbSweep* sw, fmbPool* pool, Runner* runners, int slot) {
+  Runner* r = &runners[slot];
+  close(r->in), close(r->out);
+  r->alive = 0;
+  fmbChildResult got_res;
+  while (!r->reaped && fmb_pool_wait(pool, 5.0, &got_res) == 1) { /* another one may end first */
+    runners[got_res.tag].reaped = 1;
+    runners[got_res.tag].res = got_res;
+  }
+  const int got = r->reaped;
+  const fmbChildResult res = r->res;
+  if (r->index < 0) return;
+  char tail[600] = "", err[4300], line[600];
+  snprintf(err, sizeof err, "%s/logs/runner-%d.err", sw->dir, slot);
+  FILE* f = fopen(err, "r");
+  while (f && fgets(line, sizeof line, f))
+    if (line[0] != '\n') snprintf(tail, sizeof tail, "%.*s", (int)strcspn(line, "\n"), line);
+  if (f) fclose(f);
+  fmbChildResult run = {.tag = r->index, .exit_code = got == 1 ? res.exit_code : -1,
+                        .signal = got == 1 ? res.signal : 0, .wall_s = fmb_pool_now() - r->start};
+  run.status = r->timed_out ? FMB_CHILD_TIMEOUT : FMB_CHILD_CRASHED;
+  /* the row's message says what happened (fmb_sweep_row_served); the runner's last words follow */
+  record(sw, &run, "", r->timed_out ? "" : tail);
+  r->index = -1;
+}
+
+int fmb_sweep_serve(fmbSweep* sw) {
+  long n = 0, ninf = 0;
+  long* todo = fmb_sweep_todo(sw, &n, &ninf);
+  if (!todo) return FMB_EXIT_BAD_INPUT;
+  sw->total_todo = sw->done + n;
+  int rc = fmb_sweep_rerun_inflight(sw, todo, ninf); /* alone, each in a fresh process */
+  fmbPool* pool = rc ? NULL : fmb_pool_new(sw->jobs);
+  Runner* runners = calloc((size_t)sw->jobs, sizeof *runners);
+  struct pollfd* pfd = calloc((size_t)sw->jobs, sizeof *pfd);
+  long next = ninf;
+  signal(SIGPIPE, SIG_IGN); /* a runner that died: its pipe says so by EPIPE */
+  while (pool && runners && pfd && !*sw->stop) {
+    int busy = 0;
+    for (int k = 0; k < sw->jobs; ++k) {
+      Runner* r = &runners[k];
+      if (!r->alive && next < n && start_runner(sw, pool, r, k) != 0) break;
+      if (r->alive && r->index < 0 && next < n && dispatch(sw, r, todo[next++]) != 0) ended(sw, pool, runners, k);
+      busy += r->alive && r->index >= 0;
+    }
+    sw->running = busy;
+    if (!busy && next >= n) break;
+    /* wait for an answer, a deadline, or a signal */
+    double now = fmb_pool_now(), wake = now + 0.5;
+    int np = 0;
+    for (int k = 0; k < sw->jobs; ++k) {
+      Runner* r = &runners[k];
+      if (!r->alive) continue;
+      pfd[np++] = (struct pollfd){.fd = r->out, .events = POLLIN};
+      if (r->index >= 0 && r->deadline > 0 && r->deadline < wake) wake = r->deadline;
+    }
+    int ms = (int)((wake - now) * 1e3) + 1;
+    if (poll(pfd, (nfds_t)np, ms < 0 ? 0 : ms) < 0 && errno != EINTR) break;
+    now = fmb_pool_now();
+    for (int k = 0; k < sw->jobs; ++k) {
+      Runner* r = &runners[k];
+      if (!r->alive) continue;
+      if (r->index >= 0 && r->deadline > 0 && now >= r->deadline && !r->timed_out) {
+        r->timed_out = 1;
+        fmb_pool_kill(pool, k); /* its pipe closes: ended() below */
+      }
+      ssize_t got = read(r->out, r->buf + r->n, sizeof r->buf - 1 - r->n);
+      if (got < 0 && (errno == EAGAIN || errno == EINTR)) continue;
+      if (got <= 0) {
+        ended(sw, pool, runners, k);
+        continue;
+      }
+      r->n += (size_t)got;
+      r->buf[r->n] = '\0';
+      char* nl = memchr(r->buf, '\n', r->n);
+      if (nl && r->index >= 0) {
+        *nl = '\0';
+        answered(sw, r, r->buf);
+        r->n = 0;
+      } else if (r->n == sizeof r->buf - 1) {
+        r->n = 0; /* an answer too long to be ours: dropped, the runner is killed at its deadline */
+      }
+    }
+    fmb_sweep_progress(sw, 0);
+  }
+  if (pool && *sw->stop) {
+    for (int k = 0; k < sw->jobs; ++k)
+      if (runners[k].alive && runners[k].index >= 0) fmb_journal_cancelled(sw, runners[k].index);
+    fmb_pool_kill_all(pool, 0.0);
+  }
+  for (int k = 0; runners && k < sw->jobs; ++k)
+    if (runners[k].alive) close(runners[k].in), close(runners[k].out); /* EOF: the runner ends */
+  fmb_pool_free(pool);
+  free(runners), free(pfd), free(todo);
+  return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
+}
