@@ -109,6 +109,25 @@ class Modes(ctypes.Structure):
                 ("shape_im", ctypes.POINTER(ctypes.c_double))]
 
 
+class CampbellOptions(ctypes.Structure):
+    """fmbCampbellOptions"""
+    _fields_ = [("speed_key", ctypes.c_char_p), ("count", ctypes.c_int), ("method", ctypes.c_int),
+                ("steady", StaticOptions)]
+
+
+class Campbell(ctypes.Structure):
+    """fmbCampbell (`last` and `track` are the library's own)"""
+    _fields_ = [("nspeed", ctypes.c_int), ("done", ctypes.c_int), ("count", ctypes.c_int),
+                ("speed", ctypes.POINTER(ctypes.c_double)), ("frequency", ctypes.POINTER(ctypes.c_double)),
+                ("mac", ctypes.POINTER(ctypes.c_double)), ("last", ctypes.c_void_p), ("track", ctypes.c_void_p)]
+
+
+class SceneSource(ctypes.Structure):
+    """fmbSceneSource"""
+    _fields_ = [("path", ctypes.c_char_p), ("overrides", ctypes.POINTER(ctypes.c_char_p)),
+                ("noverrides", ctypes.c_int), ("reg", ctypes.c_void_p)]
+
+
 #: fmbStats is only ever passed to the library (fmb_data_stats fills it, fmb_print_stats prints it), never
 #: read field by field: the package reads the stats *line*, so fields the library adds later
 #: (e.g. integrator=) appear without a change here. The buffer is larger than the struct will be.
@@ -156,6 +175,10 @@ _PROTOTYPES = {
     "fmb_input_name": (ctypes.c_char_p, [_P, ctypes.c_int]),
     "fmb_set_input": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.c_double]),
     "fmb_get_input": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.POINTER(ctypes.c_double)]),
+    "fmb_campbell": (ctypes.c_int, [ctypes.POINTER(SceneSource), ctypes.POINTER(CampbellOptions),
+                                    ctypes.POINTER(ctypes.c_double), ctypes.c_int,
+                                    ctypes.POINTER(ctypes.POINTER(Campbell)), _D]),
+    "fmb_campbell_free": (None, [ctypes.POINTER(Campbell)]),
     "fmb_write_table": (ctypes.c_int, [ctypes.c_char_p, ctypes.c_int, ctypes.POINTER(ctypes.c_char_p), ctypes.c_int,
                                        ctypes.POINTER(ctypes.c_double), _D]),
 }

@@ -11,8 +11,7 @@ from typing import Dict, Optional, Sequence, Union
 import numpy as np
 
 from . import _lib
-from ._scene import override
-from .model import Model, Overrides, Result, Source, _overrides, load
+from .model import Model, Overrides, Result, Source, load
 
 ModelLike = Union[Model, Source]
 
@@ -153,16 +152,17 @@ def modes(scene: ModelLike, *, count: int = 10, at: Optional[float] = None, meth
 
 
 class CampbellResult:
-    """A Campbell diagram: ``speeds`` (rad/s) and ``frequencies`` (len(speeds) × count, rad/s,
-    negative = divergent), each column one mode followed from speed to speed by its shape (the
-    greatest modal assurance criterion, fmb_modes_mac), as ``flexmbd campbell`` tracks them;
-    ``poor_matches``: (speed, mode, MAC) where a mode matched its last shape with MAC < 0.5
-    (take finer speed steps there)."""
+    """A Campbell diagram (fmb_campbell): ``speeds`` (rad/s) and ``frequencies`` (len(speeds) ×
+    count, rad/s, negative = divergent), each column one mode followed from speed to speed by its
+    shape, as ``flexmbd campbell`` tracks them; ``mac``: each mode's modal assurance criterion with
+    its own shape at the speed before (1 at the first); ``poor_matches``: (speed, mode, MAC) where
+    it is below 0.5 (the speeds are too far apart to follow that mode reliably)."""
 
-    def __init__(self, speeds: np.ndarray, frequencies: np.ndarray, poor: list):
+    def __init__(self, speeds: np.ndarray, frequencies: np.ndarray, mac: np.ndarray):
         self.speeds = speeds
         self.frequencies = frequencies
-        self.poor_matches = poor
+        self.mac = mac
+        self.poor_matches = [(float(speeds[i]), k + 1, float(mac[i, k])) for i, k in zip(*np.nonzero(mac < 0.5))]
 
     def plot(self, ax=None, **style):
         """Frequencies against speed with the 1× speed line (matplotlib); returns the Axes."""
@@ -171,65 +171,35 @@ class CampbellResult:
         return plot_campbell(self, ax=ax, **style)
 
 
-_EXTRA_MODES = 6  # computed beyond count so that a mode crossing from above can be followed (cmd_campbell.c)
-
-
 def campbell(scene: ModelLike, speed: str, speeds: Sequence[float], *, count: int = 4, at: Optional[float] = None,
-             method: str = "auto", set: Overrides = None, plugins: Sequence[str] = ()
-             ) -> CampbellResult:
-    """The modes at each hub speed: ``speed`` is the scene key that sets it (e.g.
-    ``joints.spin.speed``), given each value of ``speeds`` as an override; at each speed the
-    steady state (fmb_static), then its modes (fmb_modes), followed across speeds by MAC."""
-    base = scene if isinstance(scene, Model) else None
-    meth = _method(method)
+             method: str = "auto", set: Overrides = None, plugins: Sequence[str] = ()) -> CampbellResult:
+    """The modes at each hub speed, by the library's fmb_campbell (as ``flexmbd campbell``):
+    ``speed`` is the scene key that sets it (e.g. ``joints.spin.speed``), given each value of
+    ``speeds`` as an override; at each speed the steady state, then its modes, followed across
+    speeds by their shapes (modal assurance criterion). Raises SceneError/SolverError with the
+    speeds done so far in the error's ``.result``."""
+    m = _model(scene, set, plugins)  # loaded once here: a bad scene or set fails before any speed
     lib = _lib.library()
-    speeds = np.asarray(speeds, dtype=float)
-    freq = np.full((len(speeds), count), np.nan)
-    poor = []
-    prev = None
-    track = list(range(count))
-    try:
-        for i, s in enumerate(speeds):
-            over = _overrides(set) + [override(speed, float(s))]
-            m = base.reload(over) if base is not None else load(scene, set=over, plugins=plugins)
-            with m:
-                cur = _modes_at(m, static(m, at=at), count + _EXTRA_MODES, meth)
-                if cur.contents.count < count:
-                    n = cur.contents.count
-                    lib.fmb_modes_free(cur)
-                    raise _lib.SceneError(_lib.EXIT_BAD_INPUT, "", 0, 0,
-                                          f"the scene has only {n} modes; count={count} asks for more")
-                if prev is None:
-                    nxt = list(range(count))
-                else:
-                    nxt = _follow(lib, prev, track, cur, count, s, poor)
-                freq[i] = [cur.contents.frequency[j] for j in nxt]
-                track = nxt
-                if prev is not None:
-                    lib.fmb_modes_free(prev)
-                prev = cur
-    finally:
-        if prev is not None:
-            lib.fmb_modes_free(prev)
-    return CampbellResult(speeds, freq, poor)
+    speeds = np.ascontiguousarray(speeds, dtype=float)
+    opt = _lib.CampbellOptions(speed_key=speed.encode(), count=count, method=_method(method),
+                               steady=_lib.StaticOptions(t=at or 0.0, has_t=int(at is not None), quiet=1))
+    out = ctypes.POINTER(_lib.Campbell)()
+    diag = _lib.Diag()
+    with m._scene_source() as src:
+        rc = lib.fmb_campbell(ctypes.byref(src), ctypes.byref(opt), _dptr(speeds), len(speeds), ctypes.byref(out),
+                              ctypes.byref(diag))
+        err = m._error(diag, rc) if rc else None  # while the scene's temporary name is known
+    result = None
+    if out:
+        c = out.contents
 
+        def rows(ptr) -> np.ndarray:  # the speeds done, count values each
+            flat = np.ctypeslib.as_array(ptr, (c.nspeed * c.count,)) if c.nspeed * c.count else np.zeros(0)
+            return flat[: c.done * c.count].reshape(c.done, c.count).copy()
 
-def _follow(lib, prev, track, cur, count, speed, poor) -> list:
-    """Greedy assignment of the tracked modes to the current ones by the largest MAC (the rule of
-    tools/cmd_campbell.c, with the library's fmb_modes_mac)."""
-    ncur = cur.contents.count
-    mac = np.array([[lib.fmb_modes_mac(prev, track[k], cur, j) for j in range(ncur)] for k in range(count)])
-    nxt = [0] * count
-    free_k, free_j = set(range(count)), set(range(ncur))
-    for _ in range(count):
-        best, bk, bj = -1.0, 0, 0
-        for k in sorted(free_k):
-            for j in sorted(free_j):
-                if mac[k, j] > best:
-                    best, bk, bj = mac[k, j], k, j
-        free_k.discard(bk)
-        free_j.discard(bj)
-        nxt[bk] = bj
-        if best < 0.5:
-            poor.append((float(speed), bk + 1, float(best)))
-    return nxt
+        result = CampbellResult(speeds[: c.done].copy(), rows(c.frequency), rows(c.mac))
+        lib.fmb_campbell_free(out)
+    if err is not None:
+        err.result = result
+        raise err
+    return result

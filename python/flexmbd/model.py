@@ -1,6 +1,7 @@
 """Loading a scene (`load` → `Model`) and running it (`Model.run` → `Result`)."""
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import math
 import os
@@ -90,6 +91,28 @@ def load(scene: Source, set: Overrides = None, plugins: Sequence[Union[str, "os.
     return Model._load(path, None, overrides, plugin_files, ("path", os.path.abspath(path)))
 
 
+@contextlib.contextmanager
+def _scene_file(text: str):
+    """The scene text in a temporary file, in the current folder if it can be written (file names
+    in the scene are taken from there, as for a scene file there), else in the temporary folder;
+    removed after the block."""
+    fd = path = None
+    for folder in (os.getcwd(), tempfile.gettempdir()):
+        try:
+            fd, path = tempfile.mkstemp(prefix=".flexmbd-", suffix=".yaml", dir=folder)
+            break
+        except OSError:
+            continue
+    if fd is None:
+        raise OSError("flexmbd: no folder to write the scene text into")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        yield path
+    finally:
+        os.unlink(path)
+
+
 class _Owned:
     """An object of the library this Python object owns (``_ptr``), freed by ``_free`` (the name
     of the library's function) on close(), at the end of a ``with`` block, or when collected."""
@@ -139,21 +162,8 @@ class Model(_Owned):
 
     @classmethod
     def _from_text(cls, text: str, shown: str, overrides: List[str], plugins: Tuple[str, ...], source) -> "Model":
-        fd = path = None
-        for folder in (os.getcwd(), tempfile.gettempdir()):
-            try:
-                fd, path = tempfile.mkstemp(prefix=".flexmbd-", suffix=".yaml", dir=folder)
-                break
-            except OSError:
-                continue
-        if fd is None:
-            raise OSError("flexmbd: no folder to write the scene text into")
-        try:
-            with os.fdopen(fd, "w", encoding="utf-8") as f:
-                f.write(text)
+        with _scene_file(text) as path:
             return cls._load(path, shown, overrides, plugins, source)
-        finally:
-            os.unlink(path)
 
     @classmethod
     def _load(cls, path: str, shown: Optional[str], overrides: List[str], plugins: Tuple[str, ...], source) -> "Model":
@@ -169,6 +179,7 @@ class Model(_Owned):
         m = cls()
         m._ptr = ptr
         m._rename = rename
+        m._reg = reg
         m.path = None if shown else path
         m._shown_path = shown or path
         m.overrides = list(overrides)
@@ -197,9 +208,31 @@ class Model(_Owned):
         extra = _overrides(set)
         if kind == "path":
             return Model._load(what, None, self.overrides + extra, tuple(self.plugins), self._source)
-        text = scene_text(what) if kind == "dict" else what
-        return Model._from_text(text, "<dict>" if kind == "dict" else "<string>", self.overrides + extra,
-                                tuple(self.plugins), self._source)
+        return Model._from_text(self._text(), self._shown_path, self.overrides + extra, tuple(self.plugins),
+                                self._source)
+
+    def _text(self) -> str:
+        kind, what = self._source
+        return scene_text(what) if kind == "dict" else what
+
+    @contextlib.contextmanager
+    def _scene_source(self, extra: Sequence[str] = ()):
+        """An fmbSceneSource for the analyses that load the scene again themselves (fmb_campbell):
+        the file (a temporary one for text or a dict, its name shown as the model's in errors),
+        the overrides plus `extra`, the registry."""
+        overrides = self.overrides + list(extra)
+        arr = (ctypes.c_char_p * max(1, len(overrides)))(*[o.encode() for o in overrides])
+        with contextlib.ExitStack() as stack:
+            if self._source[0] == "path":
+                path = self._source[1]
+            else:
+                path = stack.enter_context(_scene_file(self._text()))
+                self._rename[path] = self._shown_path
+            try:
+                yield _lib.SceneSource(path=path.encode(), overrides=arr, noverrides=len(overrides), reg=self._reg)
+            finally:
+                if self._source[0] != "path":
+                    self._rename.pop(path, None)
 
     def _error(self, diag: _lib.Diag, default_code: int = _lib.EXIT_SOLVER) -> FlexmbdError:
         return _lib.error_from(diag, self._rename, default_code)

@@ -63,3 +63,19 @@ def test_compare_numbers():
     assert e["rows"] == len(a) and e["status"] == "ok" and c.ok
     tight = flexmbd.compare(a, b, columns=["beam.tip_v"], rtol=1e-6)
     assert not tight.ok and tight["beam.tip_v"]["status"] == "beyond"
+
+
+def test_campbell_of_text_and_errors():
+    """a scene given as text goes to fmb_campbell as a temporary file, named <string> in errors;
+    a failure carries the speeds done"""
+    text = open(CAMPBELL).read()
+    c = flexmbd.campbell(text, "joints.spin.speed", [0.0, 6.0], count=2)
+    ref = flexmbd.campbell(flexmbd.load(CAMPBELL), "joints.spin.speed", [0.0, 6.0], count=2)
+    np.testing.assert_allclose(c.frequencies, ref.frequencies, rtol=1e-10)  # ARPACK: its start vector differs per call
+    assert c.mac[0].tolist() == [1.0, 1.0] and (c.mac > 0.9).all() and not c.poor_matches
+    try:
+        flexmbd.campbell(text, "joints.spin.sped", [0.0, 6.0], count=2)
+    except flexmbd.SceneError as e:
+        assert e.file in ("--set", "<string>") and "sped" in str(e), str(e)
+    else:
+        raise AssertionError("a misspelt speed key was accepted")

@@ -14,7 +14,8 @@ from flexmbd import _lib
 from conftest import BUILD, SRC, cli
 
 STRUCTS = {"fmbDiag": _lib.Diag, "fmbSolverInfo": _lib.SolverInfo,
-           "fmbStaticOptions": _lib.StaticOptions, "fmbStaticResult": _lib.StaticResult, "fmbModes": _lib.Modes}
+           "fmbStaticOptions": _lib.StaticOptions, "fmbStaticResult": _lib.StaticResult, "fmbModes": _lib.Modes,
+           "fmbSceneSource": _lib.SceneSource, "fmbCampbellOptions": _lib.CampbellOptions, "fmbCampbell": _lib.Campbell}
 
 
 def test_struct_layouts_match_the_header(out):
