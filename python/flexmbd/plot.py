@@ -14,7 +14,7 @@ _QUANTITY_UNITS = {
     "x": "m", "y": "m", "theta": "rad", "omega": "rad/s", "vx": "m/s", "vy": "m/s",
     # the beam (bodies/beam.c, bodies/beam_exact.c)
     "tip_u": "m", "tip_v": "m", "tip_u_rate": "m/s", "tip_v_rate": "m/s", "tip_x": "m", "tip_y": "m",
-    "ang_momentum": "kg m^2/s",
+    "ang_momentum": "kg m^2/s", "tip_angle": "rad",
     # joints (engine/output.c power_names, reaction_names; joints/*.c)
     "power": "W", "work": "J", "reaction_x": "N", "reaction_y": "N", "reaction_torque": "N m",
     "angle": "rad", "speed": "rad/s", "length": "m", "tension": "N", "displacement": "m", "velocity": "m/s",
