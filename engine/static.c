@@ -417,12 +417,6 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
     const fmbBodyInst* bi = &m->body[b];
     bi->type->initial(bi->self, x + bi->qadr, v0 + bi->qadr);
   }
-  /* the poses as given must satisfy the joints at t0, as for a run (statics once moved bodies
-     onto their joints silently, or failed with exit 3 "no equilibrium" on joints that cannot all
-     hold, where `run` refuses the same scene); checked on a copy: the drives may stand elsewhere
-     at opt.t, which Newton reaches from the poses given */
-  memcpy(xt, x, (size_t)nq * sizeof(double));
-  if ((rc = fmb_pose_check(m, w, m->solver.t0, xt, diag))) goto done;
   if ((rc = fit_rotation(m, w, opt.t, x, &s.speed, s.center, diag))) goto done;
   res->speed = s.speed;
   res->center[0] = s.center[0];
@@ -548,29 +542,5 @@ done:
   free(F0);
   free(G);
   free(v0);
-  return rc;
-}
-
-int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
-               fmbDiag* diag) {
-  fmbDiag local;
-  if (!diag) diag = &local;
-  memset(diag, 0, sizeof *diag);
-  if (!m || !y || !yp || !res) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_static: NULL model, state or result");
-    return FMB_EXIT_BAD_INPUT;
-  }
-  if (opt && opt->has_t && !isfinite(opt->t)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_static: the time (fmbStaticOptions.t) is %g, not finite",
-                 opt->t);
-    return FMB_EXIT_BAD_INPUT;
-  }
-  fmbWorkspace* w = fmb_workspace_new(m);
-  if (!w) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
-    return FMB_EXIT_SOLVER;
-  }
-  int rc = fmb_static_solve(m, w, opt, y, yp, res, diag);
-  fmb_workspace_free(w);
   return rc;
 }

@@ -1,0 +1,47 @@
+/* static_api.c — fmb_static, the public statics entry: the poses the scene gives are checked
+ * against the joints as a run checks them (ic.c), then the equilibrium is solved (static.c). In
+ * its own file because ic.c calls static.c (`initial: static`) and this calls both: statics once
+ * moved bodies onto their joints silently, or failed with exit 3 "no equilibrium" on joints that
+ * cannot all hold, where `run` refuses the same scene. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "internal.h"
+
+int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
+               fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (!m || !y || !yp || !res) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_static: NULL model, state or result");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  memset(res, 0, sizeof *res);
+  if (opt && opt->has_t && !isfinite(opt->t)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_static: the time (fmbStaticOptions.t) is %g, not finite",
+                 opt->t);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmbWorkspace* w = fmb_workspace_new(m);
+  double* q = calloc((size_t)m->nq + 1, sizeof(double));
+  double* v = calloc((size_t)m->nq + 1, sizeof(double));
+  int rc = 0;
+  if (!w || !q || !v) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");
+    rc = FMB_EXIT_SOLVER;
+  } else {
+    /* the poses as given, at t0 (the drives may stand elsewhere at opt->t: Newton goes there) */
+    for (int b = 1; b < m->nbody; ++b) {
+      const fmbBodyInst* bi = &m->body[b];
+      bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
+    }
+    rc = fmb_pose_check(m, w, m->solver.t0, q, diag);
+    if (!rc) rc = fmb_static_solve(m, w, opt, y, yp, res, diag);
+  }
+  free(q);
+  free(v);
+  fmb_workspace_free(w);
+  return rc;
+}
