@@ -7,6 +7,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "fd.h"
 #include "internal.h"
 
 /* a body's rows [R; Rz] at (q, v, a, z): residual_aux when it has auxiliary unknowns (the only

@@ -18,6 +18,7 @@
 #include <string.h>
 #include <klu.h>
 
+#include "fd.h"
 #include "internal.h"
 #include "klu_policy.h"
 

@@ -320,10 +320,6 @@ int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t
    diagonal entry): used to explain a solver failure at the crossing itself. */
 int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double singular_tol);
 
-/* ---- pattern.c ---- */
-int fmb_pattern_build(fmbModel* m);
-void fmb_pattern_free(fmbModel* m);
-
 /* ---- integrator_ida.c: the model's CSC pattern into a SUNDIALS sparse matrix (ny x ny, nnz) ---- */
 struct _generic_SUNMatrix;
 void fmb_sparse_pattern_into(const fmbModel* m, struct _generic_SUNMatrix* J);
@@ -411,22 +407,5 @@ typedef struct fmbVtk fmbVtk;
 fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag);
 int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const double* y); /* 0 ok, -1 write failed */
 void fmb_vtk_close(fmbVtk* v);
-
-/* ---- fd.c ---- */
-double fmb_fd_increment(double y, double ewt);
-/* dense column-major derivative of a body's residual: K = dR/dq, C = dR/dv, M = dR/da */
-int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
-                         const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
-                         double* M, double* work, double* scratch);
-/* a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
-   pattern_jacobian when it has one, else by differences over its pattern, one residual pair per
-   colour; scratch doubles: fmb_body_sparse_scratch */
-size_t fmb_body_sparse_scratch(const fmbBodyInst* b);
-int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                           const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
-                           double* work, double* scratch);
-/* a body's rows [R; Rz] at (q, v, a, z): residual_aux when it has auxiliary unknowns */
-int fmb_body_eval(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                  const double* z, double* R, double* work);
 
 #endif

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "internal.h"
+#include "pattern.h"
 
 typedef struct {
   int col, start, len;

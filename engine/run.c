@@ -69,13 +69,15 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   fmbDiag local_diag;
   if (!st) st = &local_stats;
   if (!diag) diag = &local_diag;
-  memset(st, 0, sizeof *st);
-  memset(diag, 0, sizeof *diag);
   if (!m) {
+    memset(st, 0, sizeof *st);
+    memset(diag, 0, sizeof *diag);
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_run: no model (NULL)");
     return FMB_EXIT_BAD_INPUT;
   }
   const clock_t c0 = clock();
+  memset(st, 0, sizeof *st);
+  memset(diag, 0, sizeof *diag);
   st->t_reached = m->solver.t0;
   const int quiet = opt && opt->quiet;
   const volatile sig_atomic_t* stop = opt ? opt->stop : NULL;

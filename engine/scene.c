@@ -10,6 +10,7 @@
 
 #include "integrator.h"
 #include "internal.h"
+#include "pattern.h"
 
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
 #define FMB_RTOL_MIN 1e-13 /* ~500 machine epsilons: below, IDA reports "too much accuracy requested" */

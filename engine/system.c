@@ -21,6 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fd.h"
 #include "internal.h"
 
 struct fmbWorkspace {

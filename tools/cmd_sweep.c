@@ -373,7 +373,15 @@ int fmb_cmd_sweep(int argc, char** argv) {
      libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
   const int launched = fmb_sweep_launched_by_mpi();
   const fmbSweepExtension* ext = fmb_sweep_extension_load(launched);
-  if (!launched || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
+  if (launched && !ext->has_mpi) { /* every rank would run the whole sweep into one journal */
+    const char* r = getenv("OMPI_COMM_WORLD_RANK");
+    if (!r) r = getenv("PMIX_RANK");
+    if (!r) r = getenv("PMI_RANK");
+    if (r && atoi(r) > 0) return 0;
+    fprintf(stderr, "flexmbd sweep: warning: started by mpirun/srun, but built without MPI: rank 0 runs the sweep "
+                    "alone, the other ranks leave\n");
+  }
+  if (!launched || !ext->has_mpi || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
 
   int rc = 0;
   if (sw->rank != 0 && dry) { /* rank 0 alone checks the plan */

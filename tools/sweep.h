@@ -127,6 +127,19 @@ long* fmb_sweep_todo(fmbSweep* sw, long* n, long* n_inflight);
 int fmb_sweep_local(fmbSweep* sw);
 /* the same with persistent runners (`--runner serve`, sweep_serve.c) */
 int fmb_sweep_serve(fmbSweep* sw);
+/* where the runners' runs come from and their rows go: the local journal, or rank 0 (MPI) */
+typedef struct fmbRunFeed {
+  /* the next run: 1 with its index, attempt and time limit; 0 none now; -1 none any more */
+  int (*next)(void* ctx, long* index, int* attempt, double* timeout);
+  /* a finished run's row (malloc'd, taken over; NULL when out of memory) */
+  void (*done)(void* ctx, const fmbChildResult* res, char* row);
+  /* optional, called every round: fetch what arrived (nonzero when something did) */
+  int (*pump)(void* ctx);
+  /* optional: a run killed because the sweep was interrupted */
+  void (*cancelled)(void* ctx, long index);
+  void* ctx;
+} fmbRunFeed;
+int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed);
 /* runs the in-flight runs of a crash one at a time (each alone: one may be what crashed) */
 int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n);
 

@@ -103,15 +103,16 @@ static int write_columns(hid_t file, const char* group, const Text* t) {
   const char** str = malloc((n ? n : 1) * sizeof *str);
   int rc = num && str ? 0 : -1;
   for (int c = 0; c < t->ncol && !rc; ++c) {
-    int numeric = 1;
-    for (hsize_t r = 0; r < n && numeric; ++r) {
+    /* ids are hex (an all-digit one would parse), statuses and messages words even when empty */
+    const char* name = t->cell[c];
+    int numeric = strcmp(name, "run_id") && strcmp(name, "status") && strcmp(name, "message");
+    for (hsize_t r = 0; r < n; ++r) { /* every row: a word in the last row makes it a string column */
       const char* v = t->cell[(r + 1) * (hsize_t)t->ncol + (hsize_t)c];
       char* end;
       num[r] = *v ? strtod(v, &end) : NAN;
       if (*v && *end) numeric = 0;
       str[r] = v;
     }
-    const char* name = t->cell[c];
     hid_t type = numeric ? H5Tcopy(H5T_NATIVE_DOUBLE) : H5Tcopy(H5T_C_S1);
     if (!numeric) H5Tset_size(type, H5T_VARIABLE);
     hid_t d = H5Dcreate2(g, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);

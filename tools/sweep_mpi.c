@@ -148,6 +148,57 @@ static int manager(fmbSweep* sw) {
   return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
 }
 
+/* a worker starts: its slots, then one request per slot */
+static void hello(fmbSweep* sw) {
+  MPI_Send(&sw->jobs, (int)sizeof sw->jobs, MPI_CHAR, 0, TAG_HELLO, MPI_COMM_WORLD);
+  for (int s = 0; s < sw->jobs; ++s) MPI_Send(NULL, 0, MPI_CHAR, 0, TAG_ASK, MPI_COMM_WORLD);
+}
+
+/* a worker's runs: rank 0's RUN messages, queued (pump) and taken one by one (next) */
+typedef struct {
+  fmbSweep* sw;
+  double* queue; /* [jobs][3]: index, attempt, timeout; at most one request per slot is out */
+  int head, count, stops;
+} Remote;
+static int remote_pump(void* ctx) {
+  Remote* q = ctx;
+  int flag = 1, got = 0;
+  while (MPI_Iprobe(0, TAG_RUN, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE) == MPI_SUCCESS && flag) {
+    double msg[3];
+    MPI_Recv(msg, 3, MPI_DOUBLE, 0, TAG_RUN, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+    got = 1;
+    if (msg[0] < 0) {
+      ++q->stops;
+    } else if (q->count < q->sw->jobs) {
+      memcpy(q->queue + 3 * ((q->head + q->count++) % q->sw->jobs), msg, sizeof msg);
+    }
+  }
+  return got;
+}
+static int remote_next(void* ctx, long* index, int* attempt, double* timeout) {
+  Remote* q = ctx;
+  if (!q->count) return q->stops >= q->sw->jobs ? -1 : 0;
+  const double* m = q->queue + 3 * q->head;
+  *index = (long)m[0], *attempt = (int)m[1], *timeout = m[2];
+  q->head = (q->head + 1) % q->sw->jobs;
+  --q->count;
+  return 1;
+}
+static void remote_done(void* ctx, const fmbChildResult* res, char* row) {
+  (void)ctx, (void)res;
+  MPI_Send(row, row ? (int)strlen(row) : 0, MPI_CHAR, 0, TAG_ROW, MPI_COMM_WORLD);
+  free(row);
+}
+static int worker_serve(fmbSweep* sw) {
+  Remote q = {sw, calloc((size_t)sw->jobs * 3, sizeof(double)), 0, 0, 0};
+  if (!q.queue) return FMB_EXIT_BAD_INPUT;
+  hello(sw);
+  const fmbRunFeed feed = {remote_next, remote_done, remote_pump, NULL, &q};
+  const int rc = fmb_sweep_serve_feed(sw, &feed);
+  free(q.queue);
+  return rc;
+}
+
 /* a finished run's row to rank 0 (which takes it as a request for the next run too) */
 static void send_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
   char* row = fmb_sweep_row(sw, r, attempt);
@@ -155,47 +206,41 @@ static void send_row(fmbSweep* sw, const fmbChildResult* r, int attempt) {
   free(row);
 }
 
+/* a worker with a process per run */
 static int worker(fmbSweep* sw) {
   fmbPool* pool = fmb_pool_new(sw->jobs);
   int* attempt = calloc((size_t)sw->nrun, sizeof *attempt);
-  if (!pool || !attempt) {
-    free(attempt);
-    fmb_pool_free(pool);
-    return FMB_EXIT_BAD_INPUT;
-  }
-  MPI_Send(&sw->jobs, (int)sizeof sw->jobs, MPI_CHAR, 0, TAG_HELLO, MPI_COMM_WORLD);
-  for (int s = 0; s < sw->jobs; ++s) MPI_Send(NULL, 0, MPI_CHAR, 0, TAG_ASK, MPI_COMM_WORLD);
-  int stops = 0;
+  Remote q = {sw, calloc((size_t)sw->jobs * 3, sizeof(double)), 0, 0, 0};
+  int rc = pool && attempt && q.queue ? 0 : FMB_EXIT_BAD_INPUT;
+  if (!rc) hello(sw);
+  int more = 1;
   double wait = 2e-4;
-  while (!*sw->stop && (stops < sw->jobs || fmb_pool_running(pool))) {
-    int active = 0, flag = 1;
-    while (MPI_Iprobe(0, TAG_RUN, MPI_COMM_WORLD, &flag, MPI_STATUS_IGNORE) == MPI_SUCCESS && flag) {
-      double msg[3];
-      MPI_Recv(msg, 3, MPI_DOUBLE, 0, TAG_RUN, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+  while (!rc && !*sw->stop && (more || fmb_pool_running(pool))) {
+    int active = remote_pump(&q), got = 0;
+    long i;
+    int att;
+    double timeout;
+    while (fmb_pool_free_slots(pool) > 0 && (got = remote_next(&q, &i, &att, &timeout)) > 0) {
       active = 1;
-      if (msg[0] < 0) {
-        ++stops;
-        continue;
-      }
-      const long i = (long)msg[0];
-      attempt[i] = (int)msg[1];
-      if (fmb_sweep_start(sw, pool, i, msg[2]) != 0) {
+      attempt[i] = att;
+      if (fmb_sweep_start(sw, pool, i, timeout) != 0) {
         fmbChildResult r = {.tag = i, .status = FMB_CHILD_CRASHED, .exit_code = -1};
         send_row(sw, &r, attempt[i]);
       }
     }
+    if (got < 0) more = 0;
     fmbChildResult r;
     if (wait_child(pool, &wait, active, &r)) send_row(sw, &r, attempt[r.tag]);
   }
   fmb_pool_free(pool); /* kills what still runs (an interrupt) */
-  free(attempt);
-  return *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
+  free(attempt), free(q.queue);
+  return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
 }
 
 int fmb_sweep_mpi(fmbSweep* sw, int rc0) {
   MPI_Bcast(&rc0, 1, MPI_INT, 0, MPI_COMM_WORLD);
   if (rc0) return rc0;
-  return sw->rank == 0 ? manager(sw) : worker(sw);
+  return sw->rank == 0 ? manager(sw) : sw->serve ? worker_serve(sw) : worker(sw);
 }
 
 #endif

@@ -23,6 +23,7 @@ typedef struct {
   int alive;
   int in, out;     /* the runner's stdin (we write) and stdout (we read) */
   long index;      /* the run in flight, -1 none */
+  int attempt;
   double start, deadline;
   int timed_out;
   int reaped;           /* its process ended and was collected (res) */
@@ -67,18 +68,17 @@ static int start_runner(fmbSweep* sw, fmbPool* pool, Runner* r, int slot) {
 }
 
 /* hands run `index` to an idle runner: 0, or -1 (its pipe is gone: it died) */
-static int dispatch(fmbSweep* sw, Runner* r, long index) {
+static int dispatch(fmbSweep* sw, Runner* r, long index, int attempt, double timeout) {
   char line[FMB_SWEEP_MAX_PATHS * FMB_SWEEP_SET_LEN + 4400];
   int n = snprintf(line, sizeof line, "%s/series/%016llx.csv", sw->dir, (unsigned long long)sw->id[index]);
   for (int k = 0; k < sw->plan.npath && n < (int)sizeof line; ++k)
     n += snprintf(line + n, sizeof line - (size_t)n, "\t%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
   if (n >= (int)sizeof line - 1) return -1;
   line[n++] = '\n';
-  fmb_journal_started(sw, index);
   r->index = index;
+  r->attempt = attempt;
   r->start = fmb_pool_now();
-  const double t = fmb_sweep_timeout(sw);
-  r->deadline = t > 0 ? r->start + t : 0.0;
+  r->deadline = timeout > 0 ? r->start + timeout : 0.0;
   r->timed_out = 0;
   r->n = 0;
   for (const char* p = line; n > 0;) {
@@ -90,14 +90,13 @@ static int dispatch(fmbSweep* sw, Runner* r, long index) {
   return 0;
 }
 
-static void record(fmbSweep* sw, const fmbChildResult* res, const char* stats, const char* msg) {
-  char* row = fmb_sweep_row_served(sw, res, sw->starts[sw->first[res->tag]], stats, msg);
-  if (row && fmb_journal_append(sw, res->tag, row) == 0) fmb_sweep_account(sw, (int)res->status, res->wall_s);
-  free(row);
+static void record(fmbSweep* sw, const fmbRunFeed* feed, const Runner* r, const fmbChildResult* res, const char* stats,
+                   const char* msg) {
+  feed->done(feed->ctx, res, fmb_sweep_row_served(sw, res, r->attempt, stats, msg));
 }
 
 /* a runner's answer "EXIT<TAB>stats: ...<TAB>message" for its run */
-static void answered(fmbSweep* sw, Runner* r, char* line) {
+static void answered(fmbSweep* sw, const fmbRunFeed* feed, Runner* r, char* line) {
   char* save = NULL;
   const char* code = strtok_r(line, "\t", &save);
   const char* stats = strtok_r(NULL, "\t", &save);
@@ -105,12 +104,12 @@ static void answered(fmbSweep* sw, Runner* r, char* line) {
   const int rc = code ? atoi(code) : -1;
   fmbChildResult res = {.tag = r->index, .exit_code = rc, .wall_s = fmb_pool_now() - r->start};
   res.status = rc == 0 ? FMB_CHILD_OK : rc == 2 ? FMB_CHILD_BAD_INPUT : rc == 3 ? FMB_CHILD_SOLVER_STOPPED : FMB_CHILD_CRASHED;
-  record(sw, &res, stats ? stats : "", msg ? msg : "");
+  record(sw, feed, r, &res, stats ? stats : "", msg ? msg : "");
   r->index = -1;
 }
 
 /* a runner ended (crash, kill at a deadline): reaped, its run in flight recorded */
-static void ended(fmbSweep* sw, fmbPool* pool, Runner* runners, int slot) {
+static void ended(fmbSweep* sw, const fmbRunFeed* feed, fmbPool* pool, Runner* runners, int slot) {
   Runner* r = &runners[slot];
   close(r->in), close(r->out);
   r->alive = 0;
@@ -132,33 +131,49 @@ static void ended(fmbSweep* sw, fmbPool* pool, Runner* runners, int slot) {
                         .signal = got == 1 ? res.signal : 0, .wall_s = fmb_pool_now() - r->start};
   run.status = r->timed_out ? FMB_CHILD_TIMEOUT : FMB_CHILD_CRASHED;
   /* the row's message says what happened (fmb_sweep_row_served); the runner's last words follow */
-  record(sw, &run, "", r->timed_out ? "" : tail);
+  record(sw, feed, r, &run, "", r->timed_out ? "" : tail);
   r->index = -1;
 }
 
-int fmb_sweep_serve(fmbSweep* sw) {
-  long n = 0, ninf = 0;
-  long* todo = fmb_sweep_todo(sw, &n, &ninf);
-  if (!todo) return FMB_EXIT_BAD_INPUT;
-  sw->total_todo = sw->done + n;
-  int rc = fmb_sweep_rerun_inflight(sw, todo, ninf); /* alone, each in a fresh process */
-  fmbPool* pool = rc ? NULL : fmb_pool_new(sw->jobs);
+int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed) {
+  fmbPool* pool = fmb_pool_new(sw->jobs);
   Runner* runners = calloc((size_t)sw->jobs, sizeof *runners);
   struct pollfd* pfd = calloc((size_t)sw->jobs, sizeof *pfd);
-  long next = ninf;
   signal(SIGPIPE, SIG_IGN); /* a runner that died: its pipe says so by EPIPE */
+  int more = 1;           /* the feed may still hand out runs */
+  int failed = 0;         /* no runner could be started */
+  double wait = 2e-4;     /* with a pump (MPI): how long poll waits, backing off to 20 ms */
   while (pool && runners && pfd && !*sw->stop) {
-    int busy = 0;
+    int busy = 0, active = feed->pump ? feed->pump(feed->ctx) : 0;
     for (int k = 0; k < sw->jobs; ++k) {
       Runner* r = &runners[k];
-      if (!r->alive && next < n && start_runner(sw, pool, r, k) != 0) break;
-      if (r->alive && r->index < 0 && next < n && dispatch(sw, r, todo[next++]) != 0) ended(sw, pool, runners, k);
+      if (!r->alive && more && start_runner(sw, pool, r, k) != 0) {
+        int alive = 0;
+        for (int j = 0; j < sw->jobs; ++j) alive += runners[j].alive;
+        if (!alive) { /* no runner at all: the runs left stay without a row, for a resume */
+          fprintf(stderr, "flexmbd sweep: cannot start a runner (%s): stopping; run the command again to resume\n",
+                  strerror(errno));
+          more = 0, failed = 1;
+        }
+        break;
+      }
+      if (r->alive && r->index < 0 && more) {
+        long index;
+        int attempt;
+        double timeout;
+        const int got = feed->next(feed->ctx, &index, &attempt, &timeout);
+        if (got < 0) more = 0;
+        if (got > 0) {
+          active = 1;
+          if (dispatch(sw, r, index, attempt, timeout) != 0) ended(sw, feed, pool, runners, k);
+        }
+      }
       busy += r->alive && r->index >= 0;
     }
     sw->running = busy;
-    if (!busy && next >= n) break;
+    if (!busy && !more) break;
     /* wait for an answer, a deadline, or a signal */
-    double now = fmb_pool_now(), wake = now + 0.5;
+    double now = fmb_pool_now(), wake = now + (feed->pump ? wait : 0.5);
     int np = 0;
     for (int k = 0; k < sw->jobs; ++k) {
       Runner* r = &runners[k];
@@ -167,7 +182,9 @@ int fmb_sweep_serve(fmbSweep* sw) {
       if (r->index >= 0 && r->deadline > 0 && r->deadline < wake) wake = r->deadline;
     }
     int ms = (int)((wake - now) * 1e3) + 1;
-    if (poll(pfd, (nfds_t)np, ms < 0 ? 0 : ms) < 0 && errno != EINTR) break;
+    const int ready = poll(pfd, (nfds_t)np, ms < 0 ? 0 : ms);
+    if (ready < 0 && errno != EINTR) break;
+    wait = active || ready > 0 ? 2e-4 : (wait * 2 < 0.02 ? wait * 2 : 0.02);
     now = fmb_pool_now();
     for (int k = 0; k < sw->jobs; ++k) {
       Runner* r = &runners[k];
@@ -179,7 +196,7 @@ int fmb_sweep_serve(fmbSweep* sw) {
       ssize_t got = read(r->out, r->buf + r->n, sizeof r->buf - 1 - r->n);
       if (got < 0 && (errno == EAGAIN || errno == EINTR)) continue;
       if (got <= 0) {
-        ended(sw, pool, runners, k);
+        ended(sw, feed, pool, runners, k);
         continue;
       }
       r->n += (size_t)got;
@@ -187,7 +204,7 @@ int fmb_sweep_serve(fmbSweep* sw) {
       char* nl = memchr(r->buf, '\n', r->n);
       if (nl && r->index >= 0) {
         *nl = '\0';
-        answered(sw, r, r->buf);
+        answered(sw, feed, r, r->buf);
         r->n = 0;
       } else if (r->n == sizeof r->buf - 1) {
         r->n = 0; /* an answer too long to be ours: dropped, the runner is killed at its deadline */
@@ -197,12 +214,47 @@ int fmb_sweep_serve(fmbSweep* sw) {
   }
   if (pool && *sw->stop) {
     for (int k = 0; k < sw->jobs; ++k)
-      if (runners[k].alive && runners[k].index >= 0) fmb_journal_cancelled(sw, runners[k].index);
+      if (runners[k].alive && runners[k].index >= 0 && feed->cancelled) feed->cancelled(feed->ctx, runners[k].index);
     fmb_pool_kill_all(pool, 0.0);
   }
   for (int k = 0; runners && k < sw->jobs; ++k)
     if (runners[k].alive) close(runners[k].in), close(runners[k].out); /* EOF: the runner ends */
   fmb_pool_free(pool);
-  free(runners), free(pfd), free(todo);
-  return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
+  free(runners), free(pfd);
+  return *sw->stop ? FMB_EXIT_INTERRUPTED : failed ? FMB_EXIT_SOLVER : 0;
+}
+
+/* the local feed: the runs still to do, rows into the journal */
+typedef struct {
+  fmbSweep* sw;
+  const long* todo;
+  long next, n;
+} Local;
+static int local_next(void* ctx, long* index, int* attempt, double* timeout) {
+  Local* l = ctx;
+  if (l->next >= l->n) return -1;
+  *index = l->todo[l->next++];
+  fmb_journal_started(l->sw, *index);
+  *attempt = l->sw->starts[l->sw->first[*index]];
+  *timeout = fmb_sweep_timeout(l->sw);
+  return 1;
+}
+static void local_done(void* ctx, const fmbChildResult* res, char* row) {
+  Local* l = ctx;
+  if (row && fmb_journal_append(l->sw, res->tag, row) == 0) fmb_sweep_account(l->sw, (int)res->status, res->wall_s);
+  free(row);
+}
+static void local_cancelled(void* ctx, long index) { fmb_journal_cancelled(((Local*)ctx)->sw, index); }
+
+int fmb_sweep_serve(fmbSweep* sw) {
+  long n = 0, ninf = 0;
+  long* todo = fmb_sweep_todo(sw, &n, &ninf);
+  if (!todo) return FMB_EXIT_BAD_INPUT;
+  sw->total_todo = sw->done + n;
+  int rc = fmb_sweep_rerun_inflight(sw, todo, ninf); /* alone, each in a fresh process */
+  Local local = {sw, todo, ninf, n};
+  const fmbRunFeed feed = {local_next, local_done, NULL, local_cancelled, &local};
+  if (!rc) rc = fmb_sweep_serve_feed(sw, &feed);
+  free(todo);
+  return rc;
 }

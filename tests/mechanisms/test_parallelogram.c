@@ -67,7 +67,8 @@ static void stretch_errors(const fmbtCsv* c, int rows, double* flat, double* reg
 }
 
 static Linkage run(const char* scene, int cranks, int couplers, const char* const* ov, int nov, const char* out) {
-  Linkage r = {0, 0, 0, 0, 0, 0, 0};
+  Linkage r;
+  memset(&r, 0, sizeof r);
   K_ = cranks;
   C_ = couplers;
   fmbtCsv c;

@@ -2,7 +2,7 @@
 # `flexmbd sweep` under mpirun (docs/sweep.md, "On a cluster"):
 #  1. rank-count independence: a random design run with -np 1, 2 and 4 (oversubscribed) and
 #     different -j gives the same table sorted by index, but timings (wall_s, rank, cpu_s), and
-#     rows from more than one rank;
+#     rows from more than one rank; so do worker ranks with persistent runners (--runner serve);
 #  2. SIGTERM to mpirun while every rank's children hang: no child is left running.
 #   usage: test_mpi.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN MPIRUN
 . "$(dirname "$0")/lib.sh"
@@ -23,6 +23,11 @@ for np_j in 1:1 2:1 4:1 2:2; do
   [ "$(tail -n +2 "$D/np$np.j$j.table" | wc -l)" = 24 ] || fail "-np $np: 24 rows expected"
   cmp -s "$D/np1.j1.table" "$D/np$np.j$j.table" || { diff "$D/np1.j1.table" "$D/np$np.j$j.table" | head; fail "-np $np -j $j: another table than -np 1"; }
 done
+# the worker ranks with persistent runners (--runner serve): the same table
+# shellcheck disable=SC2086
+$MPI -np 3 "$F" sweep $SPEC -o "$D/serve" -j 1 --runner serve > "$D/serve.out" 2>&1 ||
+  { cat "$D/serve.out"; fail "mpirun -np 3 --runner serve failed"; }
+cut -d, -f1-6,9-18,20- "$D/serve/table.csv" | cmp -s "$D/np1.j1.table" - || fail "--runner serve under mpirun: another table"
 awk -F, 'NR > 1 && $4 != "ok" { exit 1 }' "$D/np1.j1/table.csv" || fail "a run that is not ok"
 ranks=$(tail -n +2 "$D/np4.j1/table.csv" | cut -d, -f8 | sort -u | wc -l)
 [ "$ranks" -ge 2 ] || fail "-np 4: every row from one rank ($ranks ranks worked)"

@@ -2,6 +2,7 @@
 # Nothing lost (docs/sweep.md, "Resume"):
 #  1. kill -9 of the sweep at 20 random moments, each time started again: no child outlives the
 #     sweep (PR_SET_PDEATHSIG), and at the end every planned run has exactly one row in runs.csv;
+#     the same with persistent runners (--runner serve, 5 kills);
 #  2. a run in flight at three kills is marked `lost` (attempt 3) and not started a fourth time;
 #  3. SIGINT: every child killed (a hanging one too), exit 4, the journal whole; --status says what
 #     is left; the next start resumes and ends with 0.
@@ -39,6 +40,25 @@ cmp -s "$D/planned" "$D/rows" || { diff "$D/planned" "$D/rows" | head; fail "run
 n_ok=$(awk -F, 'NR > 1 && $4 == "ok"' "$D/k/table.csv" | wc -l)
 echo "kill -9 x20: 60 runs, one row each ($n_ok ok, the others lost after three kills in flight)"
 awk -F, 'NR > 1 && $4 != "ok" && $4 != "lost" { exit 1 }' "$D/k/table.csv" || fail "a status other than ok/lost after kills"
+
+# the same with persistent runners (--runner serve): 5 kills, then to the end, one row per run
+cp "$SRC/scenes/fourbar.yaml" "$D/fb.yaml" # a path of its own, to find its runners by
+SERVE="$D/fb.yaml -o $D/ks --quiet -j 2 --runner serve --grid solver.rtol=1e-5:1e-8:20:log"
+for k in 1 2 3 4 5; do
+  # shellcheck disable=SC2086
+  "$F" sweep $SERVE 2>> "$D/ks.err" &
+  pid=$!
+  sleep "$(awk -v s=$k 'BEGIN { srand(s + 100); printf "%.3f", 0.02 + 0.15 * rand() }')"
+  kill -9 $pid 2> /dev/null || true
+  wait $pid 2> /dev/null || true
+  sleep 0.05
+  [ -z "$(pgrep -f -- "run $D/fb.yaml --serve" || true)" ] || fail "runners outlive a kill -9 of the sweep"
+done
+# shellcheck disable=SC2086
+"$F" sweep $SERVE 2>> "$D/ks.err" || fail "the resumed sweep (serve) failed"
+tail -n +2 "$D/ks/plan.csv" | cut -d, -f2 | sort > "$D/planned_s"
+grep -v '^#' "$D/ks/runs.csv" | tail -n +2 | cut -d, -f2 | sort > "$D/rows_s"
+cmp -s "$D/planned_s" "$D/rows_s" || fail "--runner serve: runs.csv does not hold each planned run exactly once"
 
 # 2. lost: a hanging run in flight at three kills
 LOST="$SRC/tests/sweep/faulty.yaml --plugin $PLUGIN -o $D/l --quiet --timeout 60 --grid bodies.f.fault=3"

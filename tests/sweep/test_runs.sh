@@ -64,13 +64,20 @@ if [ -f "$D/s1/sweep.h5" ]; then
   steps=$(tail -n +2 "$D/s1/table.csv" | cut -d, -f"$(col steps)" | tr '\n' ' ')
   for s in $steps; do grep -q "$s" "$D/h5.txt" || fail "sweep.h5 /runs/steps lacks $s"; done
   h5dump -H -g /series "$D/s1/sweep.h5" | grep -q 'DATASET "3"' || fail "sweep.h5: no /series/3 with --keep series"
-  if python3 -c "import h5py" 2> /dev/null; then
-    python3 - "$D/s1/sweep.h5" "$D/s1/table.csv" << 'EOF' || fail "h5py reads another table"
+  PY=
+  for p in python3 /usr/bin/python3; do # Debian's h5py is for Debian's python3
+    if [ -z "$PY" ] && "$p" -c "import h5py" 2> /dev/null; then PY=$p; fi
+  done
+  if [ -n "$PY" ]; then
+    "$PY" - "$D/s1/sweep.h5" "$D/s1/table.csv" << 'EOF' || fail "h5py reads another table"
 import csv, sys, h5py
 f = h5py.File(sys.argv[1], "r")
 rows = list(csv.DictReader(open(sys.argv[2])))
 assert [int(v) for v in f["runs/steps"][:]] == [int(r["steps"]) for r in rows]
+assert [v.decode() for v in f["runs/status"][:]] == [r["status"] for r in rows], f["runs/status"][:]
+assert [v.decode() for v in f["runs/run_id"][:]] == [r["run_id"] for r in rows]
 assert list(f["series/0"].attrs["columns"].decode().split(","))[0] == "t"
+assert f["series/3"].shape[1] == len(f["series/0"].attrs["columns"].decode().split(","))
 EOF
   else
     echo "h5py not installed: skipped its check"
