@@ -47,14 +47,8 @@ while [ $# -gt 0 ]; do
   shift
 done
 mkdir -p "$RES"
-if [ ! -x "$OLD_DIR/build/flexmbd" ]; then
-  echo "building $OLD_COMMIT in $OLD_DIR ..." >&2
-  mkdir -p "$OLD_DIR"
-  git -C "$ROOT" archive "$OLD_COMMIT" | tar -x -C "$OLD_DIR"
-  cmake -S "$OLD_DIR" -B "$OLD_DIR/build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-  cmake --build "$OLD_DIR/build" -j2 --target flexmbd >/dev/null
-fi
-. "$ROOT/bench/lib.sh" # median, stat_field
+. "$ROOT/bench/lib.sh" # median, stat_field, build_landed
+build_landed "$OLD_COMMIT" "$OLD_DIR"
 
 REF="ida rtol 1e-12 (atol derived)"
 if ! "$F" run "$S" -o "$WORK/ref.csv" --quiet --set solver.rtol=1e-12 --set solver.atol=auto 2>/dev/null; then

@@ -17,11 +17,14 @@
  *             (the example plus example_damped) loses it and never gains any
  *   outputs   every output of the type stays finite along the run
  * Every check can fail: tests/plugins/bad_*.c are plugins that each break one. */
+#include <fcntl.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+
+#include <unistd.h>
 
 #include "internal.h"
 
@@ -115,8 +118,13 @@ static const char* fixture_type(const fmbRegistry* reg, int joint) {
    (fmbJointType's comment): body a pinned to ground at its left end, body b to its right, of the
    types flagged FMB_TYPE_CONFORM_FIXTURE (a rigid body and a pin). */
 static int scene_write(const char* path, const char* type, const Lines* l, const SceneSpec* s) {
-  FILE* f = fopen(path, "w");
-  if (!f) return -1;
+  /* never through a link that someone else put in the work folder (O_NOFOLLOW) */
+  const int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
+  FILE* f = fd >= 0 ? fdopen(fd, "w") : NULL;
+  if (!f) {
+    if (fd >= 0) close(fd);
+    return -1;
+  }
   int line = 1;
 #define EMIT(...) (fprintf(f, __VA_ARGS__), line++)
   EMIT("solver: {t_end: %g, rtol: 1e-10, atol: 1e-12, output_step: %g}\n", CONFORM_T_END, CONFORM_T_END / 100);

@@ -412,6 +412,9 @@ typedef struct fmbStats {
   double ic_position_correction, ic_velocity_correction; /* norms of the initial projection */
   long rows_written;
   int interrupted; /* the run stopped because *fmbRunOptions.stop was set */
+  /* the integrator backend that ran last ("ida", "radau5", "projected"; solver.integrator: auto
+     picks one per model, formulation: auto may switch to projected mid-run); NULL if none ran */
+  const char* integrator;
 } fmbStats;
 
 typedef struct fmbRunOptions {
@@ -425,6 +428,7 @@ typedef struct fmbRunOptions {
   int progress;
   double progress_after_s;
   const char* vtk_dir; /* NULL = the scene's `vtk` key (if any); else a ParaView collection there */
+  int vtk_every;       /* the animation takes every Nth output row, from the first (0, 1: each) */
   /* may be NULL; when *stop becomes non-zero (e.g. set by a SIGINT handler) the run ends after
      the step in progress, keeps its rows and returns FMB_EXIT_INTERRUPTED */
   const volatile sig_atomic_t* stop;
@@ -464,6 +468,42 @@ FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
    (0 <= i < count; 0, or -1 when out of range). Lets a program address them with --set. */
 FMB_API int fmb_model_nbody(const fmbModel* m);
 FMB_API int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type);
+/* the scene's joints: their count, and joint i's name and `type:` (0 <= i < count; 0, or -1) */
+FMB_API int fmb_model_njoint(const fmbModel* m);
+FMB_API int fmb_model_joint(const fmbModel* m, int i, const char** name, const char** type);
+/* What a mechanism looks like (engine/drawing.c), fixed at load: the points and cells that the
+   ParaView animation (--vtk) and `flexmbd view` draw, from the types' ops alone: a body with a
+   `centreline` is a polyline through its stations; any other body with a frame (ncoord >= 3) is the
+   outline through the points its joints attach to (closed from three points) and its frame's x and
+   y axes; a joint with constraint rows is a vertex at its first point; a force element with two
+   points (a spring) is the line between them. */
+enum { FMB_DRAW_CENTRELINE = 0, FMB_DRAW_OUTLINE = 1, FMB_DRAW_FRAME_AXIS = 2, FMB_DRAW_JOINT = 3, FMB_DRAW_FORCE_ELEMENT = 4 };
+typedef struct fmbDrawPoint {
+  int body;        /* 0 = the world frame (local is then global); k >= 1 = fmb_model_body(m, k - 1) */
+  double local[2]; /* the material point in the body frame, as joints and `marker` take it */
+  int station;     /* a centreline station: K of the columns BODY.shapeK_x, BODY.shapeK_y; else -1 */
+} fmbDrawPoint;
+typedef struct fmbDrawCell {
+  int first, count; /* its points: conn[first .. first + count) */
+  int part;         /* FMB_DRAW_* */
+  int owner;        /* the body (numbered as fmbDrawPoint.body) or the joint (from 0) it draws */
+} fmbDrawCell;
+typedef struct fmbDrawing {
+  int npoint, ncell, nconn;
+  fmbDrawPoint* point;
+  fmbDrawCell* cell;
+  int* conn;
+} fmbDrawing;
+/* the SI unit of a CSV column the engine itself defines ("t": s; BODY.x: m; BODY.omega: rad/s;
+   JOINT.power: W; JOINT.work and energy.*: J; JOINT.reaction_x: N; reaction_torque: N m;
+   BODY.shapeK_x: m), or NULL (a type's own output, whose unit is not declared; unknown names) */
+FMB_API const char* fmb_output_unit(const char* column);
+/* s as XML text or attribute value (& < > " ' escaped, control characters other than \n \t
+   dropped): the VTK collection, JUnit reports */
+FMB_API void fmb_write_xml_text(FILE* f, const char* s);
+/* NULL when m is NULL or out of memory; free with fmb_drawing_free (NULL allowed) */
+FMB_API fmbDrawing* fmb_drawing_new(const fmbModel* m);
+FMB_API void fmb_drawing_free(fmbDrawing* d);
 /* one line per body and joint: type and active terms (nothing when m or f is NULL) */
 FMB_API void fmb_describe(const fmbModel* m, FILE* f);
 /* the constraints at t0 after the initial projection: degrees of freedom, redundant equations by
@@ -730,6 +770,15 @@ FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodie
  * ------------------------------------------------------------------------------------------- */
 typedef struct fmbSafeFile fmbSafeFile;
 /* NULL with the reason (e.g. strerror's) in err on failure */
+/* The files this process reads (the scene and its table files, noted by fmb_load; plugins, noted
+   when loaded; whatever a program notes): fmb_safe_open refuses to replace one, whatever name or
+   link leads to it (same device and inode), until the process ends or the noted name no longer
+   leads to that file (deleted or replaced since: its inode may be reused). Notes are counted:
+   each note is undone by one forget. note: 0, or -1 (not a regular file, or out of memory). input_at: the
+   noted path of the input that `path` is, or NULL. Not thread-safe: note from one thread. */
+FMB_API int fmb_safe_note_input(const char* path);
+FMB_API void fmb_safe_forget_input(const char* path);
+FMB_API const char* fmb_safe_input_at(const char* path);
 FMB_API fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen);
 FMB_API FILE* fmb_safe_stream(fmbSafeFile* f); /* a stdio stream over it (closed by fmb_safe_close) */
 FMB_API int fmb_safe_fd(const fmbSafeFile* f);

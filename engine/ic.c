@@ -354,6 +354,13 @@ int fmb_count_redundant(const fmbModel* m) {
 }
 
 int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  if (!m || !f) {
+    memset(diag, 0, sizeof *diag);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_check_constraints: NULL model or stream");
+    return FMB_EXIT_BAD_INPUT;
+  }
   const int nq = m->nq, nc = m->nc;
   const double t0 = m->solver.t0;
   memset(diag, 0, sizeof *diag);

@@ -1,6 +1,7 @@
-/* integrator_ida.c — the default backend: SUNDIALS IDA (BDF, variable order and step) on the GGL
- * system of system.c, with KLU (default; the position rows eliminated first, schur.c), KLU on the
- * whole matrix, or SUNDIALS' dense solver for the Newton systems.
+/* integrator_ida.c — SUNDIALS IDA (BDF, variable order and step) on the GGL system of system.c,
+ * the rigid mechanisms' backend under solver.integrator: auto (integrator_select.c), with KLU
+ * (default; the position rows eliminated first, schur.c), KLU on the whole matrix, or SUNDIALS'
+ * dense solver for the Newton systems.
  * The BDF order is capped by the bodies (fmbBodyType.max_bdf_order) or solver.max_order: BDF2 is
  * A-stable, while orders 3-5 have an instability wedge at the imaginary axis that amplifies
  * undamped structural modes (a 16-element beam has modes from 4 to 1e5 rad/s); the error test
@@ -402,6 +403,7 @@ static void ida_stats(const void* self, fmbStats* st) {
   st->error_test_fails = acc.error_test_fails;
   st->conv_fails = acc.conv_fails;
   st->jacobians_reused = c->reused;
+  st->integrator = fmb_integrator_ida.name;
 }
 
 static void ida_after_row(void* self, double t) {

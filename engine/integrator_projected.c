@@ -255,6 +255,7 @@ static void proj_stats(const void* self, fmbStats* st) {
   if (CVodeGetNumErrTestFails(cv, &v) == CV_SUCCESS) st->error_test_fails = v;
   if (CVodeGetNumNonlinSolvConvFails(cv, &v) == CV_SUCCESS) st->conv_fails = v;
   st->jacobians_reused = 0;
+  st->integrator = fmb_integrator_projected.name;
 }
 
 /* the projected formulation works on q and v alone, with the bodies' mass matrices */

@@ -22,7 +22,11 @@
  * systems are solved with the position rows eliminated (schur.c: their q-blocks are (gamma/h) I
  * and ((alpha + i beta)/h) I up to O(|mu|), kept as their diagonals), so KLU factorizes two
  * matrices with nq fewer rows: a modified simplified Newton iteration, as IDA's; klu_full keeps
- * the whole matrices (the exact simplified Newton, for comparison and as a fallback by hand).
+ * the whole matrices (the exact simplified Newton). If a run on the reduced systems cannot go on
+ * (a factorization fails outright, or the step falls to min_step, or the Newton matrix stays
+ * singular), the cause may be the dropped O(|mu|) part rather than the model, so the run
+ * continues from the last accepted step with the whole matrices, once, and says so: IDA's
+ * fallback (integrator_ida.c).
  *
  * Error estimate (IV.8 (8.19)-(8.20), RADAU5's ESTRAD with the mass matrix J_y'):
  *   err = (J_y + gamma/h J_y')^-1 J_y' (y'_n + (1/h) sum_i d_i Z_i),
@@ -39,8 +43,8 @@
  * while the step would change by less than 20 %. Dense output: the collocation polynomial
  * (IV.8 (8.26)-(8.28)), also for the next step's Newton start. Work integrals (m->need_work): the
  * joints' powers at the stages with the Radau quadrature (the method's own weights b_i = a_3i,
- * order 5), and between steps the cubic through the powers at t_n and the stages; they are not in
- * the error test (IDA's quadratures are, for applied forces).
+ * order 5), and between steps the cubic through the powers at t_n and the stages; applied forces'
+ * work is in the error test (try_work), as IDA's quadratures are.
  *
  * Everything is allocated in create(); advance() allocates only when KLU has to choose new pivots
  * (a refactorization whose condition estimate has degraded), as SUNDIALS' own KLU module does. */
@@ -117,6 +121,7 @@ typedef struct {
   /* solver.linear_solver: klu (default): both systems with the position rows eliminated
      (schur.c); klu_full: KLU on the whole matrices above */
   fmbSchur *red1, *red2;
+  int fell_back;                 /* the reduced systems failed once: KLU on the whole matrices since */
   double h_lu;                   /* the step the factorizations are for (0: none) */
   int need_jac;                  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
   int caljac;                    /* the Jacobian was evaluated at this step's start (t, y) */
@@ -124,8 +129,11 @@ typedef struct {
   int kept;                      /* consecutive steps that kept h although it could grow by > 1.2 */
   double hacc, erracc, faccon, theta, fnewt;
   /* work integrals */
-  int nwork;
-  double *work_old, *work_new, *p0, *pst[3], *work_out;
+  int nwork, nwork_err; /* work integrals; of them in the error test (applied forces') */
+  double *work_old, *work_new, *work_out;
+  double *p0, *pst[3];   /* the powers at the last accepted step's start and stages (work_at) */
+  double *pend, *ptry[3]; /* at the current state, and at the stages of the step being tried */
+  double* work_atol;     /* per joint: the work's absolute tolerance, 0 = out of the error test */
   fmbStats st;
   long lu_reuses;
 } RadauRun;
@@ -138,13 +146,15 @@ static void radau_destroy(void* self) {
   fmb_schur_free(c->red1);
   fmb_schur_free(c->red2);
   double** vs[] = {&c->atol, &c->scal, &c->ewt, &c->y, &c->yp, &c->ys, &c->yps, &c->e2rhs, &c->err, &c->err2,
-                   &c->jy, &c->jyp, &c->e1, &c->e2, &c->work_old, &c->work_new, &c->p0, &c->work_out};
+                   &c->jy, &c->jyp, &c->e1, &c->e2, &c->work_old, &c->work_new, &c->p0, &c->work_out,
+                   &c->pend, &c->work_atol};
   for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) free(*vs[i]);
   for (int k = 0; k < 3; ++k) {
     free(c->z[k]);
     free(c->wt[k]);
     free(c->fz[k]);
     free(c->pst[k]);
+    free(c->ptry[k]);
   }
   for (int k = 0; k < 4; ++k) free(c->cont[k]);
   free(c->colptr);
@@ -260,10 +270,22 @@ static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* 
     c->work_new = dalloc(nw);
     c->p0 = dalloc(nw);
     c->work_out = dalloc(nw);
-    ok = c->work_old && c->work_new && c->p0 && c->work_out;
-    for (int k = 0; k < 3; ++k) ok = ok && (c->pst[k] = dalloc(nw));
+    c->pend = dalloc(nw);
+    c->work_atol = dalloc(nw);
+    ok = c->work_old && c->work_new && c->p0 && c->work_out && c->pend && c->work_atol;
+    for (int k = 0; k < 3; ++k) ok = ok && (c->pst[k] = dalloc(nw)) && (c->ptry[k] = dalloc(nw));
     if (!ok) goto oom;
-    if (powers(c, t0, c->y, c->p0)) {
+    /* Applied forces' work is in the error test, as in IDA (integrator_ida.c: a load law with a
+       kink, a ramp or a table, is otherwise integrated across the kink by one polynomial: the
+       rotor's energy.balance stayed at 2.7e-2 J at rtol 1e-9, IDA 1.2e-5 J); a constraint's is not
+       (its power goes through the multipliers, roundoff of order eps/h^2). The same tolerance as
+       IDA's quadratures, mapped as the state's. */
+    for (int j = 0; j < m->njoint; ++j)
+      if (m->joint[j].nrows == 0) {
+        c->work_atol[j] = so->atol * quot;
+        c->nwork_err++;
+      }
+    if (powers(c, t0, c->y, c->pend)) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: a joint's power is not finite at t = %g", t0);
       radau_destroy(c);
       return NULL;
@@ -290,7 +312,8 @@ static int evaluate_jacobian(RadauRun* c) {
   return 0;
 }
 
-/* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized */
+/* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized: 0 ok, 1
+   singular, -1 a reduced factorization failed outright (KLU, or the tests' fault injection) */
 static int decompose(RadauRun* c) {
   const long nnz = c->m->nnz;
   const double g = GAMMA / c->h, a = ALPHA / c->h, b = BETA / c->h;
@@ -299,11 +322,16 @@ static int decompose(RadauRun* c) {
     c->e2[2 * k] = c->jy[k] + a * c->jyp[k];
     c->e2[2 * k + 1] = b * c->jyp[k];
   }
-  const int failed = c->red1 ? fmb_schur_factor(c->red1, c->e1) || fmb_schur_factor(c->red2, c->e2)
-                            : fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK || fmb_klu_factor(c->lu2, c->e2) != FMB_KLU_OK;
+  int failed = 0;
+  if (c->red1) {
+    failed = fmb_schur_factor(c->red1, c->e1);
+    if (!failed) failed = fmb_schur_factor(c->red2, c->e2);
+  } else {
+    failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK || fmb_klu_factor(c->lu2, c->e2) != FMB_KLU_OK;
+  }
   if (failed) {
     c->h_lu = 0.0;
-    return 1;
+    return failed < 0 ? -1 : 1; /* -1: the reduced factorization failed outright */
   }
   c->h_lu = c->h;
   return 0;
@@ -506,13 +534,12 @@ static void starting_values(RadauRun* c, int zero) {
   }
 }
 
-/* work integrals at t within the last step: W_old + h int_0^theta p, p the cubic through the
-   powers at the step's start and its three stages, by 3-point Gauss-Legendre (exact for it) */
-static void work_at(RadauRun* c, double t, double* out) {
-  const double t_old = c->t - c->hold, theta = (t - t_old) / c->hold;
+/* wgt[k] = int_0^theta l_k, l_k the Lagrange basis on the nodes 0, c1, c2, 1: the weights of the
+   cubic through a step's start and its three stages, by 3-point Gauss-Legendre (exact for it) */
+static void cubic_weights(double theta, double wgt[4]) {
   static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834}, gw[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
   const double nodes[4] = {0.0, C1, C2, 1.0};
-  double wgt[4] = {0, 0, 0, 0};
+  for (int k = 0; k < 4; ++k) wgt[k] = 0.0;
   for (int g = 0; g < 3; ++g) {
     const double s = 0.5 * theta * (gx[g] + 1.0);
     for (int k = 0; k < 4; ++k) {
@@ -522,22 +549,54 @@ static void work_at(RadauRun* c, double t, double* out) {
       wgt[k] += 0.5 * theta * gw[g] * l;
     }
   }
+}
+
+/* work integrals at t within the last step: W_old + h int_0^theta p, p the cubic through the
+   powers at the step's start and its three stages */
+static void work_at(RadauRun* c, double t, double* out) {
+  const double t_old = c->t - c->hold, theta = (t - t_old) / c->hold;
+  double wgt[4];
+  cubic_weights(theta, wgt);
   for (int j = 0; j < c->nwork; ++j)
     out[j] = c->work_old[j] + c->hold * (wgt[0] * c->p0[j] + wgt[1] * c->pst[0][j] + wgt[2] * c->pst[1][j] + wgt[3] * c->pst[2][j]);
 }
 
-/* the joints' powers at the accepted stages, and the work to the step's end */
-static int accept_work(RadauRun* c, double t_old, double h) {
-  memcpy(c->work_old, c->work_new, sizeof(double) * (size_t)c->nwork);
-  for (int j = 0; j < c->nwork; ++j) c->p0[j] = c->pst[2][j]; /* the previous step's end */
+/* The joints' powers at the stages of the step being tried (from c->t, c->y), and the work
+   integrals' contribution to its error norm: sum over the joints in the test of the squared
+   weighted difference between the step's quadrature (Radau, order 5) and the cubic's through the
+   step's start and stages (cubic_weights(1), exact to degree 3), an estimate of order h^5 P^(4)
+   as the state's. *sum = -1 when a power is not finite. */
+static void try_work(RadauRun* c, double h, double* sum) {
+  *sum = 0.0;
   for (int i = 0; i < 3; ++i) {
     for (int k = 0; k < c->ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
     const double ci = i == 0 ? C1 : i == 1 ? C2 : 1.0;
-    if (powers(c, t_old + ci * h, c->ys, c->pst[i])) return 1;
+    if (powers(c, c->t + ci * h, c->ys, c->ptry[i])) {
+      *sum = -1.0;
+      return;
+    }
   }
+  if (!c->nwork_err) return;
+  double wc[4];
+  cubic_weights(1.0, wc);
+  for (int j = 0; j < c->nwork; ++j) {
+    if (c->work_atol[j] <= 0.0) continue;
+    const double radau = BQ[0] * c->ptry[0][j] + BQ[1] * c->ptry[1][j] + BQ[2] * c->ptry[2][j];
+    const double cubic = wc[0] * c->pend[j] + wc[1] * c->ptry[0][j] + wc[2] * c->ptry[1][j] + wc[3] * c->ptry[2][j];
+    const double w = c->work_new[j] + h * radau;
+    const double r = h * (radau - cubic) / (c->work_atol[j] + c->rtol * fmax(fabs(w), fabs(c->work_new[j])));
+    *sum += r * r;
+  }
+}
+
+/* the step accepted: its powers become the last step's, and the work runs to its end */
+static void accept_work(RadauRun* c, double h) {
+  memcpy(c->work_old, c->work_new, sizeof(double) * (size_t)c->nwork);
+  memcpy(c->p0, c->pend, sizeof(double) * (size_t)c->nwork);
+  for (int i = 0; i < 3; ++i) memcpy(c->pst[i], c->ptry[i], sizeof(double) * (size_t)c->nwork);
+  memcpy(c->pend, c->ptry[2], sizeof(double) * (size_t)c->nwork);
   for (int j = 0; j < c->nwork; ++j)
     c->work_new[j] = c->work_old[j] + h * (BQ[0] * c->pst[0][j] + BQ[1] * c->pst[1][j] + BQ[2] * c->pst[2][j]);
-  return 0;
 }
 
 typedef enum { FAIL_NONE, FAIL_STEPS, FAIL_MIN_STEP, FAIL_SINGULAR, FAIL_RESIDUAL, FAIL_JACOBIAN, FAIL_POWER } FailKind;
@@ -601,7 +660,9 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       c->h_lu = 0.0;
     }
     if (c->h != c->h_lu) {
-      if (decompose(c)) {
+      const int dc = decompose(c);
+      if (dc < 0 && c->red1) return FAIL_SINGULAR; /* the reduced systems' own failure: the fallback */
+      if (dc) {
         if (++c->nsing >= FMB_RADAU_MAX_SINGULAR) return FAIL_SINGULAR;
         c->h *= 0.5;
         c->reject = 1;
@@ -632,7 +693,13 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       c->need_jac = !c->caljac;
       continue;
     }
-    const double err = estimate_error(c);
+    double err = estimate_error(c);
+    if (err >= 0.0 && c->nwork) {
+      double wsum = 0.0;
+      try_work(c, c->h, &wsum);
+      if (wsum < 0.0) return FAIL_POWER;
+      if (c->nwork_err) err = fmax(sqrt((err * err * c->nerr + wsum) / (c->nerr + c->nwork_err)), 1e-10);
+    }
     if (err < 0.0) { /* a solve or the residual failed: as a Newton failure */
       c->st.conv_fails++;
       c->h *= 0.5;
@@ -669,7 +736,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     c->hold = h;
     c->st.steps++;
     store_dense_output(c);
-    if (c->nwork && accept_work(c, t_old, h)) return FAIL_POWER;
+    if (c->nwork) accept_work(c, h);
     update_scal(c);
     c->first = 0;
     hnew = fmin(hnew, c->hmax);
@@ -687,6 +754,27 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
   }
 }
 
+/* the fallback (head comment): the whole matrices from here on, a fresh Jacobian, and the step
+   size of the last accepted step (the failed attempts drove h to where the reduced systems gave
+   up); 0 ok, 1 KLU could not analyze the whole pattern (the caller then reports the failure) */
+static int fall_back_to_full(RadauRun* c) {
+  fmb_schur_free(c->red1);
+  fmb_schur_free(c->red2);
+  c->red1 = c->red2 = NULL;
+  c->fell_back = 1;
+  c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0);
+  c->lu2 = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX);
+  if (!c->lu1 || !c->lu2) return 1;
+  if (c->hold > 0.0) c->h = c->hold;
+  c->need_jac = 1;
+  c->h_lu = 0.0;
+  c->nsing = 0;
+  c->reject = 1;
+  fmb_warn(c->w, "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+           "from the last good step with klu_full (the whole matrices)", c->t);
+  return 0;
+}
+
 static int radau_advance(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
                          size_t why_len) {
   RadauRun* c = self;
@@ -700,6 +788,11 @@ static int radau_advance(void* self, double tout, double* t_reached, double* y, 
       break;
     }
     fail = radau_step(c, &interrupted);
+    if (!interrupted && c->red1 && (fail == FAIL_MIN_STEP || fail == FAIL_SINGULAR)) {
+      if (fall_back_to_full(c)) break;
+      fail = FAIL_NONE;
+      continue;
+    }
     if (fail != FAIL_NONE || interrupted) break;
     steps++;
   }
@@ -740,6 +833,7 @@ static void radau_stats(const void* self, fmbStats* st) {
   st->error_test_fails = c->st.error_test_fails;
   st->conv_fails = c->st.conv_fails;
   st->jacobians_reused = c->lu_reuses;
+  st->integrator = fmb_integrator_radau5.name;
 }
 
 /* radau5's cross-key rules */

@@ -1,12 +1,12 @@
 /* integrator_select.c — which integrator backend a model runs on, and the stats line that names
  * what a run did. One place for the choice (docs/style.md: "a choice made in one place"), apart
- * from the run driver (integrate.c), so that the backends' table and the rule that picks one can
+ * from the run driver (run.c), so that the backends' table and the rule that picks one can
  * grow without touching the driver. */
 #include <stdio.h>
 
 #include "integrator.h"
 
-/* The one list of backends; the first GGL backend is solver.integrator's default. */
+/* The one list of backends; solver.integrator names a GGL one or auto (the default, the rule below). */
 const fmbIntegratorOps* const fmb_integrators[] = {&fmb_integrator_ida, &fmb_integrator_radau5, &fmb_integrator_projected,
                                                    NULL};
 
@@ -27,14 +27,34 @@ int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int
   return n;
 }
 
+/* solver.integrator: auto (the default). The rule, from the matrix of every shipped scene x
+   integrator x rtol (bench/auto.sh, docs/performance.md "Integrator auto"):
+   - a model with a body that caps the BDF order below 5 (fmbBodyType.max_bdf_order: undamped
+     structural modes, i.e. every beam model) runs radau5. BDF is held at order 2 there and buys
+     accuracy at the second-order rate, while Radau IIA is L-stable at order 5: at each beam
+     scene's former settings radau5 was 15-1600x more accurate (the ω0 = 15 spin-up at rtol 1e-6:
+     6.2e-7 against 1.8e-4 m in 0.027 against 0.044 s; the flexible pendulum 4.4e-5 against
+     6.6e-4 m), and at equal error it is the cheaper one on every beam scene from an error of
+     ~1e-4 of the output's range down (the exact beam: IDA is cheaper only above that).
+   - a model of rigid bodies runs IDA: BDF up to order 5 has no such cap, and on the four-bar it
+     reaches 8e-11 rad at rtol 1e-10 where radau5 stays at 4e-8 (its output rows between large
+     steps come from the order-3 collocation polynomial).
+   - linear_solver: dense is IDA's only (radau5's complex system), so it keeps IDA. */
+static const fmbIntegratorOps* auto_integrator(const fmbModel* m) {
+  if (m->solver.linear_solver == FMB_LS_DENSE) return &fmb_integrator_ida;
+  return m->bdf_order_cap < 5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
+}
+
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
   if (m->solver.formulation == FMB_FORM_PROJECTED ||
       (m->solver.formulation == FMB_FORM_AUTO && fmb_needs_singular_method(m)))
     return projected_backend();
   /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
-  return m->solver.integrator;
+  return m->solver.integrator ? m->solver.integrator : auto_integrator(m);
 }
 
+/* solver.integrator: auto checks nothing here: it never picks radau5 with linear_solver: dense,
+   and formulation: projected runs the projected backend whatever the integrator */
 int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
   const fmbIntegratorOps* ggl = m->solver.integrator;
   if (ggl && ggl->check && ggl->check(m, p, solver)) return -1;
@@ -47,7 +67,7 @@ void fmb_print_stats(const fmbStats* s, FILE* f) {
   if (!s || !f) return;
   fprintf(f,
           "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
-          "conv_fails=%ld jacobians_reused=%ld cpu_s=%.4f\n",
+          "conv_fails=%ld jacobians_reused=%ld integrator=%s cpu_s=%.4f\n",
           s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
-          s->error_test_fails, s->conv_fails, s->jacobians_reused, s->cpu_s);
+          s->error_test_fails, s->conv_fails, s->jacobians_reused, s->integrator ? s->integrator : "none", s->cpu_s);
 }

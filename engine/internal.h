@@ -86,8 +86,9 @@ typedef struct fmbSolverSettings {
      docs/mechanisms.md) */
   enum { FMB_FORM_GGL = 0, FMB_FORM_PROJECTED = 1, FMB_FORM_AUTO = 2 } formulation;
   int positions_only; /* error test on q only (error_control: positions) */
-  /* the GGL system's integrator: IDA (BDF, default) or Radau IIA of order 5 (integrator_radau.c),
-     which keeps order 5 on undamped structural modes where BDF is capped at 2 */
+  /* the GGL system's integrator: IDA (BDF) or Radau IIA of order 5 (integrator_radau.c), which
+     keeps order 5 on undamped structural modes where BDF is capped at 2; NULL = auto (default):
+     one of them per model by the rule of fmb_integrator_for (integrator_select.c) */
   const struct fmbIntegratorOps* integrator; /* one of fmb_integrators[] (integrator.h), never projected */
   long max_steps_per_output;
 } fmbSolverSettings;
@@ -399,6 +400,8 @@ int fmb_csv_close(fmbCsv* c);
 /* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */
 int fmb_csv_header_names(fmbCsv* c, int n, const char* const* names);
 int fmb_csv_values(fmbCsv* c, const double* values);
+/* v as printf's "%.12g" writes it, into out (>= 32 bytes); the length (format_g12.c) */
+int fmb_format_g12(double v, char* out);
 /* the scene's outputs at (t, y) into row[noutput]; 0 ok, 1 a value is not finite */
 int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* row);
 
@@ -406,6 +409,7 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
 typedef struct fmbVtk fmbVtk;
 fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag);
 int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const double* y); /* 0 ok, -1 write failed */
+int fmb_vtk_set_every(fmbVtk* v, int every); /* write every Nth step only (0, 1: each); -1 when every < 0 */
 void fmb_vtk_close(fmbVtk* v);
 
 #endif

@@ -188,15 +188,17 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
     }
     remove(file);
     if (!rc) read = k + 1;
+    if (res->code[k] == FMB_EXIT_INTERRUPTED) break; /* the models so far are written, the rest not run */
   }
   int worst = 0;
   for (int k = 0; k < res->ran; ++k)
     if (res->code[k] > worst) worst = res->code[k];
-  if (!rc && read == nmodel) {
+  const int interrupted = res->ran > 0 && res->code[res->ran - 1] == FMB_EXIT_INTERRUPTED;
+  if (!rc && read > 0 && (read == nmodel || interrupted)) {
     char err[300] = "";
     fmbSafeFile* sf = fmb_safe_open(opt->csv_path, err, sizeof err); /* beside it, renamed into place */
     FILE* f = fmb_safe_stream(sf);
-    if (!f || merge(f, part, models, nmodel)) {
+    if (!f || merge(f, part, models, read)) {
       fmb_safe_close(sf, 0);
       fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, opt->csv_path, 0, 0, "cannot write the merged table: %s",
                    err[0] ? err : "a write failed");

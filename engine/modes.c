@@ -724,6 +724,17 @@ static int pack_modes(const fmbModel* m, Eigen* E, const Reduced* R, double spee
   return 0;
 }
 
+/* LAPACK reports a bad argument through xerbla, whose reference version prints a line and STOPs:
+   the calling program would end with exit status 0. The library never ends its caller, so this
+   definition (found before liblapack's, which the library links) only returns: the routine then
+   returns with info < 0, which every call here checks. */
+FMB_API void xerbla_(const char* name, const int* info, int len);
+void xerbla_(const char* name, const int* info, int len) {
+  (void)name;
+  (void)info;
+  (void)len;
+}
+
 int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
               fmbModes** out, fmbDiag* diag) {
   fmbDiag local;
@@ -742,6 +753,15 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   }
   if (!isfinite(t)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the time %g is not finite", t);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  /* a state that is not finite is refused too: LAPACK would be handed NaN workspace sizes and its
+     error handler (xerbla, above) would end the calling program */
+  int bad = -1;
+  for (int i = 0; i < m->ny && bad < 0; ++i)
+    if (!isfinite(y[i]) || !isfinite(yp[i])) bad = i;
+  if (bad >= 0) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: the state is not finite (y or yp [%d])", bad);
     return FMB_EXIT_BAD_INPUT;
   }
   Linearized L;
@@ -789,8 +809,11 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
-  if (ncol <= 0 || !names || nrow < 0 || (nrow > 0 && !values)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0, "fmb_write_table: no columns, no values or a negative row count");
+  int named = names != NULL;
+  for (int i = 0; named && i < ncol; ++i) named = names[i] != NULL;
+  if (ncol <= 0 || !named || nrow < 0 || (nrow > 0 && !values)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0,
+                 "fmb_write_table: no columns, a NULL name, no values or a negative row count");
     return FMB_EXIT_BAD_INPUT;
   }
   fmbCsv* c = fmb_csv_open(path, diag);
@@ -842,7 +865,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
-  if (!m || !y || !yp || !md || md->nq != m->nq) {
+  if (!m || !y || !yp || !md || md->nq != m->nq || md->count < 0 || (md->count > 0 && !md->shape_re)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_shapes: NULL or mismatched arguments");
     return FMB_EXIT_BAD_INPUT;
   }
@@ -898,9 +921,11 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */
-  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || frames < 2 || !(amplitude > 0.0) ||
-      !isfinite(amplitude)) { /* an amplitude of 0, -1 or nan drew a still or inverted mode */
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_mode_animation: NULL or mismatched arguments");
+  if (!m || !y || !md || !dir || md->nq != m->nq || k < 0 || k >= md->count || !md->shape_re || !md->frequency ||
+      frames < 2 || frames > 100000 || !(amplitude > 0.0) || !isfinite(amplitude) || !isfinite(t)) {
+    /* an amplitude of 0, -1 or nan drew a still or inverted mode; 1 << 30 frames, as many files */
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0,
+                 "fmb_write_mode_animation: NULL or mismatched arguments (frames 2..100000, amplitude > 0, t finite)");
     return FMB_EXIT_BAD_INPUT;
   }
   const int nq = m->nq;

@@ -56,6 +56,12 @@ static const char* const energy_names[] = {"kinetic", "strain", "gravity", "spri
 static const char* const power_names[] = {"power", "work", NULL};
 static const char* const reaction_names[] = {"reaction_x", "reaction_y", "reaction_torque", NULL};
 static const char* const constraint_names[] = {"position", "velocity", NULL};
+/* the units of the quantities above, in their order (constraint norms mix m and rad: none) */
+static const char* const frame_units[] = {"m", "m", "rad", "rad/s", "m/s", "m/s"};
+static const char* const power_units[] = {"W", "J"};
+static const char* const reaction_units[] = {"N", "N", "N m"};
+
+
 
 const char* const* fmb_engine_outputs(const char* group) {
   static const struct {
@@ -72,6 +78,43 @@ static int lookup(const char* const* names, const char* s) {
   for (int i = 0; names[i]; ++i)
     if (strcmp(names[i], s) == 0) return i;
   return -1;
+}
+
+void fmb_write_xml_text(FILE* f, const char* s) {
+  if (!f || !s) return;
+  for (; *s; ++s) {
+    switch (*s) {
+      case '&': fputs("&amp;", f); break;
+      case '<': fputs("&lt;", f); break;
+      case '>': fputs("&gt;", f); break;
+      case '"': fputs("&quot;", f); break;
+      case '\'': fputs("&apos;", f); break;
+      default: /* XML 1.0 has no other control characters */
+        if ((unsigned char)*s >= 0x20 || *s == '\n' || *s == '\t') fputc(*s, f);
+    }
+  }
+}
+
+const char* fmb_output_unit(const char* column) {
+  if (!column) return NULL;
+  if (strcmp(column, "t") == 0) return "s";
+  const char* dot = strrchr(column, '.');
+  if (!dot) return NULL;
+  const char* q = dot + 1;
+  const size_t prefix = (size_t)(dot - column);
+  if (prefix == 6 && strncmp(column, "energy", 6) == 0) return lookup(energy_names, q) >= 0 ? "J" : NULL;
+  if (prefix == 10 && strncmp(column, "constraint", 10) == 0) return NULL;
+  int k;
+  if ((k = lookup(frame_names, q)) >= 0) return frame_units[k];
+  if ((k = lookup(power_names, q)) >= 0) return power_units[k];
+  if ((k = lookup(reaction_names, q)) >= 0) return reaction_units[k];
+  /* BODY.shapeK_x, BODY.shapeK_y: a centreline station, global frame */
+  if (strncmp(q, "shape", 5) == 0 && (strcmp(q + strlen(q) - 2, "_x") == 0 || strcmp(q + strlen(q) - 2, "_y") == 0)) {
+    const char* d = q + 5;
+    while (*d >= '0' && *d <= '9') ++d;
+    if (d > q + 5 && d == q + strlen(q) - 2) return "m";
+  }
+  return NULL; /* a type's own output: its unit is not declared */
 }
 
 int fmb_type_output_id(int (*output_lookup)(const void*, const char*), const void* self, const char* const* names,
@@ -330,8 +373,9 @@ fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
 int fmb_csv_header_names(fmbCsv* c, int n, const char* const* names) {
   size_t need = 2;
   for (int i = 0; i < n; ++i) need += strlen(names[i]) + 1;
-  /* a row: at most 24 characters per %.12g value plus its comma */
-  if (need < (size_t)n * 26 + 2) need = (size_t)n * 26 + 2;
+  /* a row: at most 24 characters per %.12g value plus its comma, and the 32 bytes
+     fmb_format_g12 may be given for the last one */
+  if (need < (size_t)n * 26 + 34) need = (size_t)n * 26 + 34;
   free(c->line);
   free(c->row);
   c->line = malloc(need);
@@ -358,8 +402,10 @@ int fmb_csv_header(fmbCsv* c, const fmbModel* m) {
 /* one whole row of as many values as the header has columns; 0 ok, -1 a write failed */
 int fmb_csv_values(fmbCsv* c, const double* values) {
   size_t used = 0;
-  for (int i = 0; i < c->nrow; ++i)
-    used += (size_t)snprintf(c->line + used, c->cap - used, "%s%.12g", i ? "," : "", values[i]);
+  for (int i = 0; i < c->nrow; ++i) { /* %.12g's bytes (format_g12.c); the line holds 24 + 1 a value */
+    if (i) c->line[used++] = ',';
+    used += (size_t)fmb_format_g12(values[i], c->line + used);
+  }
   c->line[used++] = '\n';
   return write_line(c, c->line, used) ? -1 : 0;
 }

@@ -49,6 +49,8 @@ int fmb_registry_load(fmbRegistry* reg, const char* path, fmbDiag* diag) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s() returned no descriptor", FMB_PLUGIN_ENTRY);
     return -1;
   }
+  /* its code is never unloaded, and no output of this process may replace the file */
+  fmb_safe_note_input(path);
   return fmb_registry_add(reg, desc, path, diag);
 }
 

@@ -66,7 +66,7 @@ int fmb_gauss_legendre01(int n, double* x, double* w) {
    the element ends (reduced integration against membrane locking). Newton on P'_{n-1} uses the
    Legendre equation (1 - x^2) P'' = 2x P' - k(k+1) P. */
 int fmb_gauss_lobatto01(int n, double* x, double* w) {
-  if (n < 2 || n > FMB_GAUSS_MAX) return -1;
+  if (n < 2 || n > FMB_GAUSS_MAX || !x || !w) return -1;
   const int k = n - 1;
   for (int i = 0; i < n; ++i) {
     double t = -cos(M_PI * i / k); /* Chebyshev-Lobatto guess, ascending */

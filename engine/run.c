@@ -85,7 +85,8 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   if (!csv) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
   const char* vtk_dir = (opt && opt->vtk_dir) ? opt->vtk_dir : (m->vtk_dir[0] ? m->vtk_dir : NULL);
   fmbVtk* vtk = NULL;
-  if (vtk_dir && !(vtk = fmb_vtk_open(m, vtk_dir, diag))) {
+  if (vtk_dir && (vtk = fmb_vtk_open(m, vtk_dir, diag))) fmb_vtk_set_every(vtk, opt ? opt->vtk_every : 1);
+  if (vtk_dir && !vtk) {
     fmb_csv_close(csv);
     return diag->code ? diag->code : FMB_EXIT_SOLVER;
   }

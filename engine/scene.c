@@ -71,11 +71,13 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
-  /* the GGL backends' names, from the one table of integrators (integrator_select.c) */
-  const char* integrators[8];
+  /* the GGL backends' names, from the one table of integrators (integrator_select.c), and auto */
+  const char* integrators[9];
   const fmbIntegratorOps* integrator_ops[8];
-  fmb_integrator_choices(integrators, integrator_ops, 8);
-  int formulation = FMB_FORM_AUTO, integrator = 0;
+  const int nintegrators = fmb_integrator_choices(integrators, integrator_ops, 8);
+  integrators[nintegrators] = "auto";
+  integrators[nintegrators + 1] = NULL;
+  int formulation = FMB_FORM_AUTO, integrator = nintegrators; /* auto */
   s->positions_only = -1; /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
@@ -94,7 +96,7 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_choice(p, node, "integrator", 0, integrators, &integrator))
     return -1;
   s->formulation = formulation;
-  s->integrator = integrator_ops[integrator];
+  s->integrator = integrator < nintegrators ? integrator_ops[integrator] : NULL; /* NULL: auto */
   if (fmbp_check_unknown(p, node, "solver")) return -1;
   s->atol_given = !atol_is_auto && fmb_find_key(p, node, "atol") >= 0;
   if (!s->atol_given) s->atol = FMB_ATOL_PER_RTOL * s->rtol; /* a metre of a 1 m body (tolerance.c) */
@@ -466,6 +468,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
   p.model = m;
   p.reg = reg;
   int rc = fmbp_open(&p, path, overrides, noverrides, diag);
+  if (rc == 0) fmb_safe_note_input(path); /* no output of this process may replace it */
   if (rc == 0) rc = parse_scene(&p, m);
   fmbp_close(&p);
   fmb_registry_free(p.own_reg); /* the types stay: their code is never unloaded */
@@ -479,6 +482,7 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
 
 void fmb_free(fmbModel* m) {
   if (!m) return;
+
   for (int b = 0; b < m->nbody; ++b)
     if (m->body[b].type && m->body[b].self) m->body[b].type->destroy(m->body[b].self);
   for (int j = 0; j < m->njoint; ++j)
@@ -505,6 +509,15 @@ int fmb_model_body(const fmbModel* m, int i, const char** name, const char** typ
   if (!m || i < 0 || i >= m->nbody - 1) return -1;
   if (name) *name = m->body[i + 1].name;
   if (type) *type = m->body[i + 1].type->name;
+  return 0;
+}
+
+int fmb_model_njoint(const fmbModel* m) { return m ? m->njoint : 0; }
+
+int fmb_model_joint(const fmbModel* m, int i, const char** name, const char** type) {
+  if (!m || i < 0 || i >= m->njoint) return -1;
+  if (name) *name = m->joint[i].name;
+  if (type) *type = m->joint[i].type->name;
   return 0;
 }
 

@@ -64,6 +64,10 @@ struct fmbSchur {
   double* lu;
   int* ipiv;
   int factored; /* lu holds a factorization */
+  /* fault injection for tests: FMB_TEST_FAIL_REDUCED_SETUP=N (read once, in fmb_schur_new) makes
+     the N-th and later factorizations fail as unrecoverable: how the tests reach the backends'
+     fallback to klu_full (integrator_ida.c, integrator_radau.c), which no shipped scene needs */
+  long factorizations, fail_from;
 };
 
 #define SCHUR_CAT_(a, b) a##b
@@ -84,6 +88,7 @@ struct fmbSchur {
 #include "schur_kernels.h"
 
 int fmb_schur_factor(fmbSchur* s, const double* J) {
+  if (s->fail_from && ++s->factorizations >= s->fail_from) return -1;
   return s->nc == 2 ? schur_factor_complex(s, J) : schur_factor_real(s, J);
 }
 
@@ -260,6 +265,8 @@ fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
   s->acc = calloc(nc * ((size_t)s->nr + 1), sizeof(double));
   s->dq = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
   if (!s->first_kept || !s->diag_pos || !s->dinv || !s->acc || !s->dq) goto fail;
+  const char* fault = getenv("FMB_TEST_FAIL_REDUCED_SETUP");
+  s->fail_from = fault ? strtol(fault, NULL, 10) : 0;
   for (int c = 0; c < m->nq; ++c) s->diag_pos[c] = -1;
   for (int c = 0; c < m->ny; ++c) {
     long k = m->colptr[c];
@@ -291,7 +298,6 @@ fail:
 typedef struct {
   fmbSchur* s;
   long last_flag;
-  long setups, fail_from; /* fault injection for tests: setups from fail_from on fail (0: never) */
 } SchurLS;
 
 #define SCHUR_LS(S) ((SchurLS*)(S)->content)
@@ -315,7 +321,6 @@ static int schur_initialize(SUNLinearSolver S) {
 
 static int schur_setup(SUNLinearSolver S, SUNMatrix A) {
   SchurLS* ls = SCHUR_LS(S);
-  if (ls->fail_from && ++ls->setups >= ls->fail_from) return ls->last_flag = SUNLS_PACKAGE_FAIL_UNREC;
   const int rc = fmb_schur_factor(ls->s, SUNSparseMatrix_Data(A));
   return ls->last_flag = rc == 0 ? SUNLS_SUCCESS : rc > 0 ? SUNLS_PACKAGE_FAIL_REC : SUNLS_PACKAGE_FAIL_UNREC;
 }
@@ -350,10 +355,6 @@ SUNLinearSolver fmb_schur_klu_new(const fmbModel* m, SUNContext sun) {
     if (S) SUNLinSolFreeEmpty(S);
     return NULL;
   }
-  /* FMB_TEST_FAIL_REDUCED_SETUP=N makes the N-th and later setups fail: how the tests reach the
-     fallback to klu_full (integrator_ida.c), which no shipped scene needs */
-  const char* fault = getenv("FMB_TEST_FAIL_REDUCED_SETUP");
-  ls->fail_from = fault ? strtol(fault, NULL, 10) : 0;
   S->content = ls;
   S->ops->gettype = schur_type;
   S->ops->getid = schur_id;

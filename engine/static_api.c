@@ -24,6 +24,11 @@ int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double
                  opt->t);
     return FMB_EXIT_BAD_INPUT;
   }
+  if (opt && (!(opt->tol >= 0.0) || opt->max_iter < 0 || opt->max_halvings < 0)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_static: options out of range (a negative or NaN tol, max_iter or max_halvings)");
+    return FMB_EXIT_BAD_INPUT;
+  }
   fmbWorkspace* w = fmb_workspace_new(m);
   double* q = calloc((size_t)m->nq + 1, sizeof(double));
   double* v = calloc((size_t)m->nq + 1, sizeof(double));

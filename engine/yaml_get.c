@@ -491,64 +491,107 @@ static int table_file_row(char* line, double xy[2]) {
   return parse_number(a, &xy[0]) || parse_number(b, &xy[1]) ? -1 : 0;
 }
 
-/* rows of a table: from the inline list or the file, into x/y (NULL = count only) */
+/* rows of an inline table (a list of [t, value] pairs) into x/y (NULL = count only) */
 static int table_rows(fmbParser* p, fmbNode n, const char* key, double* x, double* y, int* count) {
-  int rows = 0;
-  if (fmbp_is_seq(p, n)) {
-    rows = fmbp_seq_len(p, n);
-    for (int i = 0; i < rows; ++i) {
-      fmbNode row = fmbp_seq_item(p, n, i);
-      if (!fmbp_is_seq(p, row) || fmbp_seq_len(p, row) != 2)
-        return fmb_parse_error(p, row, "expected a pair [t, value] in the table '%s'", key);
-      double v[2];
-      for (int k = 0; k < 2; ++k)
-        if (number_at(p, fmbp_seq_item(p, row, k), key, 0, &v[k])) return -1;
-      if (x) x[i] = v[0], y[i] = v[1];
-    }
-    *count = rows;
-    return 0;
+  const int rows = fmbp_seq_len(p, n);
+  for (int i = 0; i < rows; ++i) {
+    fmbNode row = fmbp_seq_item(p, n, i);
+    if (!fmbp_is_seq(p, row) || fmbp_seq_len(p, row) != 2)
+      return fmb_parse_error(p, row, "expected a pair [t, value] in the table '%s'", key);
+    double v[2];
+    for (int k = 0; k < 2; ++k)
+      if (number_at(p, fmbp_seq_item(p, row, k), key, 0, &v[k])) return -1;
+    if (x) x[i] = v[0], y[i] = v[1];
   }
+  *count = rows;
+  return 0;
+}
+
+/* A table file is read in one pass into arrays that grow as rows come (a file that grows while it
+   is read cannot outrun them), and only if it is a regular file (a FIFO or a device would be read
+   without end: refused before reading) of at most TABLE_FILE_MAX bytes with rows of at most
+   TABLE_LINE_MAX characters (a longer row is an error, not two rows; a longer comment is skipped). */
+enum { TABLE_FILE_MAX = 64 << 20, TABLE_LINE_MAX = 4094 };
+static int table_file(fmbParser* p, fmbNode n, const char* key, double** x, double** y, int* count) {
   const char* name = fmbp_scalar(p, n);
-  char path[1024], line[4096];
+  char path[1024], line[TABLE_LINE_MAX + 2];
   sibling_path(p->path, name, path, sizeof path);
-  FILE* f = fopen(path, "r");
-  if (!f) return fmb_parse_error(p, n, "cannot read the table file '%s' for '%s': %s", path, key, strerror(errno));
-  int lineno = 0, header_ok = 1;
-  while (fgets(line, sizeof line, f)) {
+  /* O_NONBLOCK: opening a FIFO must not wait for a writer; the type is checked on the open file */
+  const int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  struct stat st;
+  if (fd < 0) return fmb_parse_error(p, n, "cannot read the table file '%s' for '%s': %s", path, key, strerror(errno));
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > TABLE_FILE_MAX) {
+    const int regular = fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
+    close(fd);
+    if (!regular) return fmb_parse_error(p, n, "the table file '%s' for '%s' is not a regular file (a FIFO or device would be "
+                                               "read without end)", path, key);
+    return fmb_parse_error(p, n, "the table file '%s' for '%s' is larger than %d MB", path, key, TABLE_FILE_MAX >> 20);
+  }
+  const int flags = fcntl(fd, F_GETFL);
+  if (flags >= 0) fcntl(fd, F_SETFL, flags & ~O_NONBLOCK);
+  FILE* f = fdopen(fd, "r");
+  if (!f) {
+    close(fd);
+    return fmb_parse_error(p, n, "cannot read the table file '%s' for '%s': %s", path, key, strerror(errno));
+  }
+  int lineno = 0, header_ok = 1, rows = 0, cap = 0, rc = 0;
+  long bytes = 0;
+  while (!rc && fgets(line, sizeof line, f)) {
     ++lineno;
-    /* a line longer than the buffer must not become two rows (its tail read as the next line):
-       a long comment is skipped whole, a long row refused */
     const size_t len = strlen(line);
+    bytes += (long)len;
+    /* a line longer than the buffer must not become two rows (its tail read as the next line): a
+       long comment is skipped whole, a long row refused */
     if (len == sizeof line - 1 && line[len - 1] != '\n') {
       const int comment = line[strspn(line, " \t")] == '#';
       int c;
-      while ((c = getc(f)) != EOF && c != '\n') {
+      while ((c = getc(f)) != EOF && c != '\n' && bytes <= TABLE_FILE_MAX) ++bytes;
+      if (comment && bytes <= TABLE_FILE_MAX) continue;
+      if (!comment) {
+        rc = fmb_parse_error(p, n, "table file '%s' line %d: longer than %d characters; a row is 't,value'", path, lineno,
+                             TABLE_LINE_MAX);
+        break;
       }
-      if (comment) continue;
-      fclose(f);
-      return fmb_parse_error(p, n, "table file '%s' line %d: longer than %d characters; a row is 't,value'", path,
-                             lineno, (int)sizeof line - 2);
+    }
+    if (bytes > TABLE_FILE_MAX) { /* it grew while being read */
+      rc = fmb_parse_error(p, n, "the table file '%s' for '%s' is larger than %d MB", path, key, TABLE_FILE_MAX >> 20);
+      break;
     }
     double v[2];
-    int r = table_file_row(line, v);
+    const int r = table_file_row(line, v);
     if (r == 1) continue;
     if (r < 0 && header_ok && rows == 0) { /* one header line of column names is allowed */
       header_ok = 0;
       continue;
     }
     if (r < 0) {
-      fclose(f);
-      return fmb_parse_error(p, n, "table file '%s' line %d: expected two numbers 't,value'", path, lineno);
+      rc = fmb_parse_error(p, n, "table file '%s' line %d: expected two numbers 't,value'", path, lineno);
+      break;
     }
-    if (x) x[rows] = v[0], y[rows] = v[1];
+    if (rows == cap) {
+      cap = cap ? 2 * cap : 64;
+      double* gx = realloc(*x, sizeof(double) * (size_t)cap);
+      if (gx) *x = gx;
+      double* gy = gx ? realloc(*y, sizeof(double) * (size_t)cap) : NULL;
+      if (gy) *y = gy;
+      if (!gx || !gy) {
+        rc = fmb_parse_error(p, n, "out of memory reading the table file '%s'", path);
+        break;
+      }
+    }
+    (*x)[rows] = v[0];
+    (*y)[rows] = v[1];
     ++rows;
   }
   fclose(f);
   *count = rows;
-  return 0;
+  /* an input: no output of this process may replace it (engine/safe_file.c) */
+  if (!rc) fmb_safe_note_input(path);
+  return rc;
 }
 
 int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, double** x, double** y, int* n) {
+  if (!p || !key || !x || !y || !n) return -1; /* a plugin bug: no parser to report it through */
   fmbNode node = fmb_find_key(p, map, key);
   *x = *y = NULL;
   *n = 0;
@@ -556,12 +599,18 @@ int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
   if (!fmbp_is_seq(p, node) && !fmbp_scalar(p, node))
     return fmb_parse_error(p, node, "expected a list of [t, value] pairs or a CSV file name for '%s'", key);
   int rows = 0;
-  if (table_rows(p, node, key, NULL, NULL, &rows)) return -1;
+  if (fmbp_is_seq(p, node)) {
+    if (table_rows(p, node, key, NULL, NULL, &rows)) return -1;
+    if (rows >= 2) {
+      *x = malloc(sizeof(double) * (size_t)rows);
+      *y = malloc(sizeof(double) * (size_t)rows);
+      if (!*x || !*y) return fmb_parse_error(p, node, "out of memory");
+      if (table_rows(p, node, key, *x, *y, &rows)) return -1;
+    }
+  } else if (table_file(p, node, key, x, y, &rows)) {
+    return -1;
+  }
   if (rows < 2) return fmb_parse_error(p, node, "the table '%s' needs at least two rows, has %d", key, rows);
-  *x = malloc(sizeof(double) * (size_t)rows);
-  *y = malloc(sizeof(double) * (size_t)rows);
-  if (!*x || !*y) return fmb_parse_error(p, node, "out of memory");
-  if (table_rows(p, node, key, *x, *y, &rows)) return -1;
   *n = rows;
   for (int i = 1; i < rows; ++i)
     if (!((*x)[i] > (*x)[i - 1]))

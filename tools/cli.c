@@ -2,6 +2,7 @@
 #include "cli.h"
 
 #include <errno.h>
+#include <signal.h>
 #include <fcntl.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -77,6 +78,7 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
     return 0; /* an option of the command's own */
   } else if (!s->scene) {
     s->scene = a;
+    fmb_safe_note_input(a); /* no output of this command may replace it (engine/safe_file.c) */
     return 1;
   } else {
     fprintf(stderr, "flexmbd %s: one scene file at a time (got '%s' and '%s')\n", cmd, s->scene, a);
@@ -110,13 +112,47 @@ int fmb_cli_check_input(const char* path, const char* what) {
 }
 
 int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n) {
-  struct stat so, si;
-  if (!out || strcmp(out, "-") == 0 || stat(out, &so) != 0 || !S_ISREG(so.st_mode)) return 0;
+  /* the inputs are noted once for the whole process, so every later write (fmb_safe_open) is
+     checked against them too, besides the scene, table files and plugins the library notes */
   for (int i = 0; i < n; ++i)
-    if (inputs[i] && stat(inputs[i], &si) == 0 && si.st_dev == so.st_dev && si.st_ino == so.st_ino) {
-      fprintf(stderr, "%s: error: the output file is the input '%s': refusing to overwrite it\n", out, inputs[i]);
-      return FMB_EXIT_BAD_INPUT;
-    }
+    if (inputs[i]) fmb_safe_note_input(inputs[i]);
+  const char* input = fmb_safe_input_at(out);
+  if (!input) return 0;
+  fprintf(stderr, "%s: error: the output file is the input '%s': refusing to overwrite it\n", out, input);
+  return FMB_EXIT_BAD_INPUT;
+}
+
+/* SIGINT/SIGTERM end the work after the step (or speed, or model) in progress: what is done so
+   far is kept and the exit code is FMB_EXIT_INTERRUPTED. One-shot (SA_RESETHAND): a second signal
+   ends the program at once. */
+static volatile sig_atomic_t stop_requested;
+static void on_stop_signal(int sig) {
+  (void)sig;
+  stop_requested = 1;
+}
+volatile sig_atomic_t* fmb_cli_catch_stop_signals(void) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof sa);
+  sa.sa_handler = on_stop_signal;
+  sa.sa_flags = SA_RESETHAND | SA_RESTART;
+  sigemptyset(&sa.sa_mask);
+  sigaction(SIGINT, &sa, NULL);
+  sigaction(SIGTERM, &sa, NULL);
+  return &stop_requested;
+}
+
+int fmb_cli_gnuplot_string(FILE* g, const char* s) {
+  /* single quotes: gnuplot expands `backquotes` (runs a shell command) inside double quotes and
+     on the command line, never inside single quotes, where '' is a quote; a line break would end
+     the command, so a string with a control character is refused instead */
+  for (const char* c = s; *c; ++c)
+    if ((unsigned char)*c < 0x20 || *c == 0x7f) return -1;
+  fputc('\'', g);
+  for (; *s; ++s) {
+    if (*s == '\'') fputc('\'', g);
+    fputc(*s, g);
+  }
+  fputc('\'', g);
   return 0;
 }
 

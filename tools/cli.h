@@ -3,12 +3,15 @@
  * command's name), listed once in the table of tools/flexmbd.c. */
 #ifndef FLEXMBD_CLI_H
 #define FLEXMBD_CLI_H
+#include <signal.h>
+#include <stdio.h>
+
 #include "flexmbd.h"
 
 #define FMB_CLI_MAX_OVERRIDES 256
 
 /* what a result records as the build that made it (CMakeLists.txt defines both for the files
-   that write them: regression references, sweep run ids, sweep.h5) */
+   that write them: regression references, sweep run ids, sweep.h5, `flexmbd --version`) */
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "unknown"
 #endif
@@ -39,9 +42,17 @@ int fmb_run_serve(const fmbCliScene* s);
 /* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
    else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
 int fmb_cli_check_input(const char* path, const char* what);
-/* FMB_EXIT_BAD_INPUT after saying so when `out` is the same file (device and inode, whatever
-   the names) as one of the n inputs, else 0; "-" and a file that does not exist are never inputs */
+/* Notes the n inputs for the whole process (engine/safe_file.c: no later write, by any writer,
+   may replace one; the library notes scenes, their table files and plugins itself), then
+   FMB_EXIT_BAD_INPUT after saying so when `out` is one of the noted inputs (device and inode,
+   whatever the names), else 0. "-", non-regular files and files that do not exist are never inputs. */
 int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n);
+/* catch SIGINT/SIGTERM: the flag they set (work stops after the step in progress, keeps what
+   it has and exits FMB_EXIT_INTERRUPTED) */
+volatile sig_atomic_t* fmb_cli_catch_stop_signals(void);
+/* `s` as a gnuplot string that gnuplot never expands (single-quoted; no command substitution);
+   -1 and nothing written when s holds a control character (a line break would end the command) */
+int fmb_cli_gnuplot_string(FILE* g, const char* s);
 /* The library's messages on stderr as the program always printed them (fmb_set_warn, installed by
    main): one line each, except the progress line on a terminal, rewritten in place; a message
    while it is shown clears it first. fmb_cli_warn_end ends a progress line left open, so that the
@@ -52,8 +63,9 @@ void fmb_cli_warn_end(void);
 fmbRegistry* fmb_cli_registry(void);
 
 /* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c
-   over the library's fmb_run_models) */
-int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet);
+   over the library's fmb_run_models); *stop (SIGINT) ends it after the model in progress, whose
+   rows and those of the models before it are written */
+int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet, volatile sig_atomic_t* stop);
 
 /* `compare`'s work on parsed options (tools/cmd_compare.c), also `run --reference`'s: one line per
    column on stdout; returns compare's exit code */
@@ -79,6 +91,7 @@ int fmb_cmd_new(int argc, char** argv);
 int fmb_cmd_static(int argc, char** argv);
 int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
+int fmb_cmd_view(int argc, char** argv);
 int fmb_cmd_sweep(int argc, char** argv);
 /* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
 typedef struct fmbCliAnalysis {

@@ -59,13 +59,20 @@ static void plot(const char* csv, const char* png, int count, const char* title)
     fmb_safe_close(fig, 0);
     return;
   }
-  fprintf(g, "set terminal pngcairo size 900,650 noenhanced\nset output '%s'\nset datafile separator ','\n"
-             "set key outside right\nset grid\nset xlabel 'hub speed (rad/s)'\nset ylabel 'frequency (rad/s)'\n"
-             "set title '%s'\nplot ",
-          fig_path, title);
-  for (int k = 0; k < count; ++k)
-    fprintf(g, "%s'%s' using 1:%d with linespoints pt 7 ps 0.5 title 'mode %d'", k ? ", " : "", csv, k + 2, k + 1);
-  fprintf(g, ", x with lines dt 2 lc rgb 'gray' title '1x speed'\n");
+  /* every file name and the title as gnuplot strings it never expands (tools/cli.c) */
+  fprintf(g, "set terminal pngcairo size 900,650 noenhanced\nset output ");
+  int bad = fmb_cli_gnuplot_string(g, fig_path);
+  fprintf(g, "\nset datafile separator ','\nset key outside right\nset grid\nset xlabel 'hub speed (rad/s)'\n"
+             "set ylabel 'frequency (rad/s)'\nset title ");
+  bad |= fmb_cli_gnuplot_string(g, title);
+  fprintf(g, "\nplot ");
+  for (int k = 0; k < count && !bad; ++k) {
+    fprintf(g, "%s", k ? ", " : "");
+    bad |= fmb_cli_gnuplot_string(g, csv);
+    fprintf(g, " using 1:%d with linespoints pt 7 ps 0.5 title 'mode %d'", k + 2, k + 1);
+  }
+  if (bad) fprintf(stderr, "flexmbd campbell: a file name holds a control character, no plot\n");
+  fprintf(g, bad ? "\nexit status 1\n" : ", x with lines dt 2 lc rgb 'gray' title '1x speed'\n");
   const int ok = pclose(g) == 0;
   if (fmb_safe_close(fig, ok) != 0 || !ok) fprintf(stderr, "flexmbd campbell: gnuplot failed, no plot (%s)\n", png);
 }
@@ -140,6 +147,9 @@ int fmb_cmd_campbell(int argc, char** argv) {
     fprintf(stderr, "flexmbd campbell: needs SCENE, --speed PATH (e.g. joints.spin.speed) and --speeds A:B:N|S1,S2,...\n");
     return FMB_EXIT_BAD_INPUT;
   }
+  /* outputs are never inputs (the scene, plugins: noted; table files: refused when written) */
+  if (fmb_cli_check_output_not_input(out, NULL, 0) || fmb_cli_check_output_not_input(png, NULL, 0))
+    return FMB_EXIT_BAD_INPUT;
   if (s.nover >= FMB_CLI_MAX_OVERRIDES) {
     fprintf(stderr, "flexmbd campbell: too many --set overrides\n");
     return FMB_EXIT_BAD_INPUT;
@@ -161,6 +171,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
   memset(&diag, 0, sizeof diag);
   int rc = c ? 0 : FMB_EXIT_SOLVER;
   if (!c) snprintf(diag.msg, sizeof diag.msg, "out of memory");
+  volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
   /* -j J: every speed's modes at once in child processes, then followed in order as below */
   Speed ctx = {&scene, &opt};
   fmbModes** pre = jobs > 1 && !rc ? calloc((size_t)nspeed, sizeof *pre) : NULL;
@@ -169,6 +180,14 @@ int fmb_cmd_campbell(int argc, char** argv) {
   memset(&pre_diag, 0, sizeof pre_diag);
   if (pre) pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, pre, &pre_done, &pre_diag);
   for (int i = 0; !rc && i < nspeed; ++i) {
+    if (*stop && (!pre || i >= pre_done)) { /* SIGINT/SIGTERM: the speeds done so far are written below */
+      memset(&diag, 0, sizeof diag);
+      diag.code = FMB_EXIT_INTERRUPTED;
+      snprintf(diag.msg, sizeof diag.msg, "interrupted (SIGINT/SIGTERM) before speed %g: the %d of %d speeds done are kept",
+               speeds[i], c->done, nspeed);
+      rc = FMB_EXIT_INTERRUPTED;
+      break;
+    }
     fmbModes* modes = NULL;
     if (!pre) {
       rc = modes_at(&ctx, speeds[i], &modes, &diag);
@@ -191,7 +210,8 @@ int fmb_cmd_campbell(int argc, char** argv) {
         fprintf(stderr, "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
                         "take finer speed steps\n", speeds[i], k + 1, c->mac[(size_t)i * count + k]);
   if (rc) fmb_cli_print_diag(&diag);
-  const int wrc = c ? write_csv(out, c) : 0;
+  /* nothing done (a bad --speed, a scene that does not load): an earlier result stays as it was */
+  const int wrc = c && done > 0 ? write_csv(out, c) : 0;
   char pngbuf[1024];
   if (!png && out && strcmp(out, "-") != 0) {
     const size_t len = strlen(out);
@@ -204,7 +224,8 @@ int fmb_cmd_campbell(int argc, char** argv) {
     snprintf(title, sizeof title, "Campbell diagram: %s", s.scene);
     plot(out, png, count, title);
   }
-  fprintf(stderr, "stats: status=%s speeds=%d of %d modes=%d\n", rc ? "failed" : "ok", done, nspeed, count);
+  fprintf(stderr, "stats: status=%s speeds=%d of %d modes=%d\n",
+          rc == FMB_EXIT_INTERRUPTED ? "interrupted" : rc ? "failed" : "ok", done, nspeed, count);
   fmb_campbell_free(c);
   free(speeds);
   return rc ? rc : wrc;

@@ -1,53 +1,92 @@
 /* cmd_conform.c — `flexmbd conform [--plugin x.so]... [TYPE]...`: the conformance checks of
  * engine/conform.c on the named types, or on every registered type. Exit 0 when all pass, 1 when
  * a check fails, 2 for bad arguments or a plugin that does not load. */
+#include <dirent.h>
 #include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "cli.h"
+
+/* empties and removes the private work folder (mkdtemp's: every entry in it is conform's) */
+static void remove_work(const char* dir) {
+  DIR* d = opendir(dir);
+  for (struct dirent* e; d && (e = readdir(d));) {
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0) continue;
+    char path[1400];
+    snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+    unlink(path);
+  }
+  if (d) closedir(d);
+  rmdir(dir);
+}
+
+static int conform_types(fmbRegistry* reg, const char* const* names, int nnames, const char* work);
 
 int fmb_cmd_conform(int argc, char** argv) {
   fmbCliScene s;
   memset(&s, 0, sizeof s);
-  const char* names[256];
+  /* the named types: at most one per argument */
+  const char** names = calloc((size_t)argc, sizeof *names);
   int nnames = 0;
+  if (!names) return FMB_EXIT_BAD_INPUT;
   const char* work = NULL;
   for (int i = 2; i < argc; ++i) {
     if (strcmp(argv[i], "--work") == 0) {
-      if (!(work = fmb_cli_value("conform", argc, argv, &i, "a folder"))) return FMB_EXIT_BAD_INPUT;
+      if (!(work = fmb_cli_value("conform", argc, argv, &i, "a folder"))) {
+        free(names);
+        return FMB_EXIT_BAD_INPUT;
+      }
       continue;
     }
     if (argv[i][0] != '-') {
-      if (nnames == 256) return FMB_EXIT_BAD_INPUT;
       names[nnames++] = argv[i];
       continue;
     }
     int r = fmb_cli_take_scene_arg("conform", argc, argv, &i, &s);
     if (r != 1 || s.nover) {
-      if (r > 1) return r;
-      fprintf(stderr, "flexmbd conform: unknown option '%s'\n", argv[i]);
-      return FMB_EXIT_BAD_INPUT;
+      if (r <= 1) fprintf(stderr, "flexmbd conform: unknown option '%s'\n", argv[i]);
+      free(names);
+      return r > 1 ? r : FMB_EXIT_BAD_INPUT;
     }
   }
   fmbRegistry* reg = fmb_cli_registry();
-  if (!reg) return FMB_EXIT_BAD_INPUT;
-  if (!work) work = getenv("TMPDIR") ? getenv("TMPDIR") : "/tmp";
-  if (mkdir(work, 0777) != 0 && errno != EEXIST) {
+  int rc = reg ? 0 : FMB_EXIT_BAD_INPUT;
+  /* the scenes and runs go to a folder of our own (mkdtemp: new, 0700, no link followed into it),
+     removed afterwards; --work DIR keeps them in DIR for a look */
+  char own[1100] = "";
+  if (!rc && !work) {
+    const char* tmp = getenv("TMPDIR");
+    snprintf(own, sizeof own, "%s/flexmbd-conform-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    if (!mkdtemp(own)) {
+      fprintf(stderr, "flexmbd conform: cannot make a work folder %s: %s\n", own, strerror(errno));
+      rc = FMB_EXIT_BAD_INPUT;
+      own[0] = '\0';
+    }
+    work = own;
+  } else if (!rc && mkdir(work, 0777) != 0 && errno != EEXIST) {
     fprintf(stderr, "flexmbd conform: cannot create the work folder '%s': %s\n", work, strerror(errno));
-    return FMB_EXIT_BAD_INPUT;
+    rc = FMB_EXIT_BAD_INPUT;
   }
+  if (!rc) rc = conform_types(reg, names, nnames, work);
+  if (own[0]) remove_work(own);
+  free(names);
+  return rc;
+}
+
+/* every named type, or every registered one (however many: no fixed list) */
+static int conform_types(fmbRegistry* reg, const char* const* names, int nnames, const char* work) {
+  const int nb = fmb_registry_nbodies(reg), nj = fmb_registry_njoints(reg);
+  const int n = nnames ? nnames : nb + nj;
   int failed = 0, types = 0;
-  if (nnames == 0) {
-    for (int i = 0; i < fmb_registry_nbodies(reg); ++i) names[nnames++] = fmb_registry_body(reg, i)->name;
-    for (int i = 0; i < fmb_registry_njoints(reg) && nnames < 256; ++i) names[nnames++] = fmb_registry_joint(reg, i)->name;
-  }
-  for (int i = 0; i < nnames; ++i) {
-    const int r = fmb_conform(reg, names[i], work, stdout);
+  for (int i = 0; i < n; ++i) {
+    const char* name = nnames ? names[i] : i < nb ? fmb_registry_body(reg, i)->name : fmb_registry_joint(reg, i - nb)->name;
+    const int r = fmb_conform(reg, name, work, stdout);
     if (r < 0) {
-      fprintf(stderr, "flexmbd conform: no type named '%s' (flexmbd types lists them)\n", names[i]);
+      fprintf(stderr, "flexmbd conform: no type named '%s' (flexmbd types lists them)\n", name);
       return FMB_EXIT_BAD_INPUT;
     }
     failed += r;

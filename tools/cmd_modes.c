@@ -74,6 +74,9 @@ int fmb_cmd_modes(int argc, char** argv) {
     fprintf(stderr, "flexmbd modes: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
   }
+  /* outputs are never inputs (the scene and plugins are noted; table files are refused when written) */
+  if (fmb_cli_check_output_not_input(out, NULL, 0) || fmb_cli_check_output_not_input(shapes, NULL, 0))
+    return FMB_EXIT_BAD_INPUT;
   if (an.at_given && static_given) {
     fprintf(stderr, "flexmbd modes: --at T and --static are alternatives (--static: the state at the scene's t0)\n");
     return FMB_EXIT_BAD_INPUT;

@@ -99,7 +99,7 @@ static const Starter starters[] = {
      "#   flexmbd run slider-crank.yaml -o slider-crank.csv --vtk slider-crank-vtk\n"
      "#   flexmbd plot slider-crank.csv slider.x\n"
      "# The guide is a prismatic joint: the slider moves along the x axis (stroke x = 0.35 .. 0.65 m)\n"
-     "# with its angle held; slide.reaction_y is the force the guide takes.\n"
+     "# with its angle held; guide.reaction_y is the force the guide takes.\n"
      "solver:\n"
      "  t_end: 2.0               # s\n"
      "  output_step: 0.005       # s\n"

@@ -1,14 +1,23 @@
 /* cmd_plot.c — `flexmbd plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [options]`
  * Any run's columns against t (or --x COLUMN) through gnuplot; several CSVs are overlaid (model
- * or mesh comparisons), --logy/--logx and --abs draw error plots. The columns are checked
+ * or mesh comparisons); --diff REF.csv draws each column minus REF's (interpolated linearly in t
+ * at the CSV's rows), with --abs --logy an error plot; --shape BEAM --at t1,t2 draws the beam's
+ * centreline (BEAM.shape columns) at the rows nearest those times. The columns are checked
  * against the CSVs first (read by the one CSV reader, tools/csv_table.c), so a typo is a message
- * (exit 2), not an empty figure. */
+ * (exit 2), not an empty figure. The curves are computed here and handed to gnuplot as a data
+ * file (never CSV names as gnuplot code); past 8 curves the dash pattern changes with the colour;
+ * the axes carry the units the library knows (fmb_output_unit). */
 #include <ctype.h>
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
+#include <signal.h>
 #include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "cli.h"
 #include "csv_table.h"
@@ -23,6 +32,7 @@ typedef struct {
   const char* out;
   const char* x;
   const char *title, *xlabel, *ylabel, *xrange, *yrange, *legend;
+  const char *diff, *shape, *at; /* --diff REF.csv, --shape BEAM --at t1,t2,... */
   int logx, logy, absval;
 } PlotArgs;
 
@@ -49,14 +59,14 @@ static void column_list(const fmbTable* tb, char* out, size_t len) {
     used += (size_t)snprintf(out + used, len - used, "%s%s", i ? ", " : "", tb->name[i]);
 }
 
-/* a gnuplot double-quoted string */
+/* every string reaches gnuplot through fmb_cli_gnuplot_string (single quotes: a column named
+   `touch PWNED` is a name, never a command); a name it refuses (a control character) is refused */
+static int bad_string;
 static void quoted(FILE* g, const char* s) {
-  fputc('"', g);
-  for (; *s; ++s) {
-    if (*s == '"' || *s == '\\') fputc('\\', g);
-    fputc(*s, g);
+  if (fmb_cli_gnuplot_string(g, s) != 0) {
+    bad_string = 1;
+    fputs("''", g);
   }
-  fputc('"', g);
 }
 
 /* the legend label of CSV i: the i-th item of --legend a,b,c, else the file name */
@@ -86,6 +96,9 @@ static int parse_args(int argc, char** argv, PlotArgs* a) {
     else if (strcmp(s, "--xrange") == 0) opt = &a->xrange;
     else if (strcmp(s, "--yrange") == 0) opt = &a->yrange;
     else if (strcmp(s, "--legend") == 0) opt = &a->legend;
+    else if (strcmp(s, "--diff") == 0) opt = &a->diff;
+    else if (strcmp(s, "--shape") == 0) opt = &a->shape;
+    else if (strcmp(s, "--at") == 0) opt = &a->at;
     if (opt) {
       if (!(*opt = fmb_cli_value("plot", argc, argv, &i, "a value"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(s, "--logx") == 0) {
@@ -104,6 +117,14 @@ static int parse_args(int argc, char** argv, PlotArgs* a) {
       if (a->ncolumn == PLOT_MAX) return fprintf(stderr, "flexmbd plot: at most %d columns\n", PLOT_MAX), FMB_EXIT_BAD_INPUT;
       a->column[a->ncolumn++] = s;
     }
+  }
+  if (!a->shape != !a->at) {
+    fprintf(stderr, "flexmbd plot: --shape BEAM and --at t1,t2,... go together\n");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (a->shape && a->diff) {
+    fprintf(stderr, "flexmbd plot: --shape and --diff do not combine\n");
+    return FMB_EXIT_BAD_INPUT;
   }
   if (a->ncsv == 0) {
     fprintf(stderr, "flexmbd plot: no CSV file given (usage: flexmbd plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png])\n");
@@ -126,12 +147,126 @@ static const char* terminal_for(const char* out) {
   return NULL;
 }
 
+/* one curve of the figure: computed here, handed to gnuplot as a data block */
+typedef struct {
+  char title[800];
+  long n;
+  double *x, *y;
+} Curve;
+
+static Curve* add_curve(Curve** curves, int* n, long rows) {
+  Curve* grown = realloc(*curves, (size_t)(*n + 1) * sizeof *grown);
+  if (!grown) return NULL;
+  *curves = grown;
+  Curve* c = &grown[*n];
+  memset(c, 0, sizeof *c);
+  c->x = malloc((size_t)(rows > 0 ? rows : 1) * sizeof(double));
+  c->y = malloc((size_t)(rows > 0 ? rows : 1) * sizeof(double));
+  if (!c->x || !c->y) {
+    free(c->x);
+    free(c->y);
+    return NULL;
+  }
+  ++*n;
+  return c;
+}
+
+/* "name [unit]" when the library knows the column's unit */
+static void with_unit(char* out, size_t len, const char* what, const char* column) {
+  const char* unit = fmb_output_unit(column);
+  if (unit) snprintf(out, len, "%s [%s]", what, unit);
+  else snprintf(out, len, "%s", what);
+}
+
+/* the rows nearest each time of "t1,t2,...": the curves of BEAM's centreline */
+static int shape_curves(const PlotArgs* a, const fmbTable* table, Curve** curves, int* ncurve) {
+  for (int i = 0; i < a->ncsv; ++i) {
+    const fmbTable* tb = &table[i];
+    char name[300];
+    int nst = 0;
+    for (;; ++nst) {
+      snprintf(name, sizeof name, "%s.shape%d_x", a->shape, nst);
+      if (fmb_table_col(tb, name) < 1) break;
+    }
+    if (nst < 2) {
+      fprintf(stderr, "flexmbd plot: '%s' has no centreline of '%s' (columns %s.shape0_x ...): run with "
+                      "--set 'outputs=[..., %s.shape]'\n", a->csv[i], a->shape, a->shape, a->shape);
+      return FMB_EXIT_BAD_INPUT;
+    }
+    for (const char* s = a->at; *s;) {
+      char* end;
+      const double t = strtod(s, &end);
+      if (end == s || (*end && *end != ',') || !isfinite(t)) {
+        fprintf(stderr, "flexmbd plot: --at expects times t1,t2,... (numbers), got '%s'\n", a->at);
+        return FMB_EXIT_BAD_INPUT;
+      }
+      s = *end ? end + 1 : end;
+      long row = 0;
+      for (long r = 1; r < tb->nrow; ++r)
+        if (fabs(fmb_table_at(tb, r, 0) - t) < fabs(fmb_table_at(tb, row, 0) - t)) row = r;
+      Curve* c = tb->nrow ? add_curve(curves, ncurve, nst) : NULL;
+      if (!c) continue;
+      for (int k = 0; k < nst; ++k) {
+        snprintf(name, sizeof name, "%s.shape%d_x", a->shape, k);
+        c->x[k] = fmb_table_at(tb, row, fmb_table_col(tb, name));
+        snprintf(name, sizeof name, "%s.shape%d_y", a->shape, k);
+        c->y[k] = fmb_table_at(tb, row, fmb_table_col(tb, name));
+      }
+      c->n = nst;
+      char label[256];
+      legend_item(a, i, label, sizeof label);
+      if (a->ncsv == 1) snprintf(c->title, sizeof c->title, "t = %.6g s", fmb_table_at(tb, row, 0));
+      else snprintf(c->title, sizeof c->title, "%s: t = %.6g s", label, fmb_table_at(tb, row, 0));
+    }
+  }
+  return 0;
+}
+
+/* each CSV's columns against x; with a reference, minus the reference's at the same time */
+static int column_curves(const PlotArgs* a, const fmbTable* table, const fmbTable* ref, const char* xcol,
+                         Curve** curves, int* ncurve) {
+  for (int i = 0; i < a->ncsv; ++i) {
+    const fmbTable* tb = &table[i];
+    char label[256];
+    legend_item(a, i, label, sizeof label);
+    const int cx = fmb_table_col(tb, xcol) >= 1 ? fmb_table_col(tb, xcol) : 0;
+    for (int c = 0; c < a->ncolumn; ++c) {
+      if (!has_column(tb, a->column[c])) continue;
+      const int cy = fmb_table_col(tb, a->column[c]);
+      const int cr = ref ? fmb_table_col(ref, a->column[c]) : 0;
+      if (ref && cr < 1) {
+        fprintf(stderr, "flexmbd plot: the reference '%s' has no column '%s' to take the difference with\n", a->diff,
+                a->column[c]);
+        return FMB_EXIT_BAD_INPUT;
+      }
+      Curve* cv = add_curve(curves, ncurve, tb->nrow);
+      if (!cv) return FMB_EXIT_BAD_INPUT;
+      long hint = 0;
+      for (long r = 0; r < tb->nrow; ++r) {
+        double v = fmb_table_at(tb, r, cy), rv = 0.0;
+        if (ref && fmb_table_at_time(ref, cr, fmb_table_at(tb, r, 0), &hint, &rv)) continue; /* outside REF's span */
+        v -= rv;
+        cv->x[cv->n] = fmb_table_at(tb, r, cx);
+        cv->y[cv->n++] = a->absval ? fabs(v) : v;
+      }
+      char what[400];
+      snprintf(what, sizeof what, "%s%s%s", a->column[c], ref ? " - " : "", ref ? "reference" : "");
+      if (a->ncsv == 1) snprintf(cv->title, sizeof cv->title, "%s", what);
+      else if (a->ncolumn == 1 && !ref) snprintf(cv->title, sizeof cv->title, "%s", label);
+      else snprintf(cv->title, sizeof cv->title, "%s: %s", label, what);
+    }
+  }
+  return 0;
+}
+
 int fmb_cmd_plot(int argc, char** argv) {
   PlotArgs a;
   memset(&a, 0, sizeof a);
   int rc = parse_args(argc, argv, &a);
   if (rc) return rc;
   static fmbTable table[PLOT_MAX];
+  fmbTable ref;
+  memset(&ref, 0, sizeof ref);
   char default_out[1024], err[1024], list[4096];
   int loaded = 0;
   for (int i = 0; i < a.ncsv && !rc; ++i, ++loaded)
@@ -139,9 +274,17 @@ int fmb_cmd_plot(int argc, char** argv) {
       fprintf(stderr, "flexmbd plot: %s\n", err);
       rc = FMB_EXIT_BAD_INPUT;
     }
+  if (!rc && a.diff && fmb_table_load(a.diff, &ref, err, sizeof err)) {
+    fprintf(stderr, "flexmbd plot: --diff: %s\n", err);
+    rc = FMB_EXIT_BAD_INPUT;
+  }
+  /* the CSVs are inputs: the figure may not replace one (engine/safe_file.c) */
+  const char* diff_input[1] = {a.diff};
+  if (!rc && (fmb_cli_check_output_not_input(a.out, a.csv, a.ncsv) || fmb_cli_check_output_not_input(a.out, diff_input, 1)))
+    rc = FMB_EXIT_BAD_INPUT;
   /* the x column: --x, else the first column (t) */
   const char* xcol = rc ? NULL : a.x ? a.x : table[0].name[0];
-  for (int i = 0; i < a.ncsv && !rc; ++i)
+  for (int i = 0; i < a.ncsv && !rc && !a.shape; ++i)
     if (!has_column(&table[i], xcol)) {
       column_list(&table[i], list, sizeof list);
       fprintf(stderr, "flexmbd plot: '%s' has no column '%s' for the x axis (its columns: %s)\n", a.csv[i], xcol, list);
@@ -149,9 +292,9 @@ int fmb_cmd_plot(int argc, char** argv) {
     }
   /* no columns named: every column of the first CSV but x */
   const int every_column = a.ncolumn == 0;
-  for (int c = 0; !rc && every_column && c < table[0].ncol && a.ncolumn < PLOT_MAX; ++c)
+  for (int c = 0; !rc && every_column && !a.shape && c < table[0].ncol && a.ncolumn < PLOT_MAX; ++c)
     if (strcmp(table[0].name[c], xcol) != 0) a.column[a.ncolumn++] = table[0].name[c];
-  if (!rc && a.ncolumn == 0) {
+  if (!rc && a.ncolumn == 0 && !a.shape) {
     fprintf(stderr, "flexmbd plot: '%s' has no column to plot besides '%s'\n", a.csv[0], xcol);
     rc = FMB_EXIT_BAD_INPUT;
   }
@@ -176,6 +319,32 @@ int fmb_cmd_plot(int argc, char** argv) {
     fprintf(stderr, "flexmbd plot: the figure's name must end in .png, .svg or .pdf (got '%s')\n", a.out);
     rc = FMB_EXIT_BAD_INPUT;
   }
+  /* the curves, computed before anything is written */
+  Curve* curves = NULL;
+  int ncurve = 0;
+  if (!rc) rc = a.shape ? shape_curves(&a, table, &curves, &ncurve)
+                        : column_curves(&a, table, a.diff ? &ref : NULL, xcol, &curves, &ncurve);
+  if (!rc && ncurve == 0) {
+    fprintf(stderr, "flexmbd plot: nothing to draw\n");
+    rc = FMB_EXIT_BAD_INPUT;
+  }
+  /* the data go to gnuplot as a file of its own (blocks `index k`), never as gnuplot code */
+  char data_path[1100] = "";
+  if (!rc) {
+    const char* tmp = getenv("TMPDIR");
+    snprintf(data_path, sizeof data_path, "%s/flexmbd-plot-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    const int fd = mkstemp(data_path);
+    FILE* df = fd >= 0 ? fdopen(fd, "w") : NULL;
+    for (int k = 0; df && k < ncurve; ++k) {
+      for (long r = 0; r < curves[k].n; ++r) fprintf(df, "%.12g %.12g\n", curves[k].x[r], curves[k].y[r]);
+      fprintf(df, "\n\n");
+    }
+    if (!df || fclose(df) != 0) {
+      fprintf(stderr, "flexmbd plot: cannot write the plot data %s: %s\n", data_path, strerror(errno));
+      if (!df && fd >= 0) close(fd);
+      rc = FMB_EXIT_BAD_INPUT;
+    }
+  }
   FILE* g = NULL;
   /* gnuplot writes a temporary file beside the figure, which replaces it only if gnuplot made one */
   fmbSafeFile* fig = NULL;
@@ -190,7 +359,10 @@ int fmb_cmd_plot(int argc, char** argv) {
     }
   }
   if (!rc) {
-    /* gnuplot reads the script from its stdin; its own messages go to our stderr */
+    /* gnuplot reads the script from its stdin; its own messages go to our stderr. A gnuplot that
+       is missing or ends early must not kill us with SIGPIPE: writes then fail, and its exit
+       status says why. */
+    signal(SIGPIPE, SIG_IGN);
     g = popen("gnuplot", "w");
     if (!g) {
       fprintf(stderr, "flexmbd plot: cannot start gnuplot (Debian: apt-get install gnuplot-nox)\n");
@@ -200,13 +372,27 @@ int fmb_cmd_plot(int argc, char** argv) {
   if (!rc) {
     fprintf(g, "set terminal %s\nset output ", term);
     quoted(g, fig_path);
-    fprintf(g, "\nset termoption noenhanced\nset datafile separator \",\"\nset key top right\nset grid\n");
+    fprintf(g, "\nset termoption noenhanced\nset key top right\nset grid\n");
+    /* the axes: the user's labels, else the column and its unit */
+    char label[600];
+    if (a.shape) with_unit(label, sizeof label, "x", "beam.x");
+    else with_unit(label, sizeof label, xcol, xcol);
     fprintf(g, "set xlabel ");
-    quoted(g, a.xlabel ? a.xlabel : xcol);
+    quoted(g, a.xlabel ? a.xlabel : label);
     fprintf(g, "\n");
-    if (a.ylabel || a.ncolumn == 1) { /* one column names the axis itself */
+    const char* yunit = a.shape ? "m" : fmb_output_unit(a.column[0]);
+    for (int c = 1; c < a.ncolumn && yunit; ++c)
+      if (!fmb_output_unit(a.column[c]) || strcmp(fmb_output_unit(a.column[c]), yunit) != 0) yunit = NULL;
+    const char* what = a.shape ? "y" : a.ncolumn == 1 ? a.column[0] : a.diff ? "difference" : NULL;
+    if (a.diff && a.ncolumn == 1) {
+      snprintf(label, sizeof label, "%s%s - reference%s", a.absval ? "|" : "", a.column[0], a.absval ? "|" : "");
+    } else {
+      snprintf(label, sizeof label, "%s", what ? what : "");
+    }
+    if (yunit) snprintf(label + strlen(label), sizeof label - strlen(label), "%s[%s]", label[0] ? " " : "", yunit);
+    if (a.ylabel || label[0]) {
       fprintf(g, "set ylabel ");
-      quoted(g, a.ylabel ? a.ylabel : a.column[0]);
+      quoted(g, a.ylabel ? a.ylabel : label);
       fprintf(g, "\n");
     }
     if (a.title) {
@@ -214,39 +400,32 @@ int fmb_cmd_plot(int argc, char** argv) {
       quoted(g, a.title);
       fprintf(g, "\n");
     }
+    if (a.shape) fprintf(g, "set size ratio -1\n"); /* a shape in true proportions */
     if (a.xrange) fprintf(g, "set xrange [%s]\n", a.xrange);
     if (a.yrange) fprintf(g, "set yrange [%s]\n", a.yrange);
     if (a.logx) fprintf(g, "set logscale x\n");
     if (a.logy) fprintf(g, "set logscale y\nset format y \"%%.0e\"\n");
     fprintf(g, "plot ");
-    int first = 1;
-    for (int i = 0; i < a.ncsv; ++i) {
-      char label[256];
-      legend_item(&a, i, label, sizeof label);
-      for (int c = 0; c < a.ncolumn; ++c) {
-        if (!has_column(&table[i], a.column[c])) continue;
-        fprintf(g, "%s", first ? "" : ", \\\n     ");
-        first = 0;
-        quoted(g, a.csv[i]);
-        fprintf(g, " using (column(");
-        quoted(g, xcol);
-        fprintf(g, ")):(%s(column(", a.absval ? "abs" : "");
-        quoted(g, a.column[c]);
-        fprintf(g, "))) with lines lw 2 title ");
-        char title[600];
-        if (a.ncsv == 1) snprintf(title, sizeof title, "%s", a.column[c]);
-        else if (a.ncolumn == 1) snprintf(title, sizeof title, "%s", label);
-        else snprintf(title, sizeof title, "%s: %s", label, a.column[c]);
-        quoted(g, title);
-      }
+    for (int k = 0; k < ncurve; ++k) {
+      fprintf(g, "%s", k ? ", \\\n     " : "");
+      quoted(g, data_path);
+      /* 8 colours, then the next dash pattern: 40 curves stay apart */
+      fprintf(g, " index %d using 1:2 with lines lw 2 lt %d dt %d title ", k, k % 8 + 1, k / 8 % 5 + 1);
+      quoted(g, curves[k].title);
     }
     fprintf(g, "\n");
+    if (bad_string) fprintf(g, "\nexit status 1\n"); /* nothing drawn with a name it could not take */
     int status = pclose(g);
     struct stat st;
     /* success is judged by the file gnuplot leaves */
     const int made = status == 0 && stat(fig_path, &st) == 0 && st.st_size > 0;
     if (fmb_safe_close(fig, made) != 0 || !made) {
-      fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out, status);
+      if (bad_string)
+        fprintf(stderr, "flexmbd plot: a column or file name holds a control character (a line break): not plotted\n");
+      else if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 127)
+        fprintf(stderr, "flexmbd plot: gnuplot is not installed (Debian: apt-get install gnuplot-nox)\n");
+      else
+        fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out, status);
       rc = FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(stderr, "flexmbd plot: wrote %s\n", a.out);
@@ -254,6 +433,13 @@ int fmb_cmd_plot(int argc, char** argv) {
     fig = NULL;
   }
   fmb_safe_close(fig, 0);
+  if (data_path[0] && !strstr(data_path, "XXXXXX")) unlink(data_path);
+  for (int k = 0; k < ncurve; ++k) {
+    free(curves[k].x);
+    free(curves[k].y);
+  }
+  free(curves);
   for (int i = 0; i < loaded; ++i) fmb_table_free(&table[i]);
+  fmb_table_free(&ref);
   return rc;
 }

@@ -2,30 +2,12 @@
  *                [--vtk DIR] [--reference REF.csv [--columns a,b]]
  *                [--models zoac,foac,complete,exact]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
-#include <signal.h>
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
 
 #include "cli.h"
-
-/* SIGINT/SIGTERM end the run after the step in progress (fmbRunOptions.stop): the rows so far
-   stay, the stats line says status=interrupted and the exit code is FMB_EXIT_INTERRUPTED. The
-   handler is one-shot (SA_RESETHAND): a second signal ends the program at once. */
-static volatile sig_atomic_t stop_requested;
-static void on_stop_signal(int sig) {
-  (void)sig;
-  stop_requested = 1;
-}
-static void catch_stop_signals(void) {
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_stop_signal;
-  sa.sa_flags = SA_RESETHAND | SA_RESTART;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
-}
 
 int fmb_cmd_run(int argc, char** argv) {
   fmbCliScene s;
@@ -35,6 +17,7 @@ int fmb_cmd_run(int argc, char** argv) {
   const char* columns = NULL;
   int quiet = 0, progress = 0;
   const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
+  int vtk_every = 1;      /* --vtk-every N: of every Nth row */
   const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
   int serve = 0;             /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
   for (int i = 2; i < argc; ++i) {
@@ -58,6 +41,15 @@ int fmb_cmd_run(int argc, char** argv) {
       progress = 1;
     } else if (strcmp(a, "--vtk") == 0) {
       if (!(vtk = fmb_cli_value("run", argc, argv, &i, "a directory"))) return FMB_EXIT_BAD_INPUT;
+    } else if (strcmp(a, "--vtk-every") == 0) {
+      const char* v = fmb_cli_value("run", argc, argv, &i, "a whole number N >= 1");
+      char* end = NULL;
+      const long n = v ? strtol(v, &end, 10) : 0;
+      if (!v || end == v || *end || n < 1 || n > 1000000000L) {
+        if (v) fprintf(stderr, "flexmbd run: --vtk-every expects a whole number N >= 1 (every Nth row), got '%s'\n", v);
+        return FMB_EXIT_BAD_INPUT;
+      }
+      vtk_every = (int)n;
     } else {
       fprintf(stderr, "flexmbd run: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -75,7 +67,6 @@ int fmb_cmd_run(int argc, char** argv) {
     fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
     return FMB_EXIT_BAD_INPUT;
   }
-  if (models) return fmb_cli_run_models(&s, models, out, quiet);
   if (serve) return fmb_run_serve(&s);
   fmbDiag diag;
   fmbStats stats;
@@ -88,7 +79,8 @@ int fmb_cmd_run(int argc, char** argv) {
   int bad = reference ? fmb_cli_check_input(reference, "reference") : 0;
   if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
   if (bad) return bad; /* nothing ran: no stats line */
-  catch_stop_signals();
+  volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
+  if (models) return fmb_cli_run_models(&s, models, out, quiet, stop);
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);
@@ -101,7 +93,8 @@ int fmb_cmd_run(int argc, char** argv) {
                        .progress = !quiet && (progress || isatty(STDERR_FILENO)),
                        .progress_after_s = progress ? 0.0 : 2.0,
                        .vtk_dir = vtk,
-                       .stop = &stop_requested};
+                       .vtk_every = vtk_every,
+                       .stop = stop};
   int rc = fmb_run(m, &opt, &stats, &diag);
   fmb_cli_warn_end();
   if (rc) fmb_cli_print_diag(&diag);

@@ -92,6 +92,7 @@ int fmb_cmd_static(int argc, char** argv) {
     fprintf(stderr, "flexmbd static: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
   }
+  if (fmb_cli_check_output_not_input(out, NULL, 0)) return FMB_EXIT_BAD_INPUT; /* the scene, plugins */
   an.opt.quiet = an.quiet;
   fmbDiag diag;
   fmbStaticResult res;

@@ -15,6 +15,7 @@ void fmb_table_free(fmbTable* tb) {
   for (int i = 0; i < tb->nmeta; ++i) free(tb->meta[i]);
   free(tb->name);
   free(tb->meta);
+  free(tb->index);
   free(tb->v);
   memset(tb, 0, sizeof *tb);
 }
@@ -52,10 +53,20 @@ static long read_line(FILE* f, char** buf, size_t* cap) {
   return (long)n;
 }
 
+/* FNV-1a, for the column-name index */
+static unsigned name_hash(const char* s) {
+  unsigned h = 2166136261u;
+  for (; *s; ++s) h = (h ^ (unsigned char)*s) * 16777619u;
+  return h;
+}
+
 static int push_string(char*** list, int* n, const char* s) {
-  char** nl = realloc(*list, (size_t)(*n + 1) * sizeof *nl);
-  if (!nl) return -1;
-  *list = nl;
+  if ((*n & (*n - 1)) == 0) { /* at 0, 1, 2, 4, ...: capacity doubles, appending stays linear */
+    char** nl = realloc(*list, (size_t)(*n ? 2 * *n : 1) * sizeof *nl);
+    if (!nl) return -1;
+    *list = nl;
+  }
+  char** nl = *list;
   if (!(nl[*n] = strdup(s))) return -1;
   ++*n;
   return 0;
@@ -112,12 +123,20 @@ int fmb_table_load_keyed(const char* path, fmbTable* tb, const char* first, char
         tb->name[0]);
     goto out;
   }
-  for (int i = 1; i < tb->ncol; ++i)
-    for (int j = 0; j < i; ++j)
-      if (strcmp(tb->name[i], tb->name[j]) == 0) {
-        say(err, errlen, "%s:%ld: column '%.80s' appears twice in the header", path, lineno, tb->name[i]);
-        goto out;
-      }
+  /* the name index: a duplicate is found as it is entered */
+  tb->nindex = 2;
+  while (tb->nindex < 2 * tb->ncol) tb->nindex *= 2;
+  if (!(tb->index = malloc((size_t)tb->nindex * sizeof *tb->index))) goto nomem;
+  for (int i = 0; i < tb->nindex; ++i) tb->index[i] = -1;
+  for (int i = 0; i < tb->ncol; ++i) {
+    unsigned h = name_hash(tb->name[i]) & (unsigned)(tb->nindex - 1);
+    while (tb->index[h] >= 0 && strcmp(tb->name[tb->index[h]], tb->name[i]) != 0) h = (h + 1) & (unsigned)(tb->nindex - 1);
+    if (tb->index[h] >= 0) {
+      say(err, errlen, "%s:%ld: column '%.80s' appears twice in the header", path, lineno, tb->name[i]);
+      goto out;
+    }
+    tb->index[h] = i;
+  }
   while ((n = read_line(f, &line, &cap)) >= 0) {
     ++lineno;
     if (line[0] == '\0') continue;
@@ -167,31 +186,45 @@ out:
 }
 
 int fmb_table_col(const fmbTable* tb, const char* name) {
-  for (int i = 1; i < tb->ncol; ++i)
-    if (strcmp(tb->name[i], name) == 0) return i;
-  return -1;
+  if (!tb->index) { /* a table built by hand */
+    for (int i = 1; i < tb->ncol; ++i)
+      if (strcmp(tb->name[i], name) == 0) return i;
+    return -1;
+  }
+  for (unsigned h = name_hash(name) & (unsigned)(tb->nindex - 1);; h = (h + 1) & (unsigned)(tb->nindex - 1)) {
+    const int i = tb->index[h];
+    if (i < 0) return -1;
+    if (strcmp(tb->name[i], name) == 0) return i >= 1 ? i : -1;
+  }
 }
 
 double fmb_table_t_end(const fmbTable* tb) { return fmb_table_at(tb, tb->nrow - 1, 0); }
 
-void fmb_table_column_error(const fmbTable* a, int ca, const fmbTable* b, int cb, fmbColumnError* e) {
-  memset(e, 0, sizeof *e);
+int fmb_table_at_time(const fmbTable* b, int cb, double t, long* j, double* value) {
+  if (b->nrow == 0) return -1;
   const double t_lo = fmb_table_at(b, 0, 0), t_hi = fmb_table_t_end(b);
   const double tol_t = 1e-9 * fmax(1.0, fmax(fabs(t_lo), fabs(t_hi)));
+  if (t < t_lo - tol_t || t > t_hi + tol_t) return -1;
+  if (*j < 0 || *j >= b->nrow || fmb_table_at(b, *j, 0) > t + tol_t) *j = 0;
+  while (*j + 1 < b->nrow && fmb_table_at(b, *j + 1, 0) <= t + tol_t) ++*j;
+  const double t0 = fmb_table_at(b, *j, 0);
+  if (fabs(t0 - t) <= tol_t || *j + 1 >= b->nrow) {
+    *value = fmb_table_at(b, *j, cb);
+  } else {
+    const double s = (t - t0) / (fmb_table_at(b, *j + 1, 0) - t0);
+    *value = (1.0 - s) * fmb_table_at(b, *j, cb) + s * fmb_table_at(b, *j + 1, cb);
+  }
+  return 0;
+}
+
+void fmb_table_column_error(const fmbTable* a, int ca, const fmbTable* b, int cb, fmbColumnError* e) {
+  memset(e, 0, sizeof *e);
   int nonfinite = 0;
   long j = 0; /* b's interval start */
   for (long k = 0; k < a->nrow; ++k) {
     const double t = fmb_table_at(a, k, 0);
-    if (t < t_lo - tol_t || t > t_hi + tol_t) continue;
-    while (j + 1 < b->nrow && fmb_table_at(b, j + 1, 0) <= t + tol_t) ++j;
-    const double t0 = fmb_table_at(b, j, 0);
     double bv;
-    if (fabs(t0 - t) <= tol_t || j + 1 >= b->nrow) {
-      bv = fmb_table_at(b, j, cb);
-    } else {
-      const double s = (t - t0) / (fmb_table_at(b, j + 1, 0) - t0);
-      bv = (1.0 - s) * fmb_table_at(b, j, cb) + s * fmb_table_at(b, j + 1, cb);
-    }
+    if (fmb_table_at_time(b, cb, t, &j, &bv)) continue;
     const double err = fabs(fmb_table_at(a, k, ca) - bv);
     if (!isfinite(err)) nonfinite = 1;
     if (err > e->max_abs || e->rows == 0) {

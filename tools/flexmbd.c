@@ -15,7 +15,7 @@ typedef struct {
 
 static const Command commands[] = {
     {"run", fmb_cmd_run,
-     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR]\n"
+     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR [--vtk-every N]]\n"
      "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
      "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each", 0},
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run", 0},
@@ -25,11 +25,16 @@ static const Command commands[] = {
      "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references", 1},
     {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs", 0},
     {"conform", fmb_cmd_conform,
-     "conform [--plugin x.so]... [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure", 0},
+     "conform [--plugin x.so]... [--work DIR] [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure", 0},
     {"plot", fmb_cmd_plot,
      "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
+     "      [--diff REF.csv]   each column minus REF's (with --abs --logy: an error plot)\n"
+     "      [--shape BEAM --at t1,t2,...]   the beam's centreline at those times (BEAM.shape columns)\n"
      "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)", 0},
+    {"view", fmb_cmd_view,
+     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--model M] [--set PATH=VALUE]... [--plugin x.so]...\n"
+     "      one self-contained HTML page animating the run (mechanism, beam shapes, traces, a plot)", 0},
     {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene", 0},
     {"static", fmb_cmd_static,
      "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive", 0},
@@ -48,6 +53,7 @@ static const Command commands[] = {
 
 static void usage(FILE* f) {
   for (int i = 0; i < NCOMMANDS; ++i) fprintf(f, "%s flexmbd %s\n", i ? "      " : "usage:", commands[i].usage);
+  fprintf(f, "       flexmbd --version\n");
   fprintf(f, "PATH addresses any scene value, bodies and joints by name: solver.rtol=1e-8, bodies.beam.elements=32\n"
              "exit codes: 0 ok, 1 beyond tolerance (compare, regress), 2 bad input, 3 solver failure, 4 interrupted\n");
 }
@@ -59,6 +65,10 @@ int main(int argc, char** argv) {
     return FMB_EXIT_BAD_INPUT;
   }
   const char* cmd = argv[1];
+  if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "version") == 0) {
+    printf("flexmbd %s (commit %s, plugin ABI %d)\n", FLEXMBD_VERSION, FLEXMBD_COMMIT, FMB_ABI_VERSION);
+    return 0;
+  }
   if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
     for (int i = 0; argc == 3 && i < NCOMMANDS; ++i)
       if (strcmp(argv[2], commands[i].name) == 0) {

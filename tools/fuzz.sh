@@ -1,6 +1,6 @@
 #!/bin/sh
 # tools/fuzz.sh SECONDS [BUILD_DIR] — run the libFuzzer harnesses (scene loader, --set override
-# parser, compare) side by side for SECONDS each, from a seed corpus of every scene in the tree.
+# parser, compare, time-table files, regression references) side by side for SECONDS each, from a seed corpus of every scene in the tree.
 #
 # Builds BUILD_DIR (default build-fuzz) with clang and -DFLEXMBD_FUZZ=ON if needed. The corpus
 # grows in BUILD_DIR/fuzz-corpus/{load,override} across runs; crashes land in
@@ -21,7 +21,7 @@ jobs=${JOBS:-2}
 if [ ! -f "$build/CMakeCache.txt" ]; then
   CC=$cc cmake -S "$src" -B "$build" -DFLEXMBD_FUZZ=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo >/dev/null
 fi
-cmake --build "$build" -j "$jobs" --target fuzz_load fuzz_override fuzz_compare >/dev/null || {
+cmake --build "$build" -j "$jobs" --target fuzz_load fuzz_override fuzz_compare fuzz_table fuzz_reference >/dev/null || {
   echo "fuzz.sh: building the harnesses failed (is tests/bad_scenes added from tests/CMakeLists.txt?)" >&2
   exit 1
 }
@@ -29,7 +29,7 @@ bin=$build/tests/bad_scenes/fuzz
 
 corpus=$build/fuzz-corpus
 art=$build/fuzz-artifacts
-mkdir -p "$corpus/load" "$corpus/override" "$corpus/compare" "$corpus/seeds-load" "$art"
+mkdir -p "$corpus/load" "$corpus/override" "$corpus/compare" "$corpus/table" "$corpus/reference" "$corpus/seeds-load" "$art"
 # seeds: every scene in the tree, good and bad (flattened; names made unique)
 find "$src/scenes" "$src/tests" -name '*.yaml' | while read -r f; do
   rel=${f#"$src"/}
@@ -44,17 +44,19 @@ run() { # NAME CORPUS... : one harness, SECONDS, log in $build/fuzz-NAME.log
     "$@" >"$build/fuzz-$name.log" 2>&1
 }
 status=0
-run load "$corpus/load" "$corpus/seeds-load" "$src/tests/fuzz/regressions/load" &
-p1=$!
-run override "$corpus/override" "$src/tests/fuzz/override_seeds" "$src/tests/fuzz/regressions/override" &
-p2=$!
-run compare "$corpus/compare" "$src/tests/fuzz/compare_seeds" "$src/tests/fuzz/regressions/compare" &
-p3=$!
-wait $p1 || status=1
-wait $p2 || status=1
-wait $p3 || status=1
+# three harnesses at a time: load, override, compare; then table, reference
+for group in "load override compare" "table reference"; do
+  pids=
+  for name in $group; do
+    seeds=$src/tests/fuzz/${name}_seeds
+    [ "$name" = load ] && seeds=$corpus/seeds-load
+    run "$name" "$corpus/$name" "$seeds" "$src/tests/fuzz/regressions/$name" &
+    pids="$pids $!"
+  done
+  for p in $pids; do wait "$p" || status=1; done
+done
 
-for name in load override compare; do
+for name in load override compare table reference; do
   log=$build/fuzz-$name.log
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -n 1)
   cov=$(grep -o 'cov: [0-9]*' "$log" | tail -n 1)
@@ -64,7 +66,7 @@ for name in load override compare; do
 done
 crashes=$(ls "$art" | wc -l)
 if [ "$status" -ne 0 ] || [ "$crashes" -ne 0 ]; then
-  echo "fuzz.sh: FINDINGS: $crashes artifact(s) in $art; logs: $build/fuzz-load.log, $build/fuzz-override.log, $build/fuzz-compare.log" >&2
+  echo "fuzz.sh: FINDINGS: $crashes artifact(s) in $art; logs: $build/fuzz-NAME.log" >&2
   exit 1
 fi
 echo "fuzz.sh: no findings"

@@ -4,7 +4,8 @@
 #         (tools/format.sh: the committed .clang-format); and
 #         python3-vtk9, with which the test vtk_reader reads the ParaView animation back through
 #         VTK itself (skipped without it); python3-h5py, with which sweep_runs reads DIR/sweep.h5 back
-#         (skipped without it)
+#         (skipped without it); chromium, in which the test view_page loads the page of
+#         `flexmbd view` headless (skipped without it)
 # python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux; python3-numpy is
 # what the Python package (python/flexmbd, docs/python.md) needs, python3-matplotlib draws its
 # plots (optional for the package, used by docs/python.md), python3-pytest runs its tests.
@@ -17,7 +18,7 @@ pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyam
       liblapack-dev libblas-dev libarpack2-dev libopenmpi-dev openmpi-bin libhdf5-dev hdf5-tools python3-numpy
       python3-matplotlib python3-pytest)
 if [ "${1:-}" = "--ci" ]; then
-  pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 python3-h5py)
+  pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 python3-h5py chromium)
 fi
 missing=()
 for p in "${pkgs[@]}"; do

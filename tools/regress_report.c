@@ -7,19 +7,6 @@
 
 #include "regress.h"
 
-static void xml_escaped(FILE* f, const char* s) {
-  for (; *s; ++s) {
-    switch (*s) {
-      case '&': fputs("&amp;", f); break;
-      case '<': fputs("&lt;", f); break;
-      case '>': fputs("&gt;", f); break;
-      case '"': fputs("&quot;", f); break;
-      default:
-        if ((unsigned char)*s >= 0x20 || *s == '\n' || *s == '\t') fputc(*s, f);
-    }
-  }
-}
-
 int regress_write_junit(const char* path, RegressJob* const* jobs, int n) {
   char err[300] = "";
   fmbSafeFile* sf = fmb_safe_open(path, err, sizeof err);
@@ -42,20 +29,20 @@ int regress_write_junit(const char* path, RegressJob* const* jobs, int n) {
   for (int i = 0; i < n; ++i) {
     const RegressJob* j = jobs[i];
     fprintf(f, "  <testcase classname=\"regress\" name=\"");
-    xml_escaped(f, j->scene);
+    fmb_write_xml_text(f, j->scene);
     fprintf(f, "\" time=\"%.4f\"", j->run.cpu_s);
     if (!j->failed && !j->bad_input) {
       fprintf(f, "/>\n");
       continue;
     }
     fprintf(f, ">\n    <%s message=\"", j->bad_input ? "error" : "failure");
-    xml_escaped(f, j->why);
+    fmb_write_xml_text(f, j->why);
     fprintf(f, "\">");
     if (j->worst[0]) {
       char detail[400];
       snprintf(detail, sizeof detail, "worst column %s: max error %.3g, tolerance %.3g, at t = %.6g", j->worst,
                j->worst_err, j->worst_tol, j->worst_t);
-      xml_escaped(f, detail);
+      fmb_write_xml_text(f, detail);
     }
     fprintf(f, "</%s>\n  </testcase>\n", j->bad_input ? "error" : "failure");
   }

@@ -24,7 +24,7 @@ static void print_model_stats(const char* model, const fmbStats* st) {
   free(text);
 }
 
-int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet) {
+int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet, volatile sig_atomic_t* stop) {
   if (!out || strcmp(out, "-") == 0) {
     fprintf(stderr, "flexmbd run: --models needs the CSV in a file (-o OUT.csv)\n");
     return FMB_EXIT_BAD_INPUT;
@@ -55,6 +55,11 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
     fmb_cli_print_diag(&diag);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
+  /* the scene's table files are inputs now too: refuse before any run, not after all of them */
+  if (fmb_cli_check_output_not_input(out, NULL, 0)) {
+    fmb_free(m);
+    return FMB_EXIT_BAD_INPUT;
+  }
   /* the beams' names point into m, kept until the runs are done */
   const int nbody = fmb_model_nbody(m);
   const char** beams = calloc((size_t)(nbody > 0 ? nbody : 1), sizeof *beams);
@@ -81,7 +86,7 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
     return FMB_EXIT_BAD_INPUT;
   }
   const fmbSceneSource scene = {s->scene, s->overrides, s->nover, fmb_cli_registry()};
-  const fmbRunOptions opt = {.csv_path = out, .quiet = quiet};
+  const fmbRunOptions opt = {.csv_path = out, .quiet = quiet, .stop = stop};
   fmbModelsResult* res = calloc(1, sizeof *res);
   if (!res) {
     fprintf(stderr, "flexmbd run: out of memory\n");

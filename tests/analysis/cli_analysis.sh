@@ -52,11 +52,14 @@ check "... quoting the override" grep -q "^--set: error: bodies.beam.elements=ma
 check "modes --animate exits 0" test $? -eq 0
 check "a collection per mode, 24 frames" test "$(grep -c '<DataSet' "$out/anim/mode2/cantilever.pvd")" -eq 24
 check "mode 1 swings through +A, 0, -A over half a period" python3 - "$out/anim/mode1" <<'PY'
-import math, re, sys
-def frame(j):
-    s = open("%s/cantilever_%06d.vtu" % (sys.argv[1], j)).read()
-    t = float(re.search(r'Name="TimeValue"[^>]*>([^<]*)<', s).group(1))
-    d = [float(x) for x in re.search(r'Name="deformation"[^>]*>([^<]*)<', s).group(1).split()]
+import math, re, struct, sys
+def frame(j):  # the .vtu's arrays are raw binary appended data: a UInt64 byte count, then doubles
+    s = open("%s/cantilever_%06d.vtu" % (sys.argv[1], j), "rb").read()
+    t = float(re.search(rb'Name="TimeValue"[^>]*>([^<]*)<', s).group(1))
+    off = int(re.search(rb'Name="deformation"[^>]*offset="([0-9]+)"', s).group(1))
+    base = s.index(b"_", s.index(b'<AppendedData encoding="raw">')) + 1 + off
+    (n,) = struct.unpack("<Q", s[base:base + 8])
+    d = struct.unpack("<%dd" % (n // 8), s[base + 8:base + 8 + n])
     return t, max((d[i:i + 2] for i in range(0, len(d), 3)), key=lambda u: abs(u[1]))
 (t0, a), (t6, b), (t12, c) = frame(0), frame(6), frame(12)
 period = 2 * math.pi / 3.9093421

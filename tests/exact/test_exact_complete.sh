@@ -33,7 +33,7 @@ for model in complete exact; do
   "$F" run scenes/paper/spinup_w15.yaml -o "$OUT/v_$model.csv" --vtk "$OUT/vtk_$model" --quiet \
     --set solver.t_end=1 --set solver.output_step=0.5 --set bodies.beam.model=$model 2>/dev/null
 done
-npts() { grep -o 'NumberOfPoints="[0-9]*"' "$1" | tr -dc 0-9; }
+npts() { grep -ao 'NumberOfPoints="[0-9]*"' "$1" | tr -dc 0-9; }  # -a: the .vtu holds binary appended data
 check "--vtk: the exact beam is a polyline through its 17 nodes and the joint point, as the complete model's" \
   "[ \"\$(npts '$OUT/vtk_exact/spinup_w15_000002.vtu')\" = 18 ] &&
    [ \"\$(npts '$OUT/vtk_exact/spinup_w15_000002.vtu')\" = \"\$(npts '$OUT/vtk_complete/spinup_w15_000002.vtu')\" ]"

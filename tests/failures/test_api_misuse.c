@@ -1,6 +1,10 @@
 /* test_api_misuse.c — the library answers misuse with an error, never a crash (issue 12):
  *   1. every public function of engine/flexmbd.h called with NULL pointers and bad values;
  *   2. (and messages: a long override is shortened, control characters escaped)
+ *   1b. the rest of the API (issue 27: seven calls crashed): quadrature, constraints check,
+ *      model queries, drawing, statics, modes (a NaN state or time is refused before LAPACK,
+ *      whose error handler would end the program with status 0), mode files, tables, the
+ *      input registry, each with NULL pointers and out-of-range values;
  *   3. the duplicate-key check is linear: a mapping of 100,000 keys costs fewer than 2 string
  *      comparisons per key (counted, not timed: the old pairwise check made n^2/2 = 5e9), and
  *      a duplicate at its end is still found, at the right line.
@@ -145,6 +149,85 @@ static void load_and_run_misuse(const char* scene, const char* csv) {
   fmb_free(m);
 }
 
+/* every other public call with NULL pointers and out-of-range values: an error, never a crash */
+static void analysis_misuse(const char* scene, const char* dir) {
+  fmbDiag d;
+  double x[FMB_GAUSS_MAX + 1], w[FMB_GAUSS_MAX + 1];
+  ENSURE(fmb_gauss_legendre01(3, NULL, NULL) == -1 && fmb_gauss_legendre01(0, x, w) == -1 &&
+         fmb_gauss_legendre01(FMB_GAUSS_MAX + 1, x, w) == -1);
+  ENSURE(fmb_gauss_lobatto01(3, NULL, NULL) == -1 && fmb_gauss_lobatto01(1, x, w) == -1 &&
+         fmb_gauss_lobatto01(FMB_GAUSS_MAX + 1, x, w) == -1);
+  ENSURE(fmb_gauss_lobatto01(3, x, w) == 0 && fabs(w[0] + w[1] + w[2] - 1.0) < 1e-15); /* still works */
+  ENSURE(fmb_eval_col0(NULL, 0) == -1 && fmb_eval_col0(NULL, 7) == -1); /* no context: no column */
+  ENSURE(fmb_model_nbody(NULL) == 0 && fmb_model_body(NULL, 0, NULL, NULL) == -1);
+  ENSURE(fmb_model_njoint(NULL) == 0 && fmb_model_joint(NULL, 0, NULL, NULL) == -1);
+  ENSURE(fmb_state_size(NULL) == 0 && fmb_drawing_new(NULL) == NULL);
+  fmb_drawing_free(NULL);
+  ENSURE(fmb_check_constraints(NULL, stdout, &d) == FMB_EXIT_BAD_INPUT && d.code == FMB_EXIT_BAD_INPUT);
+  ENSURE(isnan(fmb_modes_mac(NULL, 0, NULL, 0)));
+  fmb_modes_free(NULL);
+  const char* names[2] = {"a", NULL};
+  const double values[4] = {1, 2, 3, 4};
+  char path[1200];
+  snprintf(path, sizeof path, "%s/table.csv", dir);
+  memset(&d, 0, sizeof d); /* the first error a diag holds wins: start afresh for this message */
+  ENSURE(fmb_write_table(path, 2, names, 2, values, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "NULL name"));
+  ENSURE(fmb_write_table(path, 2, NULL, 2, values, NULL) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_write_table(path, 1, names, -2, values, &d) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_write_table(NULL, 0, NULL, 0, NULL, NULL) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_safe_note_input(NULL) == -1 && fmb_safe_input_at(NULL) == NULL);
+  fmb_safe_forget_input(NULL);
+
+  /* the pendulum turned 0.5 rad down from horizontal (horizontal is a dead point for statics) */
+  const char* turned[] = {"bodies.bob.position=[0.8775825618903728, -0.479425538604203]", "bodies.bob.angle=-0.5"};
+  fmbModel* m = fmb_load(scene, turned, 2, fmb_builtin_registry(), &d);
+  ENSURE(m != NULL);
+  if (!m) return;
+  ENSURE(fmb_check_constraints(m, NULL, &d) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_check_constraints(m, stdout, NULL) == 0); /* diag optional */
+  ENSURE(fmb_model_body(m, -1, NULL, NULL) == -1 && fmb_model_body(m, 1, NULL, NULL) == -1);
+  ENSURE(fmb_model_joint(m, -1, NULL, NULL) == -1 && fmb_model_joint(m, 1, NULL, NULL) == -1);
+  const char* name = NULL;
+  ENSURE(fmb_model_joint(m, 0, &name, NULL) == 0 && name && strcmp(name, "pin") == 0);
+  const int n = fmb_state_size(m);
+  double* y = calloc((size_t)n, sizeof(double));
+  double* yp = calloc((size_t)n, sizeof(double));
+  fmbStaticResult res;
+  fmbModes* md = NULL;
+  ENSURE(fmb_static(NULL, NULL, y, yp, &res, &d) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_static(m, NULL, NULL, NULL, &res, &d) == FMB_EXIT_BAD_INPUT);
+  const fmbStaticOptions nan_t = {.t = NAN, .has_t = 1};
+  ENSURE(fmb_static(m, &nan_t, y, yp, &res, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "not finite"));
+  ENSURE(fmb_static(m, NULL, y, yp, &res, NULL) == 0); /* the pendulum hangs down */
+  ENSURE(fmb_modes(m, 0.0, y, yp, 2, 77, &md, &d) == FMB_EXIT_BAD_INPUT && md == NULL);
+  ENSURE(fmb_modes(m, NAN, y, yp, 2, FMB_EIGEN_DENSE, &md, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "not finite"));
+  const double keep = y[0];
+  y[0] = NAN;
+  ENSURE(fmb_modes(m, 0.0, y, yp, 2, FMB_EIGEN_DENSE, &md, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "not finite"));
+  y[0] = keep;
+  ENSURE(fmb_modes(m, 0.0, y, yp, 1, FMB_EIGEN_DENSE, NULL, &d) == FMB_EXIT_BAD_INPUT);
+  ENSURE(fmb_modes(m, 0.0, y, yp, 1, FMB_EIGEN_DENSE, &md, NULL) == 0 && md && md->count == 1);
+  if (md) { /* a pendulum of 1 m from its centre, I = 0.1: w^2 = m g l / (I + m l^2) */
+    ENSURE_REL(md->frequency[0], sqrt(9.81 / 1.1), 1e-6);
+    snprintf(path, sizeof path, "%s/anim", dir);
+    ENSURE(fmb_write_mode_animation(m, 0.0, y, md, 0, NAN, 8, path, &d) == FMB_EXIT_BAD_INPUT);
+    ENSURE(fmb_write_mode_animation(m, 0.0, y, md, 0, 0.1, 1 << 30, path, &d) == FMB_EXIT_BAD_INPUT);
+    ENSURE(fmb_write_mode_animation(m, 0.0, y, md, 5, 0.1, 8, path, &d) == FMB_EXIT_BAD_INPUT);
+    const fmbModes lying = {.count = 2, .nq = md->nq}; /* no shapes behind its count */
+    snprintf(path, sizeof path, "%s/shapes.csv", dir);
+    ENSURE(fmb_write_mode_shapes(m, 0.0, y, yp, &lying, path, &d) == FMB_EXIT_BAD_INPUT);
+    ENSURE(fmb_write_mode_animation(m, 0.0, y, &lying, 0, 0.1, 8, path, &d) == FMB_EXIT_BAD_INPUT);
+  }
+  ENSURE(fmb_write_state_row(m, path, 0.0, NULL, NULL, &d) == FMB_EXIT_BAD_INPUT);
+  /* the scene is an input from its load on: no writer replaces it */
+  memset(&d, 0, sizeof d);
+  ENSURE(fmb_write_state_row(m, scene, 0.0, y, yp, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "refusing to overwrite"));
+  fmb_modes_free(md);
+  free(y);
+  free(yp);
+  fmb_free(m);
+}
+
 /* a long override is shortened in the message, which still ends with the reason; control
    characters are escaped so the message stays on one line */
 static void long_override(const char* scene) {
@@ -281,6 +364,7 @@ int main(int argc, char** argv) {
   snprintf(csv, sizeof csv, "%s/pendulum.csv", argv[1]);
   write_file(scene, scene_text);
   load_and_run_misuse(scene, csv);
+  analysis_misuse(scene, argv[1]);
   parser_misuse(scene);
   long_override(scene);
   many_keys(argv[1]);

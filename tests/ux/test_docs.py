@@ -3,7 +3,10 @@
 
 1. Every command in README.md and docs/*.md runs. A fenced block tagged `sh` (or `bash`) is a
    script; in a block tagged `console`, the lines starting with `$ ` are commands and the others
-   their output. A block that must not run (it installs packages, takes minutes, needs a file
+   their output, which is checked: each output line must be produced verbatim (on stdout or
+   stderr) by the command above it, where `…` stands for any text (numbers that change with the
+   machine: `cpu_s=…`). So a quoted message or a header of columns (`$ head -n 1 out.csv`) shown
+   in a console block cannot drift from what the program prints. A block that must not run (it installs packages, takes minutes, needs a file
    the reader brings) is tagged `sh norun` / `console norun`: the convention is explicit, so an
    untagged block that holds a command is an error too. Each document's commands run in order
    in one bash (`set -e`, so `cd` and files carry over) in a fresh directory that links the
@@ -31,6 +34,40 @@ os.makedirs(out)
 docs = ["README.md"] + sorted("docs/" + f for f in os.listdir(os.path.join(src, "docs")) if f.endswith(".md"))
 failures = []
 COMMANDISH = re.compile(r"^\s*(\$ )?(\./)?(build/)?(flexmbd|bash|sh|cmake|ctest|tools/|bench/)\b")
+def expected_regex(text):
+    """an output line as shown, `…` (or `...`) standing for any text: a grep -E pattern"""
+    parts = re.split(r"…|\.\.\.", text.strip())
+    return ".*".join(re.sub(r"([][\\.^$*+?(){}|/])", r"\\\1", p) for p in parts)
+
+
+def console_script(doc, line, body):
+    """a console block's commands, each followed by checks of the output lines shown under it"""
+    out, cmd, expect = [], None, []
+
+    def flush():
+        if cmd is None:
+            return
+        if not expect:
+            out.append(cmd)
+            return
+        # the command's stdout and stderr together; set -e still stops on its failure
+        out.append(f"{{ {cmd}\n}} >.console_out 2>&1 || {{ cat .console_out >&2; exit 1; }}")
+        for e in expect:
+            pat = expected_regex(e).replace("'", "'\\''")
+            shown = e.strip().replace("'", "'\\''")
+            out.append(f"grep -Eq -- '{pat}' .console_out || {{ echo '### {doc}:{line}' >&2; "
+                       f"echo 'not printed: {shown}' >&2; exit 1; }}")
+
+    for l in body:
+        if l.startswith("$ "):
+            flush()
+            cmd, expect = l[2:], []
+        elif l.strip() and cmd is not None:
+            expect.append(l)
+    flush()
+    return out
+
+
 def repo_status():
     """git's view of the working tree (None outside a git checkout): the commands run beside
     links into the repository, and none of them may change it"""
@@ -65,7 +102,7 @@ for doc in docs:
         if lang in ("sh", "bash"):
             cmds = body
         elif lang == "console":
-            cmds = [l[2:] for l in body if l.startswith("$ ")]
+            cmds = console_script(doc, line, body)
         else:
             bad = [l for l in body if COMMANDISH.match(l)] if lang in ("", "text") else []
             if bad:

@@ -1,0 +1,167 @@
+/* drawing.c — what a mechanism looks like (flexmbd.h, fmb_drawing_new): the points and cells
+ * that the ParaView animation (vtk.c) and `flexmbd view` (tools/cmd_view.c) draw, fixed once at
+ * load from the types' ops alone (the engine knows no body type):
+ *   - a body with a `centreline` op: a polyline through its stations (those of BODY.shape);
+ *   - any other body with a frame (ncoord >= 3): its outline through the points its joints attach
+ *     to (a bar pinned at both ends is the line between its pins; three or more points a closed
+ *     polygon) and its frame's x and y axes, a fifth of the body's size long;
+ *   - a joint with constraint rows: a vertex at its first attachment point;
+ *   - a force element with two attachments (a spring): the line between them.
+ * Where the points are at a state is the caller's business (fmb_body_point, or CSV columns). */
+#include <math.h>
+#include <stdlib.h>
+
+#include "internal.h"
+
+enum { MAX_ATTACH = 64 };
+
+static int add_point(fmbDrawing* d, int body, const double local[2], int station) {
+  fmbDrawPoint* p = &d->point[d->npoint];
+  p->body = body;
+  p->local[0] = local[0];
+  p->local[1] = local[1];
+  p->station = station;
+  return d->npoint++;
+}
+
+/* a cell through the points idx[0..count), or when idx == NULL through first .. first + count - 1 */
+static void add_cell(fmbDrawing* d, const int* idx, int first, int count, int part, int owner) {
+  fmbDrawCell* c = &d->cell[d->ncell++];
+  c->first = d->nconn;
+  c->count = count;
+  c->part = part;
+  c->owner = owner;
+  for (int i = 0; i < count; ++i) d->conn[d->nconn++] = idx ? idx[i] : first + i;
+}
+
+/* the attachment points of every joint on body b, in the body frame; returns how many */
+static int attachments_of(const fmbModel* m, int b, double* local, int cap) {
+  int n = 0;
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (!ji->type->attachment) continue;
+    for (int k = 0; k < 2; ++k) {
+      int body;
+      double pt[2];
+      if (ji->type->attachment(ji->self, k, &body, pt) || body != b || n == cap) continue;
+      local[2 * n] = pt[0];
+      local[2 * n + 1] = pt[1];
+      ++n;
+    }
+  }
+  return n;
+}
+
+/* order points counter-clockwise about their centroid, so three or more make a simple polygon */
+static void sort_by_angle(double* pts, int n) {
+  double cx = 0.0, cy = 0.0;
+  for (int i = 0; i < n; ++i) {
+    cx += pts[2 * i] / n;
+    cy += pts[2 * i + 1] / n;
+  }
+  for (int i = 1; i < n; ++i) /* insertion sort: a handful of points */
+    for (int k = i; k > 0; --k) {
+      double a0 = atan2(pts[2 * k - 1] - cy, pts[2 * k - 2] - cx), a1 = atan2(pts[2 * k + 1] - cy, pts[2 * k] - cx);
+      if (a0 <= a1) break;
+      for (int c = 0; c < 2; ++c) {
+        double tmp = pts[2 * k - 2 + c];
+        pts[2 * k - 2 + c] = pts[2 * k + c];
+        pts[2 * k + c] = tmp;
+      }
+    }
+}
+
+void fmb_drawing_free(fmbDrawing* d) {
+  if (!d) return;
+  free(d->point);
+  free(d->cell);
+  free(d->conn);
+  free(d);
+}
+
+fmbDrawing* fmb_drawing_new(const fmbModel* m) {
+  if (!m) return NULL;
+  fmbDrawing* d = calloc(1, sizeof *d);
+  if (!d) return NULL;
+  int npt = 0, ncell = 0;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bi->type->centreline) {
+      npt += bi->type->centreline(bi->self, 0, NULL);
+      ncell += 1;
+    } else if (bi->nq >= 3) {
+      npt += MAX_ATTACH + 2 + 3; /* outline (closed: +1), origin, frame axes */
+      ncell += 3;
+    }
+  }
+  npt += 2 * m->njoint;
+  ncell += m->njoint;
+  d->point = calloc((size_t)npt + 1, sizeof *d->point);
+  d->cell = calloc((size_t)ncell + 1, sizeof *d->cell);
+  d->conn = calloc(2 * (size_t)npt + 1, sizeof *d->conn); /* a frame draws 3 points in 4 entries */
+  double* local = calloc(2 * (size_t)(MAX_ATTACH + 1) + 2, sizeof *local);
+  int rc = (d->point && d->cell && d->conn && local) ? 0 : -1;
+  for (int b = 1; b < m->nbody && rc == 0; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bi->type->centreline) {
+      int n = bi->type->centreline(bi->self, 0, NULL);
+      double* st = calloc(2 * (size_t)n + 2, sizeof *st);
+      if (!st) {
+        rc = -1;
+        break;
+      }
+      bi->type->centreline(bi->self, n, st);
+      int first = d->npoint;
+      for (int i = 0; i < n; ++i) add_point(d, b, st + 2 * i, i);
+      add_cell(d, NULL, first, n, FMB_DRAW_CENTRELINE, b);
+      free(st);
+    } else if (bi->nq >= 3) {
+      int n = attachments_of(m, b, local, MAX_ATTACH);
+      double size = 0.0;
+      for (int i = 0; i < n; ++i) size = fmax(size, hypot(local[2 * i], local[2 * i + 1]));
+      if (n == 1) { /* a link hanging from one pin: the line from its pin to its centre */
+        local[2] = local[3] = 0.0;
+        n = 2;
+      }
+      if (n >= 2) {
+        if (n >= 3) {
+          sort_by_angle(local, n);
+          local[2 * n] = local[0];
+          local[2 * n + 1] = local[1];
+        }
+        int first = d->npoint, count = n >= 3 ? n + 1 : n;
+        for (int i = 0; i < count; ++i) add_point(d, b, local + 2 * i, -1);
+        add_cell(d, NULL, first, count, FMB_DRAW_OUTLINE, b);
+      }
+      /* the frame: axes a fifth of the body's size long (0.1 m for a body with no joints) */
+      const double len = size > 0.0 ? 0.2 * size : 0.1;
+      const double axes[3][2] = {{0.0, 0.0}, {len, 0.0}, {0.0, len}};
+      int origin = add_point(d, b, axes[0], -1);
+      add_point(d, b, axes[1], -1);
+      add_point(d, b, axes[2], -1);
+      const int x_axis[2] = {origin, origin + 1}, y_axis[2] = {origin, origin + 2};
+      add_cell(d, x_axis, 0, 2, FMB_DRAW_FRAME_AXIS, b);
+      add_cell(d, y_axis, 0, 2, FMB_DRAW_FRAME_AXIS, b);
+    }
+  }
+  for (int j = 0; j < m->njoint && rc == 0; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    if (!ji->type->attachment) continue;
+    int body[2];
+    double pt[2][2];
+    if (ji->type->attachment(ji->self, 0, &body[0], pt[0])) continue;
+    int first = add_point(d, body[0], pt[0], -1);
+    if (ji->nrows == 0 && ji->type->attachment(ji->self, 1, &body[1], pt[1]) == 0) {
+      add_point(d, body[1], pt[1], -1);
+      add_cell(d, NULL, first, 2, FMB_DRAW_FORCE_ELEMENT, j);
+    } else {
+      add_cell(d, NULL, first, 1, FMB_DRAW_JOINT, j);
+    }
+  }
+  free(local);
+  if (rc) {
+    fmb_drawing_free(d);
+    return NULL;
+  }
+  return d;
+}
