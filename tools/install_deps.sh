@@ -6,14 +6,17 @@
 #         VTK itself (skipped without it); python3-h5py, with which sweep_runs reads DIR/sweep.h5 back
 #         (skipped without it); chromium, in which the test view_page loads the page of
 #         `flexmbd view` headless (skipped without it)
-# python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux.
+# python3 and util-linux (`script`, a pseudo-terminal) run the tests of tests/ux; python3-numpy is
+# what the Python package (python/flexmbd, docs/python.md) needs, python3-matplotlib draws its
+# plots (optional for the package, used by docs/python.md), python3-pytest runs its tests.
 set -euo pipefail
 # liblapack-dev, libblas-dev: the dense eigen-solvers of `modes` (engine/modes.c);
 # libarpack2-dev: its sparse shift-invert path (Arnoldi) for large systems
 # libopenmpi-dev, openmpi-bin: `flexmbd sweep` over MPI ranks (mpirun); libhdf5-dev, hdf5-tools: its
 # DIR/sweep.h5 and the h5dump that the sweep test reads it with (docs/sweep.md; both optional to build)
 pkgs=(build-essential cmake pkg-config libsundials-dev libsuitesparse-dev libyaml-dev gnuplot-nox python3 util-linux
-      liblapack-dev libblas-dev libarpack2-dev libopenmpi-dev openmpi-bin libhdf5-dev hdf5-tools)
+      liblapack-dev libblas-dev libarpack2-dev libopenmpi-dev openmpi-bin libhdf5-dev hdf5-tools python3-numpy
+      python3-matplotlib python3-pytest)
 if [ "${1:-}" = "--ci" ]; then
   pkgs+=(clang-14 libclang-rt-14-dev clang-format-14 valgrind util-linux python3-vtk9 python3-h5py chromium)
 fi

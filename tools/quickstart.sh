@@ -10,3 +10,4 @@ bash tools/build.sh
 bash tools/plot_paper.sh out build/flexmbd
 echo "quickstart: CSV files and figures are in out/:"
 ls out
+echo "quickstart: from Python (docs/python.md): PYTHONPATH=python python3 -c 'import flexmbd'"

@@ -25,33 +25,15 @@ import signal
 import subprocess
 import sys
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
+from markdown_blocks import blocks  # noqa: E402  (tests/markdown_blocks.py)
+
 src, build, out = (os.path.abspath(a) for a in sys.argv[1:4])
 shutil.rmtree(out, ignore_errors=True)
 os.makedirs(out)
 docs = ["README.md"] + sorted("docs/" + f for f in os.listdir(os.path.join(src, "docs")) if f.endswith(".md"))
 failures = []
 COMMANDISH = re.compile(r"^\s*(\$ )?(\./)?(build/)?(flexmbd|bash|sh|cmake|ctest|tools/|bench/)\b")
-FENCE = re.compile(r"^(\s*)```+\s*([^`]*)$")
-
-
-def blocks(path):
-    """(line, info words, lines) of every fenced block"""
-    lines = open(path, encoding="utf-8").read().split("\n")
-    i = 0
-    while i < len(lines):
-        m = FENCE.match(lines[i])
-        if not m:
-            i += 1
-            continue
-        start, info, body = i + 1, m.group(2).split(), []
-        i += 1
-        while i < len(lines) and not re.match(r"^\s*```+\s*$", lines[i]):
-            body.append(lines[i])
-            i += 1
-        yield start, info, body
-        i += 1
-
-
 def expected_regex(text):
     """an output line as shown, `…` (or `...`) standing for any text: a grep -E pattern"""
     parts = re.split(r"…|\.\.\.", text.strip())

@@ -1,0 +1,551 @@
+"""Loading a scene (`load` → `Model`) and running it (`Model.run` → `Result`)."""
+from __future__ import annotations
+
+import contextlib
+import ctypes
+import math
+import os
+import tempfile
+import threading
+import weakref
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+
+import numpy as np
+
+from . import _lib
+from ._lib import FlexmbdError
+from ._scene import looks_like_yaml, override, scene_text
+
+Source = Union[str, "os.PathLike[str]", Mapping[str, Any]]
+
+# One registry per list of plugins, kept for the life of the process: a model calls its types'
+# ops, so the registry must outlive every model loaded with it, and loaded plugin code is never
+# unloaded anyway (engine/plugin.c).
+_registries: Dict[Tuple[str, ...], int] = {}
+_registries_lock = threading.Lock()
+
+
+def _registry(plugins: Tuple[str, ...]) -> int:
+    lib = _lib.library()
+    key = tuple(os.path.realpath(p) for p in plugins)  # the same files, whatever the folder or spelling
+    with _registries_lock:
+        reg = _registries.get(key)
+        if reg:
+            return reg
+        reg = lib.fmb_registry_new()
+        if not reg:
+            raise MemoryError("flexmbd: out of memory creating a registry")
+        diag = _lib.Diag()
+        if lib.fmb_registry_add(reg, lib.fmb_builtin_plugin(), b"built-in", ctypes.byref(diag)):
+            lib.fmb_registry_free(reg)
+            raise _lib.error_from(diag)
+        for so in plugins:
+            if lib.fmb_registry_load(reg, so.encode(), ctypes.byref(diag)):
+                lib.fmb_registry_free(reg)
+                raise _lib.error_from(diag)
+        _registries[key] = reg
+        return reg
+
+
+def _plugin_path(p: Union[str, "os.PathLike[str]"]) -> str:
+    """A plugin file as the command line's --plugin takes it; a bare name means the current folder."""
+    p = os.fspath(p)
+    return p if os.sep in p else os.path.join(".", p)
+
+
+Overrides = Union[Mapping[str, Any], Sequence[str], None]
+
+
+def _overrides(sets: Overrides) -> List[str]:
+    """{PATH: VALUE} or ["PATH=VALUE", ...] as the --set strings"""
+    if sets is None:
+        return []
+    if isinstance(sets, Mapping):
+        return [override(k, v) for k, v in sets.items()]
+    if isinstance(sets, str):
+        raise TypeError("flexmbd: set= takes a dict {PATH: VALUE} or a list of 'PATH=VALUE' strings, not one string")
+    return [str(s) for s in sets]
+
+
+def load(scene: Source, set: Overrides = None, plugins: Sequence[Union[str, "os.PathLike[str]"]] = (),
+         ) -> "Model":
+    """Load a scene: a file path, YAML text, or a dict shaped like a scene file.
+
+    ``set`` holds overrides as ``flexmbd run --set PATH=VALUE`` takes them, e.g.
+    ``{"bodies.beam.model": "exact", "solver.rtol": 1e-8}`` (or the strings
+    ``["bodies.beam.model=exact", ...]``); ``plugins`` are shared objects with
+    more body and joint types (as ``--plugin``).
+
+    Raises SceneError (with .file, .line, .column and .message, ``str()`` the command line's
+    message) when the scene, an override or a plugin is refused. Text and dicts are written to a
+    temporary file in the current folder (so that file names in them, e.g. a load table, are
+    taken from there, as for a scene file there); their errors name ``<string>`` or ``<dict>``
+    and count lines in the text (``flexmbd.scene_text(d)`` shows a dict's)."""
+    overrides = _overrides(set)
+    plugin_files = tuple(_plugin_path(p) for p in plugins)
+    if isinstance(scene, Mapping):
+        return Model._from_text(scene_text(scene), "<dict>", overrides, plugin_files, ("dict", dict(scene)))
+    if isinstance(scene, str) and looks_like_yaml(scene):
+        return Model._from_text(scene, "<string>", overrides, plugin_files, ("text", scene))
+    path = os.fspath(scene)
+    return Model._load(path, None, overrides, plugin_files, ("path", os.path.abspath(path)))
+
+
+@contextlib.contextmanager
+def _scene_file(text: str):
+    """The scene text in a temporary file, in the current folder if it can be written (file names
+    in the scene are taken from there, as for a scene file there), else in the temporary folder;
+    removed after the block."""
+    fd = path = None
+    for folder in (os.getcwd(), tempfile.gettempdir()):
+        try:
+            fd, path = tempfile.mkstemp(prefix=".flexmbd-", suffix=".yaml", dir=folder)
+            break
+        except OSError:
+            continue
+    if fd is None:
+        raise OSError("flexmbd: no folder to write the scene text into")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+        yield path
+    finally:
+        os.unlink(path)
+
+
+class _Owned:
+    """An object of the library this Python object owns (``_ptr``), freed by ``_free`` (the name
+    of the library's function) on close(), at the end of a ``with`` block, or when collected."""
+
+    _ptr: Optional[int] = None
+    _free = ""
+
+    @property
+    def handle(self) -> int:
+        """The library's pointer (fmbModel*, fmbData*), for calls this package does not wrap."""
+        if not self._ptr:
+            raise ValueError(f"flexmbd: the {type(self).__name__} was closed")
+        return self._ptr
+
+    def close(self) -> None:
+        """Free the library's object now (also done when this one is collected)."""
+        ptr, self._ptr = self._ptr, None
+        if ptr:
+            getattr(_lib.library(), self._free)(ptr)
+
+    def __del__(self) -> None:
+        try:
+            self.close()
+        except Exception:
+            pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+
+class Model(_Owned):
+    """A loaded scene (the library's fmbModel): fixed after loading, runnable many times.
+
+    Attributes: ``path`` (the scene file, None for text or a dict), ``overrides`` (the
+    ``PATH=VALUE`` strings applied), ``plugins``, ``solver`` (t0, t_end, rtol, atol, output_step
+    after the overrides), ``bodies`` (name → type), ``output_names`` (the CSV's columns after t),
+    ``inputs`` (what Simulation.set_load can set) and ``state_size``."""
+
+    _free = "fmb_free"
+
+    def __init__(self) -> None:  # use flexmbd.load
+        self._ptr = None
+        self._rename: Dict[str, str] = {}
+
+    @classmethod
+    def _from_text(cls, text: str, shown: str, overrides: List[str], plugins: Tuple[str, ...], source) -> "Model":
+        with _scene_file(text) as path:
+            return cls._load(path, shown, overrides, plugins, source)
+
+    @classmethod
+    def _load(cls, path: str, shown: Optional[str], overrides: List[str], plugins: Tuple[str, ...], source) -> "Model":
+        lib = _lib.library()
+        reg = _registry(plugins)
+        arr = (ctypes.c_char_p * max(1, len(overrides)))(*[o.encode() for o in overrides])
+        diag = _lib.Diag()
+        rename = {path: shown} if shown else {}
+        _lib.route_warnings()
+        ptr = lib.fmb_load(path.encode(), arr, len(overrides), reg, ctypes.byref(diag))
+        if not ptr:
+            raise _lib.error_from(diag, rename)
+        m = cls()
+        m._ptr = ptr
+        m._rename = rename
+        m._reg = reg
+        m.path = None if shown else path
+        m._shown_path = shown or path
+        m.overrides = list(overrides)
+        m.plugins = list(plugins)
+        m._source = source
+        info = _lib.SolverInfo()
+        lib.fmb_model_solver(ptr, ctypes.byref(info))
+        m.solver = {k: getattr(info, k) for k, _ in _lib.SolverInfo._fields_}
+        m.bodies = {}
+        name, typ = ctypes.c_char_p(), ctypes.c_char_p()
+        for i in range(lib.fmb_model_nbody(ptr)):
+            lib.fmb_model_body(ptr, i, ctypes.byref(name), ctypes.byref(typ))
+            m.bodies[name.value.decode()] = typ.value.decode()
+        m.state_size = lib.fmb_state_size(ptr)
+        m.output_names = [lib.fmb_output_name(ptr, i).decode() for i in range(lib.fmb_noutput(ptr))]
+        m.inputs = [lib.fmb_input_name(ptr, i).decode() for i in range(lib.fmb_ninput(ptr))]
+        return m
+
+    def __repr__(self) -> str:
+        where = self.path or self._rename.get(next(iter(self._rename), ""), "?")
+        return f"<flexmbd.Model {where} bodies={list(self.bodies)} t_end={self.solver['t_end']:g}>"
+
+    def reload(self, set: Overrides = None) -> "Model":
+        """The same scene loaded again with more overrides (later ones win)."""
+        kind, what = self._source
+        extra = _overrides(set)
+        if kind == "path":
+            return Model._load(what, None, self.overrides + extra, tuple(self.plugins), self._source)
+        return Model._from_text(self._text(), self._shown_path, self.overrides + extra, tuple(self.plugins),
+                                self._source)
+
+    def _text(self) -> str:
+        kind, what = self._source
+        return scene_text(what) if kind == "dict" else what
+
+    @contextlib.contextmanager
+    def _scene_source(self, extra: Sequence[str] = ()):
+        """An fmbSceneSource for the analyses that load the scene again themselves (fmb_campbell):
+        the file (a temporary one for text or a dict, its name shown as the model's in errors),
+        the overrides plus `extra`, the registry."""
+        overrides = self.overrides + list(extra)
+        arr = (ctypes.c_char_p * max(1, len(overrides)))(*[o.encode() for o in overrides])
+        with contextlib.ExitStack() as stack:
+            if self._source[0] == "path":
+                path = self._source[1]
+            else:
+                path = stack.enter_context(_scene_file(self._text()))
+                self._rename[path] = self._shown_path
+            try:
+                yield _lib.SceneSource(path=path.encode(), overrides=arr, noverrides=len(overrides), reg=self._reg)
+            finally:
+                if self._source[0] != "path":
+                    self._rename.pop(path, None)
+
+    def _error(self, diag: _lib.Diag, default_code: int = _lib.EXIT_SOLVER) -> FlexmbdError:
+        return _lib.error_from(diag, self._rename, default_code)
+
+    # -- running -------------------------------------------------------------------------------
+    def run(self, t_end: Optional[float] = None, *, check: bool = True, cancel: Optional["Cancel"] = None,
+            warn: Optional[Callable[[str], None]] = None) -> "Result":
+        """Integrate from t0 to t_end (None: the scene's ``solver.t_end``) and return the outputs.
+
+        The rows are the ones ``flexmbd run`` writes (``Result.to_csv`` gives the same bytes).
+        When the solver stops, SolverError is raised with the rows so far in its ``.result``
+        (``check=False``: the Result is returned, ``.status`` says ``failed``, ``.error`` why).
+        ``cancel.set()`` from another thread stops the run after its current step (Interrupted).
+        The library's messages go to ``warn(text)``, by default Python's warnings
+        (flexmbd.FlexmbdWarning). The library runs without the GIL: other Python threads run
+        meanwhile."""
+        if t_end is not None and t_end != self.solver["t_end"]:
+            with self.reload({"solver.t_end": float(t_end)}) as m:
+                return m.run(check=check, cancel=cancel, warn=warn)
+        return _run_whole(self, check, cancel, warn)
+
+    def start(self, *, warn: Optional[Callable[[str], None]] = None, cancel: Optional["Cancel"] = None
+              ) -> "Simulation":
+        """A run to step by hand, initialised at t0 (see Simulation)."""
+        return Simulation(self, warn=warn, cancel=cancel)
+
+
+class Cancel:
+    """A flag that stops runs from another thread: ``c = flexmbd.Cancel()``, pass it to
+    ``Model.run(cancel=c)`` or ``Model.start(cancel=c)``, then ``c.set()``. The advance in progress
+    returns at its next step (fmb_data_cancel) and the run raises Interrupted with its rows."""
+
+    def __init__(self) -> None:
+        self._set = False
+        self._sims: "weakref.WeakSet[Simulation]" = weakref.WeakSet()
+        self._lock = threading.Lock()
+
+    def set(self) -> None:
+        with self._lock:
+            self._set = True
+            sims = list(self._sims)
+        for sim in sims:
+            sim.cancel()
+
+    def is_set(self) -> bool:
+        return self._set
+
+    def _watch(self, sim: "Simulation") -> None:
+        with self._lock:
+            self._sims.add(sim)
+            already = self._set
+        if already:
+            sim.cancel()
+
+
+def _output_grid(solver: Mapping[str, float]) -> Tuple[int, Callable[[int], float]]:
+    """The rows `flexmbd run` writes: their count - 1 (nout) and the time of row k, t0 + k
+    output_step, the last one t_end (engine/run.c's grid, which fmb_run steps to as well)."""
+    t0, t_end, dt = solver["t0"], solver["t_end"], solver["output_step"]
+    nout = int(math.ceil((t_end - t0) / dt - 1e-9))
+    return nout, (lambda k: t_end if k == nout else t0 + float(k) * dt)  # t0 + (double)k * dt, as in C
+
+
+def output_times(solver: Mapping[str, float]) -> np.ndarray:
+    """The times of the rows `flexmbd run` writes for these solver settings (Model.solver)."""
+    nout, at = _output_grid(solver)
+    return np.array([at(k) for k in range(nout + 1)])
+
+
+class Simulation(_Owned):
+    """One run of a model, stepped by the caller (the library's fmbData): ``model.start()``.
+
+        sim = model.start()
+        while sim.t < 5:
+            sim.set_load("motor", -k * sim["hub.theta"])   # a joint with profile/law: input
+            sim.advance(sim.t + 0.01)
+
+    ``advance(t_out)`` integrates to t_out (time ≤ t_out ≤ the scene's t_end); a changed input
+    takes effect from the current time as a step and the integrator restarts there (no history
+    across the jump). ``outputs()`` gives the scene's outputs now (the values a CSV row at this time
+    holds), ``sim[name]`` one of them, ``state()`` the DAE state (y, y'), ``stats`` the counters so
+    far. Errors: SolverError (the state stays at the last good step), Interrupted (``cancel()``,
+    from any thread), SceneError for misuse (t_out before t, NaN or beyond t_end; an unknown input).
+    Each call into the library releases the GIL."""
+
+    _free = "fmb_data_free"
+
+    def __init__(self, model: Model, warn: Optional[Callable[[str], None]] = None,
+                 cancel: Optional[Cancel] = None) -> None:
+        lib = _lib.library()
+        self.model = model
+        diag = _lib.Diag()
+        _lib.route_warnings()
+        self._ptr = lib.fmb_data_new(model.handle, ctypes.byref(diag))
+        if not self._ptr:
+            raise model._error(diag)
+        # this run's messages go to `warn` or Python's warnings whichever thread advances it
+        self._warn = _lib.WarnFn(lambda user, msg: _lib.deliver(msg, warn)) if warn is not None else _lib.WARN_TO_PYTHON
+        lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
+        self.output_names: List[str] = model.output_names
+        self._row = np.zeros(len(self.output_names))
+        self._row_ptr = self._row.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+        if cancel is not None:
+            cancel._watch(self)
+        self.restart()
+
+    def restart(self) -> None:
+        """Back to the consistent state at t0 (fmb_init), inputs at their scene values."""
+        diag = _lib.Diag()
+        rc = _lib.library().fmb_init(self.model.handle, self.handle, ctypes.byref(diag))
+        if rc:
+            raise self.model._error(diag, rc)
+
+    @property
+    def t(self) -> float:
+        """The time the state is at."""
+        return _lib.library().fmb_data_time(self.handle)
+
+    def advance(self, t_out: float) -> None:
+        """Integrate to t_out (raises SolverError, Interrupted, or SceneError for misuse)."""
+        diag = _lib.Diag()
+        rc = _lib.library().fmb_advance(self.model.handle, self.handle, float(t_out), ctypes.byref(diag))
+        if rc:
+            raise self.model._error(diag, rc)
+
+    def _outputs_into(self, out) -> int:
+        return _lib.library().fmb_outputs(self.model.handle, self.handle, out)
+
+    def outputs(self) -> Dict[str, float]:
+        """The scene's outputs at time t, name → value (a non-finite value raises SolverError)."""
+        rc = self._outputs_into(self._row_ptr)
+        if rc == _lib.EXIT_SOLVER:
+            raise _lib.SolverError(rc, self.model.path or "", 0, 0, f"an output is not finite at t = {self.t:.6g}")
+        if rc:
+            raise _lib.FlexmbdError(rc, "", 0, 0, "fmb_outputs refused the call")
+        return dict(zip(self.output_names, self._row.tolist()))
+
+    def __getitem__(self, name: str) -> float:
+        if name == "t":
+            return self.t
+        values = self.outputs()
+        try:
+            return values[name]
+        except KeyError:
+            raise KeyError(f"no output '{name}' (outputs: {', '.join(self.output_names)}; add it to the scene's "
+                           "outputs: list)") from None
+
+    def state(self) -> Tuple[np.ndarray, np.ndarray]:
+        """(y, y') of the DAE: [q, v, λ, μ, z] and its rate (copies)."""
+        n = self.model.state_size
+        y, yp = np.zeros(n), np.zeros(n)
+        _lib.library().fmb_data_state(self.handle, y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                                      yp.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        return y, yp
+
+    @property
+    def inputs(self) -> List[str]:
+        """The names of the inputs set_load can change (joints with profile/law: input)."""
+        return self.model.inputs
+
+    def set_load(self, name: str, value: float) -> None:
+        """Set input `name` (a load with `law: input`, a drive with `profile: input`) from now on
+        (fmb_set_input): piecewise constant, the next advance starts from it."""
+        with _lib.captured_messages() as said:
+            rc = _lib.library().fmb_set_input(self.model.handle, self.handle, name.encode(), float(value))
+        if rc:
+            raise _lib.SceneError(rc, "", 0, 0, "; ".join(said) or f"set_load('{name}', {value!r}) refused")
+
+    def get_load(self, name: str) -> float:
+        """The current value of input `name`."""
+        v = ctypes.c_double()
+        if _lib.library().fmb_get_input(self.model.handle, self.handle, name.encode(), ctypes.byref(v)):
+            raise KeyError(f"no input '{name}' (inputs: {', '.join(self.inputs)})")
+        return v.value
+
+    @property
+    def stats(self) -> dict:
+        """The counters so far, as the stats line's fields (status says ok: the run goes on)."""
+        buf = ctypes.create_string_buffer(_lib.STATS_BYTES)
+        _lib.library().fmb_data_stats(self.handle, buf)
+        return _lib.stats_dict(buf)
+
+    def cancel(self) -> None:
+        """Stop the advance in progress (or the next one) with Interrupted; safe from any thread."""
+        ptr = self._ptr
+        if ptr:
+            _lib.library().fmb_data_cancel(ptr)
+
+    def __repr__(self) -> str:
+        return f"<flexmbd.Simulation t={self.t:g} of {self.model!r}>" if self._ptr else "<flexmbd.Simulation closed>"
+
+
+def _run_whole(model: Model, check: bool, cancel: Optional[Cancel], warn) -> "Result":
+    """fmb_run's loop (engine/run.c) on the stepping API: the row at t0 after fmb_init, then one
+    fmb_advance and one row per output time; the rows go straight into one NumPy array."""
+    nout, time_of = _output_grid(model.solver)
+    names = ["t"] + model.output_names
+    values = np.zeros((min(nout + 1, 4096), len(names)))  # grown by doubling: t_end may be far
+    nrow = 0
+    error: Optional[FlexmbdError] = None
+    sim = None
+    try:
+        sim = Simulation(model, warn=warn, cancel=cancel)
+        for k in range(nout + 1):
+            if k > 0:
+                sim.advance(time_of(k))
+            if k == len(values):
+                values = np.concatenate([values, np.zeros_like(values)])
+            row = values[k]
+            row[0] = sim.t
+            rc = sim._outputs_into(row[1:].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+            if rc:  # fmb_run stops here too, without the row
+                raise _lib.SolverError(rc, model._shown_path, 0, 0,
+                                       f"stopped at t = {sim.t:.6g}: an output is not finite (the solution blew up)")
+            nrow = k + 1
+            if cancel is not None and cancel.is_set() and k < nout:
+                raise _lib.Interrupted(_lib.EXIT_INTERRUPTED, model._shown_path, 0, 0,
+                                       f"interrupted at t = {sim.t:.6g} (Cancel.set()): the {nrow} rows so far are kept")
+    except (_lib.SolverError, _lib.Interrupted) as e:
+        error = e
+    stats = {}
+    if sim is not None:
+        stats = sim.stats
+        stats["status"] = "ok" if error is None else ("interrupted" if isinstance(error, _lib.Interrupted) else "failed")
+        sim.close()
+    result = Result(names, values[:nrow], stats)
+    if error is not None:
+        result.error = error
+        error.result = result
+        if check:
+            raise error
+    return result
+
+
+class Result:
+    """The outputs of a run: ``.t`` and ``result["beam.tip_v"]`` are NumPy arrays, ``.columns``
+    the CSV's column names (``t`` first), ``.values`` the rows × columns array, ``.stats`` the
+    stats line as a dict (``status``, ``t_reached``, ``steps``, ... ``cpu_s``), ``.status``
+    (``ok``, ``failed``, ``interrupted``) and ``.error`` (None, or the SolverError/Interrupted)."""
+
+    def __init__(self, columns: Sequence[str], values: np.ndarray, stats: Optional[dict] = None) -> None:
+        self.columns: List[str] = list(columns)
+        self.values: np.ndarray = values
+        self.stats: dict = stats or {}
+        self.error: Optional[FlexmbdError] = None
+        self._index = {c: i for i, c in enumerate(self.columns)}
+
+    @classmethod
+    def from_csv(cls, path: Union[str, "os.PathLike[str]"]) -> "Result":
+        """A CSV written by ``flexmbd run -o`` (or ``to_csv``) read back; the ``#`` lines a
+        regression reference carries before its header are skipped."""
+        with open(path, encoding="utf-8") as f:
+            header = f.readline()
+            while header.startswith("#"):
+                header = f.readline()
+            header = header.strip()
+            values = np.loadtxt(f, delimiter=",", ndmin=2)
+        columns = header.split(",") if header else []
+        if values.size == 0:
+            values = np.zeros((0, len(columns)))
+        return cls(columns, values)
+
+    @property
+    def status(self) -> str:
+        return str(self.stats.get("status", "ok" if self.error is None else "failed"))
+
+    @property
+    def t(self) -> np.ndarray:
+        return self["t"]
+
+    def __getitem__(self, name: str) -> np.ndarray:
+        try:
+            return self.values[:, self._index[name]]
+        except KeyError:
+            raise KeyError(f"no column '{name}' (columns: {', '.join(self.columns)})") from None
+
+    def __contains__(self, name: str) -> bool:
+        return name in self._index
+
+    def __len__(self) -> int:
+        return self.values.shape[0]
+
+    def __repr__(self) -> str:
+        span = f"t = {self.t[0]:g} .. {self.t[-1]:g}" if len(self) else "no rows"
+        return f"<flexmbd.Result {len(self)} rows, {span}, status={self.status}, columns={self.columns}>"
+
+    def to_csv(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Write the rows through the library's CSV writer: the bytes ``flexmbd run -o`` writes
+        ("-" = standard output)."""
+        lib = _lib.library()
+        names = (ctypes.c_char_p * len(self.columns))(*[c.encode() for c in self.columns])
+        vals = np.ascontiguousarray(self.values, dtype=np.float64)
+        diag = _lib.Diag()
+        rc = lib.fmb_write_table(os.fspath(path).encode(), len(self.columns), names, vals.shape[0],
+                                 vals.ctypes.data_as(ctypes.POINTER(ctypes.c_double)), ctypes.byref(diag))
+        if rc:
+            raise _lib.error_from(diag, None, rc)
+
+    def to_pandas(self):
+        """A pandas DataFrame indexed by t (needs pandas)."""
+        try:
+            import pandas as pd
+        except ImportError as e:
+            raise ImportError("flexmbd: Result.to_pandas needs pandas (Debian: python3-pandas)") from e
+        return pd.DataFrame(self.values, columns=self.columns).set_index("t")
+
+    def to_dict(self) -> Dict[str, np.ndarray]:
+        """Column name → array."""
+        return {c: self[c] for c in self.columns}
+
+    def plot(self, *columns: str, ax=None, label: Optional[str] = None, **style):
+        """Plot columns against t with matplotlib, units on the axes (see flexmbd.unit); returns
+        the Axes. Several results overlay when given the same ``ax``."""
+        from .plot import plot_result
+
+        return plot_result(self, columns, ax=ax, label=label, **style)
