@@ -137,6 +137,7 @@ _P = ctypes.c_void_p
 _D = ctypes.POINTER(Diag)
 _PROTOTYPES = {
     "fmb_registry_new": (_P, []),
+    "fmb_output_unit_in": (ctypes.c_char_p, [_P, ctypes.c_char_p]),
     "fmb_registry_free": (None, [_P]),
     "fmb_registry_add": (ctypes.c_int, [_P, _P, ctypes.c_char_p, _D]),
     "fmb_registry_load": (ctypes.c_int, [_P, ctypes.c_char_p, _D]),

@@ -1,38 +1,20 @@
 """Plots with units on the axes (matplotlib, optional: imported only when a plot is asked for)."""
 from __future__ import annotations
 
-import re
 from typing import Optional, Sequence
 
 
-# The unit of each output quantity the shipped types and the engine provide, used while the
-# library has no call that says it (engine/flexmbd.h declares units for keys, fmbParam.unit, not
-# for outputs). A library that exports fmb_output_unit(model, name) is asked first. Quantities
-# here are names, not formulas: no number of this package comes from this table.
-_QUANTITY_UNITS = {
-    # every body with a frame (engine/output.c frame_names)
-    "x": "m", "y": "m", "theta": "rad", "omega": "rad/s", "vx": "m/s", "vy": "m/s",
-    # the beam (bodies/beam.c, bodies/beam_exact.c)
-    "tip_u": "m", "tip_v": "m", "tip_u_rate": "m/s", "tip_v_rate": "m/s", "tip_x": "m", "tip_y": "m",
-    "ang_momentum": "kg m^2/s", "tip_angle": "rad",
-    # joints (engine/output.c power_names, reaction_names; joints/*.c)
-    "power": "W", "work": "J", "reaction_x": "N", "reaction_y": "N", "reaction_torque": "N m",
-    "angle": "rad", "speed": "rad/s", "length": "m", "tension": "N", "displacement": "m", "velocity": "m/s",
-}
-_OWNER_UNITS = {"energy": "J", "constraint": None}  # constraint.*: a norm over mixed rows, no unit
-_NODE = re.compile(r"^node\d+_(u|v|x|y)$")
+def unit(column: str, plugins: Sequence[str] = ()) -> Optional[str]:
+    """The SI unit of an output column (``beam.tip_v`` → ``m``; ``t`` → ``s``), None if unknown.
 
+    Asked of the library (fmb_output_unit_in): the engine's own columns, and a type's own outputs
+    as the registered types declare them (output_units; the built-ins and ``plugins``)."""
+    from . import _lib
+    from .model import _registry, _plugin_path
 
-def unit(column: str) -> Optional[str]:
-    """The SI unit of an output column (``beam.tip_v`` → ``m``; ``t`` → ``s``), None if unknown."""
-    if column == "t":
-        return "s"
-    owner, _, qty = column.partition(".")
-    if owner in _OWNER_UNITS:
-        return _OWNER_UNITS[owner]
-    if _NODE.match(qty):
-        return "m"
-    return _QUANTITY_UNITS.get(qty)
+    reg = _registry(tuple(_plugin_path(p) for p in plugins))
+    u = _lib.library().fmb_output_unit_in(reg, column.encode())
+    return u.decode() if u else None
 
 
 def axis_label(column: str) -> str:
