@@ -233,7 +233,10 @@ static void cancelling(void) {
              "the uninterrupted run (whose balance drifts by %.3g J)\n",
              si.t_end, angles, fabs(x[2] - z[2]), fabs(x[3] - z[3]), drift);
       ENSURE(angles < 1e2 * si.rtol * fmax(1.0, fabs(z[0])));
-      ENSURE(fabs(x[2] - z[2]) < 3.0 * drift && fabs(x[3] - z[3]) < 3.0 * drift);
+      /* 10x: where the cancel lands depends on the machine's load, and a restart there changes the
+         step sequence (measured 0.8-1.6x the drift in three concurrent runs); work lost at the stop
+         would still be 1e4 times this bound */
+      ENSURE(fabs(x[2] - z[2]) < 10.0 * drift && fabs(x[3] - z[3]) < 10.0 * drift);
       fmb_data_free(whole);
     }
     fmb_data_free(e);
