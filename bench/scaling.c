@@ -23,9 +23,9 @@
 #include <string.h>
 #include <time.h>
 
+#include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
 #include <sundials/sundials_linearsolver.h>
-#include <nvector/nvector_serial.h>
 #include <sunmatrix/sunmatrix_sparse.h>
 
 #include "builtin.h"
@@ -178,8 +178,8 @@ int main(int argc, char** argv) {
       }
     }
     /* the auxiliary unknowns of a banded beam, consistent with that state */
-    if (beam->nz > 0 &&
-        beam->type->aux_initial(beam->self, &m->env, q, v, a, c.y + m->zoff + beam->zadr, fmb_workspace_plugin(c.w) + beam->workadr))
+    if (beam->nz > 0 && beam->type->aux_initial(beam->self, &m->env, q, v, a, c.y + m->zoff + beam->zadr,
+                                                fmb_workspace_plugin(c.w) + beam->workadr))
       return 3;
     for (size_t k = 0; k < ny; ++k) c.ewt[k] = 1.0 / (1e-6 * fabs(c.y[k]) + 1e-8);
     /* the Newton matrix at that state, for the factorization and solve timings */
@@ -195,8 +195,8 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < ny; ++k) NV_Ith_S(c.rhs, k) = (double)rand() / RAND_MAX - 0.5;
     double t[5];
     for (c.what = 0; c.what < 5; ++c.what) t[c.what] = time_per_call(&c);
-    printf("%d,%d,%zu,%ld,%.3f,%.3f,%.3f,%.1f,%.3f,%.3f\n", ne, beam->nq, ny, m->nnz, t[0], t[1], t[2], t[2] / t[0], t[3],
-           t[4]);
+    printf("%d,%d,%zu,%ld,%.3f,%.3f,%.3f,%.1f,%.3f,%.3f\n", ne, beam->nq, ny, m->nnz, t[0], t[1], t[2], t[2] / t[0],
+           t[3], t[4]);
     SUNLinSolFree(c.LS);
     SUNMatDestroy(c.A);
     N_VDestroy(c.x);

@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
     char* s2 = NULL;
     int k = 0;
     for (char* t = strtok_r(line, ",", &s2); t; t = strtok_r(NULL, ",", &s2), ++k)
-      if (k >= 2 && k - 2 < np) snprintf(sets[k - 2], sizeof sets[k - 2], "%s=%s", path[k - 2], t), ov[k - 2] = sets[k - 2];
+      if (k >= 2 && k - 2 < np)
+        snprintf(sets[k - 2], sizeof sets[k - 2], "%s=%s", path[k - 2], t), ov[k - 2] = sets[k - 2];
     fmbDiag diag;
     fmbStats st;
     memset(&st, 0, sizeof st);

@@ -38,8 +38,8 @@ typedef struct Beam {
   int banded; /* the coupling's long-range sums carried as auxiliary unknowns (beam_residual_aux) */
   double pos0[2], angle0, vel0[2], omega0;
   /* derived */
-  double le, r;   /* element length, cross-section point offset sqrt(I/A) */
-  int n;          /* 3 * ne deformation coordinates */
+  double le, r; /* element length, cross-section point offset sqrt(I/A) */
+  int n;        /* 3 * ne deformation coordinates */
   /* quadrature points along an element; shape and slope functions there */
   double xg[FMB_GAUSS_MAX], wg[FMB_GAUSS_MAX];
   double ns_out[FMB_GAUSS_MAX][4], nd_out[FMB_GAUSS_MAX][4];
@@ -116,12 +116,14 @@ static double dot5(const double* a, const double* b) {
  * same holds for h_j = int_0^x N2j' w2', whose weights G[j][i] (h_weights) act on c.
  * ------------------------------------------------------------------------------------------- */
 static void slope_poly(const Beam* b, const double d[4], double c[3]) {
-  for (int i = 0; i < 3; ++i) c[i] = b->nslope[0][i] * d[0] + b->nslope[1][i] * d[1] + b->nslope[2][i] * d[2] + b->nslope[3][i] * d[3];
+  for (int i = 0; i < 3; ++i)
+    c[i] = b->nslope[0][i] * d[0] + b->nslope[1][i] * d[1] + b->nslope[2][i] * d[2] + b->nslope[3][i] * d[3];
 }
 
 static void h_weights(const Beam* b, const double pw[5], double G[4][3]) {
   for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 3; ++i) G[j][i] = b->nslope[j][0] * pw[i] + b->nslope[j][1] * pw[i + 1] + b->nslope[j][2] * pw[i + 2];
+    for (int i = 0; i < 3; ++i)
+      G[j][i] = b->nslope[j][0] * pw[i] + b->nslope[j][1] * pw[i + 1] + b->nslope[j][2] * pw[i + 2];
 }
 
 static void poly_mul(const double a[3], const double c[3], double out[5]) {
@@ -169,7 +171,8 @@ static void beam_setup(Beam* b) {
   for (int g = 0; g < b->ng; ++g) hermite(b->xg[g], b->le, b->ns_out[g], b->nd_out[g]);
   double le = b->le;
   /* coefficients of xi^0..2 in the slope functions d/dx [H1, le H2, H3, le H4] (hermite's nd) */
-  const double nslope[4][3] = {{0.0, -6.0 / le, 6.0 / le}, {1.0, -4.0, 3.0}, {0.0, 6.0 / le, -6.0 / le}, {0.0, -2.0, 3.0}};
+  const double nslope[4][3] = {
+      {0.0, -6.0 / le, 6.0 / le}, {1.0, -4.0, 3.0}, {0.0, 6.0 / le, -6.0 / le}, {0.0, -2.0, 3.0}};
   memcpy(b->nslope, nslope, sizeof nslope);
   for (int g = 0; g < b->ng; ++g) int_weights(le, b->xg[g], b->pw_out[g]);
   int_weights(le, 1.0, b->pw_full);
@@ -285,7 +288,7 @@ static void beam_initial(const void* self, double* q0, double* v0) {
    FOAC      J_RD^T (a_RD - f) + J_R^T a_C + J_C^T (a_R - f)
    complete  J^T (a_RD + a_C - f)                                                            */
 static inline void point_forces(int model, double m, const double aRD[2], const double aR[2], const double aC[2],
-                         const double f[2], double FR[2], double FD[2], double FC[2]) {
+                                const double f[2], double FR[2], double FD[2], double FC[2]) {
   for (int i = 0; i < 2; ++i) {
     switch (model) {
       case BEAM_ZOAC:
@@ -297,9 +300,7 @@ static inline void point_forces(int model, double m, const double aRD[2], const 
         FR[i] = FD[i] + m * aC[i];
         FC[i] = m * (aR[i] - f[i]);
         break;
-      default:
-        FR[i] = FD[i] = FC[i] = m * (aRD[i] + aC[i] - f[i]);
-        break;
+      default: FR[i] = FD[i] = FC[i] = m * (aRD[i] + aC[i] - f[i]); break;
     }
   }
 }
@@ -429,7 +430,8 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
     out->frame[0] += FR0[0];
     out->frame[1] += FR0[1];
     /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
-    out->frame[2] += pt.x * FR0[1] - r2 * FR1[0] + pt.w1 * FD0[1] - r2 * pt.w2s * FD1[1] - pt.w2 * FD0[0] + pt.wc * FC0[1];
+    out->frame[2] +=
+        pt.x * FR0[1] - r2 * FR1[0] + pt.w1 * FD0[1] - r2 * pt.w2s * FD1[1] - pt.w2 * FD0[0] + pt.wc * FC0[1];
     /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
     out->rp_a[0] += pt.n1[0] * FD0[0];
     out->rp_a[1] += pt.n1[1] * FD0[0];
@@ -508,7 +510,8 @@ static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const do
     /* the deformation scalars are linear in the element's dofs: their gradients are the shape
        functions; the coupling's are h (of p, pd, pdd) at the point */
     double gw1[NL] = {0.0}, gw2[NL] = {0.0}, gw2s[NL] = {0.0}, gw1d[NL] = {0.0}, gw2d[NL] = {0.0}, gw2sd[NL] = {0.0};
-    double gw1dd[NL] = {0.0}, gw2dd[NL] = {0.0}, gw2sdd[NL] = {0.0}, gwc[NL] = {0.0}, gwcd[NL] = {0.0}, ghacc[NL] = {0.0};
+    double gw1dd[NL] = {0.0}, gw2dd[NL] = {0.0}, gw2sdd[NL] = {0.0}, gwc[NL] = {0.0}, gwcd[NL] = {0.0},
+           ghacc[NL] = {0.0};
     for (int k = 0; k < 2; ++k) gw1[LQ + k] = gw1d[LV + k] = gw1dd[LA + k] = pt.n1[k];
     for (int j = 0; j < 4; ++j) {
       gw2[LQ + 2 + j] = gw2d[LV + 2 + j] = gw2dd[LA + 2 + j] = ns[j];
@@ -552,8 +555,8 @@ static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const do
       D->frame[0][l] += FR0[0];
       D->frame[1][l] += FR0[1];
       D->frame[2][l] += x * FR0[1] - r2 * FR1[0] + w1 * FD0[1] + pt.FD0[1] * gw1[l] -
-                        r2 * (w2s * FD1[1] + pt.FD1[1] * gw2s[l]) - (w2 * FD0[0] + pt.FD0[0] * gw2[l]) +
-                        wc * FC0[1] + pt.FC0[1] * gwc[l];
+                        r2 * (w2s * FD1[1] + pt.FD1[1] * gw2s[l]) - (w2 * FD0[0] + pt.FD0[0] * gw2[l]) + wc * FC0[1] +
+                        pt.FC0[1] * gwc[l];
       D->rp[0][l] += pt.n1[0] * FD0[0];
       D->rp[1][l] += pt.n1[1] * FD0[0];
       for (int j = 0; j < 4; ++j) D->rp[2 + j][l] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0] - h[j] * FC0[0];
@@ -659,7 +662,7 @@ static int residual_serial(const Beam* b, const fmbEnv* env, const double* q, co
   double* Rp = R + 3;
   FrameMotion fm;
   frame_motion(env, q, v, a, &fm);
-  double* Fe = work;        /* per element F[4] */
+  double* Fe = work; /* per element F[4] */
   double* csum = work + 4 * ne;
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   double prefix[3] = {0.0, 0.0, 0.0}, sums[3] = {0.0, 0.0, 0.0};
@@ -716,8 +719,7 @@ static int beam_residual_aux(const void* self, const fmbEnv* env, const double* 
   /* the recursions: P_e = P_(e-1) + dP(e-1), P_0 = 0; T_e = T_(e+1) + csum(e+1), T_last = 0;
      S_e = S_(e+1) + s(e), S_ne = 0; the element terms are subtracted below */
   for (int e = 0; e < ne; ++e) {
-    for (int k = 0; k < 3; ++k)
-      Rz[zS(b, e) + k] = z[zS(b, e) + k] - (e + 1 < ne ? z[zS(b, e + 1) + k] : 0.0);
+    for (int k = 0; k < 3; ++k) Rz[zS(b, e) + k] = z[zS(b, e) + k] - (e + 1 < ne ? z[zS(b, e + 1) + k] : 0.0);
     if (!coupled) continue;
     for (int k = 0; k < 3; ++k) Rz[zP(b, e) + k] = z[zP(b, e) + k] - (e > 0 ? z[zP(b, e - 1) + k] : 0.0);
     Rz[zT(b, e)] = z[zT(b, e)] - (e + 1 < ne ? z[zT(b, e + 1)] : 0.0);
@@ -760,9 +762,9 @@ static int beam_aux_initial(const void* self, const fmbEnv* env, const double* q
    at the root or an end) for beam_pattern_jacobian. */
 typedef struct {
   int nr, nc, rows[16], cols[32];
-  int r_dof[6], c_dof[6];                             /* local dofs, gather's order */
+  int r_dof[6], c_dof[6];                                /* local dofs, gather's order */
   int r_S[3], c_S[3], c_S1[3], c_P[3], r_P1[3], c_P1[3]; /* S_e, S_(e+1), P_e, P_(e+1) */
-  int c_T, r_T0, c_T0;                                /* T_e, T_(e-1) */
+  int c_T, r_T0, c_T0;                                   /* T_e, T_(e-1) */
 } ElementBlock;
 
 static void element_block(const Beam* b, int e, ElementBlock* k) {
@@ -812,13 +814,13 @@ static long beam_pattern(const void* self, int* rows, int* cols) {
   if (!b->banded) return -1;
   const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
   long n = 0;
-#define PAIR(r, c)         \
-  do {                     \
-    if (rows) {            \
-      rows[n] = (r);       \
-      cols[n] = (c);       \
-    }                      \
-    ++n;                   \
+#define PAIR(r, c)   \
+  do {               \
+    if (rows) {      \
+      rows[n] = (r); \
+      cols[n] = (c); \
+    }                \
+    ++n;             \
   } while (0)
   for (int e = 0; e < ne; ++e) {
     ElementBlock k;
@@ -874,9 +876,7 @@ static void add_global_row(const double* g, double s, int nq, double* rq, double
 /* beam_nwork's part for the dense Jacobian beyond the residual's: the z of residual_serial
    (7 ne), element_derivs' dprefix per element (3 NL ne) and the gradients of the prefix (3) and
    the tail (1) over q, v, a (12 nq) */
-static size_t jacobian_nwork(const Beam* b) {
-  return (size_t)b->ne * (7 + 3 * NL) + (size_t)12 * (size_t)(3 + b->n);
-}
+static size_t jacobian_nwork(const Beam* b) { return (size_t)b->ne * (7 + 3 * NL) + (size_t)12 * (size_t)(3 + b->n); }
 
 /* Dense K, C, M (column-major nq x nq; NULL blocks are skipped only all together) of the residual
    with the sums eliminated (residual_serial). Element e's rows read the prefix P_e (the sums of
@@ -916,7 +916,8 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
       element_derivs(b, &fm, e, q + 3, v + 3, a + 3, z + zP(b, e), &D);
       memcpy(Dp + 3 * NL * (size_t)e, D.dprefix, sizeof D.dprefix);
       if (e < ne - 1)
-        for (int k = 0; k < 3; ++k) add_local_row(e, D.dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
+        for (int k = 0; k < 3; ++k)
+          add_local_row(e, D.dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
     }
   }
   for (int e = ne - 1; e >= 0; --e) {
@@ -939,7 +940,8 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
         if (W[i][k] == 0.0) continue;
         add_local_row(e, D.frame[k], W[i][k], K + i, C + i, M + i, st);
         if (coupled)
-          for (int m = 0; m < 3; ++m) add_global_row(dP + 3 * st * m, W[i][k] * D.frame[k][LP + m], nq, K + i, C + i, M + i, st);
+          for (int m = 0; m < 3; ++m)
+            add_global_row(dP + 3 * st * m, W[i][k] * D.frame[k][LP + m], nq, K + i, C + i, M + i, st);
       }
     if (!coupled) continue;
     /* dT_(e-1) = dT_e + dcsum_e */
@@ -985,8 +987,8 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
 /* The banded assembly's K = d[R; Rz]/d[q; z], C, M, one value per pair of beam_pattern: each
    element's block from element_derivs (its rows read P_e and T_e as unknowns, so no chain
    through other elements), the recursions' unit entries, the frame rows A(theta) S_0. */
-static int beam_pattern_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v,
-                                 const double* a, const double* z, double* K, double* C, double* M, double* work) {
+static int beam_pattern_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                                 const double* z, double* K, double* C, double* M, double* work) {
   (void)work;
   const Beam* b = self;
   if (!b->banded || !z) return -1;
@@ -1008,22 +1010,22 @@ static int beam_pattern_jacobian(const void* self, const fmbEnv* env, const doub
     memset(Cb, 0, sizeof(double) * nv);
     memset(Mb, 0, sizeof(double) * nv);
     /* s * T into row ri: its local columns, and the prefix columns P_e */
-#define ROW(ri, T, s)                                                                   \
-  do {                                                                                  \
-    const size_t ro_ = (size_t)(ri) * (size_t)k.nc;                                      \
-    for (int l_ = 0; l_ < 6; ++l_)                                                         \
-      if (k.c_dof[l_] >= 0) {                                                            \
-        Kb[ro_ + k.c_dof[l_]] += (s) * (T)[LQ + l_];                                       \
-        Cb[ro_ + k.c_dof[l_]] += (s) * (T)[LV + l_];                                       \
-        Mb[ro_ + k.c_dof[l_]] += (s) * (T)[LA + l_];                                       \
-      }                                                                                 \
-    Kb[ro_ + 2] += (s) * (T)[LTH];                                                       \
-    Cb[ro_ + 2] += (s) * (T)[LOM];                                                       \
-    Mb[ro_ + 0] += (s) * (T)[LAX];                                                       \
-    Mb[ro_ + 1] += (s) * (T)[LAY];                                                       \
-    Mb[ro_ + 2] += (s) * (T)[LAL];                                                       \
-    if (coupled)                                                                        \
-      for (int m_ = 0; m_ < 3; ++m_) Kb[ro_ + k.c_P[m_]] += (s) * (T)[LP + m_];               \
+#define ROW(ri, T, s)                                                           \
+  do {                                                                          \
+    const size_t ro_ = (size_t)(ri) * (size_t)k.nc;                             \
+    for (int l_ = 0; l_ < 6; ++l_)                                              \
+      if (k.c_dof[l_] >= 0) {                                                   \
+        Kb[ro_ + k.c_dof[l_]] += (s) * (T)[LQ + l_];                            \
+        Cb[ro_ + k.c_dof[l_]] += (s) * (T)[LV + l_];                            \
+        Mb[ro_ + k.c_dof[l_]] += (s) * (T)[LA + l_];                            \
+      }                                                                         \
+    Kb[ro_ + 2] += (s) * (T)[LTH];                                              \
+    Cb[ro_ + 2] += (s) * (T)[LOM];                                              \
+    Mb[ro_ + 0] += (s) * (T)[LAX];                                              \
+    Mb[ro_ + 1] += (s) * (T)[LAY];                                              \
+    Mb[ro_ + 2] += (s) * (T)[LAL];                                              \
+    if (coupled)                                                                \
+      for (int m_ = 0; m_ < 3; ++m_) Kb[ro_ + k.c_P[m_]] += (s) * (T)[LP + m_]; \
   } while (0)
     for (int l = 0; l < 6; ++l) {
       const int ri = k.r_dof[l];
@@ -1295,9 +1297,17 @@ static void beam_energy(const void* self, const fmbEnv* env, const double* q, co
 /* ---------------------------------------------------------------------------------------------
  * Outputs.
  * ------------------------------------------------------------------------------------------- */
-enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
-       OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
-       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE, OUT_NTIP = FMB_BEAM_NTIP };
+enum {
+  OUT_TIP_U = FMB_BEAM_TIP_U,
+  OUT_TIP_V = FMB_BEAM_TIP_V,
+  OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
+  OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE,
+  OUT_TIP_X = FMB_BEAM_TIP_X,
+  OUT_TIP_Y = FMB_BEAM_TIP_Y,
+  OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM,
+  OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE,
+  OUT_NTIP = FMB_BEAM_NTIP
+};
 enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 
 static int beam_output_lookup(const void* self, const char* quantity) {
@@ -1412,8 +1422,8 @@ static void beam_describe(const void* self, FILE* f) {
           terms[b->model], b->beta > 0.0 ? ", stiffness-proportional damping" : "",
           b->banded ? "banded (coupling sums as auxiliary unknowns)" : "dense");
   /* its range (beam_model_range): the run warns when it is left */
-  fprintf(f, "; accurate while the tip deflects less than %.0f %% of the length (%.3g m)", 100.0 * beam_deflection_limit(b),
-          beam_deflection_limit(b) * b->L);
+  fprintf(f, "; accurate while the tip deflects less than %.0f %% of the length (%.3g m)",
+          100.0 * beam_deflection_limit(b), beam_deflection_limit(b) * b->L);
   if (b->model == BEAM_ZOAC)
     fprintf(f, " and it turns slower than %d %% of its first bending frequency (%.3g rad/s)", ZOAC_SPIN_LIMIT_PERCENT,
             0.01 * ZOAC_SPIN_LIMIT_PERCENT * beam_first_frequency(b));
@@ -1466,18 +1476,36 @@ static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NU
 
 static const fmbParam beam_params[] = {
     FMB_BEAM_SECTION_PARAMS(MAX_ELEMENTS),
-    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "complete", .choices = all_models,
+    {.key = "model",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "complete",
+     .choices = all_models,
      .doc = "coupling deformation kept in full, to first order, or left out (docs/beam.md); exact: the "
             "geometrically exact beam (docs/models.md)"},
     FMB_BEAM_FRAME_PARAMS,
-    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .fallback = "0",
+    {.key = "damping",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_NONNEGATIVE,
+     .unit = "s",
+     .fallback = "0",
      .doc = "stiffness-proportional (Kelvin-Voigt) damping time beta: forces K (p + beta dp/dt)"},
-    {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .fallback = "6 (complete), 4 (foac, zoac)", .lo = 4,
-     .hi = FMB_GAUSS_MAX, .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
-    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = integration_names,
+    {.key = "quadrature_points",
+     .kind = FMB_PARAM_INT,
+     .unit = "1",
+     .fallback = "6 (complete), 4 (foac, zoac)",
+     .lo = 4,
+     .hi = FMB_GAUSS_MAX,
+     .doc = "Gauss points per element, at least the default (fewer under-integrate the model)"},
+    {.key = "integration",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "reduced",
+     .choices = integration_names,
      .doc = "model: exact: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full); "
             "the other models ignore it"},
-    {.key = "assembly", .kind = FMB_PARAM_CHOICE, .fallback = "auto", .choices = assembly_names,
+    {.key = "assembly",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "auto",
+     .choices = assembly_names,
      .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
     {.key = NULL},
 };
@@ -1504,37 +1532,18 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
 }
 
 /* the ops of both tables below (fmb_body_beam and beam_fd) */
-#define BEAM_OPS \
-    .name = "beam", \
-    .abi = FMB_ABI_VERSION, \
-    .parse = beam_parse, \
-    .destroy = beam_destroy, \
-    .ncoord = beam_ncoord, \
-    .initial = beam_initial, \
-    .residual = beam_residual, \
-    .marker = beam_marker, \
-    .nwork = beam_nwork, \
-    .energy = beam_energy, \
-    .output_names = fmb_beam_output_names, \
-    .output_units = fmb_beam_output_units, \
-    .output_lookup = beam_output_lookup, \
-    .output = beam_output, \
-    .describe = beam_describe, \
-    .indefinite_mass = beam_indefinite_mass, \
-    .max_bdf_order = beam_max_bdf_order, \
-    .invalid_state = beam_invalid_state, \
-    .velocity_error_test = beam_velocity_error_test, \
-    .params = beam_params, \
-    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n" \
-               "angular_velocity: 3\nvelocity: [0.2, 0.5]\n", \
-    .example_damped = "damping: 0.05\n", \
-    .centreline = beam_centreline, \
-    .variant = beam_variant, \
-    .naux = beam_naux, \
-    .residual_aux = beam_residual_aux, \
-    .aux_initial = beam_aux_initial, \
-    .pattern = beam_pattern, \
-    .model_range = beam_model_range
+#define BEAM_OPS                                                                                                     \
+  .name = "beam", .abi = FMB_ABI_VERSION, .parse = beam_parse, .destroy = beam_destroy, .ncoord = beam_ncoord,       \
+  .initial = beam_initial, .residual = beam_residual, .marker = beam_marker, .nwork = beam_nwork,                    \
+  .energy = beam_energy, .output_names = fmb_beam_output_names, .output_units = fmb_beam_output_units,               \
+  .output_lookup = beam_output_lookup, .output = beam_output, .describe = beam_describe,                             \
+  .indefinite_mass = beam_indefinite_mass, .max_bdf_order = beam_max_bdf_order, .invalid_state = beam_invalid_state, \
+  .velocity_error_test = beam_velocity_error_test, .params = beam_params,                                            \
+  .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"         \
+             "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",                                                          \
+  .example_damped = "damping: 0.05\n", .centreline = beam_centreline, .variant = beam_variant, .naux = beam_naux,    \
+  .residual_aux = beam_residual_aux, .aux_initial = beam_aux_initial, .pattern = beam_pattern,                       \
+  .model_range = beam_model_range
 
 const fmbBodyType fmb_body_beam = {BEAM_OPS, .jacobian = beam_jacobian, .pattern_jacobian = beam_pattern_jacobian};
 static const fmbBodyType beam_fd = {BEAM_OPS};

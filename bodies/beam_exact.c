@@ -232,8 +232,9 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
   err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
   if (!err && fmb_find_key(p, item, "damping") >= 0)
-    err = fmb_parse_error(p, fmb_find_key(p, item, "damping"), "'damping' is not available with model: exact "
-                                                               "(the exact beam is undamped); remove the key");
+    err = fmb_parse_error(p, fmb_find_key(p, item, "damping"),
+                          "'damping' is not available with model: exact "
+                          "(the exact beam is undamped); remove the key");
   if (!err && fmb_find_key(p, item, "quadrature_points") >= 0)
     err = fmb_parse_error(p, fmb_find_key(p, item, "quadrature_points"),
                           "model: exact sets its points with `integration: reduced | full`, not 'quadrature_points'");
@@ -300,9 +301,8 @@ typedef struct PointFrame {
   double rho[2], rho_t[2], F[2]; /* position, rate, F = a_b - f_b */
 } PointFrame;
 
-static void point_frame(const Shape* sh, int e, const double X[8], const double Xd[8],
-                        const double Xdd[8], double c, double s, const double G0[2], double om, double al,
-                        PointFrame* pf) {
+static void point_frame(const Shape* sh, int e, const double X[8], const double Xd[8], const double Xdd[8], double c,
+                        double s, const double G0[2], double om, double al, PointFrame* pf) {
   double rho[2], rt[2], rtt[2];
   interp(sh->n, X, rho);
   interp(sh->n, Xd, rt);
@@ -599,9 +599,17 @@ static void exact_energy(const void* self, const fmbEnv* env, const double* q, c
 
 /* the same output names and meanings as bodies/beam.c: tip_u/tip_v = the tip's axial and
    transverse displacement in the frame (the complete model's u(L) and w2(L)) */
-enum { OUT_TIP_U = FMB_BEAM_TIP_U, OUT_TIP_V = FMB_BEAM_TIP_V, OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
-       OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE, OUT_TIP_X = FMB_BEAM_TIP_X, OUT_TIP_Y = FMB_BEAM_TIP_Y,
-       OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM, OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE, OUT_NTIP = FMB_BEAM_NTIP };
+enum {
+  OUT_TIP_U = FMB_BEAM_TIP_U,
+  OUT_TIP_V = FMB_BEAM_TIP_V,
+  OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
+  OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE,
+  OUT_TIP_X = FMB_BEAM_TIP_X,
+  OUT_TIP_Y = FMB_BEAM_TIP_Y,
+  OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM,
+  OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE,
+  OUT_NTIP = FMB_BEAM_NTIP
+};
 enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
 static int exact_output_lookup(const void* self, const char* quantity) {
   return fmb_beam_output_lookup(((const BeamExact*)self)->ne, quantity);
@@ -648,12 +656,14 @@ static int exact_output(const void* self, int id, const double* q, const double*
 
 static void exact_describe(const void* self, FILE* f) {
   const BeamExact* b = self;
-  fprintf(f, "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly; "
-          "no range limit (its accuracy is the mesh's and the tolerance's, docs/models.md)\n",
-          b->ne, b->integration == INTEGRATION_FULL ? "full" : "reduced",
-          b->integration == INTEGRATION_FULL ? "axial at 5, bending at 3 Gauss points"
-                                             : "axial at 3 Lobatto, bending at 2 Gauss points",
-          b->banded ? "banded" : "dense");
+  fprintf(
+      f,
+      "exact model (geometrically exact cable in the floating frame), %d elements, %s integration (%s), %s assembly; "
+      "no range limit (its accuracy is the mesh's and the tolerance's, docs/models.md)\n",
+      b->ne, b->integration == INTEGRATION_FULL ? "full" : "reduced",
+      b->integration == INTEGRATION_FULL ? "axial at 5, bending at 3 Gauss points"
+                                         : "axial at 3 Lobatto, bending at 2 Gauss points",
+      b->banded ? "banded" : "dense");
 }
 
 /* as for the other beam models: undamped axial modes near 5e5 rad/s */
@@ -711,14 +721,24 @@ static int exact_centreline(const void* self, int n, double* local) {
 static const fmbParam exact_params[] = {
     FMB_BEAM_SECTION_PARAMS(EXACT_MAX_ELEMENTS),
     {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = exact_models, .doc = "exact here"},
-    {.key = "integration", .kind = FMB_PARAM_CHOICE, .fallback = "reduced", .choices = exact_integrations,
+    {.key = "integration",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "reduced",
+     .choices = exact_integrations,
      .doc = "reduced: axial at 3 Lobatto, bending at 2 Gauss points; full: 5 and 3 Gauss points"},
-    {.key = "assembly", .kind = FMB_PARAM_CHOICE, .fallback = "auto", .choices = exact_assemblies,
+    {.key = "assembly",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "auto",
+     .choices = exact_assemblies,
      .doc = "body Jacobian layout: banded (O(n), the default from 64 elements) or dense"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
-    {.key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .lo = 1, .hi = FMB_GAUSS_MAX,
+    {.key = "quadrature_points",
+     .kind = FMB_PARAM_INT,
+     .unit = "1",
+     .lo = 1,
+     .hi = FMB_GAUSS_MAX,
      .doc = "refused: see integration"},
     {.key = NULL},
 };

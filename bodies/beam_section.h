@@ -10,37 +10,64 @@
 #include "flexmbd.h"
 
 /* the keys every beam model reads the same way, then the frame's initial state */
-#define FMB_BEAM_SECTION_PARAMS(max_elements)                                                                      \
-  {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m",                    \
-   .doc = "undeformed length"},                                                                                     \
-      {.key = "elements", .kind = FMB_PARAM_INT, .flags = FMB_REQUIRED, .unit = "1", .lo = 1, .hi = (max_elements), \
-       .doc = "finite elements along the length"},                                                                  \
-      {.key = "density", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg/m^3",          \
-       .doc = "mass density"},                                                                                      \
-      {.key = "area", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^2",                \
-       .doc = "cross-section area"},                                                                                \
-      {.key = "second_moment", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m^4",       \
-       .doc = "second moment of area of the cross-section"},                                                        \
-      {.key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa",       \
-       .doc = "Young's modulus"}
-#define FMB_BEAM_FRAME_PARAMS                                                                                       \
-  {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]",                                    \
-   .doc = "initial root of the floating frame"},                                                                    \
+#define FMB_BEAM_SECTION_PARAMS(max_elements)                                                              \
+  {.key = "length",                                                                                        \
+   .kind = FMB_PARAM_NUMBER,                                                                               \
+   .flags = FMB_REQUIRED | FMB_POSITIVE,                                                                   \
+   .unit = "m",                                                                                            \
+   .doc = "undeformed length"},                                                                            \
+      {.key = "elements",                                                                                  \
+       .kind = FMB_PARAM_INT,                                                                              \
+       .flags = FMB_REQUIRED,                                                                              \
+       .unit = "1",                                                                                        \
+       .lo = 1,                                                                                            \
+       .hi = (max_elements),                                                                               \
+       .doc = "finite elements along the length"},                                                         \
+      {.key = "density",                                                                                   \
+       .kind = FMB_PARAM_NUMBER,                                                                           \
+       .flags = FMB_REQUIRED | FMB_POSITIVE,                                                               \
+       .unit = "kg/m^3",                                                                                   \
+       .doc = "mass density"},                                                                             \
+      {.key = "area",                                                                                      \
+       .kind = FMB_PARAM_NUMBER,                                                                           \
+       .flags = FMB_REQUIRED | FMB_POSITIVE,                                                               \
+       .unit = "m^2",                                                                                      \
+       .doc = "cross-section area"},                                                                       \
+      {.key = "second_moment",                                                                             \
+       .kind = FMB_PARAM_NUMBER,                                                                           \
+       .flags = FMB_REQUIRED | FMB_POSITIVE,                                                               \
+       .unit = "m^4",                                                                                      \
+       .doc = "second moment of area of the cross-section"},                                               \
+  {                                                                                                        \
+    .key = "youngs_modulus", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "Pa", \
+    .doc = "Young's modulus"                                                                               \
+  }
+#define FMB_BEAM_FRAME_PARAMS                                                                                         \
+  {.key = "position",                                                                                                 \
+   .kind = FMB_PARAM_VEC2,                                                                                            \
+   .unit = "m",                                                                                                       \
+   .fallback = "[0, 0]",                                                                                              \
+   .doc = "initial root of the floating frame"},                                                                      \
       {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial frame orientation"}, \
-      {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]",                              \
-       .doc = "initial root velocity"},                                                                             \
-      {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0",                       \
-       .doc = "initial frame angular velocity"}
+      {.key = "velocity",                                                                                             \
+       .kind = FMB_PARAM_VEC2,                                                                                        \
+       .unit = "m/s",                                                                                                 \
+       .fallback = "[0, 0]",                                                                                          \
+       .doc = "initial root velocity"},                                                                               \
+  {                                                                                                                   \
+    .key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0",                            \
+    .doc = "initial frame angular velocity"                                                                           \
+  }
 
 /* the parse error for a section whose element mass or stiffness is not a usable double (length
    1e-300: EI/le^3 overflows) */
 static inline void fmb_beam_refuse_degenerate(fmbParser* p, fmbNode item, double L, int ne, double rho, double A,
-                                             double Izz, double E, double me, double k_bend, double k_axial) {
+                                              double Izz, double E, double me, double k_bend, double k_axial) {
   fmb_parse_error(p, item,
-                         "degenerate beam: length %g in %d elements with density %g, area %g, second moment %g and "
-                         "Young's modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: "
-                         "not all are usable (finite, non-zero) floating-point numbers",
-                         L, ne, rho, A, Izz, E, me, k_bend, k_axial);
+                  "degenerate beam: length %g in %d elements with density %g, area %g, second moment %g and "
+                  "Young's modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: "
+                  "not all are usable (finite, non-zero) floating-point numbers",
+                  L, ne, rho, A, Izz, E, me, k_bend, k_axial);
 }
 
 /* element e (0-based, clamped to the mesh) and local coordinate xi in [0, 1] of arc length x */
@@ -68,15 +95,24 @@ static inline int fmb_beam_centreline(double L, int ne, int n, double* local) {
    tip's deformation, its rates and position, the angular momentum, the tip cross-section's angle
    to the frame (the marker's angle at (L, 0) less theta: the slope w2'(L) of the small-strain
    models, atan2 of the tangent for the exact one), and nodeK_u/v/x/y at node K. */
-enum { FMB_BEAM_TIP_U, FMB_BEAM_TIP_V, FMB_BEAM_TIP_U_RATE, FMB_BEAM_TIP_V_RATE, FMB_BEAM_TIP_X, FMB_BEAM_TIP_Y,
-       FMB_BEAM_ANG_MOMENTUM, FMB_BEAM_TIP_ANGLE, FMB_BEAM_NTIP };
+enum {
+  FMB_BEAM_TIP_U,
+  FMB_BEAM_TIP_V,
+  FMB_BEAM_TIP_U_RATE,
+  FMB_BEAM_TIP_V_RATE,
+  FMB_BEAM_TIP_X,
+  FMB_BEAM_TIP_Y,
+  FMB_BEAM_ANG_MOMENTUM,
+  FMB_BEAM_TIP_ANGLE,
+  FMB_BEAM_NTIP
+};
 enum { FMB_BEAM_NODE_BASE = 1000, FMB_BEAM_NODE_STRIDE = 4 }; /* node k: u, v, x, y */
-static const char* const fmb_beam_output_names[] = {"tip_u",        "tip_v",     "tip_u_rate", "tip_v_rate",
-                                                    "tip_x",        "tip_y",     "ang_momentum", "tip_angle",
-                                                    "nodeK_u",      "nodeK_v",   "nodeK_x",    "nodeK_y", NULL};
+static const char* const fmb_beam_output_names[] = {"tip_u",   "tip_v",        "tip_u_rate", "tip_v_rate", "tip_x",
+                                                    "tip_y",   "ang_momentum", "tip_angle",  "nodeK_u",    "nodeK_v",
+                                                    "nodeK_x", "nodeK_y",      NULL};
 /* their units, in the same order (for plot axes) */
-static const char* const fmb_beam_output_units[] = {"m", "m", "m/s", "m/s", "m", "m", "kg m^2/s", "rad",
-                                                    "m", "m", "m",   "m",   NULL};
+static const char* const fmb_beam_output_units[] = {"m",   "m", "m/s", "m/s", "m", "m", "kg m^2/s",
+                                                    "rad", "m", "m",   "m",   "m", NULL};
 
 /* the output id of `quantity` for a beam of ne elements, or -1 */
 static inline int fmb_beam_output_lookup(int ne, const char* quantity) {

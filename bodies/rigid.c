@@ -22,7 +22,8 @@ static int rigid_parse(fmbParser* p, fmbNode item, void** self) {
       fmb_get_vec2(p, item, "velocity", 0, r->vel) || fmb_get_double(p, item, "angular_velocity", 0, &r->omega))
     return -1;
   /* subnormal values pass "positive" but their inverses overflow */
-  if (!isnormal(r->mass)) return fmb_parse_error(p, fmb_find_key(p, item, "mass"), "mass %g is too small to compute with", r->mass);
+  if (!isnormal(r->mass))
+    return fmb_parse_error(p, fmb_find_key(p, item, "mass"), "mass %g is too small to compute with", r->mass);
   if (!isnormal(r->inertia))
     return fmb_parse_error(p, fmb_find_key(p, item, "inertia"), "inertia %g is too small to compute with", r->inertia);
   return 0;
@@ -97,12 +98,23 @@ static void rigid_describe(const void* self, FILE* f) {
 
 static const fmbParam rigid_params[] = {
     {.key = "mass", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg", .doc = "mass"},
-    {.key = "inertia", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg m^2",
+    {.key = "inertia",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_REQUIRED | FMB_POSITIVE,
+     .unit = "kg m^2",
      .doc = "moment of inertia about the centre of mass"},
     {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial centre of mass"},
     {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial orientation"},
-    {.key = "velocity", .kind = FMB_PARAM_VEC2, .unit = "m/s", .fallback = "[0, 0]", .doc = "initial velocity of the centre of mass"},
-    {.key = "angular_velocity", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .fallback = "0", .doc = "initial angular velocity"},
+    {.key = "velocity",
+     .kind = FMB_PARAM_VEC2,
+     .unit = "m/s",
+     .fallback = "[0, 0]",
+     .doc = "initial velocity of the centre of mass"},
+    {.key = "angular_velocity",
+     .kind = FMB_PARAM_NUMBER,
+     .unit = "rad/s",
+     .fallback = "0",
+     .doc = "initial angular velocity"},
     {.key = NULL},
 };
 

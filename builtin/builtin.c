@@ -19,14 +19,8 @@ static const fmbBodyType* const builtin_bodies[] = {
 };
 
 static const fmbJointType* const builtin_joints[] = {
-    &fmb_joint_revolute,
-    &fmb_joint_fixed,
-    &fmb_joint_drive,
-    &fmb_joint_spring,
-    &fmb_joint_force,
-    &fmb_joint_prismatic,
-    &fmb_joint_torsion,
-    NULL,
+    &fmb_joint_revolute, &fmb_joint_fixed,     &fmb_joint_drive,   &fmb_joint_spring,
+    &fmb_joint_force,    &fmb_joint_prismatic, &fmb_joint_torsion, NULL,
 };
 
 static const fmbPlugin builtin_plugin = {

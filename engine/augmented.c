@@ -15,10 +15,10 @@
  * refactorizes with the last pivot order (it allocates only when that order has to be renewed),
  * so it costs what the mechanism's sparsity costs (a chain of linkages grows
  * linearly, where the dense matrix of earlier versions grew with the cube). */
+#include <klu.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <klu.h>
 
 #include "internal.h"
 #include "klu_policy.h"
@@ -35,7 +35,7 @@ struct fmbAugmented {
   int *eoff, *entry;
   long *pos_phi, *pos_phit, *pos_diag;
   double *phi, *phit, *phitt, *phiq_v, *rhs, *Mb;
-  fmbKlu* klu; /* klu.c: the one KLU policy */
+  fmbKlu* klu;        /* klu.c: the one KLU policy */
   double mdiag, pmax; /* scales of the last assembly (for the Tikhonov shift) */
   int failed_body;
 };
@@ -47,8 +47,10 @@ static long find_entry(const fmbAugmented* g, long row, long col) {
   while (lo <= hi) {
     const SuiteSparse_long mid = (lo + hi) / 2;
     if (g->Ai[mid] == row) return mid;
-    if (g->Ai[mid] < row) lo = mid + 1;
-    else hi = mid - 1;
+    if (g->Ai[mid] < row)
+      lo = mid + 1;
+    else
+      hi = mid - 1;
   }
   return -1;
 }
@@ -149,7 +151,8 @@ fmbAugmented* fmb_augmented_new(const fmbModel* m) {
     }
     free(fill);
   }
-  for (int c = 0; c < n; ++c) qsort(g->Ai + g->Ap[c], (size_t)(g->Ap[c + 1] - g->Ap[c]), sizeof(SuiteSparse_long), cmp_long);
+  for (int c = 0; c < n; ++c)
+    qsort(g->Ai + g->Ap[c], (size_t)(g->Ap[c + 1] - g->Ap[c]), sizeof(SuiteSparse_long), cmp_long);
   for (int rr = 0; rr < nc; ++rr) {
     for (int k = g->rowptr[rr]; k < g->rowptr[rr + 1]; ++k) {
       g->pos_phi[k] = find_entry(g, nq + rr, g->col[k]);

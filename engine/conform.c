@@ -29,8 +29,8 @@
 #include "internal.h"
 
 #define CONFORM_T_END 1.0
-#define ENERGY_TOL 1e-5    /* relative to the largest energy component along the run (rtol 1e-10) */
-#define FD_TOL 1e-5        /* analytic vs central differences, relative to the block's largest entry */
+#define ENERGY_TOL 1e-5 /* relative to the largest energy component along the run (rtol 1e-10) */
+#define FD_TOL 1e-5     /* analytic vs central differences, relative to the block's largest entry */
 #define MAX_LINES 64
 
 typedef struct {
@@ -95,8 +95,8 @@ static int lines_set(Lines* l, const char* key, const char* value) {
 }
 
 typedef struct {
-  int joint;          /* probing a joint type */
-  double gravity;     /* -9.81 or 0 */
+  int joint;           /* probing a joint type */
+  double gravity;      /* -9.81 or 0 */
   const char* outputs; /* the outputs list, or NULL */
   /* the fixture's body and joint types (FMB_TYPE_CONFORM_FIXTURE): the engine names no type */
   const char *fixture_body, *fixture_joint;
@@ -132,7 +132,8 @@ static int scene_write(const char* path, const char* type, const Lines* l, const
   EMIT("bodies:\n");
   EMIT("  - {name: a, type: %s, mass: 1, inertia: 0.1, position: [0.5, 0], velocity: [0, 0.5], angular_velocity: 1}\n",
        s->fixture_body);
-  EMIT("  - {name: b, type: %s, mass: 1.5, inertia: 0.2, position: [1.5, 0], velocity: [0.3, -0.2], angular_velocity: -1}\n",
+  EMIT("  - {name: b, type: %s, mass: 1.5, inertia: 0.2, position: [1.5, 0], velocity: [0.3, -0.2], angular_velocity: "
+       "-1}\n",
        s->fixture_body);
   if (!s->joint) EMIT("  - name: probe\n    type: %s\n", type), line++;
   const int first_body_line = line;
@@ -179,14 +180,16 @@ static void bad_case(Report* r, const char* path, const char* type, const Lines*
   int first = 0;
   fmbModel* m = scene_load(path, type, &l, s, reg, &d, &first);
   char what[192];
-  snprintf(what, sizeof what, value ? "refuses %s: %s" : "refuses a scene without required %s%s", key, value ? value : "");
+  snprintf(what, sizeof what, value ? "refuses %s: %s" : "refuses a scene without required %s%s", key,
+           value ? value : "");
   if (m) {
     fmb_free(m);
     result(r, 0, "params", "%s: accepted, expected exit 2 at the key's line", what);
     return;
   }
   const int want_line = value ? first + idx : 0;
-  const int ok = d.code == FMB_EXIT_BAD_INPUT && d.line > 0 && (!want_line || d.line == want_line) && mentions(d.msg, key);
+  const int ok =
+      d.code == FMB_EXIT_BAD_INPUT && d.line > 0 && (!want_line || d.line == want_line) && mentions(d.msg, key);
   if (ok)
     result(r, 1, "params", "%s (line %d)", what, d.line);
   else
@@ -304,7 +307,8 @@ static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b,
   const double* Muse = Md;
   if (t->jacobian) {
     rc = t->jacobian(bi->self, &m->env, q, v, a, K, C, M, work);
-    const double eK = rel_err(K, Kd, n * n, 1e-12), eC = rel_err(C, Cd, n * n, 1e-12), eM = rel_err(M, Md, n * n, 1e-12);
+    const double eK = rel_err(K, Kd, n * n, 1e-12), eC = rel_err(C, Cd, n * n, 1e-12),
+                 eM = rel_err(M, Md, n * n, 1e-12);
     result(r, !rc && eK < FD_TOL && eC < FD_TOL && eM < FD_TOL, "jacobian",
            "analytic vs central differences: K %.2g, C %.2g, M %.2g (tolerance %g)", eK, eC, eM, FD_TOL);
     Muse = M;
@@ -379,7 +383,8 @@ static void check_pattern_jacobian(Report* r, const fmbModel* m, fmbWorkspace* w
   const int n = bi->nq, nz = t->naux ? t->naux(bi->self) : 0, N = n + nz;
   double* work = fmb_workspace_plugin(w) + bi->workadr;
   const size_t NN = (size_t)N * N, Nn = (size_t)N * n;
-  double* buf = calloc(3 * (size_t)n + (size_t)nz + 3 * (size_t)N + 2 * (NN + 2 * Nn) + 3 * (size_t)np + 8, sizeof(double));
+  double* buf =
+      calloc(3 * (size_t)n + (size_t)nz + 3 * (size_t)N + 2 * (NN + 2 * Nn) + 3 * (size_t)np + 8, sizeof(double));
   int* pr = calloc(2 * (size_t)np + 2, sizeof(int));
   if (!buf || !pr) {
     result(r, 0, "pattern", "out of memory");
@@ -416,7 +421,9 @@ static void check_pattern_jacobian(Report* r, const fmbModel* m, fmbWorkspace* w
     }
   }
   /* [R; Rz] at (q, v, a, z) */
-#define EVAL(F) (nz ? t->residual_aux(bi->self, &m->env, q, v, a, z, F, F + n, work) : t->residual(bi->self, &m->env, q, v, a, F, work))
+#define EVAL(F)                                                        \
+  (nz ? t->residual_aux(bi->self, &m->env, q, v, a, z, F, F + n, work) \
+      : t->residual(bi->self, &m->env, q, v, a, F, work))
   double* xs[4] = {q, v, a, z};
   for (int k = 0; k < 4; ++k) {
     const int len = k == 3 ? nz : n;
@@ -427,7 +434,10 @@ static void check_pattern_jacobian(Report* r, const fmbModel* m, fmbWorkspace* w
       xs[k][j] = x0 - h;
       rc |= EVAL(Fm);
       xs[k][j] = x0;
-      double* col = k == 0 ? Kd + (size_t)j * N : k == 1 ? Cd + (size_t)j * N : k == 2 ? Md + (size_t)j * N : Kd + (size_t)(n + j) * N;
+      double* col = k == 0   ? Kd + (size_t)j * N
+                    : k == 1 ? Cd + (size_t)j * N
+                    : k == 2 ? Md + (size_t)j * N
+                             : Kd + (size_t)(n + j) * N;
       for (int i = 0; i < N; ++i) col[i] = (F1[i] - Fm[i]) / (2 * h);
     }
   }
@@ -438,7 +448,8 @@ static void check_pattern_jacobian(Report* r, const fmbModel* m, fmbWorkspace* w
     free(pr);
     return;
   }
-  const double eK = rel_err(Ka, Kd, (int)NN, 1e-12), eC = rel_err(Ca, Cd, (int)Nn, 1e-12), eM = rel_err(Ma, Md, (int)Nn, 1e-12);
+  const double eK = rel_err(Ka, Kd, (int)NN, 1e-12), eC = rel_err(Ca, Cd, (int)Nn, 1e-12),
+               eM = rel_err(Ma, Md, (int)Nn, 1e-12);
   /* differences outside the pattern: mark the declared entries, then look at the rest */
   double scale = 1e-300, outside = 0.0;
   for (size_t i = 0; i < NN; ++i) scale = fmax(scale, fabs(Kd[i]));
@@ -453,9 +464,10 @@ static void check_pattern_jacobian(Report* r, const fmbModel* m, fmbWorkspace* w
     }
   result(r, eK < FD_TOL && eC < FD_TOL && eM < FD_TOL, "pattern",
          "pattern_jacobian vs central differences over %d rows and columns (%ld pairs): K %.2g, C %.2g, M %.2g "
-         "(tolerance %g)", N, np, eK, eC, eM, FD_TOL);
-  result(r, outside < FD_TOL * scale, "pattern", "largest difference outside the declared pattern: %.2g of the largest entry",
-         outside / scale);
+         "(tolerance %g)",
+         N, np, eK, eC, eM, FD_TOL);
+  result(r, outside < FD_TOL * scale, "pattern",
+         "largest difference outside the declared pattern: %.2g of the largest entry", outside / scale);
   free(buf);
   free(pr);
 }
@@ -618,8 +630,8 @@ static void check_energy(Report* r, const char* base, const char* type, const Li
     return;
   }
   const double free_drift = drift;
-  result(r, drift < ENERGY_TOL, "energy", "a free run keeps the total energy: drift %.2g of the energy scale (tolerance %g)",
-           drift, ENERGY_TOL);
+  result(r, drift < ENERGY_TOL, "energy",
+         "a free run keeps the total energy: drift %.2g of the energy scale (tolerance %g)", drift, ENERGY_TOL);
   if (!damped) {
     result(r, SKIP, "energy", "no example_damped: dissipation not checked");
     return;
@@ -638,9 +650,10 @@ static void check_energy(Report* r, const char* base, const char* type, const Li
   snprintf(csv, sizeof csv, "%s-damped.csv", base);
   if (scene_write(scene, type, &l, &s) < 0 || energy_run(r, scene, csv, reg, &drift, &rise, &lost, 0)) return;
   /* dissipation must stand well above the integration error of the free run, and never reverse */
-  result(r, lost > 100 * fmax(free_drift, 1e-10) && rise < ENERGY_TOL, "energy",
-         "a damped run loses energy: %.2g of the energy scale lost (100 x the free run's drift: %.2g), largest rise %.2g",
-         lost, 100 * fmax(free_drift, 1e-10), rise);
+  result(
+      r, lost > 100 * fmax(free_drift, 1e-10) && rise < ENERGY_TOL, "energy",
+      "a damped run loses energy: %.2g of the energy scale lost (100 x the free run's drift: %.2g), largest rise %.2g",
+      lost, 100 * fmax(free_drift, 1e-10), rise);
 }
 
 /* ---- the driver ------------------------------------------------------------------------------ */
@@ -690,8 +703,10 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   snprintf(scene, sizeof scene, "%s.yaml", base);
   SceneSpec s = {joint, -9.81, NULL, fixture_type(reg, 0), fixture_type(reg, 1)};
   if (!s.fixture_body || !s.fixture_joint) {
-    result(&r, 0, "example", "no %s type in the registry declares FMB_TYPE_CONFORM_FIXTURE: the conformance scene has "
-           "no fixture (register the built-in types too)", !s.fixture_body ? "body" : "joint");
+    result(&r, 0, "example",
+           "no %s type in the registry declares FMB_TYPE_CONFORM_FIXTURE: the conformance scene has "
+           "no fixture (register the built-in types too)",
+           !s.fixture_body ? "body" : "joint");
     return r.failed;
   }
   /* the declared parameters are the registered table's: a variant's own keys are checked by
@@ -719,7 +734,8 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   const void* self = joint ? m->joint[m->njoint - 1].self : m->body[m->nbody - 1].self;
   int (*lookup)(const void*, const char*) = joint ? jt->output_lookup : bt->output_lookup;
   for (const char* const* names = own; own && *own; ++own)
-    if (fmb_type_output_id(lookup, self, names, *own) >= 0) snprintf(outputs + strlen(outputs), sizeof outputs - strlen(outputs), ", probe.%s", *own);
+    if (fmb_type_output_id(lookup, self, names, *own) >= 0)
+      snprintf(outputs + strlen(outputs), sizeof outputs - strlen(outputs), ", probe.%s", *own);
   const int has_coordinates = !joint && m->body[m->nbody - 1].nq > 0;
   if (ic == 0) {
     if (joint)
@@ -730,13 +746,14 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
     } else
       result(&r, 1, "dynamics", "no coordinates: nothing to differentiate");
   }
-  if (!joint && m->body[m->nbody - 1].nq >= 3) strncat(outputs, ", probe.x, probe.omega", sizeof outputs - strlen(outputs) - 1);
+  if (!joint && m->body[m->nbody - 1].nq >= 3)
+    strncat(outputs, ", probe.x, probe.omega", sizeof outputs - strlen(outputs) - 1);
   free(y), free(yp);
   fmb_workspace_free(w);
   fmb_free(m);
   if (ic == 0)
-    check_energy(&r, base, type_name, &ex, joint ? jt->example_damped : bt->example_damped, joint ? jt->flags : bt->flags,
-                 joint || bt->energy || !has_coordinates, outputs, joint, reg);
+    check_energy(&r, base, type_name, &ex, joint ? jt->example_damped : bt->example_damped,
+                 joint ? jt->flags : bt->flags, joint || bt->energy || !has_coordinates, outputs, joint, reg);
   fprintf(report, "%s %s: %d failed checks\n", r.failed ? "FAIL" : "ok  ", type_name, r.failed);
   return r.failed;
 }

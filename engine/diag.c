@@ -56,7 +56,8 @@ static void diag_at(fmbParser* p, fmbNode node, fmbDiag* d, const char* msg) {
   if (ov >= 0)
     fmb_diag_set(d, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", fmbp_shown_override(p->overrides[ov], shown), msg);
   else if (nd)
-    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s", msg);
+    fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, (int)nd->start_mark.line + 1, (int)nd->start_mark.column + 1, "%s",
+                 msg);
   else
     fmb_diag_set(d, FMB_EXIT_BAD_INPUT, p->path, 0, 0, "%s", msg);
 }

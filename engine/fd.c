@@ -209,8 +209,7 @@ size_t fmb_body_sparse_scratch(const fmbBodyInst* b) {
 int fmb_body_sparse_blocks(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                            const double* z, const double* ewt_q, const double* ewt_v, double* K, double* C, double* M,
                            double* work, double* scratch) {
-  if (!b->type->pattern_jacobian)
-    return fd_body_sparse(b, env, q, v, a, z, ewt_q, ewt_v, K, C, M, work, scratch);
+  if (!b->type->pattern_jacobian) return fd_body_sparse(b, env, q, v, a, z, ewt_q, ewt_v, K, C, M, work, scratch);
   double *Kp = scratch, *Cp = Kp + b->npair, *Mp = Cp + b->npair;
   const int rc = b->type->pattern_jacobian(b->self, env, q, v, a, z, Kp, Cp, Mp, work);
   if (rc) return rc;

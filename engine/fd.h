@@ -8,9 +8,9 @@
 
 double fmb_fd_increment(double y, double ewt);
 /* dense column-major derivative of a body's residual: K = dR/dq, C = dR/dv, M = dR/da */
-int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v,
-                         const double* a, const double* ewt_q, const double* ewt_v, double* K, double* C,
-                         double* M, double* work, double* scratch);
+int fmb_fd_body_jacobian(const fmbBodyInst* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                         const double* ewt_q, const double* ewt_v, double* K, double* C, double* M, double* work,
+                         double* scratch);
 /* a sparse body's K, C, M in pattern order (pnnz each), from the body's analytic
    pattern_jacobian when it has one, else by differences over its pattern, one residual pair per
    colour; scratch doubles: fmb_body_sparse_scratch */

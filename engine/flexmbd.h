@@ -53,8 +53,8 @@ extern "C" {
 #define FMB_EXIT_INTERRUPTED 4 /* SIGINT/SIGTERM: stopped at the next step, rows so far kept */
 
 typedef struct fmbDiag {
-  int code;        /* 0 none, FMB_EXIT_BAD_INPUT, FMB_EXIT_SOLVER or FMB_EXIT_INTERRUPTED */
-  char file[512];  /* scene path, or "--set" for an override */
+  int code;       /* 0 none, FMB_EXIT_BAD_INPUT, FMB_EXIT_SOLVER or FMB_EXIT_INTERRUPTED */
+  char file[512]; /* scene path, or "--set" for an override */
   int line, col;
   char msg[1024];
 } fmbDiag;
@@ -89,7 +89,7 @@ FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned f
 FMB_API int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, double** x, double** y, int* n);
 /* one of a NULL-terminated list of words; *out is the index */
 FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
-                   int* out);
+                           int* out);
 /* a point of body `body` in the body's reference frame, [x, y] (default: *out as given); a point
    the body cannot place (its `marker` fails in the pose the scene gives, e.g. beyond a beam's
    length) is refused here, at the point, instead of failing the run later with a false cause */
@@ -118,8 +118,8 @@ FMB_API fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key);
  * Evaluation environment shared by all plugins.
  * ------------------------------------------------------------------------------------------- */
 typedef struct fmbEnv {
-  double gravity[2];  /* m/s^2, global frame */
-  int has_gravity;    /* 0 when the scene has g = 0: plugins skip gravity terms entirely */
+  double gravity[2]; /* m/s^2, global frame */
+  int has_gravity;   /* 0 when the scene has g = 0: plugins skip gravity terms entirely */
 } fmbEnv;
 
 typedef struct fmbEnergy {
@@ -145,12 +145,12 @@ typedef enum {
 typedef struct fmbParam {
   const char* key;
   fmbParamKind kind;
-  unsigned flags;               /* FMB_REQUIRED, FMB_POSITIVE, FMB_NONNEGATIVE as the parse passes them */
-  const char* unit;             /* SI unit, "1" for a pure number or count, NULL for words and names */
-  const char* fallback;         /* the default as a scene would write it; NULL when required or none */
-  long lo, hi;                  /* FMB_PARAM_INT: the accepted range */
-  const char* const* choices;   /* FMB_PARAM_CHOICE: NULL-terminated */
-  const char* doc;              /* one line */
+  unsigned flags;             /* FMB_REQUIRED, FMB_POSITIVE, FMB_NONNEGATIVE as the parse passes them */
+  const char* unit;           /* SI unit, "1" for a pure number or count, NULL for words and names */
+  const char* fallback;       /* the default as a scene would write it; NULL when required or none */
+  long lo, hi;                /* FMB_PARAM_INT: the accepted range */
+  const char* const* choices; /* FMB_PARAM_CHOICE: NULL-terminated */
+  const char* doc;            /* one line */
 } fmbParam;
 
 /* type flags (fmbBodyType.flags, fmbJointType.flags) */
@@ -178,28 +178,30 @@ typedef struct fmbBodyType {
   void (*destroy)(void* self);
   int (*ncoord)(const void* self);
   void (*initial)(const void* self, double* q0, double* v0);
-  int (*residual)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                  double* R, double* work);
+  int (*residual)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a, double* R,
+                  double* work);
   /* position and angle of a material point given in the body's reference configuration
      (`local`, body frame), with their derivatives wrt q (dpos_dq: 2 x ncoord row-major, may be
      NULL; dangle_dq: ncoord, may be NULL). Joints and force elements see bodies only this way. */
-  int (*marker)(const void* self, const double* q, const double local[2], double pos[2], double* angle,
-                double* dpos_dq, double* dangle_dq, double* work);
+  int (*marker)(const void* self, const double* q, const double local[2], double pos[2], double* angle, double* dpos_dq,
+                double* dangle_dq, double* work);
   /* optional */
   size_t (*nwork)(const void* self); /* scratch doubles the engine allocates once; NULL = 0 */
   /* dense ncoord x ncoord column-major blocks K = dR/dq, C = dR/dv, M = dR/da; NULL = the engine
      differentiates `residual` numerically (engine/fd.c) */
-  int (*jacobian)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                  double* K, double* C, double* M, double* work);
-  void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e,
-                 double* work);
+  int (*jacobian)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a, double* K,
+                  double* C, double* M, double* work);
+  void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e, double* work);
   /* named outputs beyond the frame's x, y, theta, omega, vx, vy (which the engine provides for
      every body with a frame: ncoord >= 3, or a marker that places the origin [0, 0]): lookup returns an id >= 0 or -1 (NULL: the id is the name's
      index in output_names); output evaluates one id. */
   const char* const* output_names; /* NULL-terminated, for listings */
   int (*output_lookup)(const void* self, const char* quantity);
   int (*output)(const void* self, int id, const double* q, const double* v, double* value, double* work);
-  void (*describe)(const void* self, FILE* f); /* rest of one line after "body 'NAME' (TYPE, N coordinates): ": active terms, variant; ends with a newline */
+  void (*describe)(
+      const void* self,
+      FILE*
+          f); /* rest of one line after "body 'NAME' (TYPE, N coordinates): ": active terms, variant; ends with a newline */
   /* a body whose model can lose mass definiteness (FOAC) returns a hint saying why and what to
      do; the engine then checks the mass matrix reduced to the constraint manifold at every
      output time and stops the run with that hint when it is no longer positive definite.
@@ -254,8 +256,8 @@ typedef struct fmbBodyType {
   int (*naux)(const void* self);
   int (*residual_aux)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
                       const double* z, double* R, double* Rz, double* work);
-  int (*aux_initial)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                     double* z, double* work);
+  int (*aux_initial)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a, double* z,
+                     double* work);
   /* The nonzeros of d[R; Rz]/d[x; z], x = q, v or a (their union), as (row, column) pairs over
      the ncoord + naux rows and columns (duplicates allowed): with rows/cols NULL it returns the
      count, else fills them. -1 (or a NULL op) = one dense block. The engine then differentiates
@@ -303,12 +305,12 @@ typedef struct fmbJointType {
   void (*destroy)(void* self);
   void (*bodies)(const void* self, int body[2]); /* body indices; body[1] may equal -1 */
   /* optional */
-  int (*nrows)(const void* self);                /* NULL = 0 (a pure force element) */
+  int (*nrows)(const void* self); /* NULL = 0 (a pure force element) */
   int (*attachment)(const void* self, int k, int* body, double local[2]);
   int (*constraint)(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                     double* phi_tt);
   int (*force)(const void* self, const fmbJointEval* ev, double* Q); /* adds to Q */
-  double (*energy)(const void* self, const fmbJointEval* ev);       /* spring potential */
+  double (*energy)(const void* self, const fmbJointEval* ev);        /* spring potential */
   const char* const* output_names; /* as for bodies: NULL output_lookup = the index in this list */
   int (*output_lookup)(const void* self, const char* quantity);
   int (*output)(const void* self, int id, const fmbJointEval* ev, double* value);
@@ -331,14 +333,14 @@ typedef struct fmbJointType {
 /* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
    0, NULL or -1: a plugin bug, reported instead of crashing) */
 FMB_API double fmb_eval_time(const fmbJointEval* ev);
-FMB_API int fmb_eval_ncoord(const fmbJointEval* ev, int k);      /* coordinates of body k (0 for ground) */
+FMB_API int fmb_eval_ncoord(const fmbJointEval* ev, int k); /* coordinates of body k (0 for ground) */
 FMB_API const double* fmb_eval_q(const fmbJointEval* ev, int k);
 FMB_API const double* fmb_eval_v(const fmbJointEval* ev, int k);
 /* position and angle of body k's material point `local`; derivatives wrt body k's coordinates
    go to dpos_dq (row 0 at dpos_dq[0..nk), row 1 at dpos_dq[ld..ld+nk)) and dangle_dq[0..nk);
    either may be NULL. Use ld = the joint's column count to write straight into phi_q rows. */
 FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle,
-               double* dpos_dq, int ld, double* dangle_dq);
+                       double* dpos_dq, int ld, double* dangle_dq);
 /* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
 FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
 /* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
@@ -374,8 +376,8 @@ FMB_API void fmb_frame_point(const double frame[3], const double local[2], doubl
  * The engine names no type; the program hands fmb_load a registry.
  * ------------------------------------------------------------------------------------------- */
 typedef struct fmbPlugin {
-  int abi;                          /* FMB_ABI_VERSION: first, never moves */
-  const char* name;                 /* for messages and `flexmbd types` */
+  int abi;          /* FMB_ABI_VERSION: first, never moves */
+  const char* name; /* for messages and `flexmbd types` */
   const char* version;
   const fmbBodyType* const* bodies; /* NULL-terminated; NULL = none */
   const fmbJointType* const* joints;
@@ -383,9 +385,9 @@ typedef struct fmbPlugin {
 #define FMB_PLUGIN_ENTRY "fmb_plugin_descriptor"
 typedef const fmbPlugin* (*fmbPluginEntry)(void);
 
-typedef struct fmbRegistry fmbRegistry; /* growable, any number of types */
-FMB_API fmbRegistry* fmb_registry_new(void);       /* empty; NULL when out of memory */
-FMB_API void fmb_registry_free(fmbRegistry* reg);  /* types and loaded code stay valid */
+typedef struct fmbRegistry fmbRegistry;           /* growable, any number of types */
+FMB_API fmbRegistry* fmb_registry_new(void);      /* empty; NULL when out of memory */
+FMB_API void fmb_registry_free(fmbRegistry* reg); /* types and loaded code stay valid */
 /* register every type of `plugin` (origin: "built-in" or the file, for messages). Refuses, with
    *diag filled (exit code 2), another ABI, a type without a name or a required op, and a name
    already registered by another table; the same table twice is a no-op. */
@@ -458,7 +460,7 @@ typedef struct fmbRunOptions {
    "bodies.beam.elements=32"). Returns NULL with *diag filled (diag may be NULL) on error,
    including a NULL path or registry, or NULL overrides with noverrides > 0. */
 FMB_API fmbModel* fmb_load(const char* path, const char* const* overrides, int noverrides, const fmbRegistry* reg,
-                   fmbDiag* diag);
+                           fmbDiag* diag);
 /* Integrate from the scene's t0 to t_end, writing CSV rows as it goes. Returns 0 or an exit code
    (FMB_EXIT_SOLVER, FMB_EXIT_INTERRUPTED; FMB_EXIT_BAD_INPUT for a NULL model or an output that
    cannot be written) with *diag saying when and why it stopped. */
@@ -483,7 +485,13 @@ FMB_API int fmb_model_joint(const fmbModel* m, int i, const char** name, const c
    outline through the points its joints attach to (closed from three points) and its frame's x and
    y axes; a joint with constraint rows is a vertex at its first point; a force element with two
    points (a spring) is the line between them. */
-enum { FMB_DRAW_CENTRELINE = 0, FMB_DRAW_OUTLINE = 1, FMB_DRAW_FRAME_AXIS = 2, FMB_DRAW_JOINT = 3, FMB_DRAW_FORCE_ELEMENT = 4 };
+enum {
+  FMB_DRAW_CENTRELINE = 0,
+  FMB_DRAW_OUTLINE = 1,
+  FMB_DRAW_FRAME_AXIS = 2,
+  FMB_DRAW_JOINT = 3,
+  FMB_DRAW_FORCE_ELEMENT = 4
+};
 typedef struct fmbDrawPoint {
   int body;        /* 0 = the world frame (local is then global); k >= 1 = fmb_model_body(m, k - 1) */
   double local[2]; /* the material point in the body frame, as joints and `marker` take it */
@@ -633,8 +641,8 @@ typedef struct fmbStaticResult {
   /* the steady state is a rigid rotation of the whole system at `speed` (rad/s) about `center`
      (0 = static equilibrium), read from the drives' speeds at t */
   double speed, center[2];
-  double residual;        /* 2-norm of the equations at the solution (forces and Phi) */
-  double residual_start;  /* the same at the starting point (the out-of-balance load) */
+  double residual;       /* 2-norm of the equations at the solution (forces and Phi) */
+  double residual_start; /* the same at the starting point (the out-of-balance load) */
   int iterations, load_steps;
 } fmbStaticResult;
 
@@ -645,19 +653,19 @@ typedef struct fmbStaticResult {
    FMB_EXIT_BAD_INPUT (the scene has no steady state: gravity on a rotating system, drives that
    are not one rigid rotation) or FMB_EXIT_SOLVER (no convergence), with *diag saying why. */
 FMB_API int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
-               fmbDiag* diag);
+                       fmbDiag* diag);
 
 typedef struct fmbModes {
-  int count;              /* modes held, sorted by |frequency| */
-  int nq;                 /* length of a shape */
-  int nreduced;           /* degrees of freedom after the constraints were eliminated */
-  int sparse;             /* 1 when the sparse (Arnoldi) path computed them */
-  double speed;           /* the rigid rotation the state has (rad/s) */
-  double* frequency;      /* rad/s, |s| of the eigenvalue s; negative -|s| for a divergent mode
+  int count;             /* modes held, sorted by |frequency| */
+  int nq;                /* length of a shape */
+  int nreduced;          /* degrees of freedom after the constraints were eliminated */
+  int sparse;            /* 1 when the sparse (Arnoldi) path computed them */
+  double speed;          /* the rigid rotation the state has (rad/s) */
+  double* frequency;     /* rad/s, |s| of the eigenvalue s; negative -|s| for a divergent mode
                              (real s > 0, e.g. ZOAC spun above its first bending frequency) */
-  double* damping_ratio;  /* -Re(s)/|s|; -1 for a divergent mode */
-  double* shape_re;       /* count x nq, mode k at k * nq: the generalized coordinates' motion, */
-  double* shape_im;       /* scaled so the largest component is 1 (real) */
+  double* damping_ratio; /* -Re(s)/|s|; -1 for a divergent mode */
+  double* shape_re;      /* count x nq, mode k at k * nq: the generalized coordinates' motion, */
+  double* shape_im;      /* scaled so the largest component is 1 (real) */
 } fmbModes;
 
 /* eigen-solvers: dense LAPACK on the constraint-reduced problem (all modes), or shift-invert
@@ -670,18 +678,18 @@ enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
    holding at most `count` modes (count <= 0: all, dense), or an exit code with *diag
    (FMB_EXIT_BAD_INPUT for a `method` other than FMB_EIGEN_* or a time that is not finite). */
 FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
-              fmbModes** out, fmbDiag* diag);
+                      fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
 /* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
    NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);
 /* the scene's outputs at state (y, yp), one CSV row (header first) */
 FMB_API int fmb_write_state_row(const fmbModel* m, const char* path, double t, const double* y, const double* yp,
-                        fmbDiag* diag);
+                                fmbDiag* diag);
 /* each mode's effect on the scene's outputs: d(output)/d(amplitude) along the real shape, one row
    per mode, columns `mode` then the outputs (put beam.nodeK_v in `outputs` for nodal shapes) */
 FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const double* yp, const fmbModes* modes,
-                          const char* path, fmbDiag* diag);
+                                  const char* path, fmbDiag* diag);
 /* mode k (0-based) as a ParaView animation in dir (created; DIR/SCENE.pvd and one .vtu per frame,
    the run's VTK writer): `frames` states over one period, the largest coordinate moving by
    `amplitude` (its units: m or rad; positive and finite, else FMB_EXIT_BAD_INPUT) */
@@ -691,7 +699,7 @@ FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* 
    (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). With the names "t" and
    fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
-                    fmbDiag* diag);
+                            fmbDiag* diag);
 
 /* A scene as fmb_load takes it, for the analyses that load it again with an override of their own
    (one per hub speed, one per beam model): path, the caller's overrides and the registry, read
@@ -760,10 +768,10 @@ FMB_API void fmb_campbell_free(fmbCampbell* c);
  * ------------------------------------------------------------------------------------------- */
 #define FMB_MODELS_MAX 8
 typedef struct fmbModelsResult {
-  int ran;                        /* models run, in order (their entries below are filled) */
-  int code[FMB_MODELS_MAX];       /* fmb_run's result for each */
+  int ran;                  /* models run, in order (their entries below are filled) */
+  int code[FMB_MODELS_MAX]; /* fmb_run's result for each */
   fmbStats stats[FMB_MODELS_MAX];
-  fmbDiag diag[FMB_MODELS_MAX];   /* why a model's run stopped (code 0: it did not) */
+  fmbDiag diag[FMB_MODELS_MAX]; /* why a model's run stopped (code 0: it did not) */
 } fmbModelsResult;
 /* opt->csv_path (required, a file: not "-") receives the merged table; each run takes quiet and
    stop from opt. Every model is loaded before any runs (a misspelt model is bad input, not a late

@@ -32,9 +32,9 @@ int fmb_format_g12(double v, char* out) {
   return fallback(v, out);
 #else
   /* integers, so each literal is exact in a 64-bit mantissa */
-  static const long double pow10[G12_MAX_POW + 1] = {1e0L,  1e1L,  1e2L,  1e3L,  1e4L,  1e5L,  1e6L,  1e7L,  1e8L,  1e9L,
-                                                     1e10L, 1e11L, 1e12L, 1e13L, 1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L,
-                                                     1e20L, 1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L, 1e27L};
+  static const long double pow10[G12_MAX_POW + 1] = {
+      1e0L,  1e1L,  1e2L,  1e3L,  1e4L,  1e5L,  1e6L,  1e7L,  1e8L,  1e9L,  1e10L, 1e11L, 1e12L, 1e13L,
+      1e14L, 1e15L, 1e16L, 1e17L, 1e18L, 1e19L, 1e20L, 1e21L, 1e22L, 1e23L, 1e24L, 1e25L, 1e26L, 1e27L};
   if (!isfinite(v) || v == 0.0) {
     if (v != 0.0) return fallback(v, out);
     strcpy(out, signbit(v) ? "-0" : "0");

@@ -13,17 +13,17 @@
  *    so IDA starts from F(t0, y0, y0') = 0. mu = 0. The sizes of the corrections are reported.
  * Setup-time code: it may allocate. */
 #include <float.h>
+#include <klu.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <klu.h>
 
 #include "fd.h"
 #include "internal.h"
 #include "klu_policy.h"
 
-#define FMB_IC_PHI_TOL 1e-10   /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
-#define FMB_ASSEMBLY_TOL 1e-6  /* m or rad: a larger initial correction changes the mechanism */
+#define FMB_IC_PHI_TOL 1e-10  /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
+#define FMB_ASSEMBLY_TOL 1e-6 /* m or rad: a larger initial correction changes the mechanism */
 
 static double max_abs(const double* x, int n) {
   double s = 0.0;
@@ -54,7 +54,8 @@ static int gram_factor(int nc, int nq, const double* PhiQ, const unsigned char* 
 
 /* x -= Phi_q^T G^-1 r: the minimum-norm correction that removes the constraint residual r (nc,
    overwritten) to first order, with G = Phi_q Phi_q^T as gram_factor left it */
-static void subtract_min_norm(int nc, int nq, const double* PhiQ, const double* G, const int* piv, double* r, double* x) {
+static void subtract_min_norm(int nc, int nq, const double* PhiQ, const double* G, const int* piv, double* r,
+                              double* x) {
   fmb_lu_solve(nc, G, piv, r);
   for (int c = 0; c < nq; ++c) {
     double s = 0.0;
@@ -104,8 +105,8 @@ static int project_positions(const fmbModel* m, fmbWorkspace* w, double t, doubl
 }
 
 static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
-                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs, unsigned char* drop,
-                            int* rank, double* res, int* it);
+                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs,
+                            unsigned char* drop, int* rank, double* res, int* it);
 
 /* A row that depends on the others at q may do so on the whole motion (redundant: two pins that
    say the same thing) or only at q (a singular configuration, e.g. a linkage started flat). Move
@@ -160,7 +161,8 @@ static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const dou
       }
       double res = 0.0;
       int iters = 0, rank2 = 0;
-      if (settle_positions(m, w, t, qs, v, PhiQ, phi, phit, phitt, G, piv, rhs, d2, &rank2, &res, &iters) && rank2 > rank)
+      if (settle_positions(m, w, t, qs, v, PhiQ, phi, phit, phitt, G, piv, rhs, d2, &rank2, &res, &iters) &&
+          rank2 > rank)
         singular = 1;
     }
   }
@@ -180,13 +182,14 @@ static int singular_here(const fmbModel* m, fmbWorkspace* w, double t, const dou
    independent at the result, until the set settles: 1 when converged (drop[] marks the dependent
    rows, *rank their complement's size), 0 when the joints cannot be satisfied. */
 static int settle_positions(const fmbModel* m, fmbWorkspace* w, double t, double* q, const double* v, double* PhiQ,
-                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs, unsigned char* drop,
-                            int* rank, double* res, int* it) {
+                            double* phi, double* phit, double* phitt, double* G, int* piv, double* rhs,
+                            unsigned char* drop, int* rank, double* res, int* it) {
   const int nq = m->nq, nc = m->nc;
   unsigned char* before = malloc((size_t)nc);
   int converged = 0;
   for (int round = 0; before && round < 3 && !converged; ++round) {
-    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt) || (*rank = mark_dependent_rows(nc, nq, PhiQ, drop)) < 0)
+    if (fmb_constraints_all(m, w, t, q, v, phi, PhiQ, phit, phitt) ||
+        (*rank = mark_dependent_rows(nc, nq, PhiQ, drop)) < 0)
       break;
     if (project_positions(m, w, t, q, v, PhiQ, phi, phit, phitt, G, piv, rhs, drop, res, it)) break;
     memcpy(before, drop, (size_t)nc);
@@ -328,7 +331,8 @@ static int analyze_start(const fmbModel* m, Start* s) {
   s->rhs = calloc((size_t)nc + 1, sizeof(double));
   s->piv = calloc((size_t)nc + 1, sizeof(int));
   if (!s->w || !s->q || !s->v || !s->PhiQ || !s->phi || !s->phit || !s->phitt || !s->G || !s->rhs || !s->piv) return -1;
-  for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, s->q + m->body[b].qadr, s->v + m->body[b].qadr);
+  for (int b = 1; b < m->nbody; ++b)
+    m->body[b].type->initial(m->body[b].self, s->q + m->body[b].qadr, s->v + m->body[b].qadr);
   s->rank = nc;
   s->settled = 1;
   if (nc == 0) return 0;
@@ -375,16 +379,21 @@ int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag) {
   } else {
     char rows[600] = "";
     fmb_name_rows(m, fmb_workspace_redundant(s.w, NULL), rows, sizeof rows);
-    fprintf(f, "degrees of freedom: %d (%d coordinates, %d constraint equations of rank %d)\n", nq - s.rank, nq, nc, s.rank);
+    fprintf(f, "degrees of freedom: %d (%d coordinates, %d constraint equations of rank %d)\n", nq - s.rank, nq, nc,
+            s.rank);
     if (s.rank == nc)
       fprintf(f, "redundant equations: none\nsingular configuration at t = %g: no\n", t0);
     else if (s.singular)
-      fprintf(f, "redundant equations: none found (see below)\nsingular configuration at t = %g: yes: %s depend%s on the "
+      fprintf(f,
+              "redundant equations: none found (see below)\nsingular configuration at t = %g: yes: %s depend%s on the "
               "others here but not nearby (the degrees of freedom above hold only at this instant); the run refuses to "
-              "start here\n", t0, rows, s.rank == nc - 1 ? "s" : "");
+              "start here\n",
+              t0, rows, s.rank == nc - 1 ? "s" : "");
     else
-      fprintf(f, "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n"
-              "singular configuration at t = %g: no\n", rows, t0);
+      fprintf(f,
+              "redundant equations: %s (left out of the equations when run; reactions by the minimum-norm rule)\n"
+              "singular configuration at t = %g: no\n",
+              rows, t0);
   }
   start_free(&s);
   return rc;
@@ -397,7 +406,8 @@ void fmb_name_rows(const fmbModel* m, const unsigned char* drop, char* buf, size
   for (int j = 0; j < m->njoint && used + 80 < len; ++j)
     for (int r = 0; r < m->joint[j].nrows; ++r)
       if (drop[m->joint[j].rowadr + r])
-        used += (size_t)snprintf(buf + used, len - used, "%sjoint '%s' row %d", used ? ", " : "", m->joint[j].name, r + 1);
+        used +=
+            (size_t)snprintf(buf + used, len - used, "%sjoint '%s' row %d", used ? ", " : "", m->joint[j].name, r + 1);
 }
 
 typedef struct {
@@ -464,7 +474,8 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
   int rc = (!x || !G || !Qj || !ewt || !blk || !Ap || !Rb || !scratch) ? FMB_EXIT_SOLVER : 0;
   const char* why = "out of memory computing initial accelerations";
   /* the joints' forces: all forces less the bodies' own (-R at a = 0) */
-  if (!rc && fmb_generalized_forces(m, w, t0, q, v, Qj)) rc = FMB_EXIT_SOLVER, why = "the generalized forces are not finite";
+  if (!rc && fmb_generalized_forces(m, w, t0, q, v, Qj))
+    rc = FMB_EXIT_SOLVER, why = "the generalized forces are not finite";
   for (int b = 1; b < m->nbody && !rc; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     if (bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, x, G, fmb_workspace_plugin(w) + bi->workadr))
@@ -510,7 +521,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
       if (bi->pnnz >= 0) {
         double *K = blk, *C = K + bi->pnnz, *M = C + bi->pnnz;
         if (fmb_body_sparse_blocks(bi, &m->env, q + bi->qadr, v + bi->qadr, a + bi->qadr, z + bi->zadr, ewt + bi->qadr,
-                               ewt + nq + bi->qadr, K, C, M, fmb_workspace_plugin(w) + bi->workadr, scratch))
+                                   ewt + nq + bi->qadr, K, C, M, fmb_workspace_plugin(w) + bi->workadr, scratch))
           rc = FMB_EXIT_SOLVER, why = "the equations of motion are not finite";
         for (int c = 0; c < nb + bi->nz && !rc; ++c)
           for (long k = bi->pcolptr[c]; k < bi->pcolptr[c + 1] && !rc; ++k) {
@@ -521,7 +532,8 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
             if (trip_add(&t, row, col, val)) rc = FMB_EXIT_SOLVER;
           }
       } else {
-        if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, blk)) rc = FMB_EXIT_SOLVER, why = "the mass matrix could not be evaluated";
+        if (fmb_body_mass(m, w, b, q + bi->qadr, v + bi->qadr, blk))
+          rc = FMB_EXIT_SOLVER, why = "the mass matrix could not be evaluated";
         for (int c = 0; c < nb && !rc; ++c)
           for (int r = 0; r < nb && !rc; ++r)
             if (trip_add(&t, bi->qadr + r, bi->qadr + c, blk[(size_t)c * nb + r])) rc = FMB_EXIT_SOLVER;
@@ -635,8 +647,8 @@ static int scratch_new(const fmbModel* m, Scratch* s) {
 /* The minimum-norm correction of v onto Phi_q v + Phi_t = 0 (the rows marked in drop left out),
    with Phi_q (row-major nc x nq) and Phi_t at the positions: 0, or 1 when the rows kept are not
    independent. G, piv, rhs: scratch of nc^2, nc, nc. */
-static int project_velocities(int nc, int nq, const double* PhiQ, const double* phit, const unsigned char* drop, double* G,
-                              int* piv, double* rhs, double* v) {
+static int project_velocities(int nc, int nq, const double* PhiQ, const double* phit, const unsigned char* drop,
+                              double* G, int* piv, double* rhs, double* v) {
   if (gram_factor(nc, nq, PhiQ, drop, G, piv)) return 1;
   for (int r = 0; r < nc; ++r) {
     double s = phit[r];
@@ -690,9 +702,10 @@ static int accelerations_at(const fmbModel* m, fmbWorkspace* w, double t, double
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the generalized forces are not finite at t = %g", t);
     rc = FMB_EXIT_SOLVER;
   } else if (arc == FMB_AUG_SINGULAR) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
-                 "with redundant joints): cannot compute initial accelerations");
+    fmb_diag_set(
+        diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+        "the initial mass matrix is singular on the free motions (a body without mass or inertia, or a mechanism "
+        "with redundant joints): cannot compute initial accelerations");
     rc = FMB_EXIT_BAD_INPUT;
   } else if (arc == FMB_AUG_NOT_FINITE) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "initial accelerations are not finite");
@@ -777,8 +790,8 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
       }
       if (m->nredundant != nc - rank) {
         fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-                     "internal: %d redundant constraint rows at t = %g (%s), %d found when the scene was loaded", nc - rank,
-                     t0, rows, m->nredundant);
+                     "internal: %d redundant constraint rows at t = %g (%s), %d found when the scene was loaded",
+                     nc - rank, t0, rows, m->nredundant);
         rc = FMB_EXIT_SOLVER;
         goto done;
       }
@@ -800,10 +813,11 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
      resolved to 5e-4 rad) */
   const double qmax = max_abs(q, nq);
   if (qmax * DBL_EPSILON > FMB_IC_PHI_TOL) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "the initial coordinates reach %.3g (m or rad)%s: at that magnitude a double resolves only %.2g, coarser "
-                 "than the joints' tolerance %g. Place the mechanism near the origin",
-                 qmax, m->assemble ? " after assembly" : "", qmax * DBL_EPSILON, FMB_IC_PHI_TOL);
+    fmb_diag_set(
+        diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+        "the initial coordinates reach %.3g (m or rad)%s: at that magnitude a double resolves only %.2g, coarser "
+        "than the joints' tolerance %g. Place the mechanism near the origin",
+        qmax, m->assemble ? " after assembly" : "", qmax * DBL_EPSILON, FMB_IC_PHI_TOL);
     rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }
@@ -839,7 +853,8 @@ int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y
     unsigned char* drop = fmb_workspace_redundant(w, NULL);
     double res = 0.0;
     int iters = 0;
-    if (project_positions(m, w, t, y, y + nq, sc.PhiQ, sc.phi, sc.phit, sc.phitt, sc.G, sc.piv, sc.rhs, drop, &res, &iters) ||
+    if (project_positions(m, w, t, y, y + nq, sc.PhiQ, sc.phi, sc.phit, sc.phitt, sc.G, sc.piv, sc.rhs, drop, &res,
+                          &iters) ||
         fmb_constraints_all(m, w, t, y, y + nq, sc.phi, sc.PhiQ, sc.phit, sc.phitt) ||
         project_velocities(nc, nq, sc.PhiQ, sc.phit, drop, sc.G, sc.piv, sc.rhs, y + nq)) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,

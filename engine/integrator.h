@@ -68,7 +68,8 @@ typedef struct fmbIntegratorOps {
      unknowns, the multipliers consistent with it: the outputs read them), also after a failure
      (the last good state). FMB_ADVANCE_FAILED fills why (what stopped, what to try), and *h the
      last step size tried. */
-  int (*advance)(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why, size_t why_len);
+  int (*advance)(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
+                 size_t why_len);
   /* the work integrals at the last t_reached (called only when m->need_work) */
   void (*work)(void* self, double* work);
   /* counters so far (steps, residuals, jacobians, newton_iters, error_test_fails, conv_fails,

@@ -23,7 +23,7 @@
 #include "integrator.h"
 
 typedef struct {
-  double t_early;   /* simulated time at which the early rate was taken (0: not yet) */
+  double t_early;    /* simulated time at which the early rate was taken (0: not yet) */
   double rate_early; /* steps per simulated second up to then */
   long steps_last;
   double t_last;
@@ -43,7 +43,7 @@ typedef struct {
   long fresh_steps, fresh_conv_fails; /* IDA's counters at the last fresh Jacobian */
   long fresh, reused;
   StepWatch watch;
-  int fell_back;       /* the reduced Newton solve failed once: KLU on the whole matrix since */
+  int fell_back;          /* the reduced Newton solve failed once: KLU on the whole matrix since */
   fmbStats before_reinit; /* IDA's counters up to the fallback's IDAReInit (which zeroes them) */
 } IdaRun;
 
@@ -148,11 +148,13 @@ static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, 
              ymax);
     return;
   }
-  if (ymax > 1e100 && (flag == IDA_CONV_FAIL || flag == IDA_LSETUP_FAIL || flag == IDA_LSOLVE_FAIL || flag == IDA_ERR_FAIL)) {
-    snprintf(buf, len,
-             "the solution reached a magnitude of %.3g: the state is blowing up or a parameter is far beyond a physical "
-             "scale (check masses, stiffnesses, forces and their units)",
-             ymax);
+  if (ymax > 1e100 &&
+      (flag == IDA_CONV_FAIL || flag == IDA_LSETUP_FAIL || flag == IDA_LSOLVE_FAIL || flag == IDA_ERR_FAIL)) {
+    snprintf(
+        buf, len,
+        "the solution reached a magnitude of %.3g: the state is blowing up or a parameter is far beyond a physical "
+        "scale (check masses, stiffnesses, forces and their units)",
+        ymax);
     return;
   }
   const char* s = "the integrator stopped";
@@ -167,10 +169,11 @@ static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, 
           "(an unstable model or a discontinuous input)";
       break;
     case IDA_CONV_FAIL:
-      s = joints ? "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
-                   "has become unstable. Try a smaller solver.max_step or a tighter rtol"
-                 : "Newton's method failed repeatedly: the model has become unstable or too stiff for the step. Try a "
-                   "smaller solver.max_step or a tighter rtol";
+      s = joints
+              ? "Newton's method failed repeatedly: the mechanism may be passing a singular configuration or the model "
+                "has become unstable. Try a smaller solver.max_step or a tighter rtol"
+              : "Newton's method failed repeatedly: the model has become unstable or too stiff for the step. Try a "
+                "smaller solver.max_step or a tighter rtol";
       break;
     case IDA_LSETUP_FAIL:
       s = joints ? "the Newton matrix could not be factorized (it is singular): a singular mechanism configuration "
@@ -180,7 +183,8 @@ static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, 
       break;
     case IDA_LSOLVE_FAIL: s = "the linear solver failed: the Newton matrix is singular or ill-conditioned"; break;
     case IDA_REP_RES_ERR:
-      s = "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial values";
+      s = "the equations kept returning non-finite values: the state is blowing up. Check parameters and initial "
+          "values";
       break;
     case IDA_RES_FAIL: s = "a plugin could not evaluate its equations"; break;
     default: break;
@@ -220,7 +224,8 @@ static void watch_step_rate(const fmbModel* m, fmbWorkspace* w_run, void* ida, N
   }
   if (ev <= 900.0 * eq) return; /* RMS ratio 30 */
   sw->warned = 1;
-  fmb_warn(w_run, "warning: t = %.6g: %ld steps so far, %.3g per simulated second (on course for %.3g): the velocities "
+  fmb_warn(w_run,
+           "warning: t = %.6g: %ld steps so far, %.3g per simulated second (on course for %.3g): the velocities "
            "set the step (their local error is %.0fx the positions'), i.e. undamped stiff modes that the positions do "
            "not notice. error_control: full suits smooth prescribed motion only; set solver.error_control: positions "
            "(the default for beams) after a sudden load (docs/performance.md)",
@@ -287,7 +292,9 @@ static void* ida_create(const fmbIntegratorSetup* s, double t0, const double* y0
     c->LS = c->A ? SUNLinSol_Dense(c->y, c->A, c->sun) : NULL;
   } else {
     c->A = SUNSparseMatrix(ny, ny, m->nnz, CSC_MAT, c->sun);
-    if (c->A) c->LS = m->solver.linear_solver == FMB_LS_KLU_FULL ? SUNLinSol_KLU(c->y, c->A, c->sun) : fmb_schur_klu_new(m, c->sun);
+    if (c->A)
+      c->LS =
+          m->solver.linear_solver == FMB_LS_KLU_FULL ? SUNLinSol_KLU(c->y, c->A, c->sun) : fmb_schur_klu_new(m, c->sun);
   }
   if (!c->A || !c->LS || IDASetLinearSolver(c->ida, c->LS, c->A) != IDA_SUCCESS ||
       IDASetJacFn(c->ida, jacobian_fn) != IDA_SUCCESS) {
@@ -306,7 +313,8 @@ static void* ida_create(const fmbIntegratorSetup* s, double t0, const double* y0
     c->workatol = N_VNew_Serial(m->njoint, c->sun);
     if (!c->work || !c->workatol) goto oom;
     N_VConst(0.0, c->work);
-    for (int j = 0; j < m->njoint; ++j) N_VGetArrayPointer(c->workatol)[j] = m->joint[j].nrows > 0 ? 1e30 : m->solver.atol;
+    for (int j = 0; j < m->njoint; ++j)
+      N_VGetArrayPointer(c->workatol)[j] = m->joint[j].nrows > 0 ? 1e30 : m->solver.atol;
     if (IDAQuadInit(c->ida, power_fn, c->work) != IDA_SUCCESS || IDASetQuadErrCon(c->ida, SUNTRUE) != IDA_SUCCESS ||
         IDAQuadSVtolerances(c->ida, m->solver.rtol, c->workatol) != IDA_SUCCESS) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not set up the work integrals: %s", c->ida_msg);
@@ -341,16 +349,19 @@ static int fall_back_to_full(IdaRun* c, double t_good, double tout, double* tret
   double tq = t_good;
   if (c->work) IDAGetQuad(c->ida, &tq, c->work);
   add_counters(c->ida, &c->before_reinit);
-  if (!full || IDASetLinearSolver(c->ida, full, c->A) != IDA_SUCCESS || IDASetJacFn(c->ida, jacobian_fn) != IDA_SUCCESS ||
-      IDAReInit(c->ida, t_good, c->y, c->yp) != IDA_SUCCESS || (c->work && IDAQuadReInit(c->ida, c->work) != IDA_SUCCESS)) {
+  if (!full || IDASetLinearSolver(c->ida, full, c->A) != IDA_SUCCESS ||
+      IDASetJacFn(c->ida, jacobian_fn) != IDA_SUCCESS || IDAReInit(c->ida, t_good, c->y, c->yp) != IDA_SUCCESS ||
+      (c->work && IDAQuadReInit(c->ida, c->work) != IDA_SUCCESS)) {
     if (full) SUNLinSolFree(full);
     return IDA_LINIT_FAIL;
   }
   SUNLinSolFree(c->LS);
   c->LS = full;
   c->fresh = 0; /* the next Jacobian recomputes the bodies' blocks */
-  fmb_warn(c->w, "note: t = %.6g: IDA failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
-           "from the last good step with klu_full (the whole matrix)", t_good);
+  fmb_warn(c->w,
+           "note: t = %.6g: IDA failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+           "from the last good step with klu_full (the whole matrix)",
+           t_good);
   *tret = t_good;
   return IDASolve(c->ida, tout, tret, c->y, c->yp, IDA_NORMAL);
 }

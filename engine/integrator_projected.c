@@ -61,7 +61,6 @@
 #define PROJ_ATOL_FACTOR 0.1
 #define PROJ_RTOL_MIN 3e-12
 
-
 /* up to this many unknowns (2 nq + work integrals) the Newton matrix is dense; beyond, matrix-free
    GMRES. Measured on rows of N parallelograms passing flat positions (bench/mechanisms.sh): the
    dense path costs N^2 per step (0.68 s for 2 s of N = 20); GMRES is linear (0.64 s for N = 50)
@@ -81,7 +80,7 @@ typedef struct {
   SUNLinearSolver LS;
   fmbAugmented* aug;
   double* lambda; /* nc */
-  int nwork;              /* work integrals carried (njoint or 0) */
+  int nwork;      /* work integrals carried (njoint or 0) */
   char msg[512];
 } ProjRun;
 
@@ -228,12 +227,15 @@ static int proj_advance(void* self, double tout, double* t_reached, double* y, d
   if (flag >= 0 && !proj_failed) return FMB_ADVANCE_OK;
   if (fmb_stop_requested(c->stop)) return FMB_ADVANCE_INTERRUPTED;
   if (flag >= 0) {
-    snprintf(why, why_len, "the projection onto the constraints did not converge (the mechanism may have left its "
+    snprintf(why, why_len,
+             "the projection onto the constraints did not converge (the mechanism may have left its "
              "assembled configurations); try a tighter rtol");
   } else {
     char* flag_name = CVodeGetReturnFlagName(flag);
-    snprintf(why, why_len, "the integrator of the projected formulation stopped: try a tighter rtol or a smaller "
-             "solver.max_step [CVODE %s: %s]", flag_name ? flag_name : "?", c->msg);
+    snprintf(why, why_len,
+             "the integrator of the projected formulation stopped: try a tighter rtol or a smaller "
+             "solver.max_step [CVODE %s: %s]",
+             flag_name ? flag_name : "?", c->msg);
     free(flag_name);
   }
   return FMB_ADVANCE_FAILED;
@@ -261,9 +263,10 @@ static void proj_stats(const void* self, fmbStats* st) {
 /* the projected formulation works on q and v alone, with the bodies' mass matrices */
 static int proj_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
   if (m->nz > 0)
-    return fmb_parse_error(p, fmb_find_key(p, solver, "formulation"),
-                           "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
-                           "its assembly: dense, or use formulation: ggl)");
+    return fmb_parse_error(
+        p, fmb_find_key(p, solver, "formulation"),
+        "formulation: projected needs bodies without auxiliary unknowns (a banded beam has them: set "
+        "its assembly: dense, or use formulation: ggl)");
   return 0;
 }
 

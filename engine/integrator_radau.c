@@ -108,11 +108,11 @@ typedef struct {
   double rtol;         /* RADAU5's mapped tolerance */
   double *atol, *scal, *ewt;
   double t, h, hold, t_end, hmax;
-  double *y, *yp;                 /* the state at t (last accepted step) */
-  double *z[3], *wt[3], *fz[3];   /* stage increments, transformed ones, residuals / right sides */
-  double *ys, *yps;               /* one stage's value and derivative */
-  double *cont[4];                /* dense output: y_{n+1} and the Newton-form differences */
-  double* e2rhs;                  /* complex right side, interleaved (2 ny) */
+  double *y, *yp;               /* the state at t (last accepted step) */
+  double *z[3], *wt[3], *fz[3]; /* stage increments, transformed ones, residuals / right sides */
+  double *ys, *yps;             /* one stage's value and derivative */
+  double* cont[4];              /* dense output: y_{n+1} and the Newton-form differences */
+  double* e2rhs;                /* complex right side, interleaved (2 ny) */
   double *err, *err2;
   /* Jacobian parts on the model's CSC pattern, and the two iteration matrices */
   double *jy, *jyp, *e1, *e2;
@@ -121,19 +121,19 @@ typedef struct {
   /* solver.linear_solver: klu (default): both systems with the position rows eliminated
      (schur.c); klu_full: KLU on the whole matrices above */
   fmbSchur *red1, *red2;
-  int fell_back;                 /* the reduced systems failed once: KLU on the whole matrices since */
-  double h_lu;                   /* the step the factorizations are for (0: none) */
-  int need_jac;                  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
-  int caljac;                    /* the Jacobian was evaluated at this step's start (t, y) */
+  int fell_back; /* the reduced systems failed once: KLU on the whole matrices since */
+  double h_lu;   /* the step the factorizations are for (0: none) */
+  int need_jac;  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
+  int caljac;    /* the Jacobian was evaluated at this step's start (t, y) */
   int first, reject, have_cont, nsing;
-  int kept;                      /* consecutive steps that kept h although it could grow by > 1.2 */
+  int kept; /* consecutive steps that kept h although it could grow by > 1.2 */
   double hacc, erracc, faccon, theta, fnewt;
   /* work integrals */
   int nwork, nwork_err; /* work integrals; of them in the error test (applied forces') */
   double *work_old, *work_new, *work_out;
-  double *p0, *pst[3];   /* the powers at the last accepted step's start and stages (work_at) */
+  double *p0, *pst[3];    /* the powers at the last accepted step's start and stages (work_at) */
   double *pend, *ptry[3]; /* at the current state, and at the stages of the step being tried */
-  double* work_atol;     /* per joint: the work's absolute tolerance, 0 = out of the error test */
+  double* work_atol;      /* per joint: the work's absolute tolerance, 0 = out of the error test */
   fmbStats st;
   long lu_reuses;
 } RadauRun;
@@ -145,9 +145,9 @@ static void radau_destroy(void* self) {
   fmb_klu_free(c->lu2);
   fmb_schur_free(c->red1);
   fmb_schur_free(c->red2);
-  double** vs[] = {&c->atol, &c->scal, &c->ewt, &c->y, &c->yp, &c->ys, &c->yps, &c->e2rhs, &c->err, &c->err2,
-                   &c->jy, &c->jyp, &c->e1, &c->e2, &c->work_old, &c->work_new, &c->p0, &c->work_out,
-                   &c->pend, &c->work_atol};
+  double** vs[] = {&c->atol,     &c->scal,     &c->ewt,  &c->y,        &c->yp,   &c->ys,       &c->yps,
+                   &c->e2rhs,    &c->err,      &c->err2, &c->jy,       &c->jyp,  &c->e1,       &c->e2,
+                   &c->work_old, &c->work_new, &c->p0,   &c->work_out, &c->pend, &c->work_atol};
   for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) free(*vs[i]);
   for (int k = 0; k < 3; ++k) {
     free(c->z[k]);
@@ -558,7 +558,8 @@ static void work_at(RadauRun* c, double t, double* out) {
   double wgt[4];
   cubic_weights(theta, wgt);
   for (int j = 0; j < c->nwork; ++j)
-    out[j] = c->work_old[j] + c->hold * (wgt[0] * c->p0[j] + wgt[1] * c->pst[0][j] + wgt[2] * c->pst[1][j] + wgt[3] * c->pst[2][j]);
+    out[j] = c->work_old[j] +
+             c->hold * (wgt[0] * c->p0[j] + wgt[1] * c->pst[0][j] + wgt[2] * c->pst[1][j] + wgt[3] * c->pst[2][j]);
 }
 
 /* The joints' powers at the stages of the step being tried (from c->t, c->y), and the work
@@ -605,10 +606,11 @@ static void describe_failure(const RadauRun* c, FailKind kind, char* why, size_t
   const fmbSolverSettings* so = &c->m->solver;
   switch (kind) {
     case FAIL_STEPS:
-      snprintf(why, len,
-               "too many steps between two outputs (solver.max_steps = %ld): the problem is very stiff or changing very "
-               "fast here. Try a larger solver.max_steps, a looser rtol, or solver.integrator: ida",
-               so->max_steps_per_output);
+      snprintf(
+          why, len,
+          "too many steps between two outputs (solver.max_steps = %ld): the problem is very stiff or changing very "
+          "fast here. Try a larger solver.max_steps, a looser rtol, or solver.integrator: ida",
+          so->max_steps_per_output);
       break;
     case FAIL_MIN_STEP:
       snprintf(why, len,
@@ -770,8 +772,10 @@ static int fall_back_to_full(RadauRun* c) {
   c->h_lu = 0.0;
   c->nsing = 0;
   c->reject = 1;
-  fmb_warn(c->w, "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
-           "from the last good step with klu_full (the whole matrices)", c->t);
+  fmb_warn(c->w,
+           "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+           "from the last good step with klu_full (the whole matrices)",
+           c->t);
   return 0;
 }
 

@@ -7,8 +7,8 @@
 #include "integrator.h"
 
 /* The one list of backends; solver.integrator names a GGL one or auto (the default, the rule below). */
-const fmbIntegratorOps* const fmb_integrators[] = {&fmb_integrator_ida, &fmb_integrator_radau5, &fmb_integrator_projected,
-                                                   NULL};
+const fmbIntegratorOps* const fmb_integrators[] = {&fmb_integrator_ida, &fmb_integrator_radau5,
+                                                   &fmb_integrator_projected, NULL};
 
 static const fmbIntegratorOps* projected_backend(void) {
   for (int i = 0; fmb_integrators[i]; ++i)
@@ -65,9 +65,13 @@ int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
 
 void fmb_print_stats(const fmbStats* s, FILE* f) {
   if (!s || !f) return;
-  fprintf(f,
-          "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
-          "conv_fails=%ld jacobians_reused=%ld integrator=%s cpu_s=%.4f\n",
-          s->status_ok ? "ok" : s->interrupted ? "interrupted" : "failed", s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters,
-          s->error_test_fails, s->conv_fails, s->jacobians_reused, s->integrator ? s->integrator : "none", s->cpu_s);
+  fprintf(
+      f,
+      "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
+      "conv_fails=%ld jacobians_reused=%ld integrator=%s cpu_s=%.4f\n",
+      s->status_ok     ? "ok"
+      : s->interrupted ? "interrupted"
+                       : "failed",
+      s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters, s->error_test_fails, s->conv_fails,
+      s->jacobians_reused, s->integrator ? s->integrator : "none", s->cpu_s);
 }

@@ -17,7 +17,7 @@ typedef struct fmbBodyInst {
   int qadr, nq; /* slice of the coordinate vector */
   fmbNode node; /* its item in the scene, for messages about it after parsing */
   size_t workadr, nwork;
-  int zadr, nz;  /* auxiliary algebraic unknowns (fmbBodyType.naux): slice of z, at m->zoff in y */
+  int zadr, nz; /* auxiliary algebraic unknowns (fmbBodyType.naux): slice of z, at m->zoff in y */
   /* sparse body block (fmbBodyType.pattern), CSC over nq + nz rows and columns; pnnz < 0: dense.
      Columns are grouped in colours that share no row, for differencing (fd.c). */
   long pnnz;
@@ -48,15 +48,15 @@ typedef struct fmbJointInst {
 
 typedef enum {
   FMB_OUT_TIME,
-  FMB_OUT_FRAME,       /* body frame quantity: index into frame_names */
-  FMB_OUT_BODY,        /* body plugin output */
-  FMB_OUT_JOINT,       /* joint plugin output */
-  FMB_OUT_JOINT_POWER, /* power a joint feeds in: constraint forces lambda^T Phi_t + its forces Q . v */
-  FMB_OUT_JOINT_WORK,  /* that power integrated from t0 (an IDA quadrature) */
+  FMB_OUT_FRAME,          /* body frame quantity: index into frame_names */
+  FMB_OUT_BODY,           /* body plugin output */
+  FMB_OUT_JOINT,          /* joint plugin output */
+  FMB_OUT_JOINT_POWER,    /* power a joint feeds in: constraint forces lambda^T Phi_t + its forces Q . v */
+  FMB_OUT_JOINT_WORK,     /* that power integrated from t0 (an IDA quadrature) */
   FMB_OUT_JOINT_REACTION, /* 0 x, 1 y: force on body2 at its point; 2 torque about that point */
-  FMB_OUT_ENERGY,      /* 0 kinetic 1 strain 2 gravity 3 spring 4 total 5 balance */
-  FMB_OUT_CONSTRAINT,  /* 0 position 1 velocity */
-  FMB_OUT_SHAPE        /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
+  FMB_OUT_ENERGY,         /* 0 kinetic 1 strain 2 gravity 3 spring 4 total 5 balance */
+  FMB_OUT_CONSTRAINT,     /* 0 position 1 velocity */
+  FMB_OUT_SHAPE           /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
 } fmbOutKind;
 
 typedef struct fmbOutput {
@@ -73,8 +73,8 @@ typedef struct fmbSolverSettings {
      was); 0 = derived from rtol and the bodies' scales (engine/tolerance.c). atol then holds the
      derived value for one metre of a 1 m body, which the checks that take one scalar use. */
   int atol_given;
-  double min_step;     /* IDA's step floor: solver.min_step, default FMB_MIN_STEP_FRACTION (t_end - t0) */
-  int min_step_given;  /* 1 when the scene set solver.min_step (named in messages either way) */
+  double min_step;    /* IDA's step floor: solver.min_step, default FMB_MIN_STEP_FRACTION (t_end - t0) */
+  int min_step_given; /* 1 when the scene set solver.min_step (named in messages either way) */
   /* Newton systems: KLU on the Schur complement of the position rows (schur.c, default), KLU on
      the whole matrix, or SUNDIALS' dense LU on the whole matrix (a reference for both) */
   enum { FMB_LS_KLU = 0, FMB_LS_DENSE = 1, FMB_LS_KLU_FULL = 2 } linear_solver;
@@ -113,11 +113,11 @@ struct fmbModel {
   int nbody, njoint;
   fmbBodyInst* body;
   fmbJointInst* joint;
-  int nq;   /* coordinates */
-  int nc;   /* constraint rows */
-  int nz;   /* auxiliary algebraic unknowns of the bodies (fmbBodyType.naux) */
-  int zoff; /* their offset in y: y = [q | v | lambda | mu | z] */
-  int ny;   /* unknowns of the DAE: 2 nq + 2 nc + nz */
+  int nq;       /* coordinates */
+  int nc;       /* constraint rows */
+  int nz;       /* auxiliary algebraic unknowns of the bodies (fmbBodyType.naux) */
+  int zoff;     /* their offset in y: y = [q | v | lambda | mu | z] */
+  int ny;       /* unknowns of the DAE: 2 nq + 2 nc + nz */
   size_t nwork; /* total plugin scratch doubles */
   int max_joint_cols;
   fmbEnv env;
@@ -126,17 +126,17 @@ struct fmbModel {
   fmbOutput* output;
   int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
   int need_energy, need_constraint, check_definiteness;
-  int need_work; /* a work or energy.balance column: integrate every joint's power */
-  int nredundant; /* constraint rows that repeat the others at t0 (found at load, ic.c) */
-  int need_multipliers; /* a reaction or power column: multipliers recomputed at each row */
-  int bdf_order_cap; /* min over bodies' max_bdf_order */
+  int need_work;               /* a work or energy.balance column: integrate every joint's power */
+  int nredundant;              /* constraint rows that repeat the others at t0 (found at load, ic.c) */
+  int need_multipliers;        /* a reaction or power column: multipliers recomputed at each row */
+  int bdf_order_cap;           /* min over bodies' max_bdf_order */
   int bodies_prefer_positions; /* a body's velocity_error_test said 0 */
-  int initial_static; /* scene `initial: static`: runs start from the static or steady state */
+  int initial_static;          /* scene `initial: static`: runs start from the static or steady state */
   int fresh_body_blocks;       /* a body's reuse_blocks said 0 */
   /* sparsity pattern of the iteration matrix, CSC, fixed at load */
   long nnz;
-  long* colptr; /* ny + 1 */
-  long* rowind; /* nnz */
+  long* colptr;      /* ny + 1 */
+  long* rowind;      /* nnz */
   char vtk_dir[512]; /* the scene's `vtk` key: "" = no animation unless the run asks */
   /* inputs (fmb_set_input): the joints that take one, in scene order, and their `value:` */
   int ninput;
@@ -151,9 +151,9 @@ struct fmbJointEval {
   double t;
   const double* q; /* whole coordinate vector */
   const double* v;
-  double* work;    /* plugin scratch (body markers) */
-  double* mk;      /* 3 x max body ncoord: marker derivatives before scattering */
-  double* js;      /* 2 x max joint columns: the joint's own scratch */
+  double* work;        /* plugin scratch (body markers) */
+  double* mk;          /* 3 x max body ncoord: marker derivatives before scattering */
+  double* js;          /* 2 x max joint columns: the joint's own scratch */
   const double* input; /* the inputs' current values (the workspace's, set by fmb_set_input) */
 };
 
@@ -162,9 +162,9 @@ struct fmbRegistry {
   int nbodies, njoints, cap_bodies, cap_joints;
   const fmbBodyType** bodies;
   const fmbJointType** joints;
-  const char** body_names;  /* NULL-terminated, for fmb_get_choice */
+  const char** body_names; /* NULL-terminated, for fmb_get_choice */
   const char** joint_names;
-  char** body_origin;       /* owned copies */
+  char** body_origin; /* owned copies */
   char** joint_origin;
 };
 /* a copy of reg that a scene's plugins can be added to */
@@ -179,11 +179,11 @@ struct fmbParser {
   int have_doc;
   const char* path;
   fmbDiag* diag;
-  unsigned char* known;     /* per node id: key node looked up */
-  int* override_of;         /* per node id: index of the --set that made it, or -1 */
+  unsigned char* known; /* per node id: key node looked up */
+  int* override_of;     /* per node id: index of the --set that made it, or -1 */
   int nnodes_cap;
   const char* const* overrides;
-  const char* looked[64];   /* keys looked up in the current item, for "expected one of" */
+  const char* looked[64]; /* keys looked up in the current item, for "expected one of" */
   int nlooked;
   /* every key the current mapping may have, when known before its keys are read (fmbp_expect):
      the loader's own list (top level, solver, an item's name and type) and the item's type's
@@ -191,17 +191,17 @@ struct fmbParser {
      reported after an unknown key beside it (the typo that explains it, with did you mean). */
   const char* const* valid;
   const fmbParam* params;
-  int expect_complete; /* valid and params name every key the mapping may have */
-  const char* what;    /* the mapping for messages ("body 'bob' (type rigid)"), or NULL */
+  int expect_complete;          /* valid and params name every key the mapping may have */
+  const char* what;             /* the mapping for messages ("body 'bob' (type rigid)"), or NULL */
   unsigned plausibility_warned; /* the plausibility rules (yaml_get.c) that have warned: once each */
   /* named materials and sections (top-level `materials:`/`sections:` maps): while a body or
      joint item is parsed, keys it does not have are looked up in the entries it names */
-  fmbNode item;             /* the item being parsed, or -1 */
-  fmbNode inherited[2];     /* its material and section entries, or -1 */
-  fmbModel* model;          /* under construction */
-  long key_compares;        /* string comparisons of the duplicate-key check (tests count them) */
+  fmbNode item;         /* the item being parsed, or -1 */
+  fmbNode inherited[2]; /* its material and section entries, or -1 */
+  fmbModel* model;      /* under construction */
+  long key_compares;    /* string comparisons of the duplicate-key check (tests count them) */
   const fmbRegistry* reg;
-  fmbRegistry* own_reg;     /* the scene's plugins: a copy of the caller's registry, or NULL */
+  fmbRegistry* own_reg; /* the scene's plugins: a copy of the caller's registry, or NULL */
 };
 
 int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int noverrides, fmbDiag* diag);
@@ -269,13 +269,12 @@ int fmb_model_has_sparse_body(const fmbModel* m);
 int fmb_type_output_id(int (*output_lookup)(const void*, const char*), const void* self, const char* const* names,
                        const char* quantity);
 /* F(t, y, yp) of the stabilized index-2 (GGL) system; returns 0, >0 recoverable, <0 fatal */
-int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
-                        double* F);
+int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F);
 /* J = dF/dy + cj dF/dyp into a CSC matrix with the model's pattern (data only), or a dense
    column-major ny x ny matrix when dense != NULL. ewt: IDA's error weights (for FD steps).
    reuse_blocks: assemble with the bodies' K, C, M from the last fresh call (only cj changed). */
-int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj, const double* y,
-                        const double* yp, const double* ewt, int reuse_blocks, double* csc_data, double* dense);
+int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj, const double* y, const double* yp,
+                        const double* ewt, int reuse_blocks, double* csc_data, double* dense);
 /* building blocks shared by the residual, Jacobian and initial conditions */
 int fmb_joint_constraint(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                          double* phi, double* phi_q, double* phi_t, double* phi_tt);
@@ -284,10 +283,11 @@ int fmb_body_blocks(const fmbModel* m, fmbWorkspace* w, int b, const double* q, 
 int fmb_body_mass(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, double* M);
 int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
                            double* Qtot);
-int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
-                        double* phi, double* phi_q_dense, double* phi_t, double* phi_tt);
+int fmb_constraints_all(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* phi,
+                        double* phi_q_dense, double* phi_t, double* phi_tt);
 /* gamma = -(Phi_q v)_q v - Phi_tt (nc), the right side of Phi_q a = gamma */
-int fmb_constraints_gamma(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* gamma);
+int fmb_constraints_gamma(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                          double* gamma);
 /* scratch for augmented.c: the joint column list, a joint's phi / phi_q / phi_t / phi_tt (0..3)
    buffers, one nq vector */
 int* fmb_workspace_cols(fmbWorkspace* w);
@@ -330,9 +330,9 @@ struct _generic_N_Vector;
 void fmb_vector_use_fast_ops(struct _generic_N_Vector* v);
 
 /* ---- dense.c: small dense linear algebra (initial conditions, checks) ---- */
-int fmb_lu_factor(int n, double* A, int* piv);             /* column-major, in place; 0 ok */
+int fmb_lu_factor(int n, double* A, int* piv); /* column-major, in place; 0 ok */
 void fmb_lu_solve(int n, const double* LU, const int* piv, double* b);
-int fmb_cholesky(int n, double* A);                        /* lower, in place; 0 ok, else k+1 */
+int fmb_cholesky(int n, double* A); /* lower, in place; 0 ok, else k+1 */
 int fmb_independent_rows(int nr, int nc, const double* A, double tol, int* order, double* work);
 
 /* ---- ic.c ---- */
@@ -359,8 +359,7 @@ int fmb_rank_deficient_at(const fmbModel* m, fmbWorkspace* w, double t, const do
 void fmb_name_rows(const fmbModel* m, const unsigned char* rows, char* buf, size_t len);
 /* Tikhonov shift (relative) that makes the multipliers of redundant rows minimum-norm */
 #define FMB_MIN_NORM_SHIFT 1e-10
-int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st,
-                           fmbDiag* diag);
+int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double* yp, fmbStats* st, fmbDiag* diag);
 /* a consistent state at t from y's q and v (projected onto the constraints), for a restart after
    an input changed (step.c); 0 or an exit code with diag set */
 int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag);
@@ -373,8 +372,7 @@ int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbD
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
 /* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
-void fmb_rigid_rotation(const fmbModel* m, double speed, const double center[2], const double* q, double* v,
-                        double* a);
+void fmb_rigid_rotation(const fmbModel* m, double speed, const double center[2], const double* q, double* v, double* a);
 /* rotating-frame terms of a steady rotation: K += W C E + W^2 M E^2, Cg += 2 W M E (if not NULL);
    nq x nq column-major with leading dimension ld */
 void fmb_rotation_terms(const fmbModel* m, double speed, const double* C, const double* M, int ld, double* K,

@@ -35,13 +35,13 @@
 
 /* LAPACK / BLAS (Debian's liblapack-dev, libblas-dev), Fortran calling convention */
 extern void dgesvd_(const char* jobu, const char* jobvt, const int* m, const int* n, double* a, const int* lda,
-                    double* s, double* u, const int* ldu, double* vt, const int* ldvt, double* work,
-                    const int* lwork, int* info);
+                    double* s, double* u, const int* ldu, double* vt, const int* ldvt, double* work, const int* lwork,
+                    int* info);
 extern void dsygv_(const int* itype, const char* jobz, const char* uplo, const int* n, double* a, const int* lda,
                    double* b, const int* ldb, double* w, double* work, const int* lwork, int* info);
 extern void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a, const int* lda, double* wr,
-                   double* wi, double* vl, const int* ldvl, double* vr, const int* ldvr, double* work,
-                   const int* lwork, int* info);
+                   double* wi, double* vl, const int* ldvl, double* vr, const int* ldvr, double* work, const int* lwork,
+                   int* info);
 extern void dgesv_(const int* n, const int* nrhs, double* a, const int* lda, int* ipiv, double* b, const int* ldb,
                    int* info);
 extern void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const double* alpha,
@@ -115,8 +115,7 @@ static int classify(const double* wr, const double* wi, int n2, int inverted, Ro
     if (!isfinite(wr[k])) continue;
     /* an oscillating pair: keep the root with Im s > 0. Its vector: columns k, k+1 of V as
        dgeev stores them for the first of the pair (Im > 0 direct, Im < 0 after inversion) */
-    const int first = inverted ? (k + 1 < n2 && wi[k] < -tiny && wi[k + 1] > tiny)
-                               : (wi[k] > tiny);
+    const int first = inverted ? (k + 1 < n2 && wi[k] < -tiny && wi[k + 1] > tiny) : (wi[k] > tiny);
     if (first) {
       const int kk = inverted ? k + 1 : k;
       const double mg = hypot(wr[kk], wi[kk]);
@@ -323,7 +322,7 @@ static int out_of_memory(const fmbModel* m, fmbDiag* diag) {
 
 /* (M1) about the state: nq x nq column-major blocks, and J0 (ny x ny) for the constraint rows */
 typedef struct {
-  double speed;           /* the rigid rotation the state has */
+  double speed;            /* the rigid rotation the state has */
   double *J0, *K, *Cg, *M; /* dF/dy at cj = 0; stiffness, damping + gyroscopic, mass (rotating frame) */
 } Linearized;
 
@@ -446,11 +445,14 @@ static int constraint_svd(const fmbModel* m, const double* J0, double* VT, int* 
     dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, &q1, &lwork, &info);
     lwork = (int)q1 + 1;
     work = malloc((size_t)lwork * sizeof(double));
-    if (!work) rc = out_of_memory(m, diag);
-    else dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, work, &lwork, &info);
+    if (!work)
+      rc = out_of_memory(m, diag);
+    else
+      dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, work, &lwork, &info);
   }
   if (!rc && info) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the SVD of the constraint Jacobian failed (LAPACK info %d)", info);
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the SVD of the constraint Jacobian failed (LAPACK info %d)",
+                 info);
     rc = FMB_EXIT_SOLVER;
   }
   for (int i = 0; !rc && i < (nc < nq ? nc : nq); ++i)
@@ -580,7 +582,8 @@ static int solve_first_order(const fmbModel* m, double t, const Reduced* R, Eige
     if (info) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
                    "the mass matrix on the free motions is singular at t = %g: no modes (a massless degree of freedom, "
-                   "or a FOAC beam whose mass matrix lost definiteness)", t);
+                   "or a FOAC beam whose mass matrix lost definiteness)",
+                   t);
       rc = FMB_EXIT_SOLVER;
     }
   }
@@ -607,10 +610,13 @@ static int solve_first_order(const fmbModel* m, double t, const Reduced* R, Eige
     dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, E->V, &n2, &q1, &lwork, &info);
     lwork = (int)q1 + 1;
     work = malloc((size_t)lwork * sizeof(double));
-    if (!work) rc = out_of_memory(m, diag);
-    else dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, E->V, &n2, work, &lwork, &info);
+    if (!work)
+      rc = out_of_memory(m, diag);
+    else
+      dgeev_("N", "V", &n2, S, &n2, wr, wi, &vl, &one, E->V, &n2, work, &lwork, &info);
     if (!rc && info) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the eigenvalue solver did not converge (LAPACK dgeev info %d)", info);
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   "the eigenvalue solver did not converge (LAPACK dgeev info %d)", info);
       rc = FMB_EXIT_SOLVER;
     }
   }
@@ -735,8 +741,8 @@ void xerbla_(const char* name, const int* info, int len) {
   (void)len;
 }
 
-int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
-              fmbModes** out, fmbDiag* diag) {
+int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method, fmbModes** out,
+              fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag);
@@ -747,8 +753,8 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   *out = NULL;
   /* an unknown method once ran the dense path silently; a time of nan linearized at nan */
   if (method != FMB_EIGEN_AUTO && method != FMB_EIGEN_DENSE && method != FMB_EIGEN_SPARSE) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_modes: method %d is not FMB_EIGEN_AUTO, _DENSE or _SPARSE",
-                 method);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_modes: method %d is not FMB_EIGEN_AUTO, _DENSE or _SPARSE", method);
     return FMB_EXIT_BAD_INPUT;
   }
   if (!isfinite(t)) {
@@ -788,7 +794,8 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
 }
 
 double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k) {
-  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count) return NAN; /* not 0: "orthogonal" */
+  if (!a || !b || a->nq != b->nq || i < 0 || k < 0 || i >= a->count || k >= b->count)
+    return NAN; /* not 0: "orthogonal" */
   const double *ar = a->shape_re + (size_t)i * a->nq, *ai = a->shape_im + (size_t)i * a->nq;
   const double *br = b->shape_re + (size_t)k * b->nq, *bi = b->shape_im + (size_t)k * b->nq;
   double re = 0.0, im = 0.0, na = 0.0, nb = 0.0;
@@ -851,7 +858,8 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
     if (warned) fmb_warn_model_range(m, w, t, y, warned); /* a state out of a body's model's range */
     free(warned);
     if (wr) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, wr > 0 ? "an output is not finite" : "writing the output failed");
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+                   wr > 0 ? "an output is not finite" : "writing the output failed");
       rc = FMB_EXIT_SOLVER;
     }
   }
@@ -916,8 +924,8 @@ done:
    period, q = q* + amplitude Re(phi e^(i w tau)) = q* + amplitude (Re phi cos - Im phi sin), the
    time value tau (s; frame numbers for a mode of frequency 0 or a divergent one, whose motion is
    not periodic: there the shape is swept once, 0 -> amplitude -> -amplitude -> 0). */
-int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* md, int k,
-                             double amplitude, int frames, const char* dir, fmbDiag* diag) {
+int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* md, int k, double amplitude,
+                             int frames, const char* dir, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag); /* this call's error, not an earlier one (the first error wins) */

@@ -61,14 +61,15 @@ static const char* const frame_units[] = {"m", "m", "rad", "rad/s", "m/s", "m/s"
 static const char* const power_units[] = {"W", "J"};
 static const char* const reaction_units[] = {"N", "N", "N m"};
 
-
-
 const char* const* fmb_engine_outputs(const char* group) {
   static const struct {
     const char* group;
     const char* const* names;
-  } groups[] = {{"frame", frame_names},   {"power", power_names},           {"reaction", reaction_names},
-                {"energy", energy_names}, {"constraint", constraint_names}};
+  } groups[] = {{"frame", frame_names},
+                {"power", power_names},
+                {"reaction", reaction_names},
+                {"energy", energy_names},
+                {"constraint", constraint_names}};
   for (size_t i = 0; group && i < sizeof groups / sizeof groups[0]; ++i)
     if (strcmp(group, groups[i].group) == 0) return groups[i].names;
   return NULL;
@@ -183,7 +184,8 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
   snprintf(o->name, sizeof o->name, "%s", text);
   const char* dot = strchr(text, '.');
   if (!dot || dot == text || !dot[1])
-    return fmb_parse_error(p, node, "expected an output name NAME.quantity (e.g. beam.tip_v, energy.total), got '%s'", text);
+    return fmb_parse_error(p, node, "expected an output name NAME.quantity (e.g. beam.tip_v, energy.total), got '%s'",
+                           text);
   char owner[FMB_NAME_MAX];
   size_t len = (size_t)(dot - text);
   if (len >= sizeof owner) return fmb_parse_error(p, node, "no body or joint named '%.*s...'", 20, text);
@@ -210,8 +212,9 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
     for (int i = 0; i < m->njoint; ++i)
       if (strcmp(m->joint[i].name, owner) == 0) j = i;
     if (b < 0 && j < 0)
-      return fmb_parse_error(p, node, "output '%s': no body or joint named '%s' (outputs are NAME.quantity, energy.*, constraint.*)",
-                           text, owner);
+      return fmb_parse_error(
+          p, node, "output '%s': no body or joint named '%s' (outputs are NAME.quantity, energy.*, constraint.*)", text,
+          owner);
     o->id = -1;
     if (b >= 0) {
       const fmbBodyInst* bi = &m->body[b];
@@ -260,18 +263,20 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
   if (!dot || strncmp(dot + 1, "shape", 5) != 0 || (dot[6] != '\0' && dot[6] != '_')) return 0;
   int b = -1;
   for (int i = 1; i < m->nbody; ++i)
-    if (strlen(m->body[i].name) == (size_t)(dot - text) && strncmp(m->body[i].name, text, (size_t)(dot - text)) == 0) b = i;
+    if (strlen(m->body[i].name) == (size_t)(dot - text) && strncmp(m->body[i].name, text, (size_t)(dot - text)) == 0)
+      b = i;
   if (b < 0) return 0; /* not a body: resolve_one says what is wrong */
   const fmbBodyInst* bi = &m->body[b];
   if (!bi->type->centreline)
-    return fmb_parse_error(p, node, "output '%s': a %s body has no centreline (shape is a beam's output)", text, bi->type->name);
+    return fmb_parse_error(p, node, "output '%s': a %s body has no centreline (shape is a beam's output)", text,
+                           bi->type->name);
   int n = bi->type->centreline(bi->self, 0, NULL);
   if (dot[6] == '_') {
     char* end = NULL;
     long v = strtol(dot + 7, &end, 10);
     if (dot[7] < '0' || dot[7] > '9' || *end != '\0' || v < 2 || v > FMB_SHAPE_STATIONS_MAX)
-      return fmb_parse_error(p, node, "output '%s': expected shape_N with N stations from 2 to %d (or plain 'shape')", text,
-                             FMB_SHAPE_STATIONS_MAX);
+      return fmb_parse_error(p, node, "output '%s': expected shape_N with N stations from 2 to %d (or plain 'shape')",
+                             text, FMB_SHAPE_STATIONS_MAX);
     n = (int)v;
   }
   if (m->noutput + 2 * n > *cap) {
@@ -283,7 +288,8 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
   char first[sizeof m->output[0].name];
   snprintf(first, sizeof first, "%s.shape0_x", bi->name);
   for (int k = 1; k < m->noutput; ++k)
-    if (strcmp(m->output[k].name, first) == 0) return fmb_parse_error(p, node, "output '%s': %s's shape is listed twice", text, bi->name);
+    if (strcmp(m->output[k].name, first) == 0)
+      return fmb_parse_error(p, node, "output '%s': %s's shape is listed twice", text, bi->name);
   double* local = malloc(2 * (size_t)n * sizeof *local);
   if (!local) return fmb_parse_error(p, node, "out of memory");
   bi->type->centreline(bi->self, n, local);
@@ -314,7 +320,8 @@ static double shape_value(const fmbModel* m, fmbWorkspace* w, const fmbOutput* o
 }
 
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
-  if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list of output names for 'outputs', e.g. [beam.tip_v, energy.total]");
+  if (!fmbp_is_seq(p, list))
+    return fmb_parse_error(p, list, "expected a list of output names for 'outputs', e.g. [beam.tip_v, energy.total]");
   int n = fmbp_seq_len(p, list);
   int cap = n + 1;
   m->output = calloc((size_t)cap, sizeof *m->output);
@@ -409,8 +416,7 @@ fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
   char err[700];
   if (c) c->file = fmb_safe_open(path ? path : "-", err, sizeof err);
   if (!c || !c->file) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s",
-                 c ? err : "out of memory");
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", c ? err : "out of memory");
     free(c);
     return NULL;
   }
@@ -538,8 +544,8 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
           balance = e.kinetic + e.strain + e.gravity + *fmb_workspace_spring_energy0(w);
           for (int j = 0; j < m->njoint; ++j) balance -= fmb_workspace_work(w)[j];
         }
-        const double parts[6] = {e.kinetic, e.strain, e.gravity, e.spring,
-                                 e.kinetic + e.strain + e.gravity + e.spring, balance};
+        const double parts[6] = {e.kinetic, e.strain, e.gravity, e.spring, e.kinetic + e.strain + e.gravity + e.spring,
+                                 balance};
         val = parts[o->id];
         break;
       }

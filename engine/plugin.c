@@ -40,8 +40,10 @@ int fmb_registry_load(fmbRegistry* reg, const char* path, fmbDiag* diag) {
   fmbPluginEntry entry;
   *(void**)&entry = dlsym(h, FMB_PLUGIN_ENTRY); /* POSIX: an object pointer converted to a function */
   if (!entry) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "not a flexmbd plugin: it has no symbol %s (declare it "
-                 "with FMB_PLUGIN_EXPORT, docs/plugins.md)", FMB_PLUGIN_ENTRY);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0,
+                 "not a flexmbd plugin: it has no symbol %s (declare it "
+                 "with FMB_PLUGIN_EXPORT, docs/plugins.md)",
+                 FMB_PLUGIN_ENTRY);
     return -1;
   }
   const fmbPlugin* desc = entry();

@@ -170,7 +170,8 @@ int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* orig
   if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
   if (!reg || !plugin) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin ? origin : "", 0, 0, "fmb_registry_add: %s is NULL", reg ? "the plugin" : "the registry");
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin ? origin : "", 0, 0, "fmb_registry_add: %s is NULL",
+                 reg ? "the plugin" : "the registry");
     return -1;
   }
   if (!origin) origin = "?";
@@ -206,9 +207,11 @@ int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* orig
           return -1;
         }
       int same = 0;
-      const char* other = taken_by(reg, k, name, k ? (const void*)plugin->joints[i] : (const void*)plugin->bodies[i], &same);
+      const char* other =
+          taken_by(reg, k, name, k ? (const void*)plugin->joints[i] : (const void*)plugin->bodies[i], &same);
       if (other) {
-        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0, "%s '%s' is already registered (from %s)", kind, name, other);
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0, "%s '%s' is already registered (from %s)", kind, name,
+                     other);
         return -1;
       }
     }

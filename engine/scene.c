@@ -13,7 +13,7 @@
 #include "pattern.h"
 
 #define FMB_MAX_ROWS 100000000L /* output rows: beyond this a scene is a typo, not a plan */
-#define FMB_RTOL_MIN 1e-13 /* ~500 machine epsilons: below, IDA reports "too much accuracy requested" */
+#define FMB_RTOL_MIN 1e-13      /* ~500 machine epsilons: below, IDA reports "too much accuracy requested" */
 #define FMB_RTOL_MAX 0.1
 #define FMB_ATOL_MIN 1e-16
 #define FMB_ATOL_MAX 1e-3 /* 1 mm, 1 mrad: looser hides errors as large as a small mechanism */
@@ -44,9 +44,9 @@ static int get_atol(fmbParser* p, fmbNode node, double* atol, int* is_auto) {
 }
 
 /* the keys of `solver:`, in the order parse_solver reads them: the one list for its messages */
-static const char* const solver_keys[] = {"t_end",         "rtol",      "atol",      "output_step", "max_step",
-                                          "min_step",      "linear_solver", "error_control", "max_steps", "max_order",
-                                          "formulation",   "integrator", NULL};
+static const char* const solver_keys[] = {
+    "t_end",         "rtol",      "atol",      "output_step", "max_step",   "min_step", "linear_solver",
+    "error_control", "max_steps", "max_order", "formulation", "integrator", NULL};
 
 static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   fmbSolverSettings* s = &m->solver;
@@ -59,7 +59,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->min_step = 0.0;
   s->linear_solver = FMB_LS_KLU;
   s->max_steps_per_output = 100000;
-  if (node < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
+  if (node < 0)
+    return fmb_parse_error(p, fmbp_root(p), "missing required key 'solver' (a mapping with at least t_end)");
   if (!fmbp_is_map(p, node)) {
     char keys[400] = "";
     for (size_t i = 0, used = 0; solver_keys[i]; ++i)
@@ -78,13 +79,12 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   integrators[nintegrators] = "auto";
   integrators[nintegrators + 1] = NULL;
   int formulation = FMB_FORM_AUTO, integrator = nintegrators; /* auto */
-  s->positions_only = -1; /* unset: chosen from the bodies */
+  s->positions_only = -1;                                     /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
   int atol_is_auto = 0;
   if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
-      fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) ||
-      get_atol(p, node, &s->atol, &atol_is_auto) ||
+      fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) || get_atol(p, node, &s->atol, &atol_is_auto) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
       fmb_get_double(p, node, "max_step", FMB_NONNEGATIVE, &s->max_step) ||
       fmb_get_double(p, node, "min_step", FMB_POSITIVE, &s->min_step) ||
@@ -107,24 +107,26 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
      weighs errors by 1/(rtol |y| + atol); 1e-200 makes every step fail). */
   if (s->rtol >= FMB_RTOL_MAX || s->rtol < FMB_RTOL_MIN)
     return fmb_parse_error(p, fmb_find_key(p, node, "rtol"),
-                           "expected rtol from %g to below %g (a relative tolerance), got %g", FMB_RTOL_MIN, FMB_RTOL_MAX,
-                           s->rtol);
+                           "expected rtol from %g to below %g (a relative tolerance), got %g", FMB_RTOL_MIN,
+                           FMB_RTOL_MAX, s->rtol);
   if (s->atol > FMB_ATOL_MAX || s->atol < FMB_ATOL_MIN)
-    return fmb_parse_error(p, fmb_find_key(p, node, "atol"),
-                           "expected atol from %g to %g (an absolute tolerance in SI units: metres, radians, m/s), got %g",
-                           FMB_ATOL_MIN, FMB_ATOL_MAX, s->atol);
+    return fmb_parse_error(
+        p, fmb_find_key(p, node, "atol"),
+        "expected atol from %g to %g (an absolute tolerance in SI units: metres, radians, m/s), got %g", FMB_ATOL_MIN,
+        FMB_ATOL_MAX, s->atol);
   s->min_step_given = s->min_step > 0.0;
   if (!s->min_step_given) s->min_step = FMB_MIN_STEP_FRACTION * (s->t_end - s->t0);
   if (s->min_step >= s->t_end - s->t0)
-    return fmb_parse_error(p, fmb_find_key(p, node, "min_step"), "min_step (%g) must be shorter than the run (t_end %g)",
-                           s->min_step, s->t_end);
+    return fmb_parse_error(p, fmb_find_key(p, node, "min_step"),
+                           "min_step (%g) must be shorter than the run (t_end %g)", s->min_step, s->t_end);
   if (s->output_step == 0.0) s->output_step = s->t_end / 1000.0;
   if (s->output_step > s->t_end)
     return fmb_parse_error(p, fmb_find_key(p, node, "output_step"), "output_step (%g) is longer than t_end (%g)",
-                         s->output_step, s->t_end);
+                           s->output_step, s->t_end);
   if (s->t_end / s->output_step > (double)FMB_MAX_ROWS)
     return fmb_parse_error(p, fmb_find_key(p, node, "output_step"),
-                         "output_step %g with t_end %g asks for more than %ld rows", s->output_step, s->t_end, FMB_MAX_ROWS);
+                           "output_step %g with t_end %g asks for more than %ld rows", s->output_step, s->t_end,
+                           FMB_MAX_ROWS);
   return 0;
 }
 
@@ -137,10 +139,13 @@ static int check_library(fmbParser* p, fmbNode lib, const char* what) {
   if (lib < 0) return 0;
   yaml_node_t* nd = fmbp_node(p, lib);
   if (!fmbp_is_map(p, lib))
-    return fmb_parse_error(p, lib, "expected a mapping of named entries for '%s', e.g. {steel: {density: 7850, youngs_modulus: 2.1e11}}", what);
+    return fmb_parse_error(
+        p, lib, "expected a mapping of named entries for '%s', e.g. {steel: {density: 7850, youngs_modulus: 2.1e11}}",
+        what);
   for (yaml_node_pair_t* pr = nd->data.mapping.pairs.start; pr < nd->data.mapping.pairs.top; ++pr)
     if (!fmbp_is_map(p, pr->value))
-      return fmb_parse_error(p, pr->value, "expected a mapping of keys for %s entry '%s'", what, fmbp_scalar(p, pr->key));
+      return fmb_parse_error(p, pr->value, "expected a mapping of keys for %s entry '%s'", what,
+                             fmbp_scalar(p, pr->key));
   return 0;
 }
 
@@ -163,7 +168,8 @@ static int resolve_references(fmbParser* p, fmbNode item) {
       char list[400] = "";
       size_t used = 0;
       yaml_node_t* nd = fmbp_node(p, lib);
-      for (yaml_node_pair_t* pr = nd ? nd->data.mapping.pairs.start : NULL; nd && pr < nd->data.mapping.pairs.top && used + 70 < sizeof list; ++pr)
+      for (yaml_node_pair_t* pr = nd ? nd->data.mapping.pairs.start : NULL;
+           nd && pr < nd->data.mapping.pairs.top && used + 70 < sizeof list; ++pr)
         used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", used ? ", " : "", fmbp_scalar(p, pr->key));
       return fmb_parse_error(p, ref, "no %s named '%s' (defined under '%s' at the top level: %s)", reference_keys[k],
                              name ? name : "?", library_keys[k], used ? list : "none");
@@ -202,7 +208,7 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   if (fmbp_get_name(p, item, "name", name)) return -1;
   if (name_taken(m, name))
     return fmb_parse_error(p, fmb_find_key(p, item, "name"),
-                         "duplicate or reserved name '%s': every body and joint needs its own name", name);
+                           "duplicate or reserved name '%s': every body and joint needs its own name", name);
   if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
   if (resolve_references(p, item)) return -1;
   p->item = item;
@@ -233,8 +239,11 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
 }
 
 static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
-  if (list < 0) return fmb_parse_error(p, fmbp_root(p), "missing required key 'bodies' (a list of bodies, each with name and type)");
-  if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list for 'bodies' (each item a mapping with name and type)");
+  if (list < 0)
+    return fmb_parse_error(p, fmbp_root(p),
+                           "missing required key 'bodies' (a list of bodies, each with name and type)");
+  if (!fmbp_is_seq(p, list))
+    return fmb_parse_error(p, list, "expected a list for 'bodies' (each item a mapping with name and type)");
   int n = fmbp_seq_len(p, list);
   if (n == 0) return fmb_parse_error(p, list, "'bodies' is empty: a scene needs at least one body");
   m->body = calloc((size_t)n + 1, sizeof *m->body);
@@ -272,7 +281,8 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
 
 static int parse_joints(fmbParser* p, fmbModel* m, fmbNode list) {
   if (list < 0) return 0;
-  if (!fmbp_is_seq(p, list)) return fmb_parse_error(p, list, "expected a list for 'joints' (each item a mapping with name and type)");
+  if (!fmbp_is_seq(p, list))
+    return fmb_parse_error(p, list, "expected a list for 'joints' (each item a mapping with name and type)");
   int n = fmbp_seq_len(p, list);
   m->joint = calloc((size_t)n + 1, sizeof *m->joint);
   m->input_joint = calloc((size_t)n + 1, sizeof *m->input_joint);
@@ -367,18 +377,19 @@ static int check_resources(fmbParser* p, fmbModel* m) {
     int big = 1;
     for (int b = 2; b < m->nbody; ++b)
       if (m->body[b].nq > m->body[big].nq) big = b;
-    return fmb_parse_error(p, m->nbody > 1 ? m->body[big].node : fmbp_root(p),
-                           "the model is too large to run here (largest body '%s', %d coordinates): %d unknowns need an "
-                           "estimated %.3g GB of memory (this machine offers %.3g GB) and %.3g operations per Newton "
-                           "matrix factorization (limit %.3g, a few seconds each): use fewer elements or bodies",
-                           m->body[big].name, m->body[big].nq, m->ny, bytes / 1e9, avail / 1e9, flops, FMB_WORK_FLOPS_MAX);
+    return fmb_parse_error(
+        p, m->nbody > 1 ? m->body[big].node : fmbp_root(p),
+        "the model is too large to run here (largest body '%s', %d coordinates): %d unknowns need an "
+        "estimated %.3g GB of memory (this machine offers %.3g GB) and %.3g operations per Newton "
+        "matrix factorization (limit %.3g, a few seconds each): use fewer elements or bodies",
+        m->body[big].name, m->body[big].nq, m->ny, bytes / 1e9, avail / 1e9, flops, FMB_WORK_FLOPS_MAX);
   }
   return 0;
 }
 
 /* the top-level keys, in the order parse_scene reads them (solver and bodies, the required ones,
    first: yaml_get.c's messages rely on it) */
-const char* const fmb_scene_keys[] = {"solver", "bodies", "joints", "outputs", "plugins", "gravity",
+const char* const fmb_scene_keys[] = {"solver",  "bodies", "joints",    "outputs",  "plugins", "gravity",
                                       "initial", "vtk",    "materials", "sections", NULL};
 
 static int parse_scene(fmbParser* p, fmbModel* m) {
@@ -414,7 +425,9 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);
   for (int k = 0; k < 2; ++k)
     if (check_library(p, library[k], library_keys[k])) return -1;
-  if (fmb_scene_plugins(p, plugins) || parse_solver(p, m, solver) || parse_bodies(p, m, bodies) || parse_joints(p, m, joints)) return -1;
+  if (fmb_scene_plugins(p, plugins) || parse_solver(p, m, solver) || parse_bodies(p, m, bodies) ||
+      parse_joints(p, m, joints))
+    return -1;
   for (int k = 0; k < 2; ++k)
     if (library[k] >= 0 && check_library_keys(p, library[k], reference_keys[k])) return -1;
   if (m->nq == 0) return fmb_parse_error(p, bodies, "the scene has no moving body (no generalized coordinates)");
@@ -447,10 +460,11 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
   if (!diag) diag = &local_diag;
   memset(diag, 0, sizeof *diag);
   /* the registry itself is whole: every type entered it through fmb_registry_add's checks */
-  const char* misuse = !path                                                ? "fmb_load: no scene path (NULL)"
-                       : (noverrides < 0 || (noverrides > 0 && !overrides)) ? "fmb_load: overrides NULL or a negative count"
-                       : !reg                                               ? "fmb_load: no registry (NULL)"
-                                                                            : NULL;
+  const char* misuse = !path ? "fmb_load: no scene path (NULL)"
+                       : (noverrides < 0 || (noverrides > 0 && !overrides))
+                           ? "fmb_load: overrides NULL or a negative count"
+                       : !reg ? "fmb_load: no registry (NULL)"
+                              : NULL;
   for (int i = 0; !misuse && i < noverrides; ++i)
     if (!overrides[i]) misuse = "fmb_load: an override is NULL";
   if (misuse) {
@@ -523,12 +537,13 @@ int fmb_model_joint(const fmbModel* m, int i, const char** name, const char** ty
 
 void fmb_describe(const fmbModel* m, FILE* f) {
   if (!m || !f) return;
-  fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n",
-          m->path, m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);
+  fprintf(f, "scene %s: %d bodies, %d joints, %d coordinates, %d constraint rows, %d unknowns, %ld nonzeros\n", m->path,
+          m->nbody - 1, m->njoint, m->nq, m->nc, m->ny, m->nnz);
   fprintf(f, "gravity: %s\n", m->env.has_gravity ? "on" : "off (no gravity terms evaluated)");
   double bytes = 0.0, flops = 0.0;
   estimate_resources(m, &bytes, &flops);
-  fprintf(f, "resources: ~%.3g MB of memory, ~%.3g flops per Newton matrix factorization (estimates)\n", bytes / 1e6, flops);
+  fprintf(f, "resources: ~%.3g MB of memory, ~%.3g flops per Newton matrix factorization (estimates)\n", bytes / 1e6,
+          flops);
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     fprintf(f, "body '%s' (%s, %d coordinates)%s", bi->name, bi->type->name, bi->nq, bi->type->describe ? ": " : "\n");
@@ -536,7 +551,8 @@ void fmb_describe(const fmbModel* m, FILE* f) {
   }
   for (int j = 0; j < m->njoint; ++j) {
     const fmbJointInst* ji = &m->joint[j];
-    fprintf(f, "joint '%s' (%s, %d constraint rows)%s", ji->name, ji->type->name, ji->nrows, ji->type->describe ? ": " : "\n");
+    fprintf(f, "joint '%s' (%s, %d constraint rows)%s", ji->name, ji->type->name, ji->nrows,
+            ji->type->describe ? ": " : "\n");
     if (ji->type->describe) ji->type->describe(ji->self, f);
   }
   fprintf(f, "outputs:");

@@ -38,25 +38,25 @@
 
 struct fmbSchur {
   const fmbModel* m;
-  int nq, nr;          /* eliminated rows, rows kept */
-  int nc;              /* doubles per value: 1 real, 2 complex (interleaved, as KLU's klu_zl_*) */
-  long* first_kept;    /* per column of J: position of its first row >= nq (rows are sorted) */
-  long* diag_pos;      /* per q column: position of J's (i, i) */
+  int nq, nr;                        /* eliminated rows, rows kept */
+  int nc;                            /* doubles per value: 1 real, 2 complex (interleaved, as KLU's klu_zl_*) */
+  long* first_kept;                  /* per column of J: position of its first row >= nq (rows are sorted) */
+  long* diag_pos;                    /* per q column: position of J's (i, i) */
   SuiteSparse_long *colptr, *rowind; /* S, CSC */
   /* the blocks the solves need, copied at factorization with D^-1 applied and kept-row indices
      made relative (a tight loop: the solves run once per Newton iteration, factorizations rarely) */
   int *rq_ptr, *rq_run_ptr, *run_row, *run_len; /* J_Rq by q column, in runs of consecutive */
-  int *qr_ptr, *qr_row;                           /* rows (the inner loop vectorizes); D^-1 J_qR by kept column */
+  int *qr_ptr, *qr_row;                         /* rows (the inner loop vectorizes); D^-1 J_qR by kept column */
   /* J_Rq = dF_R/dq is real for every cj, complex included: F_R holds no q' (the only q' is in
      F_q), so J_Rq has no cj J_y' part. It is kept real (one double per value) and D^-1 is applied
      to the complex b_q or coefficient instead: a real times a complex is half a complex product.
      The real system keeps J_Rq D^-1 (schur_kernels.h) */
   double* rq_val;
   /* values, nc doubles each */
-  double* dinv;        /* 1 / J_ii of the last factorization */
-  double* data;        /* S */
+  double* dinv; /* 1 / J_ii of the last factorization */
+  double* data; /* S */
   double* qr_val;
-  double* acc;         /* dense column / vector scratch, nr, kept zero between uses */
+  double* acc; /* dense column / vector scratch, nr, kept zero between uses */
   double* dq;
   fmbKlu* klu; /* S's LU (klu.c), complex when nc == 2 */
   /* small, dense S (schur_use_dense): a dense LU instead of KLU; lu is S column-major (nr x nr,
@@ -226,7 +226,8 @@ static int schur_blocks(fmbSchur* s) {
   s->qr_val = malloc(sizeof(double) * (size_t)s->nc * (size_t)(n + 1));
   if (!s->qr_row || !s->qr_val) return -1;
   for (int c = 0; c < nr; ++c)
-    for (long k = m->colptr[nq + c]; k < s->first_kept[nq + c]; ++k) s->qr_row[s->qr_ptr[c] + (k - m->colptr[nq + c])] = (int)m->rowind[k];
+    for (long k = m->colptr[nq + c]; k < s->first_kept[nq + c]; ++k)
+      s->qr_row[s->qr_ptr[c] + (k - m->colptr[nq + c])] = (int)m->rowind[k];
   return 0;
 }
 

@@ -80,8 +80,8 @@ static double norm2(const double* x, int n) {
 
 /* The rigid rotation the constraints prescribe at t, from the least-squares fit of
    Phi_q v(W, W c) = -Phi_t (module comment). 0, or FMB_EXIT_BAD_INPUT with *diag. */
-static int fit_rotation(const fmbModel* m, fmbWorkspace* w, double t, const double* q, double* speed,
-                        double center[2], fmbDiag* diag) {
+static int fit_rotation(const fmbModel* m, fmbWorkspace* w, double t, const double* q, double* speed, double center[2],
+                        fmbDiag* diag) {
   const int nq = m->nq, nc = m->nc;
   *speed = 0.0;
   center[0] = center[1] = 0.0;
@@ -164,7 +164,8 @@ static int fit_rotation(const fmbModel* m, fmbWorkspace* w, double t, const doub
     goto done;
   }
   if (frameless) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "a steady rotation needs every body to have a frame (x, y, theta)");
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "a steady rotation needs every body to have a frame (x, y, theta)");
     rc = FMB_EXIT_BAD_INPUT;
     goto done;
   }
@@ -201,7 +202,7 @@ typedef struct {
   const fmbModel* m;
   fmbWorkspace* w;
   double t, speed, center[2];
-  int n;            /* nq + nc */
+  int n; /* nq + nc */
   double *y, *yp, *F, *ewt, *J0, *J1, *A;
   int* piv;
 } Newton;
@@ -424,7 +425,8 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
   if (s.speed != 0.0) turn_to_drives(&s, x);
   if ((rc = initial_multipliers(&s, x, diag))) goto done;
   if (eval_F(&s, x, F0)) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the starting point (t = %g)", opt.t);
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the starting point (t = %g)",
+                 opt.t);
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
@@ -438,17 +440,19 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
   if (s.speed == 0.0 && res->residual_start <= FMB_STATIC_NO_LOAD) {
     const int free_motions = singular_stiffness(&s, x);
     if (free_motions < 0) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equilibrium equations cannot be evaluated (t = %g)", opt.t);
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equilibrium equations cannot be evaluated (t = %g)",
+                   opt.t);
       rc = FMB_EXIT_SOLVER;
       goto done;
     }
     if (free_motions > 0) {
-      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                   "no unique equilibrium: nothing loads the system (no gravity, spring or applied force; out-of-balance "
-                   "load %.3g) and its stiffness is singular, so every pose along its free motion (a mechanism's degree "
-                   "of freedom, a free body) is in equilibrium. Add the load or the spring that holds it, or fix that "
-                   "motion with a joint or a drive",
-                   res->residual_start);
+      fmb_diag_set(
+          diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+          "no unique equilibrium: nothing loads the system (no gravity, spring or applied force; out-of-balance "
+          "load %.3g) and its stiffness is singular, so every pose along its free motion (a mechanism's degree "
+          "of freedom, a free body) is in equilibrium. Add the load or the spring that holds it, or fix that "
+          "motion with a joint or a drive",
+          res->residual_start);
       rc = FMB_EXIT_BAD_INPUT;
       goto done;
     }
@@ -499,11 +503,12 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
     } else {
       ds *= 0.5;
       if (++halvings > opt.max_halvings && singular) {
-        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0,
-                     "no equilibrium found: the equilibrium equations are singular (%d Newton iterations): some motion "
-                     "is held by nothing (a body without supports under a load, a mechanism at a dead point, a pendulum "
-                     "started exactly horizontal). Support the body, or start it away from the dead point",
-                     res->iterations);
+        fmb_diag_set(
+            diag, FMB_EXIT_SOLVER, m->path, 0, 0,
+            "no equilibrium found: the equilibrium equations are singular (%d Newton iterations): some motion "
+            "is held by nothing (a body without supports under a load, a mechanism at a dead point, a pendulum "
+            "started exactly horizontal). Support the body, or start it away from the dead point",
+            res->iterations);
         rc = FMB_EXIT_SOLVER;
         goto done;
       }

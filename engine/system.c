@@ -25,7 +25,7 @@
 #include "internal.h"
 
 struct fmbWorkspace {
-  double* plugin;  /* m->nwork: plugin scratch */
+  double* plugin; /* m->nwork: plugin scratch */
   /* joint scratch */
   double *phi, *phi_q, *phi_q2, *phi_t, *phi_tt, *jq, *jv, *jQ, *jQ2;
   int* cols;
@@ -42,9 +42,9 @@ struct fmbWorkspace {
   double* cache;
   size_t* cache_adr;
   int cache_valid;
-  double* work_done; /* njoint: accumulated work of each joint (step.c fills it) */
+  double* work_done;        /* njoint: accumulated work of each joint (step.c fills it) */
   unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
-  int nredundant_cap; /* nc */
+  int nredundant_cap;       /* nc */
   /* an object a layer above keeps with the workspace and frees with it (output.c: the augmented
      system of the multipliers the outputs show), so that this file calls nothing above it */
   void* attached;
@@ -116,8 +116,9 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
     fmb_workspace_free(w);
     return NULL;
   }
-  if (!w->work_done || !w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq || !w->jv || !w->jQ ||
-      !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fdcol || !w->fd || !w->mk || !w->js || !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
+  if (!w->work_done || !w->plugin || !w->phi || !w->phi_t || !w->phi_tt || !w->phi_q || !w->phi_q2 || !w->jq ||
+      !w->jv || !w->jQ || !w->jQ2 || !w->cols || !w->K || !w->C || !w->M || !w->fdcol || !w->fd || !w->mk || !w->js ||
+      !w->qpert || !w->vpert || !w->ewt_default || !w->Qg) {
     fmb_workspace_free(w);
     return NULL;
   }
@@ -154,8 +155,9 @@ void fmb_workspace_free(fmbWorkspace* w) {
   free(w->redundant);
   free(w->input);
   if (w->attached_free) w->attached_free(w->attached);
-  double* bufs[] = {w->cache, w->plugin, w->phi, w->phi_t, w->phi_tt, w->phi_q, w->phi_q2, w->jq, w->jv, w->jQ, w->jQ2,
-                    w->K, w->C, w->M, w->fdcol, w->fd, w->mk, w->js, w->qpert, w->vpert, w->ewt_default, w->Mg, w->PhiQ, w->Qg};
+  double* bufs[] = {w->cache, w->plugin, w->phi,   w->phi_t, w->phi_tt,      w->phi_q, w->phi_q2, w->jq,
+                    w->jv,    w->jQ,     w->jQ2,   w->K,     w->C,           w->M,     w->fdcol,  w->fd,
+                    w->mk,    w->js,     w->qpert, w->vpert, w->ewt_default, w->Mg,    w->PhiQ,   w->Qg};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
   free(w->cols);
   free(w);
@@ -287,7 +289,8 @@ int fmb_joint_support(const fmbModel* m, fmbWorkspace* w, int j, int* sup) {
   int all = !hit || !q;
   if (!all) {
     double *v = q + nq, *q0 = v + nq, *v0 = q0 + nq;
-    for (int b = 1; b < m->nbody; ++b) m->body[b].type->initial(m->body[b].self, q0 + m->body[b].qadr, v0 + m->body[b].qadr);
+    for (int b = 1; b < m->nbody; ++b)
+      m->body[b].type->initial(m->body[b].self, q0 + m->body[b].qadr, v0 + m->body[b].qadr);
     unsigned long long seed = 0x9E3779B97F4A7C15ull + (unsigned long long)j;
     for (int probe = 0; probe < 2 && !all; ++probe) {
       for (int i = 0; i < 2 * nq; ++i) {
@@ -435,7 +438,8 @@ static void sink_block(const Sink* s, int r0, int nr, int c0, int nc, const doub
     return;
   }
   for (int j = 0; j < nc; ++j)
-    for (int i = 0; i < nr; ++i) s->dense[(size_t)(c0 + j) * (size_t)s->m->ny + (size_t)(r0 + i)] += scale * vals[(size_t)j * ld + i];
+    for (int i = 0; i < nr; ++i)
+      s->dense[(size_t)(c0 + j) * (size_t)s->m->ny + (size_t)(r0 + i)] += scale * vals[(size_t)j * ld + i];
 }
 
 int fmb_body_blocks(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double* v, const double* a,
@@ -475,7 +479,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     }
     if (!reuse) {
       int rc = bi->pnnz >= 0 ? fmb_body_sparse_blocks(bi, &m->env, q + a0, v + a0, vp + a0, y + m->zoff + bi->zadr,
-                                                  ewt + a0, ewt + nq + a0, K, C, M, w->plugin + bi->workadr, w->fd)
+                                                      ewt + a0, ewt + nq + a0, K, C, M, w->plugin + bi->workadr, w->fd)
                              : fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, K, C, M);
       if (rc) {
         w->cache_valid = 0;
@@ -593,7 +597,8 @@ int fmb_body_mass(const fmbModel* m, fmbWorkspace* w, int b, const double* q, co
   return fmb_fd_body_jacobian(bi, &m->env, q, v, a, ew, ew + m->nq, NULL, NULL, M, w->plugin + bi->workadr, w->fd);
 }
 
-int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* Qtot) {
+int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                           double* Qtot) {
   memset(Qtot, 0, (size_t)m->nq * sizeof(double));
   double* zero = w->fd + 6 * (size_t)w->max_nq;
   for (int b = 1; b < m->nbody; ++b) {
@@ -624,7 +629,8 @@ int fmb_generalized_forces(const fmbModel* m, fmbWorkspace* w, double t, const d
    error is divided by the vanishing singular value of Phi_q: the accelerations of a parallelogram
    4e-4 rad from flat were ~1e-3 off, and the integrator failed its error test there at tight
    tolerances. Uses w->qpert. */
-int fmb_constraints_gamma(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double* gamma) {
+int fmb_constraints_gamma(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                          double* gamma) {
   const int nq = m->nq;
   double vmax = 0.0;
   for (int i = 0; i < nq; ++i) vmax = fmax(vmax, fabs(v[i]));
@@ -709,7 +715,8 @@ void fmb_energy(const fmbModel* m, fmbWorkspace* w, double t, const double* q, c
  * definite on null(Phi_q) iff M + r Phi_q^T Phi_q is positive definite for r large enough; a
  * Cholesky factorization with r = 1e8 (relative to M's diagonal) tells. Runs only when a body
  * declares its model can lose definiteness (FOAC). */
-int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v, double singular_tol) {
+int fmb_check_mass(const fmbModel* m, fmbWorkspace* w, double t, const double* q, const double* v,
+                   double singular_tol) {
   if (!m->check_definiteness) return 0;
   const int nq = m->nq;
   memset(w->Mg, 0, (size_t)nq * nq * sizeof(double));

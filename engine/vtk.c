@@ -12,8 +12,8 @@
  * .vtu when complete, the .pvd when the run ends, also when it stops early, so a run that stops
  * leaves a valid collection of the steps written so far, like its CSV). */
 #include <errno.h>
-#include <stdint.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -35,7 +35,7 @@ static int cell_type(int part) {
 
 struct fmbVtk {
   char* dir;
-  char* stem; /* the scene's file name without directory and extension */
+  char* stem;            /* the scene's file name without directory and extension */
   fmbSafeFile* pvd_file; /* beside its target until the run closes it (engine/safe_file.c) */
   FILE* pvd;
   long step;
@@ -49,7 +49,6 @@ struct fmbVtk {
   int64_t* i64;
   uint8_t* u8;
 };
-
 
 static const char pvd_tail[] = "  </Collection>\n</VTKFile>\n";
 
@@ -104,12 +103,15 @@ fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag) {
   v->pvd_file = fmb_safe_open(path, err, sizeof err);
   v->pvd = fmb_safe_stream(v->pvd_file);
   if (!v->pvd) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the VTK collection: %s", err[0] ? err : strerror(errno));
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the VTK collection: %s",
+                 err[0] ? err : strerror(errno));
     fmb_vtk_close(v);
     return NULL;
   }
-  fprintf(v->pvd, "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-                  "  <Collection>\n%s", pvd_tail);
+  fprintf(v->pvd,
+          "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+          "  <Collection>\n%s",
+          pvd_tail);
   fflush(v->pvd);
   return v;
 }
@@ -130,8 +132,9 @@ static const ArraySpec array_spec[NARR] = {
 };
 
 static void array_tag(FILE* f, int k, const uint64_t* offset) {
-  fprintf(f, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"appended\" offset=\"%llu\"/>\n",
-          array_spec[k].type, array_spec[k].name, array_spec[k].ncomp, (unsigned long long)offset[k]);
+  fprintf(
+      f, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"appended\" offset=\"%llu\"/>\n",
+      array_spec[k].type, array_spec[k].name, array_spec[k].ncomp, (unsigned long long)offset[k]);
 }
 
 static void block(FILE* f, const void* data, uint64_t bytes) {
@@ -180,8 +183,8 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
       v->rot[i] = ang - qb[2];
     }
   }
-  const uint64_t count[NARR] = {3 * (uint64_t)np, (uint64_t)np, (uint64_t)nc, (uint64_t)nc, 3 * (uint64_t)np,
-                                (uint64_t)nconn, (uint64_t)nc, (uint64_t)nc};
+  const uint64_t count[NARR] = {3 * (uint64_t)np, (uint64_t)np,    (uint64_t)nc, (uint64_t)nc,
+                                3 * (uint64_t)np, (uint64_t)nconn, (uint64_t)nc, (uint64_t)nc};
   uint64_t offset[NARR], at = 0;
   for (int k = 0; k < NARR; ++k) {
     offset[k] = at;
@@ -195,12 +198,14 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   }
   const uint16_t one = 1;
   const int little = *(const unsigned char*)&one == 1;
-  fprintf(f, "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
-             "header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n"
-             "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.12g</DataArray>\n"
-             "    </FieldData>\n    <Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n"
-             "      <PointData Vectors=\"deformation\" Scalars=\"rotation\">\n",
-          little ? "LittleEndian" : "BigEndian", t, np, nc);
+  fprintf(
+      f,
+      "<?xml version=\"1.0\"?>\n<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"%s\" "
+      "header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n"
+      "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.12g</DataArray>\n"
+      "    </FieldData>\n    <Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n"
+      "      <PointData Vectors=\"deformation\" Scalars=\"rotation\">\n",
+      little ? "LittleEndian" : "BigEndian", t, np, nc);
   array_tag(f, ARR_DEFORMATION, offset);
   array_tag(f, ARR_ROTATION, offset);
   fprintf(f, "      </PointData>\n      <CellData Scalars=\"part\">\n");

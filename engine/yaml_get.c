@@ -45,7 +45,7 @@ int fmbp_is_seq(fmbParser* p, fmbNode n) {
 int fmbp_seq_len(fmbParser* p, fmbNode seq) {
   yaml_node_t* nd = fmbp_node(p, seq);
   return (nd && nd->type == YAML_SEQUENCE_NODE) ? (int)(nd->data.sequence.items.top - nd->data.sequence.items.start)
-                                                 : 0;
+                                                : 0;
 }
 fmbNode fmbp_seq_item(fmbParser* p, fmbNode seq, int i) {
   yaml_node_t* nd = fmbp_node(p, seq);
@@ -156,7 +156,8 @@ static int key_distance(const char* a, const char* b) {
       int v = d[i - 1][j] + 1;
       if (d[i][j - 1] + 1 < v) v = d[i][j - 1] + 1;
       if (d[i - 1][j - 1] + cost < v) v = d[i - 1][j - 1] + cost;
-      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && d[i - 2][j - 2] + 1 < v) v = d[i - 2][j - 2] + 1;
+      if (i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] && d[i - 2][j - 2] + 1 < v)
+        v = d[i - 2][j - 2] + 1;
       d[i][j] = v;
     }
   return d[la][lb];
@@ -208,8 +209,10 @@ int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {
       char read[600] = "";
       for (int i = 0, used = 0; i < p->nlooked && used + 40 < (int)sizeof read; ++i)
         used += snprintf(read + used, sizeof read - used, "%s%s", i ? ", " : "", p->looked[i]);
-      return fmb_parse_error(p, pr->key, "key '%s' does not apply to %s as written: it is read only with other "
-                             "settings (keys read here: %s)", k, what, read);
+      return fmb_parse_error(p, pr->key,
+                             "key '%s' does not apply to %s as written: it is read only with other "
+                             "settings (keys read here: %s)",
+                             k, what, read);
     }
     return unknown_key_error(p, pr->key, k, what);
   }
@@ -283,7 +286,8 @@ static int check_duplicates(fmbParser* p) {
       }
       if (slot[h]) {
         yaml_node_t* first = fmbp_node(p, slot[h]->key);
-        rc = fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka, (int)first->start_mark.line + 1);
+        rc = fmb_parse_error(p, a->key, "duplicate key '%s' (first given at line %d)", ka,
+                             (int)first->start_mark.line + 1);
         break;
       }
       slot[h] = a;
@@ -365,12 +369,13 @@ static void check_plausible(fmbParser* p, fmbNode n, const char* key, double val
   for (unsigned r = 0; r < sizeof plausibility / sizeof plausibility[0]; ++r) {
     if (strcmp(par->unit, plausibility[r].unit) != 0 || (plausibility[r].key && strcmp(plausibility[r].key, key) != 0))
       continue;
-    const int low = value < plausibility[r].lo, high = value > plausibility[r].hi;
+    const int low = value<plausibility[r].lo, high = value> plausibility[r].hi;
     if ((!low && !high) || (p->plausibility_warned & (1u << r))) continue;
     p->plausibility_warned |= 1u << r;
-    fmbp_warning_at(p, n, "'%s: %g' %s %g %s, outside the range of real parts and materials (%g to %g %s): %s", key, value,
-               low ? "is below" : "is above", low ? plausibility[r].lo : plausibility[r].hi, par->unit,
-               plausibility[r].lo, plausibility[r].hi, par->unit, low ? plausibility[r].below : plausibility[r].above);
+    fmbp_warning_at(p, n, "'%s: %g' %s %g %s, outside the range of real parts and materials (%g to %g %s): %s", key,
+                    value, low ? "is below" : "is above", low ? plausibility[r].lo : plausibility[r].hi, par->unit,
+                    plausibility[r].lo, plausibility[r].hi, par->unit,
+                    low ? plausibility[r].below : plausibility[r].above);
   }
 }
 
@@ -391,16 +396,19 @@ int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
   if (n < 0) return absent(p, map, key, flags, "an angle");
   yaml_node_t* nd = fmbp_node(p, n);
   const char* s = fmbp_scalar(p, n);
-  if (!s || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE || nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
-    return fmb_parse_error(p, n, "expected an angle for '%s' (radians, or with a unit: 120 deg, 2.1 rad), found %s", key,
-                           node_kind(nd));
+  if (!s || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
+      nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
+    return fmb_parse_error(p, n, "expected an angle for '%s' (radians, or with a unit: 120 deg, 2.1 rad), found %s",
+                           key, node_kind(nd));
   char num[64];
   size_t len = strcspn(s, " \tdr"); /* the number ends where the unit (deg, rad) begins */
   double scale = 1.0;
   const char* unit = s + len;
   while (*unit == ' ' || *unit == '\t') ++unit;
-  if (strcmp(unit, "deg") == 0) scale = two_pi / 360.0;
-  else if (*unit && strcmp(unit, "rad") != 0) len = strlen(s); /* not a unit: the whole text is reported */
+  if (strcmp(unit, "deg") == 0)
+    scale = two_pi / 360.0;
+  else if (*unit && strcmp(unit, "rad") != 0)
+    len = strlen(s); /* not a unit: the whole text is reported */
   double v = 0.0;
   int rc = len < sizeof num ? 0 : -1;
   if (rc == 0) {
@@ -409,13 +417,16 @@ int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
     rc = parse_number(num, &v);
   }
   if (rc == -2) return fmb_parse_error(p, n, "expected a finite angle for '%s', got '%s'", key, s);
-  if (rc) return fmb_parse_error(p, n, "expected an angle for '%s' (radians, or with a unit: 120 deg, 2.1 rad), got '%s'", key, s);
-  if ((flags & FMB_POSITIVE) && !(v > 0)) return fmb_parse_error(p, n, "expected a positive angle for '%s', got %s", key, s);
+  if (rc)
+    return fmb_parse_error(p, n, "expected an angle for '%s' (radians, or with a unit: 120 deg, 2.1 rad), got '%s'",
+                           key, s);
+  if ((flags & FMB_POSITIVE) && !(v > 0))
+    return fmb_parse_error(p, n, "expected a positive angle for '%s', got %s", key, s);
   if ((flags & FMB_NONNEGATIVE) && !(v >= 0))
     return fmb_parse_error(p, n, "expected a non-negative angle for '%s', got %s", key, s);
   if ((flags & FMB_POSE) && !*unit && fabs(v) > two_pi)
     fmbp_warning_at(p, n, "'%s: %s' is taken as radians (%.3g turns); write '%s deg' if degrees were meant", key, s,
-               fabs(v) / two_pi, s);
+                    fabs(v) / two_pi, s);
   *out = v * scale;
   return 0;
 }
@@ -432,7 +443,7 @@ int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long
   if (!s || !*s || *end != '\0' || errno == ERANGE || nd->data.scalar.style == YAML_SINGLE_QUOTED_SCALAR_STYLE ||
       nd->data.scalar.style == YAML_DOUBLE_QUOTED_SCALAR_STYLE)
     return fmb_parse_error(p, n, "expected a whole number for '%s', found %s%s%s%s", key, s ? "'" : "",
-                         s ? s : node_kind(nd), s ? "'" : "", "");
+                           s ? s : node_kind(nd), s ? "'" : "", "");
   if (v < lo || v > hi)
     return fmb_parse_error(p, n, "expected a whole number from %ld to %ld for '%s', got %ld", lo, hi, key, v);
   *out = (int)v;
@@ -445,7 +456,7 @@ int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, dou
   if (n < 0) return absent(p, map, key, flags, "a list of two numbers [x, y]");
   if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != 2)
     return fmb_parse_error(p, n, "expected a list of two numbers [x, y] for '%s', found %s", key,
-                         fmbp_is_seq(p, n) ? "a list of another length" : node_kind(fmbp_node(p, n)));
+                           fmbp_is_seq(p, n) ? "a list of another length" : node_kind(fmbp_node(p, n)));
   double v[2];
   for (int i = 0; i < 2; ++i)
     if (number_at(p, fmbp_seq_item(p, n, i), key, flags & ~(unsigned)FMB_REQUIRED, &v[i])) return -1;
@@ -523,8 +534,11 @@ static int table_file(fmbParser* p, fmbNode n, const char* key, double** x, doub
   if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode) || st.st_size > TABLE_FILE_MAX) {
     const int regular = fstat(fd, &st) == 0 && S_ISREG(st.st_mode);
     close(fd);
-    if (!regular) return fmb_parse_error(p, n, "the table file '%s' for '%s' is not a regular file (a FIFO or device would be "
-                                               "read without end)", path, key);
+    if (!regular)
+      return fmb_parse_error(p, n,
+                             "the table file '%s' for '%s' is not a regular file (a FIFO or device would be "
+                             "read without end)",
+                             path, key);
     return fmb_parse_error(p, n, "the table file '%s' for '%s' is larger than %d MB", path, key, TABLE_FILE_MAX >> 20);
   }
   const int flags = fcntl(fd, F_GETFL);
@@ -548,8 +562,8 @@ static int table_file(fmbParser* p, fmbNode n, const char* key, double** x, doub
       while ((c = getc(f)) != EOF && c != '\n' && bytes <= TABLE_FILE_MAX) ++bytes;
       if (comment && bytes <= TABLE_FILE_MAX) continue;
       if (!comment) {
-        rc = fmb_parse_error(p, n, "table file '%s' line %d: longer than %d characters; a row is 't,value'", path, lineno,
-                             TABLE_LINE_MAX);
+        rc = fmb_parse_error(p, n, "table file '%s' line %d: longer than %d characters; a row is 't,value'", path,
+                             lineno, TABLE_LINE_MAX);
         break;
       }
     }
@@ -614,13 +628,12 @@ int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, do
   *n = rows;
   for (int i = 1; i < rows; ++i)
     if (!((*x)[i] > (*x)[i - 1]))
-      return fmb_parse_error(p, node, "the table '%s' must have strictly increasing t (row %d: %g after %g)", key, i + 1,
-                             (*x)[i], (*x)[i - 1]);
+      return fmb_parse_error(p, node, "the table '%s' must have strictly increasing t (row %d: %g after %g)", key,
+                             i + 1, (*x)[i], (*x)[i - 1]);
   return 0;
 }
 
-int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
-                   int* out) {
+int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices, int* out) {
   if (!p || !key || !choices || !out) return -1;
   fmbNode n = fmb_find_key(p, map, key);
   char list[400] = "";
@@ -643,7 +656,7 @@ int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, c
         return 0;
       }
   return fmb_parse_error(p, n, "expected one of %s for '%s', got %s%s%s", list, key, s ? "'" : "",
-                       s ? s : node_kind(fmbp_node(p, n)), s ? "'" : "");
+                         s ? s : node_kind(fmbp_node(p, n)), s ? "'" : "");
 }
 
 int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_MAX]) {
@@ -652,7 +665,8 @@ int fmbp_get_name(fmbParser* p, fmbNode map, const char* key, char out[FMB_NAME_
   const char* s = fmbp_scalar(p, n);
   if (!s || !*s) return fmb_parse_error(p, n, "expected a name for '%s', found %s", key, node_kind(fmbp_node(p, n)));
   size_t len = strlen(s);
-  if (len >= FMB_NAME_MAX) return fmb_parse_error(p, n, "name '%.20s...' is too long (at most %d characters)", s, FMB_NAME_MAX - 1);
+  if (len >= FMB_NAME_MAX)
+    return fmb_parse_error(p, n, "name '%.20s...' is too long (at most %d characters)", s, FMB_NAME_MAX - 1);
   for (const char* c = s; *c; ++c)
     if (!(isalnum((unsigned char)*c) || *c == '_' || *c == '-'))
       return fmb_parse_error(p, n, "name '%s' may contain only letters, digits, '_' and '-'", s);
@@ -683,9 +697,9 @@ static int get_named(fmbParser* p, fmbNode map, const char* key, unsigned flags,
   size_t used = 0;
   for (int i = 0; i < count && used + 70 < sizeof list; ++i)
     used += (size_t)snprintf(list + used, sizeof list - used, "%s%s", i ? ", " : "", name_at(m, i));
-  return fmb_parse_error(p, n, "no %s named %s%s%s for '%s' (%s%s)", what, s ? "'" : "", s ? s : "(not a name)", s ? "'" : "",
-                       key, joints ? "a joint must be defined above the one that uses it; defined: " : "bodies: ",
-                       used ? list : "none");
+  return fmb_parse_error(
+      p, n, "no %s named %s%s%s for '%s' (%s%s)", what, s ? "'" : "", s ? s : "(not a name)", s ? "'" : "", key,
+      joints ? "a joint must be defined above the one that uses it; defined: " : "bodies: ", used ? list : "none");
 }
 
 int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out) {
@@ -738,8 +752,8 @@ static int copy_node(fmbParser* p, yaml_document_t* src, int id, int* budget) {
   yaml_node_t* s = yaml_document_get_node(src, id);
   int nid = 0;
   if (s->type == YAML_SCALAR_NODE) {
-    nid = yaml_document_add_scalar(&p->doc, NULL, s->data.scalar.value, (int)s->data.scalar.length,
-                                   s->data.scalar.style);
+    nid =
+        yaml_document_add_scalar(&p->doc, NULL, s->data.scalar.value, (int)s->data.scalar.length, s->data.scalar.style);
   } else if (s->type == YAML_SEQUENCE_NODE) {
     nid = yaml_document_add_sequence(&p->doc, NULL, YAML_FLOW_SEQUENCE_STYLE);
     int n = (int)(s->data.sequence.items.top - s->data.sequence.items.start);
@@ -815,14 +829,15 @@ static int apply_override(fmbParser* p, int ov) {
   }
   yaml_parser_delete(&parser);
   if (more) {
-    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: expected one YAML value after '=', found more after it",
-                 text);
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0,
+                 "%s: expected one YAML value after '=', found more after it", text);
     yaml_document_delete(&vdoc);
     return -1;
   }
 
   if (path[0] == '.' || path[plen - 1] == '.' || strstr(path, "..")) {
-    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: empty name in the path (write names separated by single dots, e.g. solver.rtol)", text);
+    fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0,
+                 "%s: empty name in the path (write names separated by single dots, e.g. solver.rtol)", text);
     yaml_document_delete(&vdoc);
     return -1;
   }
@@ -871,8 +886,9 @@ static int apply_override(fmbParser* p, int ov) {
       int budget = FMB_OVERRIDE_NODES_MAX;
       int vid = copy_node(p, &vdoc, 1, &budget);
       if (!vid) {
-        fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", text,
-                     budget < 0 ? "the value is too large or refers to itself (through a YAML alias)" : "out of memory");
+        fmb_diag_set(
+            p->diag, FMB_EXIT_BAD_INPUT, "--set", 0, 0, "%s: %s", text,
+            budget < 0 ? "the value is too large or refers to itself (through a YAML alias)" : "out of memory");
         rc = -1;
         break;
       }
@@ -913,7 +929,8 @@ static int apply_override(fmbParser* p, int ov) {
    it was reading began. */
 static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* parser, FILE* f) {
   if (parser->error == YAML_MEMORY_ERROR) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "the scene is too large to load: out of memory while parsing it");
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0,
+                 "the scene is too large to load: out of memory while parsing it");
     return;
   }
   const char* problem = parser->problem ? parser->problem : "unknown problem";
@@ -939,8 +956,10 @@ static void syntax_error(fmbDiag* diag, const char* path, const yaml_parser_t* p
   rewind(f);
   for (size_t line = 0, col = 0; (at = getc(f)) != EOF;) {
     if (line == mk.line && col == mk.column && (at & 0xC0) != 0x80) break;
-    if (at == '\n') ++line, col = 0;
-    else if ((at & 0xC0) != 0x80) ++col;
+    if (at == '\n')
+      ++line, col = 0;
+    else if ((at & 0xC0) != 0x80)
+      ++col;
     if (line > mk.line) {
       at = -1;
       break;
@@ -1055,7 +1074,8 @@ static int pairs_have_key(yaml_document_t* doc, const yaml_node_pair_t* pairs, i
   if (!k || k->type != YAML_SCALAR_NODE) return 0;
   for (int i = 0; i < n; ++i) {
     yaml_node_t* o = yaml_document_get_node(doc, pairs[i].key);
-    if (o && o->type == YAML_SCALAR_NODE && strcmp((const char*)o->data.scalar.value, (const char*)k->data.scalar.value) == 0)
+    if (o && o->type == YAML_SCALAR_NODE &&
+        strcmp((const char*)o->data.scalar.value, (const char*)k->data.scalar.value) == 0)
       return 1;
   }
   return 0;
@@ -1075,9 +1095,11 @@ static int merge_keys(Composer* c, int id) {
     }
     ++nmerge;
     yaml_node_t* v = yaml_document_get_node(doc, pr.value);
-    const int nsrc = v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
+    const int nsrc =
+        v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
     for (int k = 0; k < nsrc; ++k) {
-      yaml_node_t* src = v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
+      yaml_node_t* src =
+          v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
       if (src->type != YAML_MAPPING_NODE)
         return fmb_parse_error(c->p, v->type == YAML_SEQUENCE_NODE ? v->data.sequence.items.start[k] : pr.value,
                                "the value of a merge key '<<' must be a mapping (e.g. *anchor) or a list of mappings, "
@@ -1087,7 +1109,8 @@ static int merge_keys(Composer* c, int id) {
     }
   }
   if (!nmerge) return 0;
-  if (total > FMB_MERGE_KEYS_MAX) return fmb_parse_error(c->p, id, "merge keys add more than %d keys to one mapping", FMB_MERGE_KEYS_MAX);
+  if (total > FMB_MERGE_KEYS_MAX)
+    return fmb_parse_error(c->p, id, "merge keys add more than %d keys to one mapping", FMB_MERGE_KEYS_MAX);
   yaml_node_pair_t* out = malloc(((size_t)total + 1) * sizeof *out);
   if (!out) return fmb_parse_error(c->p, id, "out of memory merging keys");
   int m = 0;
@@ -1099,11 +1122,14 @@ static int merge_keys(Composer* c, int id) {
     const yaml_node_pair_t pr = nd->data.mapping.pairs.start[i];
     if (!is_merge_key(doc, pr.key)) continue;
     yaml_node_t* v = yaml_document_get_node(doc, pr.value);
-    const int nsrc = v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
+    const int nsrc =
+        v->type == YAML_SEQUENCE_NODE ? (int)(v->data.sequence.items.top - v->data.sequence.items.start) : 1;
     for (int k = 0; k < nsrc; ++k) {
-      yaml_node_t* src = v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
+      yaml_node_t* src =
+          v->type == YAML_SEQUENCE_NODE ? yaml_document_get_node(doc, v->data.sequence.items.start[k]) : v;
       for (yaml_node_pair_t* sp = src->data.mapping.pairs.start; sp < src->data.mapping.pairs.top; ++sp)
-        if (!pairs_have_key(doc, out, own, sp->key) && !pairs_have_key(doc, out + own, m - own, sp->key)) out[m++] = *sp;
+        if (!pairs_have_key(doc, out, own, sp->key) && !pairs_have_key(doc, out + own, m - own, sp->key))
+          out[m++] = *sp;
     }
   }
   free(nd->data.mapping.pairs.start); /* libyaml allocates with malloc (yaml_malloc) */
@@ -1155,7 +1181,8 @@ static int compose_event(Composer* c, const yaml_event_t* ev, int* ndocs) {
   int id = 0;
   if (node_count(p) > FMB_SCENE_NODES_MAX) {
     fmb_diag_set(p->diag, FMB_EXIT_BAD_INPUT, path, (int)ev->start_mark.line + 1, (int)ev->start_mark.column + 1,
-                 "the scene is too large: more than %d YAML nodes (counting every use of an alias)", FMB_SCENE_NODES_MAX);
+                 "the scene is too large: more than %d YAML nodes (counting every use of an alias)",
+                 FMB_SCENE_NODES_MAX);
     return -1;
   }
   switch (ev->type) {
@@ -1168,7 +1195,8 @@ static int compose_event(Composer* c, const yaml_event_t* ev, int* ndocs) {
       }
       return 0;
     case YAML_SCALAR_EVENT:
-      id = yaml_document_add_scalar(doc, NULL, ev->data.scalar.value, (int)ev->data.scalar.length, ev->data.scalar.style);
+      id = yaml_document_add_scalar(doc, NULL, ev->data.scalar.value, (int)ev->data.scalar.length,
+                                    ev->data.scalar.style);
       if (!id || remember_anchor(c, ev->data.scalar.anchor, id)) break;
       set_marks(doc, id, ev->start_mark, ev->end_mark);
       return attach(c, id);
@@ -1262,9 +1290,10 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
     if (fd >= 0) close(fd);
     return -1;
   }
-  const char* refuse = S_ISDIR(st.st_mode)    ? "is a directory, expected a YAML scene file"
-                       : !S_ISREG(st.st_mode) ? "is not a regular file (a device, FIFO or socket), expected a YAML scene file"
-                                              : NULL;
+  const char* refuse = S_ISDIR(st.st_mode) ? "is a directory, expected a YAML scene file"
+                       : !S_ISREG(st.st_mode)
+                           ? "is not a regular file (a device, FIFO or socket), expected a YAML scene file"
+                           : NULL;
   if (refuse) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s", refuse);
     close(fd);
@@ -1293,10 +1322,14 @@ int fmbp_open(fmbParser* p, const char* path, const char* const* overrides, int 
   /* the top-level keys as the loader reads them (engine/scene.c): the first two are required */
   char top[400] = "";
   for (size_t i = 0, used = 0; fmb_scene_keys[i] && used + 40 < sizeof top; ++i)
-    used += (size_t)snprintf(top + used, sizeof top - used, "%s%s", i == 0 ? "" : i == 2 ? " (and optionally " : ", ",
+    used += (size_t)snprintf(top + used, sizeof top - used, "%s%s",
+                             i == 0   ? ""
+                             : i == 2 ? " (and optionally "
+                                      : ", ",
                              fmb_scene_keys[i]);
   if (!yaml_document_get_root_node(&p->doc)) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1, "the scene file is empty: expected a mapping with keys %s)", top);
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 1, 1, "the scene file is empty: expected a mapping with keys %s)",
+                 top);
     return -1;
   }
   if (!fmbp_is_map(p, fmbp_root(p)))

@@ -24,7 +24,8 @@ static int drive_parse(fmbParser* p, fmbNode item, void** self) {
   if (fmb_get_joint(p, item, "joint", FMB_REQUIRED, &joint)) return -1;
   for (int k = 0; k < 2; ++k)
     if (fmb_joint_attachment(p, joint, k, &d->body[k], d->point[k]))
-      return fmb_parse_error(p, fmb_find_key(p, item, "joint"), "a drive needs a revolute joint to drive (one with two attachment points)");
+      return fmb_parse_error(p, fmb_find_key(p, item, "joint"),
+                             "a drive needs a revolute joint to drive (one with two attachment points)");
   return fmbj_motion_parse(p, item, 1, &d->motion) || fmb_get_angle(p, item, "angle0", FMB_POSE, &d->angle0) ? -1 : 0;
 }
 
@@ -82,7 +83,9 @@ static int drive_output(const void* self, int id, const fmbJointEval* ev, double
   return 0;
 }
 
-static int drive_input(const void* self, double* initial) { return fmbj_law_input(&((const Drive*)self)->motion.law, initial); }
+static int drive_input(const void* self, double* initial) {
+  return fmbj_law_input(&((const Drive*)self)->motion.law, initial);
+}
 
 static void drive_describe(const void* self, FILE* f) {
   const Drive* d = self;
@@ -90,7 +93,10 @@ static void drive_describe(const void* self, FILE* f) {
 }
 
 static const fmbParam drive_params[] = {
-    {.key = "joint", .kind = FMB_PARAM_JOINT, .flags = FMB_REQUIRED, .doc = "the revolute joint whose angle is prescribed"},
+    {.key = "joint",
+     .kind = FMB_PARAM_JOINT,
+     .flags = FMB_REQUIRED,
+     .doc = "the revolute joint whose angle is prescribed"},
     {.key = "angle0", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "relative angle at f = 0"},
     FMBJ_MOTION_PARAMS("rad"),
     {.key = NULL},

@@ -50,7 +50,11 @@ static void fixed_describe(const void* self, FILE* out) {
 
 static const fmbParam fixed_params[] = {
     FMBJ_TWO_POINT_PARAMS,
-    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "angle of body2 relative to body1"},
+    {.key = "angle",
+     .kind = FMB_PARAM_NUMBER,
+     .unit = "rad",
+     .fallback = "0",
+     .doc = "angle of body2 relative to body1"},
     {.key = NULL},
 };
 

@@ -27,7 +27,8 @@ static int load_parse(fmbParser* p, fmbNode item, void** self) {
       fmb_get_vec2(p, item, "force", 0, l->force) || fmb_get_double(p, item, "torque", 0, &l->torque) ||
       fmb_get_choice(p, item, "frame", 0, load_frames, &l->follower) || fmbj_law_parse(p, item, &l->law))
     return -1;
-  if (l->body == 0) return fmb_parse_error(p, fmb_find_key(p, item, "body"), "a load on the ground does nothing: name a moving body");
+  if (l->body == 0)
+    return fmb_parse_error(p, fmb_find_key(p, item, "body"), "a load on the ground does nothing: name a moving body");
   return 0;
 }
 
@@ -74,10 +75,17 @@ static void load_describe(const void* self, FILE* out) {
 
 static const fmbParam load_params[] = {
     {.key = "body", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "the loaded body (not ground)"},
-    {.key = "point", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point of application, body frame"},
+    {.key = "point",
+     .kind = FMB_PARAM_VEC2,
+     .unit = "m",
+     .fallback = "[0, 0]",
+     .doc = "point of application, body frame"},
     {.key = "force", .kind = FMB_PARAM_VEC2, .unit = "N", .fallback = "[0, 0]", .doc = "force at s = 1, in `frame`"},
     {.key = "torque", .kind = FMB_PARAM_NUMBER, .unit = "N m", .fallback = "0", .doc = "torque at s = 1"},
-    {.key = "frame", .kind = FMB_PARAM_CHOICE, .choices = load_frames, .fallback = "global",
+    {.key = "frame",
+     .kind = FMB_PARAM_CHOICE,
+     .choices = load_frames,
+     .fallback = "global",
      .doc = "global: fixed direction; body: turns with the point (a follower load)"},
     FMBJ_LAW_PARAMS,
     {.key = NULL},

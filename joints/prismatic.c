@@ -37,14 +37,15 @@ static int prismatic_parse(fmbParser* p, fmbNode item, void** self) {
     if (fmb_initial_marker(p, s->tp.body[k], s->tp.point[k], pos, &ang[k]))
       return fmb_parse_error(p, item, "prismatic joint: cannot place point%d on its body", k + 1);
   s->angle = ang[1] - ang[0]; /* as drawn, like a weld's */
-  if (fmb_get_vec2(p, item, "axis", 0, s->axis) ||
-      fmb_get_angle(p, item, "angle", FMB_POSE, &s->angle) || fmb_get_double(p, item, "offset", 0, &s->offset) ||
+  if (fmb_get_vec2(p, item, "axis", 0, s->axis) || fmb_get_angle(p, item, "angle", FMB_POSE, &s->angle) ||
+      fmb_get_double(p, item, "offset", 0, &s->offset) ||
       fmb_get_double(p, item, "stiffness", FMB_NONNEGATIVE, &s->stiffness) ||
       fmb_get_double(p, item, "damping", FMB_NONNEGATIVE, &s->damping) ||
       fmb_get_double(p, item, "rest_displacement", 0, &s->rest))
     return -1;
   const double len = hypot(s->axis[0], s->axis[1]);
-  if (!(len > 0)) return fmb_parse_error(p, fmb_find_key(p, item, "axis"), "expected a non-zero axis direction [ax, ay]");
+  if (!(len > 0))
+    return fmb_parse_error(p, fmb_find_key(p, item, "axis"), "expected a non-zero axis direction [ax, ay]");
   s->axis[0] /= len;
   s->axis[1] /= len;
   s->driven = fmb_find_key(p, item, "profile") >= 0;
@@ -181,17 +182,45 @@ static void prismatic_describe(const void* self, FILE* out) {
 
 static const fmbParam prismatic_params[] = {
     FMBJ_TWO_POINT_PARAMS,
-    {.key = "axis", .kind = FMB_PARAM_VEC2, .fallback = "[1, 0]", .doc = "slide direction in body1's frame at point1 (non-zero)"},
-    {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "angle of body2 relative to body1"},
+    {.key = "axis",
+     .kind = FMB_PARAM_VEC2,
+     .fallback = "[1, 0]",
+     .doc = "slide direction in body1's frame at point1 (non-zero)"},
+    {.key = "angle",
+     .kind = FMB_PARAM_NUMBER,
+     .unit = "rad",
+     .fallback = "0",
+     .doc = "angle of body2 relative to body1"},
     {.key = "offset", .kind = FMB_PARAM_NUMBER, .unit = "m", .fallback = "0", .doc = "slide at f = 0 (with a profile)"},
-    {.key = "stiffness", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "N/m", .fallback = "0", .doc = "spring along the axis"},
-    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "N s/m", .fallback = "0", .doc = "damper along the axis"},
-    {.key = "rest_displacement", .kind = FMB_PARAM_NUMBER, .unit = "m", .fallback = "0", .doc = "slide where the spring is relaxed"},
-    {.key = "profile", .kind = FMB_PARAM_CHOICE, .choices = fmbj_motion_names, .doc = "optional: prescribed slide f(t), as a drive's"},
+    {.key = "stiffness",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_NONNEGATIVE,
+     .unit = "N/m",
+     .fallback = "0",
+     .doc = "spring along the axis"},
+    {.key = "damping",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_NONNEGATIVE,
+     .unit = "N s/m",
+     .fallback = "0",
+     .doc = "damper along the axis"},
+    {.key = "rest_displacement",
+     .kind = FMB_PARAM_NUMBER,
+     .unit = "m",
+     .fallback = "0",
+     .doc = "slide where the spring is relaxed"},
+    {.key = "profile",
+     .kind = FMB_PARAM_CHOICE,
+     .choices = fmbj_motion_names,
+     .doc = "optional: prescribed slide f(t), as a drive's"},
     {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = "m/s", .doc = "profile constant, ramp: (final) speed"},
     {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = "m/s", .doc = "profile spinup: final speed"},
     {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = "m", .doc = "profile harmonic"},
-    {.key = "value", .kind = FMB_PARAM_NUMBER, .unit = "m", .fallback = "0", .doc = "profile input: f until a program sets it"},
+    {.key = "value",
+     .kind = FMB_PARAM_NUMBER,
+     .unit = "m",
+     .fallback = "0",
+     .doc = "profile input: f until a program sets it"},
     FMBJ_LAW_KEYS("profile "),
     {.key = NULL},
 };

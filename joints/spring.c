@@ -27,7 +27,6 @@ static int spring_parse(fmbParser* p, fmbNode item, void** self) {
 
 static void spring_destroy(void* self) { free(self); }
 
-
 /* length, its rate, unit vector from point1 to point2; D (2 x ld) = d(p1 - p2)/dq */
 static int spring_geometry(const Spring* s, const fmbJointEval* ev, double* D, int ld, double* len, double* rate,
                            double e[2]) {
@@ -91,9 +90,22 @@ static void spring_describe(const void* self, FILE* out) {
 
 static const fmbParam spring_params[] = {
     FMBJ_TWO_POINT_PARAMS,
-    {.key = "stiffness", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_NONNEGATIVE, .unit = "N/m", .doc = "spring rate k"},
-    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "N s/m", .fallback = "0", .doc = "damper rate c"},
-    {.key = "rest_length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_NONNEGATIVE, .unit = "m", .doc = "unstretched length l0"},
+    {.key = "stiffness",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_REQUIRED | FMB_NONNEGATIVE,
+     .unit = "N/m",
+     .doc = "spring rate k"},
+    {.key = "damping",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_NONNEGATIVE,
+     .unit = "N s/m",
+     .fallback = "0",
+     .doc = "damper rate c"},
+    {.key = "rest_length",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_REQUIRED | FMB_NONNEGATIVE,
+     .unit = "m",
+     .doc = "unstretched length l0"},
     {.key = NULL},
 };
 

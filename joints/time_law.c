@@ -46,7 +46,8 @@ static int table_setup(fmbParser* p, fmbNode item, fmbTimeLaw* law, int smooth) 
 static int parse_kind(fmbParser* p, fmbNode item, fmbTimeLaw* law, int smooth, int angular) {
   switch (law->kind) {
     case FMB_LAW_INPUT:
-      return angular ? fmb_get_angle(p, item, "value", 0, &law->value) : fmb_get_double(p, item, "value", 0, &law->value);
+      return angular ? fmb_get_angle(p, item, "value", 0, &law->value)
+                     : fmb_get_double(p, item, "value", 0, &law->value);
     case FMB_LAW_RAMP:
     case FMB_LAW_SPINUP: return fmb_get_double(p, item, "ramp_time", FMB_REQUIRED | FMB_POSITIVE, &law->ramp_time);
     case FMB_LAW_HARMONIC:
@@ -229,6 +230,7 @@ void fmbj_motion_eval(const fmbMotion* mo, const fmbJointEval* ev, double f[3]) 
 }
 
 const char* fmbj_motion_name(const fmbMotion* mo) {
-  static const char* const described[] = {"constant speed", "speed ramp", "harmonic", "spin-up (Eq. 41)", "table", "input"};
+  static const char* const described[] = {"constant speed",   "speed ramp", "harmonic",
+                                          "spin-up (Eq. 41)", "table",      "input"};
   return described[mo->law.kind];
 }

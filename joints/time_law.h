@@ -17,14 +17,21 @@
 #define FLEXMBD_TIME_LAW_H
 #include "flexmbd.h"
 
-typedef enum { FMB_LAW_CONSTANT, FMB_LAW_RAMP, FMB_LAW_HARMONIC, FMB_LAW_SPINUP, FMB_LAW_TABLE, FMB_LAW_INPUT } fmbLawKind;
+typedef enum {
+  FMB_LAW_CONSTANT,
+  FMB_LAW_RAMP,
+  FMB_LAW_HARMONIC,
+  FMB_LAW_SPINUP,
+  FMB_LAW_TABLE,
+  FMB_LAW_INPUT
+} fmbLawKind;
 
 typedef struct {
   fmbLawKind kind;
   double ramp_time, frequency, phase;
-  int n;                        /* table rows */
-  double *t, *s, *integral;     /* table points; integral of s from t[0] to t[i] */
-  double integral_at_zero;      /* of s from t[0] to 0 (tables may start before or after 0) */
+  int n;                    /* table rows */
+  double *t, *s, *integral; /* table points; integral of s from t[0] to t[i] */
+  double integral_at_zero;  /* of s from t[0] to 0 (tables may start before or after 0) */
   /* a position table (a prescribed motion): C1 cubic Hermite through the rows, continued along the
      end slopes, with the slope at each row (NULL for a load's piecewise-linear table) */
   double* slope;
@@ -69,24 +76,53 @@ typedef struct {
 
 /* angular: f is an angle (a drive): amplitude may carry a unit (`10 deg`, fmb_get_angle) */
 int fmbj_motion_parse(fmbParser* p, fmbNode item, int angular, fmbMotion* motion);
-extern const char* const fmbj_law_names[], * const fmbj_motion_names[];
+extern const char *const fmbj_law_names[], *const fmbj_motion_names[];
 
 /* the keys the two parsers read, for the types' fmbParam tables (UNIT: of f, "rad" or "m") */
-#define FMBJ_LAW_KEYS(what)                                                                                         \
-  {.key = "ramp_time", .kind = FMB_PARAM_NUMBER, .flags = FMB_POSITIVE, .unit = "s", .doc = what "ramp, spinup: rise time (required)"}, \
-      {.key = "frequency", .kind = FMB_PARAM_NUMBER, .flags = FMB_POSITIVE, .unit = "rad/s", .doc = what "harmonic (required)"}, \
-      {.key = "phase", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = what "harmonic"},          \
-      {.key = "table", .kind = FMB_PARAM_TABLE, .doc = what "table: [[t, value], ...] or a CSV file (required)"}
-#define FMBJ_LAW_PARAMS                                                                                             \
-  {.key = "law", .kind = FMB_PARAM_CHOICE, .choices = fmbj_law_names, .fallback = "constant", .doc = "time law s(t) scaling force and torque"}, \
-      FMBJ_LAW_KEYS(""),                                                                                            \
-      {.key = "value", .kind = FMB_PARAM_NUMBER, .unit = "1", .fallback = "0", .doc = "input: s until a program sets it (fmb_set_input)"}
-#define FMBJ_MOTION_PARAMS(UNIT)                                                                                    \
-  {.key = "profile", .kind = FMB_PARAM_CHOICE, .flags = FMB_REQUIRED, .choices = fmbj_motion_names, .doc = "f(t), docs/scenes.md"}, \
-      {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "constant, ramp: (final) speed (required)"}, \
-      {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "spinup: final speed (required)"},     \
-      {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = UNIT, .doc = "harmonic: f = amplitude sin(frequency t + phase) (required)"}, \
-      {.key = "value", .kind = FMB_PARAM_NUMBER, .unit = UNIT, .fallback = "0", .doc = "input: f until a program sets it (fmb_set_input)"}, \
+#define FMBJ_LAW_KEYS(what)                                                                                  \
+  {.key = "ramp_time",                                                                                       \
+   .kind = FMB_PARAM_NUMBER,                                                                                 \
+   .flags = FMB_POSITIVE,                                                                                    \
+   .unit = "s",                                                                                              \
+   .doc = what "ramp, spinup: rise time (required)"},                                                        \
+      {.key = "frequency",                                                                                   \
+       .kind = FMB_PARAM_NUMBER,                                                                             \
+       .flags = FMB_POSITIVE,                                                                                \
+       .unit = "rad/s",                                                                                      \
+       .doc = what "harmonic (required)"},                                                                   \
+      {.key = "phase", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = what "harmonic"}, {  \
+    .key = "table", .kind = FMB_PARAM_TABLE, .doc = what "table: [[t, value], ...] or a CSV file (required)" \
+  }
+#define FMBJ_LAW_PARAMS                                                     \
+  {.key = "law",                                                            \
+   .kind = FMB_PARAM_CHOICE,                                                \
+   .choices = fmbj_law_names,                                               \
+   .fallback = "constant",                                                  \
+   .doc = "time law s(t) scaling force and torque"},                        \
+      FMBJ_LAW_KEYS(""), {                                                  \
+    .key = "value", .kind = FMB_PARAM_NUMBER, .unit = "1", .fallback = "0", \
+    .doc = "input: s until a program sets it (fmb_set_input)"               \
+  }
+#define FMBJ_MOTION_PARAMS(UNIT)                                                                               \
+  {.key = "profile",                                                                                           \
+   .kind = FMB_PARAM_CHOICE,                                                                                   \
+   .flags = FMB_REQUIRED,                                                                                      \
+   .choices = fmbj_motion_names,                                                                               \
+   .doc = "f(t), docs/scenes.md"},                                                                             \
+      {.key = "speed",                                                                                         \
+       .kind = FMB_PARAM_NUMBER,                                                                               \
+       .unit = UNIT "/s",                                                                                      \
+       .doc = "constant, ramp: (final) speed (required)"},                                                     \
+      {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "spinup: final speed (required)"}, \
+      {.key = "amplitude",                                                                                     \
+       .kind = FMB_PARAM_NUMBER,                                                                               \
+       .unit = UNIT,                                                                                           \
+       .doc = "harmonic: f = amplitude sin(frequency t + phase) (required)"},                                  \
+      {.key = "value",                                                                                         \
+       .kind = FMB_PARAM_NUMBER,                                                                               \
+       .unit = UNIT,                                                                                           \
+       .fallback = "0",                                                                                        \
+       .doc = "input: f until a program sets it (fmb_set_input)"},                                             \
       FMBJ_LAW_KEYS("")
 /* f, f', f'' at the evaluation's time (an input: the value set, f' = f'' = 0) */
 void fmbj_motion_eval(const fmbMotion* motion, const fmbJointEval* ev, double f[3]);

@@ -10,11 +10,17 @@ typedef struct {
 
 /* keys body1, body2 (required), point1, point2 (default [0, 0]); their declarations, for a
    type's params list */
-#define FMBJ_TWO_POINT_PARAMS                                                                                  \
-  {.key = "body1", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "first body (or ground)"},            \
-      {.key = "body2", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "second body (or ground)"},       \
-      {.key = "point1", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body1, body frame"}, \
-      {.key = "point2", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body2, body frame"}
+#define FMBJ_TWO_POINT_PARAMS                                                                                       \
+  {.key = "body1", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "first body (or ground)"},                 \
+      {.key = "body2", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "second body (or ground)"},            \
+      {.key = "point1",                                                                                             \
+       .kind = FMB_PARAM_VEC2,                                                                                      \
+       .unit = "m",                                                                                                 \
+       .fallback = "[0, 0]",                                                                                        \
+       .doc = "point on body1, body frame"},                                                                        \
+  {                                                                                                                 \
+    .key = "point2", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body2, body frame" \
+  }
 int fmbj_parse_two_points(fmbParser* p, fmbNode item, fmbTwoPoint* tp);
 /* the `bodies` and `attachment` ops of a joint whose state begins with its fmbTwoPoint */
 void fmbj_two_point_bodies(const void* self, int body[2]);

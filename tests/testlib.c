@@ -36,8 +36,8 @@ int fmbt_run(const char* scene_rel, const char* const* overrides, int noverrides
   return rc;
 }
 
-int fmbt_run_read(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name,
-                  fmbtCsv* c, fmbStats* st) {
+int fmbt_run_read(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name, fmbtCsv* c,
+                  fmbStats* st) {
   fmbDiag d;
   memset(c, 0, sizeof *c);
   int rc = fmbt_run(scene_rel, overrides, noverrides, out_name, st, &d);
@@ -76,7 +76,8 @@ int fmbt_csv_read(const char* path, fmbtCsv* c) {
   c->names = calloc((size_t)c->ncol, sizeof(char*));
   char* save = NULL;
   int k = 0;
-  for (char* tok = strtok_r(line, ",", &save); tok && k < c->ncol; tok = strtok_r(NULL, ",", &save)) c->names[k++] = strdup(tok);
+  for (char* tok = strtok_r(line, ",", &save); tok && k < c->ncol; tok = strtok_r(NULL, ",", &save))
+    c->names[k++] = strdup(tok);
   /* rows */
   int rows = 0;
   for (char* p = nl + 1; *p; ++p) rows += *p == '\n';

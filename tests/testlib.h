@@ -20,11 +20,11 @@ typedef struct {
 const char* fmbt_path(const char* rel, char* buf, size_t len);
 /* run SCENE (path relative to the source tree) with overrides, writing OUT (in the build's test
    output folder); returns fmb_run's code (or the load error's), stats and diag filled */
-int fmbt_run(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name,
-             fmbStats* st, fmbDiag* diag);
+int fmbt_run(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name, fmbStats* st,
+             fmbDiag* diag);
 /* run and read the CSV back; returns the run code, c filled (empty on load failure) */
-int fmbt_run_read(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name,
-                  fmbtCsv* c, fmbStats* st);
+int fmbt_run_read(const char* scene_rel, const char* const* overrides, int noverrides, const char* out_name, fmbtCsv* c,
+                  fmbStats* st);
 int fmbt_csv_read(const char* path, fmbtCsv* c);
 /* the column called name, or NULL (and a failure recorded) */
 const double* fmbt_col(const fmbtCsv* c, const char* name);

@@ -105,8 +105,9 @@ static void child_setup(const fmbChildSpec* s, pid_t parent) {
   if (in >= 0) dup2(in, 0);
   const char* paths[2] = {s->stdout_path, s->stderr_path};
   for (int k = 0; k < 2; ++k) {
-    int fd = k == 0 && s->use_fds ? s->stdout_fd
-                                  : open(paths[k] ? paths[k] : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    int fd = k == 0 && s->use_fds
+                 ? s->stdout_fd
+                 : open(paths[k] ? paths[k] : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
     if (fd >= 0) dup2(fd, k + 1);
   }
   struct sigaction dfl;

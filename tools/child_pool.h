@@ -31,7 +31,7 @@ typedef struct fmbChildSpec {
   char* const* argv;     /* a program to execute (argv[0] is its path) ... */
   void (*fn)(void* arg); /* ... or a function run in the forked child; it must _exit */
   void* arg;
-  const char* stdout_path, *stderr_path; /* NULL: /dev/null */
+  const char *stdout_path, *stderr_path; /* NULL: /dev/null */
   int use_fds, stdin_fd, stdout_fd;      /* use_fds: stdin and stdout are these (pipes) instead */
   double timeout_s;                      /* wall time allowed; <= 0: none */
   double mem_limit_mb;                   /* RLIMIT_AS of the child; <= 0: none */

@@ -65,7 +65,8 @@ fmbRegistry* fmb_cli_registry(void);
 /* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c
    over the library's fmb_run_models); *stop (SIGINT) ends it after the model in progress, whose
    rows and those of the models before it are written */
-int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet, volatile sig_atomic_t* stop);
+int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet,
+                       volatile sig_atomic_t* stop);
 
 /* `compare`'s work on parsed options (tools/cmd_compare.c), also `run --reference`'s: one line per
    column on stdout; returns compare's exit code */
@@ -74,8 +75,8 @@ typedef struct fmbCliCompare {
   const char* columns;   /* "a,b,..." or NULL: every column (both files must have the same) */
   const char* tag;       /* appended to every line (run --reference: the run's cost), or NULL */
   double rtol, atol;
-  int check;             /* apply rtol/atol: status=ok|beyond, exit 1 beyond */
-  int common;            /* the columns both files have; a missing or extra one is no failure */
+  int check;  /* apply rtol/atol: status=ok|beyond, exit 1 beyond */
+  int common; /* the columns both files have; a missing or extra one is no failure */
 } fmbCliCompare;
 int fmb_cli_compare(const fmbCliCompare* c);
 

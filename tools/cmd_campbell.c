@@ -126,7 +126,8 @@ int fmb_cmd_campbell(int argc, char** argv) {
     } else if (strcmp(a, "--plot") == 0) {
       if (!(png = fmb_cli_value("campbell", argc, argv, &i, "a PNG file name"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--speed") == 0) {
-      if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed"))) return FMB_EXIT_BAD_INPUT;
+      if (!(path = fmb_cli_value("campbell", argc, argv, &i, "the scene key that sets the speed")))
+        return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
       const char* v = fmb_cli_value("campbell", argc, argv, &i, "a number of processes");
       char* end;
@@ -144,7 +145,8 @@ int fmb_cmd_campbell(int argc, char** argv) {
   }
   const int count = an.count;
   if (!s.scene || !path || !speeds_text) {
-    fprintf(stderr, "flexmbd campbell: needs SCENE, --speed PATH (e.g. joints.spin.speed) and --speeds A:B:N|S1,S2,...\n");
+    fprintf(stderr,
+            "flexmbd campbell: needs SCENE, --speed PATH (e.g. joints.spin.speed) and --speeds A:B:N|S1,S2,...\n");
     return FMB_EXIT_BAD_INPUT;
   }
   /* outputs are never inputs (the scene, plugins: noted; table files: refused when written) */
@@ -157,8 +159,10 @@ int fmb_cmd_campbell(int argc, char** argv) {
   double* speeds = malloc(MAX_SPEEDS * sizeof(double));
   const int nspeed = speeds ? parse_speeds(speeds_text, speeds) : -1;
   if (nspeed < 1) {
-    fprintf(stderr, "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,... of finite speeds, got '%s'\n",
-            MAX_SPEEDS, speeds_text);
+    fprintf(
+        stderr,
+        "flexmbd campbell: --speeds expects A:B:N (N from 1 to %d) or a list S1,S2,... of finite speeds, got '%s'\n",
+        MAX_SPEEDS, speeds_text);
     free(speeds);
     return FMB_EXIT_BAD_INPUT;
   }
@@ -183,8 +187,9 @@ int fmb_cmd_campbell(int argc, char** argv) {
     if (*stop && (!pre || i >= pre_done)) { /* SIGINT/SIGTERM: the speeds done so far are written below */
       memset(&diag, 0, sizeof diag);
       diag.code = FMB_EXIT_INTERRUPTED;
-      snprintf(diag.msg, sizeof diag.msg, "interrupted (SIGINT/SIGTERM) before speed %g: the %d of %d speeds done are kept",
-               speeds[i], c->done, nspeed);
+      snprintf(diag.msg, sizeof diag.msg,
+               "interrupted (SIGINT/SIGTERM) before speed %g: the %d of %d speeds done are kept", speeds[i], c->done,
+               nspeed);
       rc = FMB_EXIT_INTERRUPTED;
       break;
     }
@@ -207,8 +212,10 @@ int fmb_cmd_campbell(int argc, char** argv) {
   for (int i = 1; i < done; ++i)
     for (int k = 0; k < count; ++k)
       if (c->mac[(size_t)i * count + k] < 0.5)
-        fprintf(stderr, "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
-                        "take finer speed steps\n", speeds[i], k + 1, c->mac[(size_t)i * count + k]);
+        fprintf(stderr,
+                "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
+                "take finer speed steps\n",
+                speeds[i], k + 1, c->mac[(size_t)i * count + k]);
   if (rc) fmb_cli_print_diag(&diag);
   /* nothing done (a bad --speed, a scene that does not load): an earlier result stays as it was */
   const int wrc = c && done > 0 ? write_csv(out, c) : 0;
@@ -225,7 +232,10 @@ int fmb_cmd_campbell(int argc, char** argv) {
     plot(out, png, count, title);
   }
   fprintf(stderr, "stats: status=%s speeds=%d of %d modes=%d\n",
-          rc == FMB_EXIT_INTERRUPTED ? "interrupted" : rc ? "failed" : "ok", done, nspeed, count);
+          rc == FMB_EXIT_INTERRUPTED ? "interrupted"
+          : rc                       ? "failed"
+                                     : "ok",
+          done, nspeed, count);
   fmb_campbell_free(c);
   free(speeds);
   return rc ? rc : wrc;

@@ -83,7 +83,9 @@ static int conform_types(fmbRegistry* reg, const char* const* names, int nnames,
   const int n = nnames ? nnames : nb + nj;
   int failed = 0, types = 0;
   for (int i = 0; i < n; ++i) {
-    const char* name = nnames ? names[i] : i < nb ? fmb_registry_body(reg, i)->name : fmb_registry_joint(reg, i - nb)->name;
+    const char* name = nnames   ? names[i]
+                       : i < nb ? fmb_registry_body(reg, i)->name
+                                : fmb_registry_joint(reg, i - nb)->name;
     const int r = fmb_conform(reg, name, work, stdout);
     if (r < 0) {
       fprintf(stderr, "flexmbd conform: no type named '%s' (flexmbd types lists them)\n", name);

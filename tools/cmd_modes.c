@@ -108,7 +108,8 @@ int fmb_cmd_modes(int argc, char** argv) {
     fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints, %s eigen-solver):\n",
             res.speed != 0.0 ? "steady rotation" : "static equilibrium", res.t, md->nreduced,
             md->sparse ? "sparse shift-invert" : "dense");
-    if (res.speed != 0.0) fprintf(stderr, "  speed %.8g rad/s about (%g, %g)\n", res.speed, res.center[0], res.center[1]);
+    if (res.speed != 0.0)
+      fprintf(stderr, "  speed %.8g rad/s about (%g, %g)\n", res.speed, res.center[0], res.center[1]);
     fprintf(stderr, "  %4s %16s %14s %14s\n", "mode", "frequency rad/s", "Hz", "damping ratio");
     for (int k = 0; k < md->count; ++k)
       fprintf(stderr, "  %4d %16.8g %14.8g %14.6g%s\n", k + 1, md->frequency[k], md->frequency[k] / (2.0 * M_PI),

@@ -10,11 +10,11 @@
 #include <ctype.h>
 #include <errno.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <strings.h>
-#include <signal.h>
 #include <sys/stat.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -88,17 +88,28 @@ static int parse_args(int argc, char** argv, PlotArgs* a) {
   for (int i = 2; i < argc; ++i) {
     const char* s = argv[i];
     const char** opt = NULL;
-    if (strcmp(s, "-o") == 0 || strcmp(s, "--output") == 0) opt = &a->out;
-    else if (strcmp(s, "--x") == 0) opt = &a->x;
-    else if (strcmp(s, "--title") == 0) opt = &a->title;
-    else if (strcmp(s, "--xlabel") == 0) opt = &a->xlabel;
-    else if (strcmp(s, "--ylabel") == 0) opt = &a->ylabel;
-    else if (strcmp(s, "--xrange") == 0) opt = &a->xrange;
-    else if (strcmp(s, "--yrange") == 0) opt = &a->yrange;
-    else if (strcmp(s, "--legend") == 0) opt = &a->legend;
-    else if (strcmp(s, "--diff") == 0) opt = &a->diff;
-    else if (strcmp(s, "--shape") == 0) opt = &a->shape;
-    else if (strcmp(s, "--at") == 0) opt = &a->at;
+    if (strcmp(s, "-o") == 0 || strcmp(s, "--output") == 0)
+      opt = &a->out;
+    else if (strcmp(s, "--x") == 0)
+      opt = &a->x;
+    else if (strcmp(s, "--title") == 0)
+      opt = &a->title;
+    else if (strcmp(s, "--xlabel") == 0)
+      opt = &a->xlabel;
+    else if (strcmp(s, "--ylabel") == 0)
+      opt = &a->ylabel;
+    else if (strcmp(s, "--xrange") == 0)
+      opt = &a->xrange;
+    else if (strcmp(s, "--yrange") == 0)
+      opt = &a->yrange;
+    else if (strcmp(s, "--legend") == 0)
+      opt = &a->legend;
+    else if (strcmp(s, "--diff") == 0)
+      opt = &a->diff;
+    else if (strcmp(s, "--shape") == 0)
+      opt = &a->shape;
+    else if (strcmp(s, "--at") == 0)
+      opt = &a->at;
     if (opt) {
       if (!(*opt = fmb_cli_value("plot", argc, argv, &i, "a value"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(s, "--logx") == 0) {
@@ -111,10 +122,12 @@ static int parse_args(int argc, char** argv, PlotArgs* a) {
       fprintf(stderr, "flexmbd plot: unknown option '%s'\n", s);
       return FMB_EXIT_BAD_INPUT;
     } else if (ends_with(s, ".csv") || is_file(s)) {
-      if (a->ncsv == PLOT_MAX) return fprintf(stderr, "flexmbd plot: at most %d CSV files\n", PLOT_MAX), FMB_EXIT_BAD_INPUT;
+      if (a->ncsv == PLOT_MAX)
+        return fprintf(stderr, "flexmbd plot: at most %d CSV files\n", PLOT_MAX), FMB_EXIT_BAD_INPUT;
       a->csv[a->ncsv++] = s;
     } else {
-      if (a->ncolumn == PLOT_MAX) return fprintf(stderr, "flexmbd plot: at most %d columns\n", PLOT_MAX), FMB_EXIT_BAD_INPUT;
+      if (a->ncolumn == PLOT_MAX)
+        return fprintf(stderr, "flexmbd plot: at most %d columns\n", PLOT_MAX), FMB_EXIT_BAD_INPUT;
       a->column[a->ncolumn++] = s;
     }
   }
@@ -127,7 +140,8 @@ static int parse_args(int argc, char** argv, PlotArgs* a) {
     return FMB_EXIT_BAD_INPUT;
   }
   if (a->ncsv == 0) {
-    fprintf(stderr, "flexmbd plot: no CSV file given (usage: flexmbd plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png])\n");
+    fprintf(stderr,
+            "flexmbd plot: no CSV file given (usage: flexmbd plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png])\n");
     return FMB_EXIT_BAD_INPUT;
   }
   for (const char* const* r = (const char* const[]){a->xrange, a->yrange, NULL}; *r; ++r)
@@ -174,8 +188,10 @@ static Curve* add_curve(Curve** curves, int* n, long rows) {
 /* "name [unit]" when the library knows the column's unit */
 static void with_unit(char* out, size_t len, const char* what, const char* column) {
   const char* unit = fmb_output_unit_in(fmb_cli_registry(), column);
-  if (unit) snprintf(out, len, "%s [%s]", what, unit);
-  else snprintf(out, len, "%s", what);
+  if (unit)
+    snprintf(out, len, "%s [%s]", what, unit);
+  else
+    snprintf(out, len, "%s", what);
 }
 
 /* the rows nearest each time of "t1,t2,...": the curves of BEAM's centreline */
@@ -189,8 +205,10 @@ static int shape_curves(const PlotArgs* a, const fmbTable* table, Curve** curves
       if (fmb_table_col(tb, name) < 1) break;
     }
     if (nst < 2) {
-      fprintf(stderr, "flexmbd plot: '%s' has no centreline of '%s' (columns %s.shape0_x ...): run with "
-                      "--set 'outputs=[..., %s.shape]'\n", a->csv[i], a->shape, a->shape, a->shape);
+      fprintf(stderr,
+              "flexmbd plot: '%s' has no centreline of '%s' (columns %s.shape0_x ...): run with "
+              "--set 'outputs=[..., %s.shape]'\n",
+              a->csv[i], a->shape, a->shape, a->shape);
       return FMB_EXIT_BAD_INPUT;
     }
     for (const char* s = a->at; *s;) {
@@ -215,8 +233,10 @@ static int shape_curves(const PlotArgs* a, const fmbTable* table, Curve** curves
       c->n = nst;
       char label[256];
       legend_item(a, i, label, sizeof label);
-      if (a->ncsv == 1) snprintf(c->title, sizeof c->title, "t = %.6g s", fmb_table_at(tb, row, 0));
-      else snprintf(c->title, sizeof c->title, "%s: t = %.6g s", label, fmb_table_at(tb, row, 0));
+      if (a->ncsv == 1)
+        snprintf(c->title, sizeof c->title, "t = %.6g s", fmb_table_at(tb, row, 0));
+      else
+        snprintf(c->title, sizeof c->title, "%s: t = %.6g s", label, fmb_table_at(tb, row, 0));
     }
   }
   return 0;
@@ -251,9 +271,12 @@ static int column_curves(const PlotArgs* a, const fmbTable* table, const fmbTabl
       }
       char what[400];
       snprintf(what, sizeof what, "%s%s%s", a->column[c], ref ? " - " : "", ref ? "reference" : "");
-      if (a->ncsv == 1) snprintf(cv->title, sizeof cv->title, "%s", what);
-      else if (a->ncolumn == 1 && !ref) snprintf(cv->title, sizeof cv->title, "%s", label);
-      else snprintf(cv->title, sizeof cv->title, "%s: %s", label, what);
+      if (a->ncsv == 1)
+        snprintf(cv->title, sizeof cv->title, "%s", what);
+      else if (a->ncolumn == 1 && !ref)
+        snprintf(cv->title, sizeof cv->title, "%s", label);
+      else
+        snprintf(cv->title, sizeof cv->title, "%s: %s", label, what);
     }
   }
   return 0;
@@ -280,7 +303,8 @@ int fmb_cmd_plot(int argc, char** argv) {
   }
   /* the CSVs are inputs: the figure may not replace one (engine/safe_file.c) */
   const char* diff_input[1] = {a.diff};
-  if (!rc && (fmb_cli_check_output_not_input(a.out, a.csv, a.ncsv) || fmb_cli_check_output_not_input(a.out, diff_input, 1)))
+  if (!rc &&
+      (fmb_cli_check_output_not_input(a.out, a.csv, a.ncsv) || fmb_cli_check_output_not_input(a.out, diff_input, 1)))
     rc = FMB_EXIT_BAD_INPUT;
   /* the x column: --x, else the first column (t) */
   const char* xcol = rc ? NULL : a.x ? a.x : table[0].name[0];
@@ -322,8 +346,9 @@ int fmb_cmd_plot(int argc, char** argv) {
   /* the curves, computed before anything is written */
   Curve* curves = NULL;
   int ncurve = 0;
-  if (!rc) rc = a.shape ? shape_curves(&a, table, &curves, &ncurve)
-                        : column_curves(&a, table, a.diff ? &ref : NULL, xcol, &curves, &ncurve);
+  if (!rc)
+    rc = a.shape ? shape_curves(&a, table, &curves, &ncurve)
+                 : column_curves(&a, table, a.diff ? &ref : NULL, xcol, &curves, &ncurve);
   if (!rc && ncurve == 0) {
     fprintf(stderr, "flexmbd plot: nothing to draw\n");
     rc = FMB_EXIT_BAD_INPUT;
@@ -375,14 +400,18 @@ int fmb_cmd_plot(int argc, char** argv) {
     fprintf(g, "\nset termoption noenhanced\nset key top right\nset grid\n");
     /* the axes: the user's labels, else the column and its unit */
     char label[600];
-    if (a.shape) with_unit(label, sizeof label, "x", "beam.x");
-    else with_unit(label, sizeof label, xcol, xcol);
+    if (a.shape)
+      with_unit(label, sizeof label, "x", "beam.x");
+    else
+      with_unit(label, sizeof label, xcol, xcol);
     fprintf(g, "set xlabel ");
     quoted(g, a.xlabel ? a.xlabel : label);
     fprintf(g, "\n");
     const char* yunit = a.shape ? "m" : fmb_output_unit_in(fmb_cli_registry(), a.column[0]);
     for (int c = 1; c < a.ncolumn && yunit; ++c)
-      if (!fmb_output_unit_in(fmb_cli_registry(), a.column[c]) || strcmp(fmb_output_unit_in(fmb_cli_registry(), a.column[c]), yunit) != 0) yunit = NULL;
+      if (!fmb_output_unit_in(fmb_cli_registry(), a.column[c]) ||
+          strcmp(fmb_output_unit_in(fmb_cli_registry(), a.column[c]), yunit) != 0)
+        yunit = NULL;
     const char* what = a.shape ? "y" : a.ncolumn == 1 ? a.column[0] : a.diff ? "difference" : NULL;
     if (a.diff && a.ncolumn == 1) {
       snprintf(label, sizeof label, "%s%s - reference%s", a.absval ? "|" : "", a.column[0], a.absval ? "|" : "");
@@ -425,7 +454,8 @@ int fmb_cmd_plot(int argc, char** argv) {
       else if (status != -1 && WIFEXITED(status) && WEXITSTATUS(status) == 127)
         fprintf(stderr, "flexmbd plot: gnuplot is not installed (Debian: apt-get install gnuplot-nox)\n");
       else
-        fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out, status);
+        fprintf(stderr, "flexmbd plot: gnuplot did not write '%s' (exit status %d; its messages are above)\n", a.out,
+                status);
       rc = FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(stderr, "flexmbd plot: wrote %s\n", a.out);

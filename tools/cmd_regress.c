@@ -27,18 +27,19 @@
 #define DEFAULT_TIMEOUT_S 600.0
 
 static void usage(FILE* f) {
-  fprintf(f,
-          "usage: flexmbd regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]... [--slow F] [--rows N]\n"
-          "  PATH        a scene, or a folder searched for scenes with a reference SCENE.ref.csv (default: .)\n"
-          "  --bless     write or update the references (a folder: every *.yaml in it); with --set, the\n"
-          "              references record those overrides, otherwise the ones they had\n"
-          "  --junit F   also write the results as JUnit XML\n"
-          "  -j N        run N scenes at once\n"
-          "  --slow F    warn when a scene takes more than F times its reference's CPU time (default 3)\n"
-          "  --rows N    rows kept in a reference (default %d)\n"
-          "  --timeout S wall time allowed per scene, in seconds (default %g)\n"
-          "exit: 0 all pass, 1 a scene fails, 2 bad input, 4 interrupted\n",
-          REGRESS_DEFAULT_ROWS, DEFAULT_TIMEOUT_S);
+  fprintf(
+      f,
+      "usage: flexmbd regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]... [--slow F] [--rows N]\n"
+      "  PATH        a scene, or a folder searched for scenes with a reference SCENE.ref.csv (default: .)\n"
+      "  --bless     write or update the references (a folder: every *.yaml in it); with --set, the\n"
+      "              references record those overrides, otherwise the ones they had\n"
+      "  --junit F   also write the results as JUnit XML\n"
+      "  -j N        run N scenes at once\n"
+      "  --slow F    warn when a scene takes more than F times its reference's CPU time (default 3)\n"
+      "  --rows N    rows kept in a reference (default %d)\n"
+      "  --timeout S wall time allowed per scene, in seconds (default %g)\n"
+      "exit: 0 all pass, 1 a scene fails, 2 bad input, 4 interrupted\n",
+      REGRESS_DEFAULT_ROWS, DEFAULT_TIMEOUT_S);
 }
 
 static int positive_int(const char* s, int lo, int hi, int* out) {
@@ -74,9 +75,9 @@ static int parse_arguments(int argc, char** argv, RegressOptions* op, RegressLis
   RegressList paths = {0}, scenes = {0};
   int rc = -1;
 #define return_code(c) \
-  do {                  \
-    rc = (c);           \
-    goto out;           \
+  do {                 \
+    rc = (c);          \
+    goto out;          \
   } while (0)
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
@@ -194,8 +195,8 @@ static int shared_reference(RegressJob* const* jobs, int n) {
   for (int i = 0; i < n; ++i)
     for (int k = i + 1; k < n; ++k)
       if (strcmp(jobs[i]->ref_path, jobs[k]->ref_path) == 0) {
-        fprintf(stderr, "flexmbd regress: %s and %s would share one reference %s: rename one of them\n",
-                jobs[i]->scene, jobs[k]->scene, jobs[i]->ref_path);
+        fprintf(stderr, "flexmbd regress: %s and %s would share one reference %s: rename one of them\n", jobs[i]->scene,
+                jobs[k]->scene, jobs[i]->ref_path);
         return -1;
       }
   return 0;

@@ -16,8 +16,8 @@ int fmb_cmd_run(int argc, char** argv) {
   const char* reference = NULL; /* --reference REF.csv: error against REF and the run's cost */
   const char* columns = NULL;
   int quiet = 0, progress = 0;
-  const char* vtk = NULL; /* --vtk DIR: a ParaView animation there */
-  int vtk_every = 1;      /* --vtk-every N: of every Nth row */
+  const char* vtk = NULL;    /* --vtk DIR: a ParaView animation there */
+  int vtk_every = 1;         /* --vtk-every N: of every Nth row */
   const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
   int serve = 0;             /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
   for (int i = 2; i < argc; ++i) {
@@ -32,7 +32,8 @@ int fmb_cmd_run(int argc, char** argv) {
     } else if (strcmp(a, "--columns") == 0) {
       if (!(columns = fmb_cli_value("run", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--models") == 0) {
-      if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models"))) return FMB_EXIT_BAD_INPUT;
+      if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models")))
+        return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
       quiet = 1;
     } else if (strcmp(a, "--serve") == 0) {
@@ -64,7 +65,8 @@ int fmb_cmd_run(int argc, char** argv) {
     return FMB_EXIT_BAD_INPUT;
   }
   if (models && reference) {
-    fprintf(stderr, "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
+    fprintf(stderr,
+            "flexmbd run: --models and --reference do not combine (compare the merged CSV's columns instead)\n");
     return FMB_EXIT_BAD_INPUT;
   }
   if (serve) return fmb_run_serve(&s);

@@ -63,8 +63,9 @@ int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions
 }
 
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f) {
-  fprintf(f, "stats: status=%s t=%.10g speed=%.10g center=%.6g,%.6g iterations=%d load_steps=%d residual=%.3e "
-             "residual_start=%.3e cpu_s=%.4f\n",
+  fprintf(f,
+          "stats: status=%s t=%.10g speed=%.10g center=%.6g,%.6g iterations=%d load_steps=%d residual=%.3e "
+          "residual_start=%.3e cpu_s=%.4f\n",
           ok ? "ok" : "failed", r->t, r->speed, r->center[0], r->center[1], r->iterations, r->load_steps, r->residual,
           r->residual_start, cpu_s);
 }

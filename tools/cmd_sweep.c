@@ -12,8 +12,8 @@
  * 4 interrupted (SIGINT/SIGTERM: every child killed, the journal flushed; run again to resume). */
 #define _GNU_SOURCE /* sched_getaffinity */
 #include <errno.h>
-#include <sched.h>
 #include <math.h>
+#include <sched.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -44,7 +44,8 @@ static int bad(const char* fmt, const char* what) {
 static int add_metrics(fmbSweep* sw, const char* spec) {
   static const char* const kinds[4] = {"max", "min", "end", "rms"};
   const char* colon = strrchr(spec, ':');
-  if (!colon || colon == spec || !colon[1]) return bad("--metric expects COLUMN:max|min|end|rms (several: max,rms), got '%s'", spec);
+  if (!colon || colon == spec || !colon[1])
+    return bad("--metric expects COLUMN:max|min|end|rms (several: max,rms), got '%s'", spec);
   const char* s = colon + 1;
   while (*s) {
     size_t n = strcspn(s, ",");
@@ -116,7 +117,8 @@ static int make_ids(fmbSweep* sw) {
   if (!p) return -1;
   for (long i = 0; i < sw->nrun; ++i) p[i] = (IdIndex){sw->id[i], i};
   qsort(p, (size_t)sw->nrun, sizeof *p, by_id);
-  for (long k = 0; k < sw->nrun; ++k) sw->first[p[k].i] = k > 0 && p[k].id == p[k - 1].id ? sw->first[p[k - 1].i] : p[k].i;
+  for (long k = 0; k < sw->nrun; ++k)
+    sw->first[p[k].i] = k > 0 && p[k].id == p[k - 1].id ? sw->first[p[k - 1].i] : p[k].i;
   free(p);
   return 0;
 }
@@ -130,7 +132,9 @@ static int check_run(fmbSweep* sw, long index, int verbose) {
   fmb_sweep_argv(sw, index, "check", NULL, argv, sets);
   fmbPool* pool = fmb_pool_new(1);
   /* a check that crashes or hangs is left to the runs to record; only refused input stops the sweep */
-  fmbChildSpec spec = {.argv = argv, .stderr_path = err, .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,
+  fmbChildSpec spec = {.argv = argv,
+                       .stderr_path = err,
+                       .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,
                        .mem_limit_mb = sw->mem_limit_mb};
   fmbChildResult r = {.status = FMB_CHILD_CRASHED};
   if (pool && fmb_pool_start(pool, &spec) == 0)
@@ -166,18 +170,21 @@ static int make_dirs(const char* dir) {
 }
 
 static void usage(FILE* f) {
-  fprintf(f,
-          "usage: flexmbd sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log] | --grid PATH=v1,v2,...]... [--zip PATH=v1,v2,...]...\n"
-          "         [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)]... --count N [--seed S]\n"
-          "         [--design mc|lhs] [--set PATH=VALUE]... [--verb run|static|modes] [--metric COL:max,min,end,rms]...\n"
-          "         [--reference REF.csv [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...]\n"
-          "         [--keep summary|series] [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes]\n"
-          "         [--quiet] [--plugin x.so]...\n"
-          "       flexmbd sweep --status DIR\n"
-          "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
-          "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
-          "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
-          "spec, 4 interrupted (resumable). docs/sweep.md\n");
+  fprintf(
+      f,
+      "usage: flexmbd sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log] | --grid PATH=v1,v2,...]... [--zip "
+      "PATH=v1,v2,...]...\n"
+      "         [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)]... --count N [--seed S]\n"
+      "         [--design mc|lhs] [--set PATH=VALUE]... [--verb run|static|modes] [--metric COL:max,min,end,rms]...\n"
+      "         [--reference REF.csv [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...]\n"
+      "         [--keep summary|series] [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] "
+      "[--yes]\n"
+      "         [--quiet] [--plugin x.so]...\n"
+      "       flexmbd sweep --status DIR\n"
+      "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
+      "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
+      "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
+      "spec, 4 interrupted (resumable). docs/sweep.md\n");
 }
 
 int fmb_cmd_sweep(int argc, char** argv) {
@@ -206,7 +213,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
       if (!(sw->dir = VALUE("a folder"))) return FMB_EXIT_BAD_INPUT;
     } else if (strcmp(a, "--grid") == 0 || strcmp(a, "--zip") == 0 || strcmp(a, "--random") == 0) {
       if (!(v = VALUE("PATH=VALUES"))) return FMB_EXIT_BAD_INPUT;
-      int r = a[2] == 'g' ? fmb_plan_add_grid(&sw->plan, v, err, sizeof err)
+      int r = a[2] == 'g'   ? fmb_plan_add_grid(&sw->plan, v, err, sizeof err)
               : a[2] == 'z' ? fmb_plan_add_zip(&sw->plan, v, err, sizeof err)
                             : fmb_plan_add_random(&sw->plan, v, err, sizeof err);
       if (r) return bad("%s", err);
@@ -217,7 +224,8 @@ int fmb_cmd_sweep(int argc, char** argv) {
       char* end;
       if (!(v = VALUE("N"))) return FMB_EXIT_BAD_INPUT;
       double c = strtod(v, &end);
-      if (*end || !(c >= 1) || c > MAX_PLAN || c != floor(c)) return bad("--count expects a whole number from 1 to 1e9, got '%s'", v);
+      if (*end || !(c >= 1) || c > MAX_PLAN || c != floor(c))
+        return bad("--count expects a whole number from 1 to 1e9, got '%s'", v);
       count = (long)c;
     } else if (strcmp(a, "--seed") == 0) {
       char* end;
@@ -251,7 +259,8 @@ int fmb_cmd_sweep(int argc, char** argv) {
       sw->plugins[sw->nplugins++] = real;
     } else if (strcmp(a, "--verb") == 0) {
       if (!(v = VALUE("run, static or modes"))) return FMB_EXIT_BAD_INPUT;
-      if (strcmp(v, "run") && strcmp(v, "static") && strcmp(v, "modes")) return bad("--verb expects run, static or modes, got '%s'", v);
+      if (strcmp(v, "run") && strcmp(v, "static") && strcmp(v, "modes"))
+        return bad("--verb expects run, static or modes, got '%s'", v);
       sw->verb = v;
     } else if (strcmp(a, "--metric") == 0) {
       if (!(v = VALUE("COLUMN:max|min|end|rms")) || add_metrics(sw, v)) return FMB_EXIT_BAD_INPUT;
@@ -270,7 +279,8 @@ int fmb_cmd_sweep(int argc, char** argv) {
       if (!(v = VALUE("SEC or Nx"))) return FMB_EXIT_BAD_INPUT;
       double t = strtod(v, &end);
       const int rel = *end == 'x' && !end[1];
-      if (end == v || (*end && !rel) || !(t > 0) || !isfinite(t)) return bad("--timeout expects SEC (> 0) or Nx (N times the median of ok runs), got '%s'", v);
+      if (end == v || (*end && !rel) || !(t > 0) || !isfinite(t))
+        return bad("--timeout expects SEC (> 0) or Nx (N times the median of ok runs), got '%s'", v);
       if (rel)
         sw->timeout_factor = t;
       else
@@ -332,25 +342,32 @@ int fmb_cmd_sweep(int argc, char** argv) {
   sw->plan.lhs = design_lhs == 1;
   const double size = fmb_plan_size(&sw->plan);
   if (fmb_plan_finish(&sw->plan, err, sizeof err) && !(size > MAX_PLAN)) return bad("%s", err);
-  if (size > MAX_PLAN) return fprintf(stderr, "flexmbd sweep: a plan of %.4g runs is beyond the limit of 1e9\n", size), FMB_EXIT_BAD_INPUT;
+  if (size > MAX_PLAN)
+    return fprintf(stderr, "flexmbd sweep: a plan of %.4g runs is beyond the limit of 1e9\n", size), FMB_EXIT_BAD_INPUT;
   if (size > YES_LIMIT && !yes && !dry)
-    return fprintf(stderr, "flexmbd sweep: the plan has %.4g runs (more than 1e6): check it with --dry-run, then add --yes\n", size),
+    return fprintf(stderr,
+                   "flexmbd sweep: the plan has %.4g runs (more than 1e6): check it with --dry-run, then add --yes\n",
+                   size),
            FMB_EXIT_BAD_INPUT;
   sw->nrun = (long)size;
   for (int k = 0; k < sw->nfixed; ++k)
     for (int p = 0; p < sw->plan.npath; ++p)
-      if (strncmp(sw->fixed[k], sw->plan.path[p], strlen(sw->plan.path[p])) == 0 && sw->fixed[k][strlen(sw->plan.path[p])] == '=')
+      if (strncmp(sw->fixed[k], sw->plan.path[p], strlen(sw->plan.path[p])) == 0 &&
+          sw->fixed[k][strlen(sw->plan.path[p])] == '=')
         return bad("'%s' is both swept and fixed by --set", sw->plan.path[p]);
   if (sw->reference) { /* the error per run against a reference, per column */
     if (fmb_cli_check_input(sw->reference, "reference")) return FMB_EXIT_BAD_INPUT;
     if (fmb_table_load(sw->reference, &sw->ref, err, sizeof err)) return bad("%s", err);
-    for (int c = 1; c < sw->ref.ncol && !columns && sw->nrefcol < FMB_SWEEP_MAX_METRICS; ++c) sw->refcol[sw->nrefcol++] = c;
+    for (int c = 1; c < sw->ref.ncol && !columns && sw->nrefcol < FMB_SWEEP_MAX_METRICS; ++c)
+      sw->refcol[sw->nrefcol++] = c;
     for (const char* s = columns; s && *s && sw->nrefcol < FMB_SWEEP_MAX_METRICS;) {
       char name[200];
       size_t n = strcspn(s, ",");
       snprintf(name, sizeof name, "%.*s", (int)(n < 199 ? n : 199), s);
       int c = fmb_table_col(&sw->ref, name);
-      if (c < 0) return fprintf(stderr, "flexmbd sweep: --columns: no column '%s' in %s\n", name, sw->reference), FMB_EXIT_BAD_INPUT;
+      if (c < 0)
+        return fprintf(stderr, "flexmbd sweep: --columns: no column '%s' in %s\n", name, sw->reference),
+               FMB_EXIT_BAD_INPUT;
       sw->refcol[sw->nrefcol++] = c;
       s += n + (s[n] == ',');
     }
@@ -428,7 +445,9 @@ int fmb_cmd_sweep(int argc, char** argv) {
     ext = fmb_sweep_extension_load(1);
     if (rc == 0 && ext->write_h5(sw) < 0) fprintf(stderr, "flexmbd sweep: cannot write %s/sweep.h5\n", sw->dir);
     if (rc == FMB_EXIT_INTERRUPTED)
-      fprintf(stderr, "sweep: interrupted; every child stopped, %s/runs.csv is complete: run the same command to resume\n", sw->dir);
+      fprintf(stderr,
+              "sweep: interrupted; every child stopped, %s/runs.csv is complete: run the same command to resume\n",
+              sw->dir);
     fmb_journal_close(sw);
   }
   ext->mpi_finalize(rc);

@@ -130,7 +130,8 @@ int fmb_table_load_keyed(const char* path, fmbTable* tb, const char* first, char
   for (int i = 0; i < tb->nindex; ++i) tb->index[i] = -1;
   for (int i = 0; i < tb->ncol; ++i) {
     unsigned h = name_hash(tb->name[i]) & (unsigned)(tb->nindex - 1);
-    while (tb->index[h] >= 0 && strcmp(tb->name[tb->index[h]], tb->name[i]) != 0) h = (h + 1) & (unsigned)(tb->nindex - 1);
+    while (tb->index[h] >= 0 && strcmp(tb->name[tb->index[h]], tb->name[i]) != 0)
+      h = (h + 1) & (unsigned)(tb->nindex - 1);
     if (tb->index[h] >= 0) {
       say(err, errlen, "%s:%ld: column '%.80s' appears twice in the header", path, lineno, tb->name[i]);
       goto out;

@@ -15,39 +15,57 @@ typedef struct {
 
 static const Command commands[] = {
     {"run", fmb_cmd_run,
-     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR [--vtk-every N]]\n"
+     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR "
+     "[--vtk-every N]]\n"
      "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
-     "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each", 0},
+     "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each",
+     0},
     {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run", 0},
     {"compare", fmb_cmd_compare,
-     "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance", 1},
+     "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance",
+     1},
     {"regress", fmb_cmd_regress,
-     "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references", 1},
-    {"types", fmb_cmd_types, "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs", 0},
+     "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references",
+     1},
+    {"types", fmb_cmd_types,
+     "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs", 0},
     {"conform", fmb_cmd_conform,
-     "conform [--plugin x.so]... [--work DIR] [TYPE]...   conformance checks of every (or the named) type; exit 1 on a failure", 0},
+     "conform [--plugin x.so]... [--work DIR] [TYPE]...   conformance checks of every (or the named) type; exit 1 on a "
+     "failure",
+     0},
     {"plot", fmb_cmd_plot,
      "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
      "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
      "      [--diff REF.csv]   each column minus REF's (with --abs --logy: an error plot)\n"
      "      [--shape BEAM --at t1,t2,...]   the beam's centreline at those times (BEAM.shape columns)\n"
-     "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)", 0},
+     "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)",
+     0},
     {"view", fmb_cmd_view,
-     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--model M] [--set PATH=VALUE]... [--plugin x.so]...\n"
-     "      one self-contained HTML page animating the run (mechanism, beam shapes, traces, a plot)", 0},
+     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--model M] [--set PATH=VALUE]... "
+     "[--plugin x.so]...\n"
+     "      one self-contained HTML page animating the run (mechanism, beam shapes, traces, a plot)",
+     0},
     {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene", 0},
     {"static", fmb_cmd_static,
-     "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a constant-speed drive", 0},
+     "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a "
+     "constant-speed drive",
+     0},
     {"modes", fmb_cmd_modes,
      "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv] [--animate DIR]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state", 0},
+     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state",
+     0},
     {"campbell", fmb_cmd_campbell,
-     "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j K] [-o campbell.csv] [--plot campbell.png]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC)", 0},
+     "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j K] [-o campbell.csv] [--plot "
+     "campbell.png]\n"
+     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC)",
+     0},
     {"sweep", fmb_cmd_sweep,
-     "sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log]|PATH=v1,v2,...]... [--zip ...] [--samples F.csv] [--random ...]\n"
-     "      [-j K] [--metric COL:max] [--timeout SEC|Nx] ...   many runs, each a child process; resumable (docs/sweep.md)\n"
-     "sweep --status DIR   what a sweep has done", 1},
+     "sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log]|PATH=v1,v2,...]... [--zip ...] [--samples F.csv] [--random "
+     "...]\n"
+     "      [-j K] [--metric COL:max] [--timeout SEC|Nx] ...   many runs, each a child process; resumable "
+     "(docs/sweep.md)\n"
+     "sweep --status DIR   what a sweep has done",
+     1},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

@@ -32,7 +32,8 @@ static void child(void* arg) {
   if (ok && rc == 0) {
     const size_t n = (size_t)m->count, nq = (size_t)m->nq;
     ok = fwrite(m, sizeof *m, 1, f) == 1 && fwrite(m->frequency, sizeof(double), n, f) == n &&
-         fwrite(m->damping_ratio, sizeof(double), n, f) == n && fwrite(m->shape_re, sizeof(double), n * nq, f) == n * nq &&
+         fwrite(m->damping_ratio, sizeof(double), n, f) == n &&
+         fwrite(m->shape_re, sizeof(double), n * nq, f) == n * nq &&
          fwrite(m->shape_im, sizeof(double), n * nq, f) == n * nq;
   }
   ok = fclose(f) == 0 && ok;
@@ -56,7 +57,8 @@ static fmbModes* read_back(const char* file, int* rc, fmbDiag* diag) {
       m->shape_im = malloc(n * nq * sizeof(double) + 1);
       if (!m->frequency || !m->damping_ratio || !m->shape_re || !m->shape_im ||
           fread(m->frequency, sizeof(double), n, f) != n || fread(m->damping_ratio, sizeof(double), n, f) != n ||
-          fread(m->shape_re, sizeof(double), n * nq, f) != n * nq || fread(m->shape_im, sizeof(double), n * nq, f) != n * nq) {
+          fread(m->shape_re, sizeof(double), n * nq, f) != n * nq ||
+          fread(m->shape_im, sizeof(double), n * nq, f) != n * nq) {
         fmb_modes_free(m);
         m = NULL;
       }

@@ -135,7 +135,8 @@ int regress_run_all(RegressJob* jobs, int n, const RegressOptions* o) {
       fcntl(fds[0], F_SETFL, O_NONBLOCK); /* other children hold copies of the write end */
       fcntl(fds[0], F_SETFD, FD_CLOEXEC);
       ChildArg arg = {j, o, fds[1]};
-      fmbChildSpec spec = {.fn = child_run, .arg = &arg, .stderr_path = j->err, .timeout_s = o->timeout_s, .tag = index};
+      fmbChildSpec spec = {
+          .fn = child_run, .arg = &arg, .stderr_path = j->err, .timeout_s = o->timeout_s, .tag = index};
       if (fmb_pool_start(pool, &spec) != 0) {
         regress_say(j->why, sizeof j->why, "cannot start a process: %s", strerror(errno));
         j->failed = 1;
@@ -172,15 +173,16 @@ void regress_check_job(RegressJob* job) {
   char err[600];
   if (fmb_table_load(job->csv, &out, err, sizeof err)) {
     job->failed = 1;
-    regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, run->msg[0] ? ": " : "", run->msg);
+    regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, run->msg[0] ? ": " : "",
+                run->msg);
     return;
   }
   char* w = job->why;
   size_t left = sizeof job->why;
-#define WHY(...)                                                   \
-  do {                                                             \
-    int k_ = snprintf(w, left, __VA_ARGS__);                       \
-    if (k_ > 0 && (size_t)k_ < left) w += k_, left -= (size_t)k_;  \
+#define WHY(...)                                                  \
+  do {                                                            \
+    int k_ = snprintf(w, left, __VA_ARGS__);                      \
+    if (k_ > 0 && (size_t)k_ < left) w += k_, left -= (size_t)k_; \
   } while (0)
   /* the run must get as far as the reference did, and stop only where the reference stopped */
   const double t_ref = ref->t_reached, t_run = run->t_reached;

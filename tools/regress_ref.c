@@ -56,9 +56,7 @@ static int has_suffix(const char* s, const char* suf) {
   return n >= m && strcmp(s + n - m, suf) == 0;
 }
 
-static int is_scene_name(const char* s) {
-  return (has_suffix(s, ".yaml") || has_suffix(s, ".yml")) && s[0] != '.';
-}
+static int is_scene_name(const char* s) { return (has_suffix(s, ".yaml") || has_suffix(s, ".yml")) && s[0] != '.'; }
 
 char* regress_reference_path(const char* scene) {
   size_t n = strlen(scene);
@@ -341,7 +339,8 @@ int regress_bless_job(RegressJob* job, const RegressOptions* o) {
   char err[600];
   if (fmb_table_load(job->csv, &out, err, sizeof err)) {
     job->failed = 1;
-    regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, run->msg[0] ? ": " : "", run->msg);
+    regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, run->msg[0] ? ": " : "",
+                run->msg);
     return -1;
   }
   size_t csv_len = 0;
@@ -383,11 +382,17 @@ int regress_bless_job(RegressJob* job, const RegressOptions* o) {
   PUT("# status: %s\n# t_reached: %.10g\n# steps: %ld\n# cpu_s: %.4f\n", run->status_ok ? "ok" : "stopped",
       run->t_reached, run->steps, run->cpu_s);
   PUT("# rows: every %ld%s of %ld output rows and the last\n", stride,
-      stride == 1 ? "st" : stride == 2 ? "nd" : stride == 3 ? "rd" : "th", nrow);
+      stride == 1   ? "st"
+      : stride == 2 ? "nd"
+      : stride == 3 ? "rd"
+                    : "th",
+      nrow);
   const double rtol = run->solver.rtol, atol = run->solver.atol;
   column_noise(job + 1, &out, noise);
   PUT("# noise: the largest difference from runs at rtol x %g and x %g; atol = %g x noise + %g x solver atol, "
-      "rtol = %g x solver rtol\n", regress_companion_rtol[0], regress_companion_rtol[1], REGRESS_NOISE_FACTOR, REGRESS_SOLVER_FACTOR, REGRESS_SOLVER_FACTOR);
+      "rtol = %g x solver rtol\n",
+      regress_companion_rtol[0], regress_companion_rtol[1], REGRESS_NOISE_FACTOR, REGRESS_SOLVER_FACTOR,
+      REGRESS_SOLVER_FACTOR);
   for (int c = 1; c < out.ncol; ++c) {
     const RegressTol* keep = job->ref.present ? regress_find_tol(&job->ref, out.name[c]) : NULL;
     if (keep && keep->override)

@@ -24,8 +24,10 @@ int regress_write_junit(const char* path, RegressJob* const* jobs, int n) {
     total += jobs[i]->run.cpu_s;
   }
   fprintf(f, "<?xml version=\"1.0\" encoding=\"UTF-8\"?>\n");
-  fprintf(f, "<testsuites>\n<testsuite name=\"flexmbd regress\" tests=\"%d\" failures=\"%d\" errors=\"%d\" time=\"%.4f\">\n",
-          n, nfail, nerr, total);
+  fprintf(
+      f,
+      "<testsuites>\n<testsuite name=\"flexmbd regress\" tests=\"%d\" failures=\"%d\" errors=\"%d\" time=\"%.4f\">\n",
+      n, nfail, nerr, total);
   for (int i = 0; i < n; ++i) {
     const RegressJob* j = jobs[i];
     fprintf(f, "  <testcase classname=\"regress\" name=\"");

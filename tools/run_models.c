@@ -11,7 +11,6 @@
 
 #include "cli.h"
 
-
 static void print_model_stats(const char* model, const fmbStats* st) {
   char* text = NULL;
   size_t len = 0;
@@ -24,7 +23,8 @@ static void print_model_stats(const char* model, const fmbStats* st) {
   free(text);
 }
 
-int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet, volatile sig_atomic_t* stop) {
+int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet,
+                       volatile sig_atomic_t* stop) {
   if (!out || strcmp(out, "-") == 0) {
     fprintf(stderr, "flexmbd run: --models needs the CSV in a file (-o OUT.csv)\n");
     return FMB_EXIT_BAD_INPUT;
@@ -38,8 +38,10 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
   }
   for (char* tok = strtok(words, ","); tok; tok = strtok(NULL, ",")) {
     if (nmodel == FMB_MODELS_MAX || strlen(tok) > 63 || strspn(tok, "abcdefghijklmnopqrstuvwxyz") != strlen(tok)) {
-      fprintf(stderr, "flexmbd run: --models expects up to %d model names separated by commas (zoac,foac,complete,exact), "
-                      "got '%s'\n", FMB_MODELS_MAX, list);
+      fprintf(stderr,
+              "flexmbd run: --models expects up to %d model names separated by commas (zoac,foac,complete,exact), "
+              "got '%s'\n",
+              FMB_MODELS_MAX, list);
       return FMB_EXIT_BAD_INPUT;
     }
     model[nmodel++] = tok;

@@ -23,7 +23,8 @@ int fmb_run_serve(const fmbCliScene* s) {
     for (int k = 0; k < s->nover; ++k) sets[n++] = s->overrides[k];
     char* save = NULL;
     const char* out = strtok_r(line, "\t", &save);
-    for (char* t = strtok_r(NULL, "\t", &save); t && n < (int)(sizeof sets / sizeof sets[0]); t = strtok_r(NULL, "\t", &save))
+    for (char* t = strtok_r(NULL, "\t", &save); t && n < (int)(sizeof sets / sizeof sets[0]);
+         t = strtok_r(NULL, "\t", &save))
       sets[n++] = t;
     fmbDiag diag;
     memset(&diag, 0, sizeof diag);

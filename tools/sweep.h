@@ -33,7 +33,7 @@ typedef struct fmbSweep {
   /* options */
   const char* scene;
   const char* dir;
-  const char* verb; /* run, static, modes */
+  const char* verb;                       /* run, static, modes */
   const char* fixed[FMB_SWEEP_MAX_FIXED]; /* --set, numbers normalized */
   int nfixed;
   const char* plugins[16];
@@ -50,7 +50,7 @@ typedef struct fmbSweep {
   double mem_limit_mb;
   unsigned retry_mask; /* bit per fmbChildStatus re-run on resume */
   int keep_series, quiet, progress;
-  int serve; /* --runner serve: one `flexmbd run --serve` per slot instead of a process per run */
+  int serve;      /* --runner serve: one `flexmbd run --serve` per slot instead of a process per run */
   char exe[4096]; /* this program, for the children */
   /* the plan and its identities */
   fmbSweepPlan plan;
@@ -62,9 +62,9 @@ typedef struct fmbSweep {
   int rank, nranks;
   /* the journal (rank 0) */
   int journal_fd;
-  long* row_at;   /* per index: file offset of its latest row in runs.csv, -1 none */
-  int* status;    /* per index: its latest status, -1 none */
-  int* starts;    /* per index: dispatches recorded in DIR/inflight.log */
+  long* row_at; /* per index: file offset of its latest row in runs.csv, -1 none */
+  int* status;  /* per index: its latest status, -1 none */
+  int* starts;  /* per index: dispatches recorded in DIR/inflight.log */
   int inflight_fd;
   double last_sync; /* when the journal last went to the disk */
   long count[FMB_CHILD_NSTATUS];

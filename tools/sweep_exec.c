@@ -178,7 +178,8 @@ static char* build_row(fmbSweep* sw, const fmbChildResult* r, int attempt, char 
   run_file(sw, index, "series", ".csv", series, sizeof series);
   if (r->status == FMB_CHILD_CRASHED && r->signal) {
     char m[msglen];
-    snprintf(m, sizeof m, "killed by signal %d (%s)%s%.1800s", r->signal, strsignal(r->signal), msg[0] ? ": " : "", msg);
+    snprintf(m, sizeof m, "killed by signal %d (%s)%s%.1800s", r->signal, strsignal(r->signal), msg[0] ? ": " : "",
+             msg);
     memcpy(msg, m, msglen);
   } else if (r->status == FMB_CHILD_CRASHED && !msg[0]) {
     snprintf(msg, msglen, "exit code %d (flexmbd ends with 0, 2, 3 or 4)%s", r->exit_code,
@@ -196,8 +197,8 @@ static char* build_row(fmbSweep* sw, const fmbChildResult* r, int attempt, char 
   for (int k = 0; k < FMB_SWEEP_NSTATS; ++k) put(&b, ",%s", stats[k]);
   fmbTable t;
   memset(&t, 0, sizeof t);
-  const int usable = (r->status == FMB_CHILD_OK || r->status == FMB_CHILD_SOLVER_STOPPED) &&
-                     (sw->nmetric + sw->nrefcol) > 0;
+  const int usable =
+      (r->status == FMB_CHILD_OK || r->status == FMB_CHILD_SOLVER_STOPPED) && (sw->nmetric + sw->nrefcol) > 0;
   char why[600] = "";
   /* run and static write t first, modes writes mode first: any first column for the metrics */
   const int have = usable && fmb_table_load_keyed(series, &t, NULL, why, sizeof why) == 0;

@@ -37,11 +37,13 @@ static int split(char* line, char** out, int max) {
     if (*s == '"') {
       ++s;
       for (; *s; ++s) {
-        if (*s == '"' && s[1] == '"') *w++ = '"', ++s;
+        if (*s == '"' && s[1] == '"')
+          *w++ = '"', ++s;
         else if (*s == '"') {
           ++s;
           break;
-        } else *w++ = *s;
+        } else
+          *w++ = *s;
       }
     } else {
       while (*s && *s != ',' && *s != '\n') *w++ = *s++;
@@ -116,7 +118,8 @@ static int write_columns(hid_t file, const char* group, const Text* t) {
     hid_t type = numeric ? H5Tcopy(H5T_NATIVE_DOUBLE) : H5Tcopy(H5T_C_S1);
     if (!numeric) H5Tset_size(type, H5T_VARIABLE);
     hid_t d = H5Dcreate2(g, name, type, space, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
-    if (d < 0 || (n && H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, numeric ? (const void*)num : (const void*)str) < 0))
+    if (d < 0 ||
+        (n && H5Dwrite(d, type, H5S_ALL, H5S_ALL, H5P_DEFAULT, numeric ? (const void*)num : (const void*)str) < 0))
       rc = -1;
     if (d >= 0) H5Dclose(d);
     H5Tclose(type);

@@ -24,21 +24,22 @@
 #include "sweep.h"
 
 const char* const fmb_sweep_stat_names[FMB_SWEEP_NSTATS] = {
-    "t_reached", "steps", "residuals", "jacobians", "newton_iters", "error_test_fails", "conv_fails", "jacobians_reused",
-    "cpu_s"};
+    "t_reached",        "steps",      "residuals",        "jacobians", "newton_iters",
+    "error_test_fails", "conv_fails", "jacobians_reused", "cpu_s"};
 
 static const char* const metric_suffix[4] = {"max", "min", "end", "rms"};
 
 int fmb_sweep_header(const fmbSweep* sw, char* buf, size_t len) {
   size_t n = (size_t)snprintf(buf, len, "%s", FMB_SWEEP_LEAD);
-#define PUT(...)                                                 \
-  do {                                                           \
+#define PUT(...)                                                       \
+  do {                                                                 \
     if (n < len) n += (size_t)snprintf(buf + n, len - n, __VA_ARGS__); \
   } while (0)
   for (int k = 0; k < sw->plan.npath; ++k) PUT(",%s", sw->plan.path[k]);
   for (int k = 0; k < FMB_SWEEP_NSTATS; ++k) PUT(",%s", fmb_sweep_stat_names[k]);
   for (int k = 0; k < sw->nmetric; ++k) PUT(",%s.%s", sw->metric[k].column, metric_suffix[sw->metric[k].kind]);
-  for (int k = 0; k < sw->nrefcol; ++k) PUT(",%s.err_max,%s.err_end", sw->ref.name[sw->refcol[k]], sw->ref.name[sw->refcol[k]]);
+  for (int k = 0; k < sw->nrefcol; ++k)
+    PUT(",%s.err_max,%s.err_end", sw->ref.name[sw->refcol[k]], sw->ref.name[sw->refcol[k]]);
   PUT(",message");
 #undef PUT
   return n < len ? (int)n : -1;
@@ -130,7 +131,8 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
       set_aside(sw, "inflight.log");
     } else if (!has_plan) {
       fclose(f);
-      fprintf(stderr, "flexmbd sweep: %s is not a sweep journal; give another -o DIR, or --fresh to set it aside\n", path);
+      fprintf(stderr, "flexmbd sweep: %s is not a sweep journal; give another -o DIR, or --fresh to set it aside\n",
+              path);
       return FMB_EXIT_BAD_INPUT;
     } else if (!same_plan && !resume) {
       fclose(f);

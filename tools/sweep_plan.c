@@ -48,7 +48,9 @@ double fmb_plan_normal_quantile(double u) {
   }
 }
 
-static void say(char* err, size_t len, const char* what, const char* spec) { snprintf(err, len, "%s: '%s'", what, spec); }
+static void say(char* err, size_t len, const char* what, const char* spec) {
+  snprintf(err, len, "%s: '%s'", what, spec);
+}
 
 /* a value as the runs get it: a finite number printed %.17g, anything else as written */
 static void normalized(const char* text, char* out, size_t len) {

@@ -26,16 +26,16 @@ typedef struct fmbSweepPlan {
   int random_path[FMB_SWEEP_MAX_PATHS];
   int random_kind[FMB_SWEEP_MAX_PATHS]; /* 0 uniform(a,b), 1 normal(m,s), 2 lognormal(m,s) */
   double random_p[FMB_SWEEP_MAX_PATHS][2];
-  long count;        /* --count N */
-  uint64_t seed;     /* --seed S */
-  int lhs;           /* --design lhs */
+  long count;    /* --count N */
+  uint64_t seed; /* --seed S */
+  int lhs;       /* --design lhs */
 } fmbSweepPlan;
 
 /* Each adds a factor (or a random path); 0, or -1 with "what was expected" in err. */
-int fmb_plan_add_grid(fmbSweepPlan* p, const char* spec, char* err, size_t len);   /* PATH=A:B:N[:log] | PATH=v1,v2 */
-int fmb_plan_add_zip(fmbSweepPlan* p, const char* spec, char* err, size_t len);    /* PATH=v1,v2,... (paired) */
+int fmb_plan_add_grid(fmbSweepPlan* p, const char* spec, char* err, size_t len);    /* PATH=A:B:N[:log] | PATH=v1,v2 */
+int fmb_plan_add_zip(fmbSweepPlan* p, const char* spec, char* err, size_t len);     /* PATH=v1,v2,... (paired) */
 int fmb_plan_add_samples(fmbSweepPlan* p, const char* file, char* err, size_t len); /* CSV, header = paths */
-int fmb_plan_add_random(fmbSweepPlan* p, const char* spec, char* err, size_t len); /* PATH=uniform(a,b)|... */
+int fmb_plan_add_random(fmbSweepPlan* p, const char* spec, char* err, size_t len);  /* PATH=uniform(a,b)|... */
 /* after all options: the random factor (needs --count); 0 or -1 */
 int fmb_plan_finish(fmbSweepPlan* p, char* err, size_t len);
 /* the number of runs, as a double (a product that may not fit a long: checked before use) */

@@ -21,14 +21,14 @@
 
 typedef struct {
   int alive;
-  int in, out;     /* the runner's stdin (we write) and stdout (we read) */
-  long index;      /* the run in flight, -1 none */
+  int in, out; /* the runner's stdin (we write) and stdout (we read) */
+  long index;  /* the run in flight, -1 none */
   int attempt;
   double start, deadline;
   int timed_out;
-  int reaped;           /* its process ended and was collected (res) */
+  int reaped; /* its process ended and was collected (res) */
   fmbChildResult res;
-  char buf[8192];  /* its answer so far */
+  char buf[8192]; /* its answer so far */
   size_t n;
 } Runner;
 
@@ -103,7 +103,10 @@ static void answered(fmbSweep* sw, const fmbRunFeed* feed, Runner* r, char* line
   const char* msg = strtok_r(NULL, "", &save);
   const int rc = code ? atoi(code) : -1;
   fmbChildResult res = {.tag = r->index, .exit_code = rc, .wall_s = fmb_pool_now() - r->start};
-  res.status = rc == 0 ? FMB_CHILD_OK : rc == 2 ? FMB_CHILD_BAD_INPUT : rc == 3 ? FMB_CHILD_SOLVER_STOPPED : FMB_CHILD_CRASHED;
+  res.status = rc == 0   ? FMB_CHILD_OK
+               : rc == 2 ? FMB_CHILD_BAD_INPUT
+               : rc == 3 ? FMB_CHILD_SOLVER_STOPPED
+                         : FMB_CHILD_CRASHED;
   record(sw, feed, r, &res, stats ? stats : "", msg ? msg : "");
   r->index = -1;
 }
@@ -127,8 +130,10 @@ static void ended(fmbSweep* sw, const fmbRunFeed* feed, fmbPool* pool, Runner* r
   while (f && fgets(line, sizeof line, f))
     if (line[0] != '\n') snprintf(tail, sizeof tail, "%.*s", (int)strcspn(line, "\n"), line);
   if (f) fclose(f);
-  fmbChildResult run = {.tag = r->index, .exit_code = got == 1 ? res.exit_code : -1,
-                        .signal = got == 1 ? res.signal : 0, .wall_s = fmb_pool_now() - r->start};
+  fmbChildResult run = {.tag = r->index,
+                        .exit_code = got == 1 ? res.exit_code : -1,
+                        .signal = got == 1 ? res.signal : 0,
+                        .wall_s = fmb_pool_now() - r->start};
   run.status = r->timed_out ? FMB_CHILD_TIMEOUT : FMB_CHILD_CRASHED;
   /* the row's message says what happened (fmb_sweep_row_served); the runner's last words follow */
   record(sw, feed, r, &run, "", r->timed_out ? "" : tail);
@@ -140,9 +145,9 @@ int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed) {
   Runner* runners = calloc((size_t)sw->jobs, sizeof *runners);
   struct pollfd* pfd = calloc((size_t)sw->jobs, sizeof *pfd);
   signal(SIGPIPE, SIG_IGN); /* a runner that died: its pipe says so by EPIPE */
-  int more = 1;           /* the feed may still hand out runs */
-  int failed = 0;         /* no runner could be started */
-  double wait = 2e-4;     /* with a pump (MPI): how long poll waits, backing off to 20 ms */
+  int more = 1;             /* the feed may still hand out runs */
+  int failed = 0;           /* no runner could be started */
+  double wait = 2e-4;       /* with a pump (MPI): how long poll waits, backing off to 20 ms */
   while (pool && runners && pfd && !*sw->stop) {
     int busy = 0, active = feed->pump ? feed->pump(feed->ctx) : 0;
     for (int k = 0; k < sw->jobs; ++k) {

@@ -68,7 +68,8 @@ int main(int argc, char** argv) {
     if (isnan(e0)) e0 = e;
     drift = fmax(drift, fabs(e - e0));
     /* downward zero crossings of theta (it starts at +theta0), linearly interpolated */
-    if (!isnan(th_prev) && th_prev > 0 && th <= 0 && nc < 64) crossings[nc++] = t_prev + (t - t_prev) * th_prev / (th_prev - th);
+    if (!isnan(th_prev) && th_prev > 0 && th <= 0 && nc < 64)
+      crossings[nc++] = t_prev + (t - t_prev) * th_prev / (th_prev - th);
     th_prev = th, t_prev = t;
     (void)tp, (void)reaction;
   }
@@ -83,6 +84,7 @@ int main(int argc, char** argv) {
   int ok = heave_err < 1e-6 * fabs(y0) && fabs(measured - period) < 1e-6 * period && drift < 1e-6 * rocking_energy;
   /* the nonlinear period must be told apart from the small-angle one */
   ok = ok && fabs(small_angle - period) > 100 * fabs(measured - period);
-  printf("%s\n", ok ? "foundation: agrees with the analytic solution" : "foundation: DISAGREES with the analytic solution");
+  printf("%s\n",
+         ok ? "foundation: agrees with the analytic solution" : "foundation: DISAGREES with the analytic solution");
   return ok ? 0 : 1;
 }

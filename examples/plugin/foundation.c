@@ -75,10 +75,10 @@ static void foundation(const Bar* b, const double* q, const double* v, double Q[
     /* df/dy, df/dtheta, df/dydot, df/dthetadot */
     const double fy = -b->stiffness, ft = -b->stiffness * s * cs + b->damping * s * sn * v[2];
     const double fyd = -b->damping, ftd = -b->damping * s * cs;
-    K[3 * 1 + 1] -= w * fy;                              /* dR_y/dy */
-    K[3 * 2 + 1] -= w * ft;                              /* dR_y/dtheta */
-    K[3 * 1 + 2] -= w * fy * s * cs;                     /* dR_theta/dy */
-    K[3 * 2 + 2] -= w * (ft * s * cs - f * s * sn);      /* dR_theta/dtheta */
+    K[3 * 1 + 1] -= w * fy;                         /* dR_y/dy */
+    K[3 * 2 + 1] -= w * ft;                         /* dR_y/dtheta */
+    K[3 * 1 + 2] -= w * fy * s * cs;                /* dR_theta/dy */
+    K[3 * 2 + 2] -= w * (ft * s * cs - f * s * sn); /* dR_theta/dtheta */
     C[3 * 1 + 1] -= w * fyd;
     C[3 * 2 + 1] -= w * ftd;
     C[3 * 1 + 2] -= w * fyd * s * cs;
@@ -150,12 +150,22 @@ static void bar_describe(const void* self, FILE* f) {
 
 static const fmbParam bar_params[] = {
     {.key = "mass", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg", .doc = "mass"},
-    {.key = "inertia", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "kg m^2",
+    {.key = "inertia",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_REQUIRED | FMB_POSITIVE,
+     .unit = "kg m^2",
      .doc = "moment of inertia about the centre"},
     {.key = "length", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "m", .doc = "bar length"},
-    {.key = "stiffness", .kind = FMB_PARAM_NUMBER, .flags = FMB_REQUIRED | FMB_POSITIVE, .unit = "N/m^2",
+    {.key = "stiffness",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_REQUIRED | FMB_POSITIVE,
+     .unit = "N/m^2",
      .doc = "foundation modulus k (force per unit length per unit height)"},
-    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "N s/m^2", .fallback = "0",
+    {.key = "damping",
+     .kind = FMB_PARAM_NUMBER,
+     .flags = FMB_NONNEGATIVE,
+     .unit = "N s/m^2",
+     .fallback = "0",
      .doc = "foundation damping c per unit length"},
     {.key = "position", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "initial centre"},
     {.key = "angle", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = "initial angle"},

@@ -65,8 +65,8 @@ int main(void) {
   for (int n = 0; n < 4; ++n) {
     double err[3];
     for (int r = 0; r < 3; ++r) err[r] = f[r][n] / f[3][n] - 1.0;
-    printf("mode %d relative error against 64 elements at 4, 8, 16: %.3e %.3e %.3e (ratios %.1f %.1f)\n", n + 1,
-           err[0], err[1], err[2], err[0] / err[1], err[1] / err[2]);
+    printf("mode %d relative error against 64 elements at 4, 8, 16: %.3e %.3e %.3e (ratios %.1f %.1f)\n", n + 1, err[0],
+           err[1], err[2], err[0] / err[1], err[1] / err[2]);
     for (int r = 0; r < 3; ++r) ENSURE(err[r] > 0.0);
     ENSURE(err[0] / err[1] > 6.0); /* mode 4 on 4 elements is barely resolved: 6.5 */
     ENSURE(err[1] / err[2] > 8.0);

@@ -106,7 +106,8 @@ int main(void) {
   {
     char path[1024];
     fmbDiag d;
-    fmbModel* m = fmb_load(fmbt_path("scenes/paper/spinup_w4.yaml", path, sizeof path), NULL, 0, fmb_builtin_registry(), &d);
+    fmbModel* m =
+        fmb_load(fmbt_path("scenes/paper/spinup_w4.yaml", path, sizeof path), NULL, 0, fmb_builtin_registry(), &d);
     double* y = calloc((size_t)fmb_state_size(m), sizeof(double));
     double* yp = calloc((size_t)fmb_state_size(m), sizeof(double));
     fmbStaticOptions o = {5.0, 1, 0, 0, 0.0, 1};

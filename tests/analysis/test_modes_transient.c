@@ -99,7 +99,8 @@ int main(void) {
   const double stretch = 2767.0 * 225.0 * pow(SEED_L, 3) / (3.0 * 68.95e9);
   dev = 0.0;
   for (int i = 0; tu && i < c.nrow; ++i) dev = fmax(dev, fabs(tu[i] - stretch));
-  printf("initial: static at 15 rad/s: tip_u stays within %.2e m of rho Omega^2 L^3/(3E) = %.4e m over 1 s\n", dev, stretch);
+  printf("initial: static at 15 rad/s: tip_u stays within %.2e m of rho Omega^2 L^3/(3E) = %.4e m over 1 s\n", dev,
+         stretch);
   ENSURE(dev < 1e-3 * stretch);
   fmbt_csv_free(&c);
   return fmbt_finish("test_modes_transient");

@@ -83,19 +83,21 @@ int main(void) {
     Analysis a;
     ENSURE(analyse(&a, SCENE, o, 1, 0, 0.0, 0) == 0);
     const double q = SEED_RHOA * 0.01, sag = state_output(&a, "beam.tip_v");
-    printf("gravity sag: %.9e m, q L^4/(8EI) = %.9e m (%d iterations, residual %.2e)\n", sag, -q * pow(L, 4) / (8.0 * EI),
-           a.st.iterations, a.st.residual);
+    printf("gravity sag: %.9e m, q L^4/(8EI) = %.9e m (%d iterations, residual %.2e)\n", sag,
+           -q * pow(L, 4) / (8.0 * EI), a.st.iterations, a.st.residual);
     ENSURE_REL(sag, -q * pow(L, 4) / (8.0 * EI), 1e-5);
     ENSURE(a.st.residual < 1e-9 * a.st.residual_start);
     analysis_free(&a);
   }
   /* pendulum */
   {
-    const char* o[] = {"bodies.bob.position=[0.98480775301221, -0.17364817766693]", "bodies.bob.angle=1.3962634015954636"};
+    const char* o[] = {"bodies.bob.position=[0.98480775301221, -0.17364817766693]",
+                       "bodies.bob.angle=1.3962634015954636"};
     Analysis a;
     ENSURE(analyse(&a, "scenes/pendulum.yaml", o, 2, 0, 0.0, 1) == 0);
-    printf("pendulum: rests at (%.3g, %.12g), theta %.3g; mode %.9f rad/s, sqrt(g/l) = %.9f\n", state_output(&a, "bob.x"),
-           state_output(&a, "bob.y"), state_output(&a, "bob.theta"), a.modes ? a.modes->frequency[0] : NAN, sqrt(9.81));
+    printf("pendulum: rests at (%.3g, %.12g), theta %.3g; mode %.9f rad/s, sqrt(g/l) = %.9f\n",
+           state_output(&a, "bob.x"), state_output(&a, "bob.y"), state_output(&a, "bob.theta"),
+           a.modes ? a.modes->frequency[0] : NAN, sqrt(9.81));
     ENSURE_NEAR(state_output(&a, "bob.x"), 0.0, 1e-12);
     ENSURE_NEAR(state_output(&a, "bob.y"), -1.0, 1e-12);
     ENSURE_NEAR(state_output(&a, "bob.theta"), 0.0, 1e-12);
@@ -111,7 +113,8 @@ int main(void) {
     elastica(a, &ve, &ue);
     if (isfinite(table[i])) ENSURE_NEAR(ve, table[i], 1e-8);
     const double vt = tip_under_load(a * EI / (L * L), &tip_u, &steps);
-    printf("alpha %-4g: complete model v_tip/L %.6f, elastica %.6f (%+6.2f %%); (L - x_tip)/L %.6f, elastica %.6f (%+6.2f %%)\n",
+    printf("alpha %-4g: complete model v_tip/L %.6f, elastica %.6f (%+6.2f %%); (L - x_tip)/L %.6f, elastica %.6f "
+           "(%+6.2f %%)\n",
            a, vt / L, ve, 100 * (vt / L / ve - 1.0), -tip_u / L, ue, 100 * (-tip_u / L / ue - 1.0));
     ENSURE_REL(vt / L, a / 3.0, 1e-6);
     ENSURE_REL(-tip_u / L, a * a / 15.0, 1e-3);

@@ -56,7 +56,7 @@ static inline double* bt_work(const Beam* b) { return calloc(beam_nwork(b) + 1, 
 
 /* the plugin's residual */
 static inline void bt_residual(const Beam* b, const fmbEnv* env, const double* q, const double* v, const double* a,
-                        double* R) {
+                               double* R) {
   double* w = bt_work(b);
   beam_residual(b, env, q, v, a, R, w);
   free(w);

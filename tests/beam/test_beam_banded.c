@@ -36,8 +36,8 @@ static void compare(const char* model, int n, const char* rtol, const char* atol
   snprintf(ov[4], sizeof ov[4], "solver.t_end=3");
   snprintf(ov[5], sizeof ov[5], "solver.output_step=0.05");
   /* the stored references were made with the scene's former full error control */
-  const char* const list[] = {ov[0], ov[1], ov[2], ov[3], ov[4], ov[5], "bodies.beam.assembly=banded",
-                              "solver.error_control=full"};
+  const char* const list[] = {
+      ov[0], ov[1], ov[2], ov[3], ov[4], ov[5], "bodies.beam.assembly=banded", "solver.error_control=full"};
   snprintf(name, sizeof name, "banded_%s_%d_%s.csv", model, n, rtol);
   fmbtCsv run, old;
   fmbStats st;

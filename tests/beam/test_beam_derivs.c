@@ -140,8 +140,10 @@ int main(void) {
       ENSURE_NEAR(out(b, "node0_y", q, v), q[1], 1e-15);
       ENSURE_NEAR(out(b, "node2_v", q, v), q[3 + 3 * 1 + 1], 1e-15);
       double uL = q[3 + 3 * (b->ne - 1)], vL = q[3 + 3 * (b->ne - 1) + 1];
-      if (model == BEAM_ZOAC) ENSURE_NEAR(out(b, "tip_u", q, v), uL, 1e-15);
-      else ENSURE(out(b, "tip_u", q, v) < uL); /* w_c shortens */
+      if (model == BEAM_ZOAC)
+        ENSURE_NEAR(out(b, "tip_u", q, v), uL, 1e-15);
+      else
+        ENSURE(out(b, "tip_u", q, v) < uL); /* w_c shortens */
       ENSURE_NEAR(out(b, "tip_v", q, v), vL, 1e-15);
       /* rates: d/dt along v */
       const char* pairs[2][2] = {{"tip_u", "tip_u_rate"}, {"tip_v", "tip_v_rate"}};

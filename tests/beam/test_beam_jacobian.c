@@ -124,7 +124,10 @@ static void check_banded(int model) {
         xs[k][j] = x0 - h;
         beam_residual_aux(b, &grav, q, v, a, z, F2, F2 + n, work);
         xs[k][j] = x0;
-        double* col = k == 0 ? Kd + (size_t)j * N : k == 1 ? Cd + (size_t)j * N : k == 2 ? Md + (size_t)j * N : Kd + (size_t)(n + j) * N;
+        double* col = k == 0   ? Kd + (size_t)j * N
+                      : k == 1 ? Cd + (size_t)j * N
+                      : k == 2 ? Md + (size_t)j * N
+                               : Kd + (size_t)(n + j) * N;
         for (int i = 0; i < N; ++i) col[i] = (F1[i] - F2[i]) / (2.0 * h);
       }
     const double eK = block_err(Ka, Kd, NN), eC = block_err(Ca, Cd, Nn), eM = block_err(Ma, Md, Nn);

@@ -358,8 +358,10 @@ static double foac_threshold(int ne, int skip) {
   ENSURE(min_mass_eig(b, shape, hi, skip) < 0.0);
   for (int it = 0; it < 40; ++it) {
     double mid = 0.5 * (lo + hi);
-    if (min_mass_eig(b, shape, mid, skip) > 0.0) lo = mid;
-    else hi = mid;
+    if (min_mass_eig(b, shape, mid, skip) > 0.0)
+      lo = mid;
+    else
+      hi = mid;
   }
   double r = hi / b->L;
   free(shape);

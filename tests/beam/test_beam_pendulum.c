@@ -55,9 +55,9 @@ static void conservative(const char* model) {
         thmin = fmin(thmin, th[i]);
         tvmax = fmax(tvmax, fabs(tv[i]));
       }
-      ENSURE(thmin < -2.5);  /* swings through the bottom towards the other side */
-      ENSURE(tvmax > 0.01);  /* and bends visibly */
-      ENSURE(tvmax < 0.18);  /* small deformation (the paper's choice of I) */
+      ENSURE(thmin < -2.5); /* swings through the bottom towards the other side */
+      ENSURE(tvmax > 0.01); /* and bends visibly */
+      ENSURE(tvmax < 0.18); /* small deformation (the paper's choice of I) */
     }
     fmbt_csv_free(&c);
   }

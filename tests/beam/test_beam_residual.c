@@ -150,15 +150,9 @@ static void slow_build(const Beam* b, const fmbEnv* env, const double* q, const 
             double jrd = JRD[k * nc + i], jr = JR[k * nc + i], jc = JC[k * nc + i];
             double jall = jrd + jc;
             switch (model) {
-              case BEAM_ZOAC:
-                S->Q[i] += -m * jrd * gRD[k] + m * jrd * f[k];
-                break;
-              case BEAM_FOAC:
-                S->Q[i] += -m * (jrd * gRD[k] + jr * gC[k] + jc * gR[k]) + m * jall * f[k];
-                break;
-              default:
-                S->Q[i] += -m * jall * (gRD[k] + gC[k]) + m * jall * f[k];
-                break;
+              case BEAM_ZOAC: S->Q[i] += -m * jrd * gRD[k] + m * jrd * f[k]; break;
+              case BEAM_FOAC: S->Q[i] += -m * (jrd * gRD[k] + jr * gC[k] + jc * gR[k]) + m * jall * f[k]; break;
+              default: S->Q[i] += -m * jall * (gRD[k] + gC[k]) + m * jall * f[k]; break;
             }
             for (int j = 0; j < nc; ++j) {
               double krd = JRD[k * nc + j], kr = JR[k * nc + j], kc = JC[k * nc + j];
@@ -209,8 +203,8 @@ static void slow_free(Slow* S) {
 }
 
 /* compare R_fast with R = M a - Q + K (p + beta pd), per row against the row's own scale */
-static double compare(const Beam* b, const Slow* S, const double* q, const double* v, const double* a,
-                      const double* Rf, const char* what) {
+static double compare(const Beam* b, const Slow* S, const double* q, const double* v, const double* a, const double* Rf,
+                      const char* what) {
   int nc = 3 + b->n;
   double worst = 0.0;
   for (int i = 0; i < nc; ++i) {
@@ -386,7 +380,8 @@ int main(void) {
         double worst = 0.0;
         for (int i = 0; i < nc; ++i) {
           double sc = 0.0;
-          for (int j = 0; j < nc; ++j) sc += fabs(S.M[i + (size_t)j * nc] * a[j]) + fabs(S.K[i + (size_t)j * nc] * q[j]);
+          for (int j = 0; j < nc; ++j)
+            sc += fabs(S.M[i + (size_t)j * nc] * a[j]) + fabs(S.K[i + (size_t)j * nc] * q[j]);
           sc += fabs(S.Q[i]);
           worst = fmax(worst, fabs(Rs[i] - Rf[i]) / sc);
         }

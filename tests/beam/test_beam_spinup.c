@@ -47,7 +47,7 @@ static int run(const char* scene, const char* model, int elements, double t_end,
   /* the checks compare meshes and models to 1e-4 m and less: the integration error must stay
      below that, which the scenes' rtol 1e-6 with the beam default (positions control, 1.8e-4 m
      at omega0 = 15) does not; their former full control with atol 1e-8 (3.1e-5 m) did */
-  const char* ov[] = {set_model, set_el, set_t, "bodies.beam.assembly=banded", "solver.error_control=full",
+  const char* ov[] = {set_model,         set_el, set_t, "bodies.beam.assembly=banded", "solver.error_control=full",
                       "solver.atol=1e-8"};
   int rc = fmbt_run_read(scene, ov, 6, out, c, st);
   const double* tv = fmbt_col(c, "beam.tip_v");
@@ -73,8 +73,8 @@ int main(void) {
   double d4 = max_diff(&c4[0], &c4[1], "beam.tip_v");
   printf("omega0 = 4: complete peak %.5f m, |complete - FOAC| <= %.2e m, ZOAC max |tip_v| %.3g m (exit %d)\n", peak4,
          d4, zoac4, rc4[2]);
-  ENSURE(peak4 > 0.03 && peak4 < 0.1);   /* bounded, quasi-static load rho A theta'' x gives ~0.07 m */
-  ENSURE(d4 < 0.01 * peak4);             /* FOAC and complete agree */
+  ENSURE(peak4 > 0.03 && peak4 < 0.1);            /* bounded, quasi-static load rho A theta'' x gives ~0.07 m */
+  ENSURE(d4 < 0.01 * peak4);                      /* FOAC and complete agree */
   ENSURE(zoac4 > L || rc4[2] == FMB_EXIT_SOLVER); /* ZOAC diverges */
 
   /* omega0 = 15: models and mesh refinement */
@@ -91,9 +91,9 @@ int main(void) {
          "mesh 16-32 %.3e m, 32-64 %.3e m\n",
          peak15, L / 10, dmodel, d16_32, d32_64);
   ENSURE(peak15 > L / 10);
-  ENSURE(d32_64 < 0.5 * d16_32);    /* converges */
-  ENSURE(dmodel > 100.0 * d16_32);  /* FOAC's error is not discretization error */
-  ENSURE(dmodel > 0.01 * peak15);   /* and is visible on the plot */
+  ENSURE(d32_64 < 0.5 * d16_32);   /* converges */
+  ENSURE(dmodel > 100.0 * d16_32); /* FOAC's error is not discretization error */
+  ENSURE(dmodel > 0.01 * peak15);  /* and is visible on the plot */
 
   /* energy balance against the drive's work */
   fmbtCsv* cb[4] = {&c4[0], &c4[1], &c15[0], &c15[1]};
@@ -111,8 +111,9 @@ int main(void) {
     for (int k = 0; k < 2; ++k) {
       int n;
       double om = fmbt_crossing_frequency(cs[w][k], "beam.tip_v", 15.5, &n);
-      printf("omega0 = %s, %-8s: free vibration after spin-up %.5f rad/s over %d crossings (continuum %.5f, %+.3f %%)\n",
-             w ? "15" : "4", models[k], om, n, ref[w], 100.0 * (om / ref[w] - 1.0));
+      printf(
+          "omega0 = %s, %-8s: free vibration after spin-up %.5f rad/s over %d crossings (continuum %.5f, %+.3f %%)\n",
+          w ? "15" : "4", models[k], om, n, ref[w], 100.0 * (om / ref[w] - 1.0));
       ENSURE(n >= 6);
       ENSURE(fabs(om / ref[w] - 1.0) < 0.003);
     }

@@ -32,7 +32,7 @@ static uint64_t next(void) { /* xorshift64* */
 int main(void) {
   for (long i = 0; i < 2000000; ++i) {
     const double mant = (double)(next() >> 11) / 9007199254740992.0; /* [0, 1), 53 bits */
-    const int e2 = (int)(next() % 245) - 110;                          /* 2^-110 .. 2^134 */
+    const int e2 = (int)(next() % 245) - 110;                        /* 2^-110 .. 2^134 */
     const double v = ldexp(0.5 + 0.5 * mant, e2);
     one(next() & 1 ? -v : v);
   }
@@ -52,9 +52,34 @@ int main(void) {
     one(nextafter(v, 0.0));
     one(nextafter(v, INFINITY));
   }
-  const double special[] = {0.0, -0.0, 1.0, -1.0, 0.1, 0.5, 1e-5, 9.99999999999e-6, 9.999999999995e-5, 1e-4, 1e11, 1e12,
-                            999999999999.0, 999999999999.5, 999999999999.49, 123456789012.5, 2.5, 1e-300, 1e300,
-                            DBL_MAX, DBL_MIN, 5e-324, INFINITY, -INFINITY, NAN, 3.14159265358979, 20.0, 0.005};
+  const double special[] = {0.0,
+                            -0.0,
+                            1.0,
+                            -1.0,
+                            0.1,
+                            0.5,
+                            1e-5,
+                            9.99999999999e-6,
+                            9.999999999995e-5,
+                            1e-4,
+                            1e11,
+                            1e12,
+                            999999999999.0,
+                            999999999999.5,
+                            999999999999.49,
+                            123456789012.5,
+                            2.5,
+                            1e-300,
+                            1e300,
+                            DBL_MAX,
+                            DBL_MIN,
+                            5e-324,
+                            INFINITY,
+                            -INFINITY,
+                            NAN,
+                            3.14159265358979,
+                            20.0,
+                            0.005};
   for (size_t i = 0; i < sizeof special / sizeof special[0]; ++i) one(special[i]);
   for (long k = -100000; k <= 100000; k += 7) one((double)k);
   printf("%ld values, %ld differ from printf's %%.12g\n", checked, mismatches);

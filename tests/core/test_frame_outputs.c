@@ -59,9 +59,14 @@ static int ball_marker(const void* self, const double* q, const double local[2],
   if (dangle_dq) dangle_dq[0] = dangle_dq[1] = 0;
   return 0;
 }
-static const fmbBodyType ball_type = {.name = "ball", .abi = FMB_ABI_VERSION, .parse = ball_parse,
-                                      .destroy = ball_destroy, .ncoord = ball_ncoord, .initial = ball_initial,
-                                      .residual = ball_residual, .marker = ball_marker};
+static const fmbBodyType ball_type = {.name = "ball",
+                                      .abi = FMB_ABI_VERSION,
+                                      .parse = ball_parse,
+                                      .destroy = ball_destroy,
+                                      .ncoord = ball_ncoord,
+                                      .initial = ball_initial,
+                                      .residual = ball_residual,
+                                      .marker = ball_marker};
 static const fmbBodyType* const ball_types[] = {&ball_type, NULL};
 static const fmbPlugin ball_plugin = {.abi = FMB_ABI_VERSION, .name = "ball", .version = "1", .bodies = ball_types};
 
@@ -89,10 +94,10 @@ static int run_text(const char* name, const char* text, fmbtCsv* c, fmbDiag* dia
   return rc;
 }
 
-#define THROW                                                                                         \
-  "solver: {t_end: 1.0, rtol: 1.0e-8, atol: 1.0e-10, output_step: 0.1}\n"                              \
-  "gravity: [0, -9.81]\n"                                                                              \
-  "bodies:\n"                                                                                          \
+#define THROW                                                             \
+  "solver: {t_end: 1.0, rtol: 1.0e-8, atol: 1.0e-10, output_step: 0.1}\n" \
+  "gravity: [0, -9.81]\n"                                                 \
+  "bodies:\n"                                                             \
   "  - {name: ball, type: ball, mass: 0.5, position: [0, 1], velocity: [3, 4]}\n"
 
 int main(void) {
@@ -113,8 +118,9 @@ int main(void) {
   double err = 0.0;
   for (int r = 0; t && x && y && th && om && vx && vy && r < c.nrow; ++r) {
     const double tr = t[r];
-    const double e[6] = {x[r] - 3.0 * tr, y[r] - (1.0 + 4.0 * tr - 0.5 * 9.81 * tr * tr), th[r], om[r],
-                         vx[r] - 3.0, vy[r] - (4.0 - 9.81 * tr)};
+    const double e[6] = {x[r] - 3.0 * tr, y[r] - (1.0 + 4.0 * tr - 0.5 * 9.81 * tr * tr),
+                         th[r],           om[r],
+                         vx[r] - 3.0,     vy[r] - (4.0 - 9.81 * tr)};
     for (int k = 0; k < 6; ++k) err = fmax(err, fabs(e[k]));
   }
   printf("point mass thrown: max |frame output - parabola| = %.3g over %d rows\n", err, c.nrow);

@@ -56,7 +56,8 @@ static int check_scene(const char* rel, const char* const* ov, int nov) {
     ENSURE(fmb_system_jacobian(m, w, t, 3.0 * cj, y, yp, ewt, 1, NULL, J2) == 0);
     ENSURE(fmb_system_jacobian(m, w, t, 3.0 * cj, y, yp, ewt, 0, NULL, J3) == 0);
     double reuse_diff = 0.0;
-    for (size_t k = 0; k < (size_t)ny * ny; ++k) reuse_diff = fmax(reuse_diff, fabs(J2[k] - J3[k]) / (1.0 + fabs(J3[k])));
+    for (size_t k = 0; k < (size_t)ny * ny; ++k)
+      reuse_diff = fmax(reuse_diff, fabs(J2[k] - J3[k]) / (1.0 + fabs(J3[k])));
     ENSURE(reuse_diff < 1e-12);
     free(J2);
     free(J3);
@@ -100,8 +101,9 @@ static int check_scene(const char* rel, const char* const* ov, int nov) {
     }
     sparse_diff = fmax(sparse_diff, fabs(colsum_dense - colsum_sparse));
   }
-  printf("%s: ny=%d nnz=%ld worst Jacobian error (relative to column max) %.3g at (%d,%d), max entry %.3g, dense/sparse diff %.3g\n", rel,
-         ny, m->nnz, worst, wr, wc, jmax, sparse_diff);
+  printf("%s: ny=%d nnz=%ld worst Jacobian error (relative to column max) %.3g at (%d,%d), max entry %.3g, "
+         "dense/sparse diff %.3g\n",
+         rel, ny, m->nnz, worst, wr, wc, jmax, sparse_diff);
   ENSURE(worst < 1e-5);
   ENSURE(sparse_diff <= 1e-9 * (1.0 + jmax));
   free(y), free(yp), free(ewt), free(J), free(csc), free(Fp), free(Fm);
@@ -114,7 +116,8 @@ int main(void) {
   check_scene("scenes/pendulum.yaml", NULL, 0);
   check_scene("scenes/fourbar.yaml", NULL, 0);
   check_scene("tests/core/scenes/conformance_rigid.yaml", NULL, 0);
-  static const char* const models[][1] = {{"bodies.beam.model=complete"}, {"bodies.beam.model=foac"}, {"bodies.beam.model=zoac"}};
+  static const char* const models[][1] = {
+      {"bodies.beam.model=complete"}, {"bodies.beam.model=foac"}, {"bodies.beam.model=zoac"}};
   for (int k = 0; k < 3; ++k) check_scene("tests/core/scenes/conformance_beam.yaml", models[k], 1);
   /* the banded assembly: auxiliary unknowns, a declared pattern differenced by colours */
   static const char* const banded[][2] = {{"bodies.beam.model=complete", "bodies.beam.assembly=banded"},

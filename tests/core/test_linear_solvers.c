@@ -44,10 +44,10 @@ static void check_vector_ops(SUNContext sun, int n) {
   for (int i = 0; i < n; ++i) NV_Ith_S(ref[3], i) = NV_Ith_S(fast[3], i) = (i % 3) ? 1.0 : 0.0;
   N_Vector rz = N_VClone(ref[0]), fz = N_VClone(fast[0]);
   double worst = 0.0;
-#define SAME_VEC(call_ref, call_fast) \
-  do {                                \
-    call_ref;                         \
-    call_fast;                        \
+#define SAME_VEC(call_ref, call_fast)          \
+  do {                                         \
+    call_ref;                                  \
+    call_fast;                                 \
     worst = fmax(worst, max_rel_diff(fz, rz)); \
   } while (0)
 #define SAME_NUM(a, b) worst = fmax(worst, fabs((a) - (b)) / (1.0 + fabs(a)))
@@ -244,7 +244,8 @@ static void check_runs(const char* rel, const char* const* cols, int ncol, const
       for (int i = 0; i < c[3].nrow; ++i) err[k] = fmax(err[k], fabs(a[i] - ref[i]));
     }
     ENSURE(ok);
-    printf("%s %s: error against the reference: klu %.3g, klu_full %.3g, dense %.3g\n", rel, cols[j], err[0], err[1], err[2]);
+    printf("%s %s: error against the reference: klu %.3g, klu_full %.3g, dense %.3g\n", rel, cols[j], err[0], err[1],
+           err[2]);
     ENSURE(err[0] <= 3.0 * fmax(err[1], err[2]) + 1e-12);
   }
   for (int k = 0; k < NS; ++k) fmbt_csv_free(&c[k]);

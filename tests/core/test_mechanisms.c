@@ -21,7 +21,8 @@ static int double_pendulum(double rtol, double* drift, double* cmax) {
   char name[64];
   snprintf(name, sizeof name, "double_pendulum_%g.csv", rtol);
   int rc = fmbt_run_read("scenes/double_pendulum.yaml", ov, 2, name, &c, &st);
-  const double *e = fmbt_col(&c, "energy.total"), *ke = fmbt_col(&c, "energy.kinetic"), *cp = fmbt_col(&c, "constraint.position");
+  const double *e = fmbt_col(&c, "energy.total"), *ke = fmbt_col(&c, "energy.kinetic"),
+               *cp = fmbt_col(&c, "constraint.position");
   *drift = *cmax = 0.0;
   double kmax = 0.0;
   if (e && cp && ke)
@@ -62,8 +63,8 @@ int main(void) {
   double d6, c6, d9, c9;
   ENSURE(double_pendulum(1e-6, &d6, &c6) == 0);
   ENSURE(double_pendulum(1e-9, &d9, &c9) == 0);
-  printf("double pendulum: relative energy drift %.2e (rtol 1e-6), %.2e (rtol 1e-9); constraint max %.2e, %.2e\n", d6, c6,
-         d9, c9);
+  printf("double pendulum: relative energy drift %.2e (rtol 1e-6), %.2e (rtol 1e-9); constraint max %.2e, %.2e\n", d6,
+         c6, d9, c9);
   ENSURE(d6 < 1e-3);
   ENSURE(d9 < 1e-6);
   ENSURE(d9 < d6);
@@ -79,7 +80,8 @@ int main(void) {
       double dth = remainder(th4[i] - ref, 2 * M_PI);
       err4 = fmax(err4, fabs(dth));
     }
-  printf("four-bar: crank angle error %.2e, rocker angle error vs closed form %.2e rad over %d rows\n", err2, err4, c.nrow);
+  printf("four-bar: crank angle error %.2e, rocker angle error vs closed form %.2e rad over %d rows\n", err2, err4,
+         c.nrow);
   ENSURE(c.nrow == 501);
   ENSURE(err2 < 1e-8);
   ENSURE(err4 < 1e-7);
@@ -97,7 +99,8 @@ int main(void) {
       eom = fmax(eom, fabs(om[i] - fd));
       if (t[i] > 15.0) esteady = fmax(esteady, fabs(om[i] - 4.0));
     }
-  printf("spin-up drive: angle error %.2e rad, speed error %.2e rad/s, steady-state speed error %.2e\n", eth, eom, esteady);
+  printf("spin-up drive: angle error %.2e rad, speed error %.2e rad/s, steady-state speed error %.2e\n", eth, eom,
+         esteady);
   ENSURE(eth < 1e-8);
   ENSURE(eom < 1e-7);
   ENSURE(esteady < 1e-7);

@@ -46,7 +46,8 @@ static int crossings(const double* t, const double* x, const double* vx, int n, 
   return k;
 }
 
-static double measure_period(double phi0, const char* out, double t_end, double rtol, double* drift_e, double* drift_c) {
+static double measure_period(double phi0, const char* out, double t_end, double rtol, double* drift_e,
+                             double* drift_c) {
   char o[6][96];
   snprintf(o[0], sizeof o[0], "bodies.bob.angle=%.17g", phi0);
   snprintf(o[1], sizeof o[1], "bodies.bob.position=[%.17g, %.17g]", L * sin(phi0), -L * cos(phi0));
@@ -85,14 +86,15 @@ int main(void) {
   const double small = 0.01;
   const double T_small = measure_period(small, "pendulum_small.csv", 8.0, 1e-8, &de, &dc);
   const double T_lin = 2.0 * M_PI * sqrt(Leq / g) * (1.0 + small * small / 16.0);
-  printf("small amplitude: T = %.12f, reference %.12f, relative error %.2e\n", T_small, T_lin, fabs(T_small / T_lin - 1));
+  printf("small amplitude: T = %.12f, reference %.12f, relative error %.2e\n", T_small, T_lin,
+         fabs(T_small / T_lin - 1));
   ENSURE_REL(T_small, T_lin, 2e-7);
 
   const double big = 170.0 * M_PI / 180.0;
   const double T_big = measure_period(big, "pendulum_170.csv", 10.0, 1e-10, &de, &dc);
   const double T_exact = 4.0 * sqrt(Leq / g) * elliptic_K(sin(0.5 * big));
-  printf("170 degrees: T = %.12f, exact %.12f, relative error %.2e; energy drift %.2e, constraint %.2e\n", T_big, T_exact,
-         fabs(T_big / T_exact - 1), de, dc);
+  printf("170 degrees: T = %.12f, exact %.12f, relative error %.2e; energy drift %.2e, constraint %.2e\n", T_big,
+         T_exact, fabs(T_big / T_exact - 1), de, dc);
   ENSURE_REL(T_big, T_exact, 5e-7);
   /* a wrong period by the small-angle formula would be off by 140 %: the test discriminates */
   ENSURE(fabs(T_big / (2 * M_PI * sqrt(Leq / g)) - 1) > 0.5);
@@ -102,6 +104,6 @@ int main(void) {
      period's error between 7e-7 and 4e-6; at 1e-10 it is 3e-8 to 4e-8 and the energy error 4e-8.
      A wrong force term drifts by orders of magnitude more */
   ENSURE(de < 5e-7);
-  ENSURE(dc < 1e-8);  /* atol 1e-12 on positions */
+  ENSURE(dc < 1e-8); /* atol 1e-12 on positions */
   return fmbt_finish("test_pendulum");
 }

@@ -45,7 +45,8 @@ int main(void) {
   ENSURE(f != NULL);
   if (f) {
     fprintf(f, "solver: {t_end: 1}\ngravity: [0, -9.81]\nbodies:\n"
-               "  - {name: a, type: copy249, mass: 2, inertia: 1, velocity: [1, 2]}\n  - {name: b, type: rigid, mass: 2, inertia: 1, velocity: [1, 2]}\n"
+               "  - {name: a, type: copy249, mass: 2, inertia: 1, velocity: [1, 2]}\n  - {name: b, type: rigid, mass: "
+               "2, inertia: 1, velocity: [1, 2]}\n"
                "outputs: [a.y, b.y]\n");
     fclose(f);
   }

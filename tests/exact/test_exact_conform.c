@@ -18,8 +18,8 @@ int main(int argc, char** argv) {
   const char* work = argc > 1 ? argv[1] : ".";
   /* the built-in types conform's fixture uses, with the exact table as type beam */
   const fmbBodyType* bodies[] = {&fmb_body_ground, &fmb_body_rigid, &fmb_body_beam_exact, NULL};
-  const fmbJointType* joints[] = {&fmb_joint_revolute, &fmb_joint_fixed, &fmb_joint_drive, &fmb_joint_spring,
-                                  &fmb_joint_force, NULL};
+  const fmbJointType* joints[] = {&fmb_joint_revolute, &fmb_joint_fixed, &fmb_joint_drive,
+                                  &fmb_joint_spring,   &fmb_joint_force, NULL};
   const fmbPlugin plugin = {
       .abi = FMB_ABI_VERSION, .name = "exact-beam-test", .version = "1", .bodies = bodies, .joints = joints};
   fmbRegistry* reg = fmb_registry_new();

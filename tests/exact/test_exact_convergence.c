@@ -68,8 +68,10 @@ static void convergence(int omega0) {
     fmbtCsv comp;
     ENSURE(run(15, "complete", 16, "1e-8", "1e-10", &comp) == 0);
     const double dc = max_abs_diff(&comp, &ref);
-    printf("omega0 = 15: complete (16 elements, rtol 1e-8) deviates from the exact reference by %.3e m (%.0fx the exact "
-           "model's 16-element error)\n", dc, dc / e[0]);
+    printf(
+        "omega0 = 15: complete (16 elements, rtol 1e-8) deviates from the exact reference by %.3e m (%.0fx the exact "
+        "model's 16-element error)\n",
+        dc, dc / e[0]);
     ENSURE(dc > 100.0 * e[0]);
     fmbt_csv_free(&comp);
   }

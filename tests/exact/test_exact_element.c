@@ -152,7 +152,8 @@ static void test_jacobian(int integration) {
   jacobian_errors(&inertial, &env, q, v, a, ei);
   jacobian_errors(b, &env0, q, z, z, ee);
   printf("A. Jacobian vs differences (%s integration, column-relative): inertial K %.2e, C %.2e, M %.2e; "
-         "elastic K %.2e\n", integration ? "full" : "reduced", ei[0], ei[1], ei[2], ee[0]);
+         "elastic K %.2e\n",
+         integration ? "full" : "reduced", ei[0], ei[1], ei[2], ee[0]);
   printf("   banded pattern values vs differences: inertial K %.2e, C %.2e, M %.2e, elastic K %.2e; "
          "vs the dense analytic Jacobian: K %.1e, C %.1e, M %.1e, elastic K %.1e\n",
          ei[3], ei[4], ei[5], ee[3], ei[6], ei[7], ei[8], ee[6]);
@@ -424,7 +425,8 @@ static void test_rotating(int ne, int integration, double freq_tol) {
   et_sub(C, nc, 3, G);
   et_sub(M, nc, 3, Mp);
   const double w1 = et_frequency(n, P, G, Mp, 1, 0.5, 50.0);
-  printf("F. %d elements, %s: first in-plane frequency at %g rad/s: %.7f rad/s (rotating cantilever 6.33515)\n", ne, integration ? "full" : "reduced", Omega, w1);
+  printf("F. %d elements, %s: first in-plane frequency at %g rad/s: %.7f rad/s (rotating cantilever 6.33515)\n", ne,
+         integration ? "full" : "reduced", Omega, w1);
   ENSURE_REL(w1, 6.33515, freq_tol);
   free(P);
   free(K);

@@ -45,8 +45,8 @@ static void pendulum(void) {
       d[k] = fmax(d[k], fabs(e[i] - e[0]));
       scale = fmax(scale, fabs(g[i]));
     }
-    printf("pendulum exact %s %s: energy drift %.3e J of |U_g| up to %.3f J (%.1e), %ld steps, %.2f s CPU\n",
-           tol[k][0], tol[k][1], d[k], scale, d[k] / scale, st.steps, st.cpu_s);
+    printf("pendulum exact %s %s: energy drift %.3e J of |U_g| up to %.3f J (%.1e), %ld steps, %.2f s CPU\n", tol[k][0],
+           tol[k][1], d[k], scale, d[k] / scale, st.steps, st.cpu_s);
     ENSURE(scale > 5.0); /* it swung down */
     ENSURE(d[k] < 1e-5 * scale);
     fmbt_csv_free(&c);
@@ -83,13 +83,14 @@ static void spinup_w1(void) {
 static void spinup_w15_vibration(void) {
   fmbtCsv c;
   fmbStats st;
-  const char* ov[] = {"bodies.beam.model=exact", "bodies.beam.elements=20", "solver.t_end=30", "solver.rtol=1e-8",
-                      "solver.atol=1e-10", "solver.error_control=positions"};
+  const char* ov[] = {"bodies.beam.model=exact", "bodies.beam.elements=20", "solver.t_end=30",
+                      "solver.rtol=1e-8",        "solver.atol=1e-10",       "solver.error_control=positions"};
   ENSURE(fmbt_run_read("scenes/paper/spinup_w15.yaml", ov, 6, "exact_w15_30s.csv", &c, &st) == 0);
   int n;
   const double w = fmbt_crossing_frequency(&c, "beam.tip_v", 15.5, &n);
   printf("spin-up omega0 = 15, exact, 20 elements: free vibration after the ramp %.5f rad/s over %d crossings "
-         "(rotating cantilever 6.33515, %+.3f %%), %.2f s CPU\n", w, n, 100.0 * (w / 6.33515 - 1.0), st.cpu_s);
+         "(rotating cantilever 6.33515, %+.3f %%), %.2f s CPU\n",
+         w, n, 100.0 * (w / 6.33515 - 1.0), st.cpu_s);
   ENSURE(n >= 6);
   ENSURE(fabs(w / 6.33515 - 1.0) < 0.003);
   fmbt_csv_free(&c);
@@ -107,8 +108,8 @@ static void spinup_w15_banded(void) {
     char set[64], out[64];
     snprintf(set, sizeof set, "bodies.beam.assembly=%s", assembly[k]);
     snprintf(out, sizeof out, "exact_w15_%s.csv", assembly[k]);
-    const char* ov[] = {"bodies.beam.model=exact", "bodies.beam.elements=16", set, "solver.rtol=1e-8",
-                        "solver.atol=1e-10", "solver.error_control=positions"};
+    const char* ov[] = {"bodies.beam.model=exact", "bodies.beam.elements=16", set,
+                        "solver.rtol=1e-8",        "solver.atol=1e-10",       "solver.error_control=positions"};
     ENSURE(fmbt_run_read("scenes/paper/spinup_w15.yaml", ov, 6, out, &c[k], &st[k]) == 0);
     printf("spin-up omega0 = 15, exact, 16 elements, %-6s assembly: %ld steps, %ld Newton iterations, %.3f s CPU\n",
            assembly[k], st[k].steps, st[k].newton_iters, st[k].cpu_s);

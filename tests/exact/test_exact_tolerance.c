@@ -31,7 +31,8 @@ static void write_scene(double s, const char* path) {
   ENSURE(f != NULL);
   if (!f) return;
   fprintf(f,
-          "solver: {t_end: %.17g, rtol: 1.0e-6, atol: 1.0e-8, output_step: %.17g, error_control: positions, integrator: ida}\n"
+          "solver: {t_end: %.17g, rtol: 1.0e-6, atol: 1.0e-8, output_step: %.17g, error_control: positions, "
+          "integrator: ida}\n"
           "bodies:\n"
           "  - {name: beam, type: beam, model: exact, elements: 16, length: %.17g, density: 2767.0, area: %.17g,\n"
           "     second_moment: %.17g, youngs_modulus: 68.95e9}\n"

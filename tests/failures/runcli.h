@@ -16,10 +16,10 @@
 extern char** environ;
 
 typedef struct {
-  int exit_code;   /* -1 if killed by a signal */
-  int signal;      /* the signal, or 0 */
-  long maxrss_kb;  /* peak resident set size of the child */
-  char* err;       /* whole stderr, NUL-terminated (malloc) */
+  int exit_code;  /* -1 if killed by a signal */
+  int signal;     /* the signal, or 0 */
+  long maxrss_kb; /* peak resident set size of the child */
+  char* err;      /* whole stderr, NUL-terminated (malloc) */
 } runcliResult;
 
 /* argv: NULL-terminated, argv[0] the program. stderr goes to err_path and is read back. */

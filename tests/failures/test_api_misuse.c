@@ -47,8 +47,8 @@ static void write_file(const char* path, const char* text) {
 static void wrong_results(const fmbModel* m, const char* csv) {
   fmbDiag d = {.code = FMB_EXIT_SOLVER, .msg = "an earlier error"}; /* each call reports its own */
   double shape[2] = {1.0, 0.0}, freq = 1.0, zeta = 0.0;
-  fmbModes one = {.count = 1, .nq = 1, .frequency = &freq, .damping_ratio = &zeta, .shape_re = shape,
-                  .shape_im = shape + 1};
+  fmbModes one = {
+      .count = 1, .nq = 1, .frequency = &freq, .damping_ratio = &zeta, .shape_re = shape, .shape_im = shape + 1};
   ENSURE(fmb_modes_mac(&one, 0, &one, 0) == 1.0);
   ENSURE(isnan(fmb_modes_mac(&one, 1, &one, 0)) && isnan(fmb_modes_mac(&one, 0, &one, -1)));
   ENSURE(isnan(fmb_modes_mac(NULL, 0, &one, 0)));
@@ -65,8 +65,8 @@ static void wrong_results(const fmbModel* m, const char* csv) {
   ENSURE(fmb_modes(m, 0.0, y, yp, 0, 7, &md, &d) == FMB_EXIT_BAD_INPUT && md == NULL && strstr(d.msg, "method 7"));
   ENSURE(fmb_modes(m, NAN, y, yp, 0, FMB_EIGEN_DENSE, &md, &d) == FMB_EXIT_BAD_INPUT && strstr(d.msg, "not finite"));
   double mshape[3] = {0.0, 0.0, 1.0}, mim[3] = {0.0, 0.0, 0.0};
-  fmbModes mode = {.count = 1, .nq = m->nq, .frequency = &freq, .damping_ratio = &zeta, .shape_re = mshape,
-                   .shape_im = mim};
+  fmbModes mode = {
+      .count = 1, .nq = m->nq, .frequency = &freq, .damping_ratio = &zeta, .shape_re = mshape, .shape_im = mim};
   ENSURE(m->nq == 3);
   char dir[1100];
   snprintf(dir, sizeof dir, "%s.anim", csv);
@@ -158,7 +158,7 @@ static void analysis_misuse(const char* scene, const char* dir) {
   ENSURE(fmb_gauss_lobatto01(3, NULL, NULL) == -1 && fmb_gauss_lobatto01(1, x, w) == -1 &&
          fmb_gauss_lobatto01(FMB_GAUSS_MAX + 1, x, w) == -1);
   ENSURE(fmb_gauss_lobatto01(3, x, w) == 0 && fabs(w[0] + w[1] + w[2] - 1.0) < 1e-15); /* still works */
-  ENSURE(fmb_eval_col0(NULL, 0) == -1 && fmb_eval_col0(NULL, 7) == -1); /* no context: no column */
+  ENSURE(fmb_eval_col0(NULL, 0) == -1 && fmb_eval_col0(NULL, 7) == -1);                /* no context: no column */
   ENSURE(fmb_model_nbody(NULL) == 0 && fmb_model_body(NULL, 0, NULL, NULL) == -1);
   ENSURE(fmb_model_njoint(NULL) == 0 && fmb_model_joint(NULL, 0, NULL, NULL) == -1);
   ENSURE(fmb_state_size(NULL) == 0 && fmb_drawing_new(NULL) == NULL);

@@ -33,25 +33,27 @@ static const Case cases[] = {
     {"min_step_floor", 0.01, 1.585, 1.5874, "the error test failed repeatedly",
      "the step reached solver.min_step = 1e-06 (as given)", NULL},
     {"too_much_work", 2.0, 0.0, 2.0, "too many steps between two outputs", "Try a larger solver.max_steps", NULL},
-    {"foac_pendulum", 0.005, 0.02, 0.5, "the mass matrix is no longer positive definite", "use `model: complete`", NULL},
+    {"foac_pendulum", 0.005, 0.02, 0.5, "the mass matrix is no longer positive definite", "use `model: complete`",
+     NULL},
     /* a free body: no joints, so no dead point or singular configuration may be named */
     {"overflow_force", 1000.0, 0.0, 0.0, "the equations kept returning non-finite values",
      "Check parameters and initial values", "singular configuration"},
-    {"infinite_energy", 0.001, 0.0, 0.0, "is not finite (the solution blew up)", "check the initial values and parameters", NULL},
+    {"infinite_energy", 0.001, 0.0, 0.0, "is not finite (the solution blew up)",
+     "check the initial values and parameters", NULL},
     /* a coupler of 1e200 kg: the parameters' scale is to blame, not the mechanism's geometry */
     {"huge_mass", 0.01, 0.0, 0.0, "a parameter is far beyond a physical scale", "check masses, stiffnesses, forces",
      "singular configuration"},
 };
 
 static int failures = 0;
-#define CHECK(cond, ...)                                \
-  do {                                                  \
-    if (!(cond)) {                                      \
-      fprintf(stderr, "%s:%d: ", __FILE__, __LINE__);   \
-      fprintf(stderr, __VA_ARGS__);                     \
-      fprintf(stderr, "\n");                            \
-      ++failures;                                       \
-    }                                                   \
+#define CHECK(cond, ...)                              \
+  do {                                                \
+    if (!(cond)) {                                    \
+      fprintf(stderr, "%s:%d: ", __FILE__, __LINE__); \
+      fprintf(stderr, __VA_ARGS__);                   \
+      fprintf(stderr, "\n");                          \
+      ++failures;                                     \
+    }                                                 \
   } while (0)
 
 static char* read_all(const char* path, long* len) {
@@ -93,7 +95,8 @@ static long check_csv(const char* path, const Case* c, double t_reached, double*
     while (p < nl) {
       char* end = NULL;
       double v = strtod(p, &end);
-      CHECK(end != p && (*end == ',' || *end == '\n'), "%s: row %ld, column %d is not a number", path, rows + 1, col + 1);
+      CHECK(end != p && (*end == ',' || *end == '\n'), "%s: row %ld, column %d is not a number", path, rows + 1,
+            col + 1);
       CHECK(isfinite(v), "%s: row %ld, column %d is not finite", path, rows + 1, col + 1);
       if (end == p) break;
       if (col == 0) t = v;
@@ -150,8 +153,8 @@ int main(int argc, char** argv) {
   CHECK(nerr == 1, "%d error lines, expected one", nerr);
   char prefix[1100];
   snprintf(prefix, sizeof prefix, "\n%s: error: ", scene);
-  CHECK(strstr(r.err, prefix) != NULL || strncmp(r.err, prefix + 1, strlen(prefix + 1)) == 0,
-        "no line starting '%s'", prefix + 1);
+  CHECK(strstr(r.err, prefix) != NULL || strncmp(r.err, prefix + 1, strlen(prefix + 1)) == 0, "no line starting '%s'",
+        prefix + 1);
   double t_reached = runcli_stat(&r, "t_reached");
   CHECK(strstr(r.err, "stats: status=failed ") != NULL, "no stats line with status=failed");
   CHECK(t_reached >= c->t_lo && t_reached <= c->t_hi, "stopped at t = %.10g, expected within [%g, %g]", t_reached,
@@ -167,7 +170,8 @@ int main(int argc, char** argv) {
     }
     CHECK(strstr(msg, c->cause) != NULL, "the message lacks the cause '%s'", c->cause);
     if (c->advice) CHECK(strstr(msg, c->advice) != NULL, "the message lacks the advice '%s'", c->advice);
-    if (c->wrong) CHECK(strstr(msg, c->wrong) == NULL, "the message names '%s', which this scene cannot have", c->wrong);
+    if (c->wrong)
+      CHECK(strstr(msg, c->wrong) == NULL, "the message names '%s', which this scene cannot have", c->wrong);
   }
   double t_last = -1.0;
   long rows = check_csv(csv, c, t_reached, &t_last);

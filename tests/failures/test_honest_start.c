@@ -89,7 +89,8 @@ static void drive_angle(void) {
       e = fmax(e, fabs(ang[i] - (0.3 + t[i])));
       es = fmax(es, fabs(sp[i] - 1.0));
     }
-    printf("drive angle: max |angle - (0.3 + t)| = %.3g, |angle - bar.theta| = %.3g\n", e, max_abs_diff(ang, th, 0.0, c.nrow));
+    printf("drive angle: max |angle - (0.3 + t)| = %.3g, |angle - bar.theta| = %.3g\n", e,
+           max_abs_diff(ang, th, 0.0, c.nrow));
     ENSURE(e <= 1e-8);
     ENSURE(es <= 1e-12);
     ENSURE(max_abs_diff(ang, th, 0.0, c.nrow) <= 1e-12);

@@ -9,8 +9,8 @@
 int main(void) {
   char path[1024];
   fmbDiag d;
-  fmbModel* m = fmb_load(fmbt_path("tests/failures/merge_keys.yaml", path, sizeof path), NULL, 0,
-                         fmb_builtin_registry(), &d);
+  fmbModel* m =
+      fmb_load(fmbt_path("tests/failures/merge_keys.yaml", path, sizeof path), NULL, 0, fmb_builtin_registry(), &d);
   ENSURE(m != NULL);
   if (!m) {
     fprintf(stderr, "%s:%d: %s\n", d.file, d.line, d.msg);

@@ -94,7 +94,8 @@ static void pendulum(void) {
     fmbStats st;
     char out[64];
     snprintf(out, sizeof out, "radau_pendulum_%d.csv", k);
-    const int rc = run("scenes/pendulum.yaml", "radau5", rtols[k], 10.0, out, &c, &st, "solver.output_step=0.002", NULL);
+    const int rc =
+        run("scenes/pendulum.yaml", "radau5", rtols[k], 10.0, out, &c, &st, "solver.output_step=0.002", NULL);
     ENSURE(rc == 0);
     const double T = period(&c);
     err[k] = fabs(T / T_exact - 1.0);
@@ -126,8 +127,8 @@ static void spinup(void) {
     if (k == 0) st_red = st;
     err[k] = max_diff(&c[k], &ref, "beam.tip_v");
     const double eth = max_diff(&c[k], &ref, "beam.theta");
-    printf("spin-up 5 s, radau5 rtol %g: tip_v error %.3e m (scale %.3g m), theta error %.3e rad, %ld steps\n", rtols[k],
-           err[k], scale, eth, st.steps);
+    printf("spin-up 5 s, radau5 rtol %g: tip_v error %.3e m (scale %.3g m), theta error %.3e rad, %ld steps\n",
+           rtols[k], err[k], scale, eth, st.steps);
     /* agreement with IDA to the tolerance radau5 applies (measured: 0.16 rtol' and 0.2 rtol' of the
        tip's excursion, theta 0.002 rtol') */
     const double rtol_applied = 0.1 * pow(rtols[k], 2.0 / 3.0);
@@ -158,12 +159,14 @@ static void spinup(void) {
   fmbtCsv fb;
   fmbStats st_fb;
   setenv("FMB_TEST_FAIL_REDUCED_SETUP", "5", 1);
-  rc = run("scenes/paper/spinup_w15.yaml", "radau5", rtols[0], t_end, "radau_spinup_fallback.csv", &fb, &st_fb, NULL, NULL);
+  rc = run("scenes/paper/spinup_w15.yaml", "radau5", rtols[0], t_end, "radau_spinup_fallback.csv", &fb, &st_fb, NULL,
+           NULL);
   unsetenv("FMB_TEST_FAIL_REDUCED_SETUP");
   ENSURE(rc == 0);
   const double efb = max_diff(&fb, &ref, "beam.tip_v"), dfb = max_diff(&fb, &c[0], "beam.tip_v");
   printf("spin-up 5 s, radau5 rtol 1e-6, reduced solve failing from the 5th factorization: tip_v error %.3e m, %.3e m "
-         "from the reduced run, %ld steps\n", efb, dfb, st_fb.steps);
+         "from the reduced run, %ld steps\n",
+         efb, dfb, st_fb.steps);
   ENSURE(efb < 0.1 * pow(rtols[0], 2.0 / 3.0) * scale);
   ENSURE(dfb > 0.0);
   fmbt_csv_free(&fb);

@@ -32,7 +32,8 @@ static void law_case(const char* name, const char* const* ov, int nov, Integral 
   snprintf(out, sizeof out, "load_%s.csv", name);
   ENSURE(fmbt_run_read("tests/mechanisms/scenes/free_load.yaml", ov, nov, out, &c, &st) == 0);
   const double *t = fmbt_col(&c, "t"), *vx = fmbt_col(&c, "puck.vx"), *om = fmbt_col(&c, "puck.omega"),
-               *W = fmbt_col(&c, "push.work"), *T = fmbt_col(&c, "energy.kinetic"), *bal = fmbt_col(&c, "energy.balance");
+               *W = fmbt_col(&c, "push.work"), *T = fmbt_col(&c, "energy.kinetic"),
+               *bal = fmbt_col(&c, "energy.balance");
   if (!t || !vx || !om || !W || !T || !bal) return;
   double ev = 0, ew = 0, eb = 0, scale = 0;
   for (int i = 0; i < c.nrow; ++i) {
@@ -42,8 +43,8 @@ static void law_case(const char* name, const char* const* ov, int nov, Integral 
     eb = fmax(eb, fabs(bal[i]));
     scale = fmax(scale, T[i]);
   }
-  printf("load law %-9s: velocity error %.2e, |work - kinetic energy| %.2e J, balance %.2e J (energy up to %.3g J)\n", name,
-         ev, ew, eb, scale);
+  printf("load law %-9s: velocity error %.2e, |work - kinetic energy| %.2e J, balance %.2e J (energy up to %.3g J)\n",
+         name, ev, ew, eb, scale);
   ENSURE(ev < 1e-8);
   ENSURE(ew < 1e-7 * scale && eb < 1e-7 * scale);
   fmbt_csv_free(&c);
@@ -53,18 +54,21 @@ static void follower(int body_frame) {
   fmbtCsv c;
   fmbStats st;
   const char* ov[1] = {"joints.push.frame=global"};
-  ENSURE(fmbt_run_read("tests/mechanisms/scenes/follower_load.yaml", ov, body_frame ? 0 : 1, "follower.csv", &c, &st) == 0);
+  ENSURE(fmbt_run_read("tests/mechanisms/scenes/follower_load.yaml", ov, body_frame ? 0 : 1, "follower.csv", &c, &st) ==
+         0);
   const double *t = fmbt_col(&c, "t"), *vx = fmbt_col(&c, "puck.vx"), *vy = fmbt_col(&c, "puck.vy"),
                *bal = fmbt_col(&c, "energy.balance");
   if (!t || !vx || !vy || !bal) return;
   const double F = 0.5, w = 2.0;
   double err = 0, eb = 0;
   for (int i = 0; i < c.nrow; ++i) {
-    const double ax = body_frame ? F / w * sin(w * t[i]) : F * t[i], ay = body_frame ? F / w * (1 - cos(w * t[i])) : 0.0;
+    const double ax = body_frame ? F / w * sin(w * t[i]) : F * t[i],
+                 ay = body_frame ? F / w * (1 - cos(w * t[i])) : 0.0;
     err = fmax(err, hypot(vx[i] - ax, vy[i] - ay));
     eb = fmax(eb, fabs(bal[i] - bal[0]));
   }
-  printf("%s load on a spinning puck: velocity error %.2e, balance drift %.2e J\n", body_frame ? "follower" : "global", err, eb);
+  printf("%s load on a spinning puck: velocity error %.2e, balance drift %.2e J\n", body_frame ? "follower" : "global",
+         err, eb);
   ENSURE(err < 1e-8);
   ENSURE(eb < 1e-8);
   fmbt_csv_free(&c);
@@ -88,8 +92,9 @@ static void drive_table(const char* name, const char* const* ov, int nov) {
     ew = fmax(ew, fabs(om[i] - df));
     eb = fmax(eb, fabs(bal[i] - bal[0]));
   }
-  printf("drive table %-6s: %d rows to t = %g, %ld steps, |theta - f| %.2e rad, |omega - f'| %.2e rad/s, balance %.2e J\n",
-         name, c.nrow, c.nrow ? t[c.nrow - 1] : 0.0, st.steps, ea, ew, eb);
+  printf(
+      "drive table %-6s: %d rows to t = %g, %ld steps, |theta - f| %.2e rad, |omega - f'| %.2e rad/s, balance %.2e J\n",
+      name, c.nrow, c.nrow ? t[c.nrow - 1] : 0.0, st.steps, ea, ew, eb);
   ENSURE(c.nrow == 401);
   ENSURE(ea < 1e-7 && ew < 1e-6);
   /* energy.balance is printed, not checked: the constraint's work is outside the error test and

@@ -61,8 +61,10 @@ static void stretch_errors(const fmbtCsv* c, int rows, double* flat, double* reg
     const double e = fabs(y - th[i + rows]) + 0.01 * fabs(yd - om[i + rows]);
     int passes = 0;
     for (int j = i; j < i + rows; ++j) passes |= sin(th[j]) * sin(th[j + 1]) <= 0.0;
-    if (passes) *flat = fmax(*flat, e);
-    else *regular = fmax(*regular, e);
+    if (passes)
+      *flat = fmax(*flat, e);
+    else
+      *regular = fmax(*regular, e);
   }
 }
 
@@ -111,8 +113,8 @@ static Linkage checked(const char* scene, int cranks, int couplers, double rtol,
   const char* ov[4] = {o[0], o[1], o[2], o[3]};
   Linkage r = run(scene, cranks, couplers, ov, defaults ? 1 : 4, out);
   printf("%d crank(s), rtol %g, %s/%s: %d flat passages, crank angle error %.2e rad, cranks differ by %.1e, coupler "
-         "turns %.1e rad, energy drift %.2e of %.4g J\n", cranks, rtol, formulation, integrator, r.flats, r.err, r.spread,
-         r.coupler_turn, r.energy_drift, r.energy);
+         "turns %.1e rad, energy drift %.2e of %.4g J\n",
+         cranks, rtol, formulation, integrator, r.flats, r.err, r.spread, r.coupler_turn, r.energy_drift, r.energy);
   ENSURE(r.ok);
   ENSURE(r.flats >= 10);
   ENSURE(r.spread < 1e-8 && r.coupler_turn < 1e-8);
@@ -157,8 +159,8 @@ int main(void) {
      error committed within 0.05 s stretches (the exact motion restarted from the run's state at
      each stretch), those passing one of the ~20 flat positions against those that do not */
   stretch_rows = 5;
-  const Linkage s = checked("tests/mechanisms/scenes/parallelogram_row1_default.yaml", 2, 1, 1e-8, "default", "default",
-                            1e-5 / 3);
+  const Linkage s =
+      checked("tests/mechanisms/scenes/parallelogram_row1_default.yaml", 2, 1, 1e-8, "default", "default", 1e-5 / 3);
   printf("error committed within 0.05 s: at most %.2e rad over a flat position, %.2e elsewhere\n", s.stretch_flat,
          s.stretch_regular);
   ENSURE(s.stretch_regular > 0.0 && s.stretch_flat <= 3.0 * s.stretch_regular);

@@ -15,7 +15,8 @@ static void slider_spring(double damping) {
   ENSURE(fmbt_run_read("tests/mechanisms/scenes/slider_spring.yaml", ovs, 1, "slider_spring.csv", &c, &st) == 0);
   const double *t = fmbt_col(&c, "t"), *s = fmbt_col(&c, "slide.displacement"), *rx = fmbt_col(&c, "slide.reaction_x"),
                *ry = fmbt_col(&c, "slide.reaction_y"), *rt = fmbt_col(&c, "slide.reaction_torque"),
-               *e = fmbt_col(&c, "energy.total"), *bal = fmbt_col(&c, "energy.balance"), *th = fmbt_col(&c, "block.theta");
+               *e = fmbt_col(&c, "energy.total"), *bal = fmbt_col(&c, "energy.balance"),
+               *th = fmbt_col(&c, "block.theta");
   if (!t || !s || !rx || !ry || !rt || !e || !bal || !th) return;
   const double m = 2.0, k = 50.0, g = 9.81, w = sqrt(k / m), seq = -m * g * 0.5 / k, s0 = 0.3;
   const double nx = -0.5, ny = 0.866025403784439; /* normal of the axis */
@@ -29,18 +30,19 @@ static void slider_spring(double damping) {
     drift_e = fmax(drift_e, fabs(e[i] - e[0]));
     drift_b = fmax(drift_b, fabs(bal[i] - bal[0]));
   }
-  printf("slider spring (damping %g): |s - analytic| %.2e, normal reaction error %.2e N, along %.2e N, torque %.2e N m, "
-         "angle %.2e; energy drift %.3g J, balance drift %.2e J\n",
-         damping, err_s, err_n, along, err_t, err_th, drift_e, drift_b);
+  printf(
+      "slider spring (damping %g): |s - analytic| %.2e, normal reaction error %.2e N, along %.2e N, torque %.2e N m, "
+      "angle %.2e; energy drift %.3g J, balance drift %.2e J\n",
+      damping, err_s, err_n, along, err_t, err_th, drift_e, drift_b);
   if (damping == 0) {
-    ENSURE(err_s < 1e-7);        /* amplitude 0.5 m, rtol 1e-9 */
+    ENSURE(err_s < 1e-7);         /* amplitude 0.5 m, rtol 1e-9 */
     ENSURE(drift_e < 1e-6 * 5.2); /* E = 5.19 J */
   } else {
-    ENSURE(drift_e > 1.0);       /* the damper takes energy out ... */
+    ENSURE(drift_e > 1.0); /* the damper takes energy out ... */
   }
   ENSURE(err_n < 1e-6 * 17.0 && along < 1e-6 * 17.0 && err_t < 1e-6);
   ENSURE(err_th < 1e-9);
-  ENSURE(drift_b < 1e-6 * 5.2);  /* ... and energy.balance accounts for it */
+  ENSURE(drift_b < 1e-6 * 5.2); /* ... and energy.balance accounts for it */
   fmbt_csv_free(&c);
 }
 

@@ -11,10 +11,11 @@
 static void pendulum(void) {
   fmbtCsv c;
   fmbStats st;
-  ENSURE(fmbt_run_read("tests/mechanisms/scenes/pendulum_reaction.yaml", NULL, 0, "pendulum_reaction.csv", &c, &st) == 0);
+  ENSURE(fmbt_run_read("tests/mechanisms/scenes/pendulum_reaction.yaml", NULL, 0, "pendulum_reaction.csv", &c, &st) ==
+         0);
   const double *x = fmbt_col(&c, "bob.x"), *y = fmbt_col(&c, "bob.y"), *th = fmbt_col(&c, "bob.theta"),
-               *om = fmbt_col(&c, "bob.omega"), *rx = fmbt_col(&c, "pin.reaction_x"), *ry = fmbt_col(&c, "pin.reaction_y"),
-               *p = fmbt_col(&c, "pin.power");
+               *om = fmbt_col(&c, "bob.omega"), *rx = fmbt_col(&c, "pin.reaction_x"),
+               *ry = fmbt_col(&c, "pin.reaction_y"), *p = fmbt_col(&c, "pin.power");
   if (!x || !y || !th || !om || !rx || !ry || !p) return;
   const double m = 1.0, g = 9.81, L = 1.0;
   double err = 0, tmax = 0, pmax = 0;
@@ -63,14 +64,16 @@ int main(void) {
   const char* spin_out = "[beam.tip_v, energy.total, energy.balance, spin.work]";
   const double d6 = balance_drift("scenes/paper/spinup_w4.yaml", 1e-6, spin_out, "spin.work", &w6),
                d8 = balance_drift("scenes/paper/spinup_w4.yaml", 1e-8, spin_out, "spin.work", &w8);
-  printf("spin-up w0 = 4 (complete beam): drive work up to %.4g J; energy.balance drift %.2e J (rtol 1e-6), %.2e J (rtol 1e-8)\n",
+  printf("spin-up w0 = 4 (complete beam): drive work up to %.4g J; energy.balance drift %.2e J (rtol 1e-6), %.2e J "
+         "(rtol 1e-8)\n",
          w6, d6, d8);
-  ENSURE(w6 > 10.0);               /* the drive does real work ... */
-  ENSURE(d6 < 1e-5 * w6);          /* ... and the balance holds to the tolerance's order */
+  ENSURE(w6 > 10.0);      /* the drive does real work ... */
+  ENSURE(d6 < 1e-5 * w6); /* ... and the balance holds to the tolerance's order */
   ENSURE(d8 < 1e-7 * w8 && d8 < d6);
   const double r6 = balance_drift("scenes/rotor.yaml", 1e-6, NULL, "motor.work", &w6),
                r8 = balance_drift("scenes/rotor.yaml", 1e-8, NULL, "motor.work", &w8);
-  printf("rotor (torque table, 3 complete blades): torque work %.4g J; energy.balance drift %.2e J (rtol 1e-6), %.2e J (rtol 1e-8)\n",
+  printf("rotor (torque table, 3 complete blades): torque work %.4g J; energy.balance drift %.2e J (rtol 1e-6), %.2e J "
+         "(rtol 1e-8)\n",
          w6, r6, r8);
   ENSURE(w6 > 20.0);
   ENSURE(r6 < 1e-3 * w6 && r8 < 2e-5 * w8 && r8 < r6 / 10);

@@ -59,8 +59,9 @@ static void two_pins(void) {
   fmbStats st;
   ENSURE(fmbt_run_read("tests/mechanisms/scenes/pendulum_one_pin.yaml", NULL, 0, "one_pin.csv", &one, &st) == 0);
   ENSURE(fmbt_run_read("tests/mechanisms/scenes/pendulum_two_pins.yaml", NULL, 0, "two_pins.csv", &two, &st) == 0);
-  const double *th1 = fmbt_col(&one, "bar.theta"), *th2 = fmbt_col(&two, "bar.theta"), *rx = fmbt_col(&one, "pin.reaction_x"),
-               *ry = fmbt_col(&one, "pin.reaction_y"), *ax = fmbt_col(&two, "pin.reaction_x"), *ay = fmbt_col(&two, "pin.reaction_y"),
+  const double *th1 = fmbt_col(&one, "bar.theta"), *th2 = fmbt_col(&two, "bar.theta"),
+               *rx = fmbt_col(&one, "pin.reaction_x"), *ry = fmbt_col(&one, "pin.reaction_y"),
+               *ax = fmbt_col(&two, "pin.reaction_x"), *ay = fmbt_col(&two, "pin.reaction_y"),
                *bx = fmbt_col(&two, "pin2.reaction_x"), *by = fmbt_col(&two, "pin2.reaction_y");
   if (!th1 || !th2 || !rx || !ry || !ax || !ay || !bx || !by || one.nrow != two.nrow) return;
   double dth = 0, dsplit = 0, dsum = 0, rmax = 0;
@@ -71,8 +72,9 @@ static void two_pins(void) {
     rmax = fmax(rmax, hypot(rx[i], ry[i]));
   }
   printf("two identical pins vs one: angle difference %.2e rad; pin forces sum to the single pin's within %.2e N, "
-         "differ from each other by %.2e N (reaction up to %.3g N)\n", dth, dsum, dsplit, rmax);
-  ENSURE(dth < 1e-6); /* two runs at rtol 1e-8, different step sequences */
+         "differ from each other by %.2e N (reaction up to %.3g N)\n",
+         dth, dsum, dsplit, rmax);
+  ENSURE(dth < 1e-6);                                 /* two runs at rtol 1e-8, different step sequences */
   ENSURE(dsum < 1e-5 * rmax && dsplit < 1e-5 * rmax); /* Tikhonov shift 1e-10: ~1e-6 relative */
   fmbt_csv_free(&one);
   fmbt_csv_free(&two);
@@ -87,7 +89,7 @@ static void three_cranks(void) {
   fmbStats st;
   ENSURE(fmbt_run_read("tests/mechanisms/scenes/parallelogram3.yaml", NULL, 0, "parallelogram3.csv", &c, &st) == 0);
   const double *t = fmbt_col(&c, "t"), *th = fmbt_col(&c, "crank1.theta"), *om = fmbt_col(&c, "crank1.omega");
-  const double *R[3][4];
+  const double* R[3][4];
   const char* names[3][4] = {{"o1.reaction_x", "o1.reaction_y", "a1.reaction_x", "a1.reaction_y"},
                              {"o2.reaction_x", "o2.reaction_y", "a2.reaction_x", "a2.reaction_y"},
                              {"o3.reaction_x", "o3.reaction_y", "a3.reaction_x", "a3.reaction_y"}};
@@ -123,7 +125,8 @@ static void three_cranks(void) {
     }
   }
   printf("three-crank parallelogram (one redundant equation): crank angle vs the 1-DOF pendulum %.2e rad; coupler "
-         "Newton residual %.2e N, crank Euler residual %.2e N m (pin forces up to %.3g N)\n", err, coupler, crank, fmax_);
+         "Newton residual %.2e N, crank Euler residual %.2e N m (pin forces up to %.3g N)\n",
+         err, coupler, crank, fmax_);
   ENSURE(err < 1e-6);
   ENSURE(coupler < 1e-6 * fmax_ && crank < 1e-6 * fmax_);
   fmbt_csv_free(&c);

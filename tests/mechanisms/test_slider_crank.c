@@ -22,8 +22,10 @@ static Crank run(int elements, double rtol, double youngs, const char* name) {
   snprintf(ov[1], sizeof ov[1], "solver.rtol=%g", rtol);
   snprintf(ov[2], sizeof ov[2], "solver.atol=%g", rtol * 1e-3);
   snprintf(ov[3], sizeof ov[3], "bodies.rod.youngs_modulus=%g", youngs);
-  snprintf(ov[4], sizeof ov[4], "outputs=[slider.x, rod.x, rod.y, rod.tip_x, rod.tip_y, rod.node%d_x, rod.node%d_y, "
-           "energy.kinetic, energy.balance]", mid, mid);
+  snprintf(ov[4], sizeof ov[4],
+           "outputs=[slider.x, rod.x, rod.y, rod.tip_x, rod.tip_y, rod.node%d_x, rod.node%d_y, "
+           "energy.kinetic, energy.balance]",
+           mid, mid);
   const char* ovs[5] = {ov[0], ov[1], ov[2], ov[3], ov[4]};
   fmbtCsv c;
   fmbStats st;
@@ -31,9 +33,10 @@ static Crank run(int elements, double rtol, double youngs, const char* name) {
   char nx[32], ny[32];
   snprintf(nx, sizeof nx, "rod.node%d_x", mid);
   snprintf(ny, sizeof ny, "rod.node%d_y", mid);
-  const double *t = fmbt_col(&c, "t"), *xs = fmbt_col(&c, "slider.x"), *rx = fmbt_col(&c, "rod.x"), *ry = fmbt_col(&c, "rod.y"),
-               *tx = fmbt_col(&c, "rod.tip_x"), *ty = fmbt_col(&c, "rod.tip_y"), *mx = fmbt_col(&c, nx), *my = fmbt_col(&c, ny),
-               *ke = fmbt_col(&c, "energy.kinetic"), *bal = fmbt_col(&c, "energy.balance");
+  const double *t = fmbt_col(&c, "t"), *xs = fmbt_col(&c, "slider.x"), *rx = fmbt_col(&c, "rod.x"),
+               *ry = fmbt_col(&c, "rod.y"), *tx = fmbt_col(&c, "rod.tip_x"), *ty = fmbt_col(&c, "rod.tip_y"),
+               *mx = fmbt_col(&c, nx), *my = fmbt_col(&c, ny), *ke = fmbt_col(&c, "energy.kinetic"),
+               *bal = fmbt_col(&c, "energy.balance");
   if (!t || !xs || !rx || !ry || !tx || !ty || !mx || !my || !ke || !bal) return r;
   const double a = 0.15, L = 0.3, w = 100.0;
   for (int i = 0; i < c.nrow; ++i) {
@@ -54,10 +57,11 @@ int main(void) {
   Crank m4 = run(4, 1e-6, E, "slider_crank_4.csv"), m8 = run(8, 1e-6, E, "slider_crank_8.csv"),
         m16 = run(16, 1e-6, E, "slider_crank_16.csv"), t8 = run(8, 1e-8, E, "slider_crank_tight.csv");
   ENSURE(rigid.ok && m4.ok && m8.ok && m16.ok && t8.ok);
-  printf("rigid limit (E x 1e5): slider error %.2e m, rod mid-span deflection %.2e m\n", rigid.slider_err, rigid.deflection);
+  printf("rigid limit (E x 1e5): slider error %.2e m, rod mid-span deflection %.2e m\n", rigid.slider_err,
+         rigid.deflection);
   printf("flexible rod: slider off the rigid closed form by %.2e m\n", m8.slider_err);
-  printf("mid-span deflection: %.7e (4 el.), %.7e (8), %.7e (16) m; rtol 1e-8 (8 el.): %.7e m\n", m4.deflection, m8.deflection,
-         m16.deflection, t8.deflection);
+  printf("mid-span deflection: %.7e (4 el.), %.7e (8), %.7e (16) m; rtol 1e-8 (8 el.): %.7e m\n", m4.deflection,
+         m8.deflection, m16.deflection, t8.deflection);
   printf("energy.balance drift %.2e J (rtol 1e-6), %.2e J (rtol 1e-8); kinetic energy up to %.3g J\n", m8.balance_drift,
          t8.balance_drift, m8.energy);
   ENSURE(rigid.slider_err < 5e-7 && rigid.deflection < 1e-7);

@@ -37,8 +37,8 @@ static double fourbar(const char* solver) {
 static double stiff_slider(const char* solver) {
   char ls[64];
   snprintf(ls, sizeof ls, "solver.linear_solver=%s", solver);
-  const char* ov[] = {"solver.rtol=1e-12", "solver.atol=1e-12", ls, "joints.slide.stiffness=1e6", "solver.t_end=0.1",
-                      "solver.output_step=1e-4"};
+  const char* ov[] = {"solver.rtol=1e-12",          "solver.atol=1e-12", ls,
+                      "joints.slide.stiffness=1e6", "solver.t_end=0.1",  "solver.output_step=1e-4"};
   fmbtCsv c;
   fmbStats st;
   ENSURE(fmbt_run_read("tests/mechanisms/scenes/slider_spring.yaml", ov, 6, "tight_slider.csv", &c, &st) == 0);
@@ -59,8 +59,9 @@ int main(void) {
   ENSURE(fallback < 1e-10);
   const double f = fourbar("klu"), ff = fourbar("klu_full"), s = stiff_slider("klu"), sf = stiff_slider("klu_full");
   printf("rtol = atol = 1e-12: four-bar rocker error %.2e rad (klu), %.2e (klu_full); stiff slider error %.2e m (klu), "
-         "%.2e (klu_full)\n", f, ff, s, sf);
-  ENSURE(f < 1e-10 && ff < 1e-10);  /* the CSV's 12 significant digits limit what can be seen */
-  ENSURE(s < 1e-9 && sf < 1e-9);    /* amplitude 0.3 m, 700 rad/s, 11 periods */
+         "%.2e (klu_full)\n",
+         f, ff, s, sf);
+  ENSURE(f < 1e-10 && ff < 1e-10); /* the CSV's 12 significant digits limit what can be seen */
+  ENSURE(s < 1e-9 && sf < 1e-9);   /* amplitude 0.3 m, 700 rad/s, 11 periods */
   return fmbt_finish("test_tight");
 }

@@ -17,11 +17,8 @@
 
 static void fail(int fault) {
   switch (fault) {
-    case 1:
-      raise(SIGSEGV);
-      break;
-    case 2:
-      abort();
+    case 1: raise(SIGSEGV); break;
+    case 2: abort();
     case 3:
       for (;;) sleep(1);
     case 4:
@@ -30,10 +27,8 @@ static void fail(int fault) {
         if (!p) abort(); /* what a program that does not check would do, one step later */
         memset(p, 1, 64u << 20);
       }
-    case 5:
-      _exit(7);
-    default:
-      break;
+    case 5: _exit(7);
+    default: break;
   }
 }
 
