@@ -598,31 +598,20 @@ static void exact_energy(const void* self, const fmbEnv* env, const double* q, c
 }
 
 /* the same output names and meanings as bodies/beam.c: tip_u/tip_v = the tip's axial and
-   transverse displacement in the frame (the complete model's u(L) and w2(L)) */
-enum {
-  OUT_TIP_U = FMB_BEAM_TIP_U,
-  OUT_TIP_V = FMB_BEAM_TIP_V,
-  OUT_TIP_U_RATE = FMB_BEAM_TIP_U_RATE,
-  OUT_TIP_V_RATE = FMB_BEAM_TIP_V_RATE,
-  OUT_TIP_X = FMB_BEAM_TIP_X,
-  OUT_TIP_Y = FMB_BEAM_TIP_Y,
-  OUT_ANG_MOMENTUM = FMB_BEAM_ANG_MOMENTUM,
-  OUT_TIP_ANGLE = FMB_BEAM_TIP_ANGLE,
-  OUT_NTIP = FMB_BEAM_NTIP
-};
-enum { OUT_NODE_BASE = FMB_BEAM_NODE_BASE, OUT_NODE_STRIDE = FMB_BEAM_NODE_STRIDE };
+   transverse displacement in the frame (the complete model's u(L) and w2(L)); the ids are
+   beam_section.h's FMB_BEAM_*, one list for all four models */
 static int exact_output_lookup(const void* self, const char* quantity) {
   return fmb_beam_output_lookup(((const BeamExact*)self)->ne, quantity);
 }
 
 static int exact_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
   const BeamExact* b = self;
-  if (id == OUT_ANG_MOMENTUM) {
+  if (id == FMB_BEAM_ANG_MOMENTUM) {
     fmbEnergy en;
     exact_integrals(b, NULL, q, v, &en, value);
     return 0;
   }
-  if (id == OUT_TIP_ANGLE) {
+  if (id == FMB_BEAM_TIP_ANGLE) {
     const double tip[2] = {b->L, 0.0};
     double pos[2], angle;
     if (exact_marker(b, q, tip, pos, &angle, NULL, NULL, work)) return -1;
@@ -630,11 +619,11 @@ static int exact_output(const void* self, int id, const double* q, const double*
     return 0;
   }
   int node = b->ne, comp = id;
-  if (id >= OUT_NODE_BASE) {
-    node = (id - OUT_NODE_BASE) / OUT_NODE_STRIDE;
-    const int k = (id - OUT_NODE_BASE) % OUT_NODE_STRIDE;
-    comp = k == 0 ? OUT_TIP_U : k == 1 ? OUT_TIP_V : k == 2 ? OUT_TIP_X : OUT_TIP_Y;
-  } else if (id < 0 || id >= OUT_NTIP) {
+  if (id >= FMB_BEAM_NODE_BASE) {
+    node = (id - FMB_BEAM_NODE_BASE) / FMB_BEAM_NODE_STRIDE;
+    const int k = (id - FMB_BEAM_NODE_BASE) % FMB_BEAM_NODE_STRIDE;
+    comp = k == 0 ? FMB_BEAM_TIP_U : k == 1 ? FMB_BEAM_TIP_V : k == 2 ? FMB_BEAM_TIP_X : FMB_BEAM_TIP_Y;
+  } else if (id < 0 || id >= FMB_BEAM_NTIP) {
     return -1;
   }
   /* a node's displacement and rate are coordinates (the root node is fixed in the frame) */
@@ -644,11 +633,11 @@ static int exact_output(const void* self, int id, const double* q, const double*
   const double rho[2] = {node * b->le + u[0], u[1]};
   const double c = cos(q[2]), s = sin(q[2]);
   switch (comp) {
-    case OUT_TIP_U: *value = u[0]; break;
-    case OUT_TIP_V: *value = u[1]; break;
-    case OUT_TIP_U_RATE: *value = ud[0]; break;
-    case OUT_TIP_V_RATE: *value = ud[1]; break;
-    case OUT_TIP_X: *value = q[0] + c * rho[0] - s * rho[1]; break;
+    case FMB_BEAM_TIP_U: *value = u[0]; break;
+    case FMB_BEAM_TIP_V: *value = u[1]; break;
+    case FMB_BEAM_TIP_U_RATE: *value = ud[0]; break;
+    case FMB_BEAM_TIP_V_RATE: *value = ud[1]; break;
+    case FMB_BEAM_TIP_X: *value = q[0] + c * rho[0] - s * rho[1]; break;
     default: *value = q[1] + s * rho[0] + c * rho[1]; break;
   }
   return 0;
