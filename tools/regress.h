@@ -86,6 +86,9 @@ typedef struct {
 } RegressList;
 
 /* regress_ref.c */
+/* the CSV the job's run wrote, read into *out (the caller frees it); -1 with job->failed and
+   job->why set when it is missing or unreadable (bless and check read it the same way) */
+int regress_load_run_csv(RegressJob* job, fmbTable* out);
 void regress_say(char* buf, size_t len, const char* fmt, ...) __attribute__((format(printf, 3, 4)));
 /* 0, or -1 when out of memory */
 int regress_list_push(RegressList* l, char* s);

@@ -170,13 +170,7 @@ void regress_check_job(RegressJob* job) {
     return;
   }
   fmbTable out;
-  char err[600];
-  if (fmb_table_load(job->csv, &out, err, sizeof err)) {
-    job->failed = 1;
-    regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, run->msg[0] ? ": " : "",
-                run->msg);
-    return;
-  }
+  if (regress_load_run_csv(job, &out)) return;
   char* w = job->why;
   size_t left = sizeof job->why;
 #define WHY(...)                                                  \

@@ -328,6 +328,15 @@ static void column_noise(const RegressJob* companions, const fmbTable* out, doub
   }
 }
 
+int regress_load_run_csv(RegressJob* job, fmbTable* out) {
+  char err[600];
+  if (!fmb_table_load(job->csv, out, err, sizeof err)) return 0;
+  job->failed = 1;
+  regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, job->run.msg[0] ? ": " : "",
+              job->run.msg);
+  return -1;
+}
+
 int regress_bless_job(RegressJob* job, const RegressOptions* o) {
   const RegressRun* run = &job->run;
   if (!run->loaded) {
@@ -336,13 +345,7 @@ int regress_bless_job(RegressJob* job, const RegressOptions* o) {
     return -1;
   }
   fmbTable out;
-  char err[600];
-  if (fmb_table_load(job->csv, &out, err, sizeof err)) {
-    job->failed = 1;
-    regress_say(job->why, sizeof job->why, "the run wrote no usable CSV (%s)%s%s", err, run->msg[0] ? ": " : "",
-                run->msg);
-    return -1;
-  }
+  if (regress_load_run_csv(job, &out)) return -1;
   size_t csv_len = 0;
   char* csv = slurp(job->csv, &csv_len);
   if (!csv) {
