@@ -10,6 +10,7 @@
  *   ida        IDA (BDF, variable order and step) on the GGL index-2 system of system.c, KLU
  *   radau5     Radau IIA of order 5 (3 stages, after Hairer & Wanner's RADAU5) on the same GGL
  *              system, KLU real and complex (solver.integrator: radau5)
+ *   radau9     Radau IIA of order 9 (5 stages, RADAU's), the same code (solver.integrator: radau9)
  *   projected  the index-1 form with minimum-norm multipliers and projections onto the
  *              constraints (solver.formulation: projected; passes singular configurations)
  * A backend's name is its ops' .name: solver.integrator's words are the names of the GGL
@@ -84,6 +85,7 @@ typedef struct fmbIntegratorOps {
 extern const fmbIntegratorOps fmb_integrator_ida;
 extern const fmbIntegratorOps fmb_integrator_projected;
 extern const fmbIntegratorOps fmb_integrator_radau5;
+extern const fmbIntegratorOps fmb_integrator_radau9;
 
 /* every backend, NULL-terminated; the first GGL one is the default of solver.integrator */
 extern const fmbIntegratorOps* const fmb_integrators[];

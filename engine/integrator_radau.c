@@ -1,6 +1,16 @@
-/* integrator_radau.c — Radau IIA of order 5 (3 stages) on the GGL index-2 system of system.c,
- * after Hairer & Wanner's RADAU5 (Solving ODEs II, 2nd ed.: IV.8 for the implementation, VI.1 and
- * VII.4 for index-2 problems), written for the fully implicit F(t, y, y') = 0.
+/* integrator_radau.c — Radau IIA of order 5 (3 stages, solver.integrator: radau5) and of order 9
+ * (5 stages, radau9) on the GGL index-2 system of system.c, after Hairer & Wanner's RADAU5 and
+ * RADAU (Solving ODEs II, 2nd ed.: IV.8 for the implementation, VI.1 and VII.4 for index-2
+ * problems), written for the fully implicit F(t, y, y') = 0. The description below is of s = 3;
+ * s = 5 is the same code with its tableau (RadauTableau): A^-1 has one real eigenvalue and two
+ * complex pairs, so each Newton iteration solves one real and two complex systems, the error
+ * estimate is the embedded one of order 5 and the step controller's exponent 1/6.
+ *
+ * Why order 9: the flexible pendulum's tip error against its converged solution is set by the
+ * bending modes up to ~2000 rad/s, which must keep their phase over 5 s (docs/performance.md,
+ * "Where it is hardest"); Radau IIA's error per step in a mode of frequency w is ~ (w h)^(2s)
+ * times (s! (s-1)!)/((2s)! (2s-1)!): 1/7200 for s = 3, 2.2e-9 for s = 5, so order 9 keeps them
+ * with 3-4x longer steps.
  *
  * Why: BDF above order 2 amplifies the undamped structural modes of a beam (integrator_ida.c), so
  * IDA buys accuracy at the second-order rate. Radau IIA is L-stable at order 5 (order 5 in q and v
@@ -57,25 +67,83 @@
 #include "integrator.h"
 #include "klu_policy.h"
 
-/* Radau IIA (s = 3) nodes, collocation matrix inverse, its eigen-decomposition (T, T^-1 as in
-   RADAU5; T^-1 A^-1 T = diag(gamma, [[alpha, -beta], [beta, alpha]]) to 1e-15 when written, and a
-   wrong digit would show as lost order in tests/integrators) and the error-estimate coefficients
-   d_i (IV.8 (8.19)) */
+/* The methods' coefficients: nodes c_i (c_s = 1), the collocation matrix inverse A^-1, the weights
+   b_i = a_si (stiffly accurate: also the work integrals' quadrature), the eigen-decomposition of
+   A^-1 (T^-1 A^-1 T = diag(gamma, [[alpha_1, -beta_1], [beta_1, alpha_1]], ...), to 1e-15 when
+   written: a wrong digit shows as lost order in tests/integrators) and the error estimate's d_i
+   (IV.8 (8.19)): d = gamma (bhat - b)^T A^-1, bhat the embedded weights of order s with bhat_0 =
+   1/gamma on f(y_n). s = 3 (order 5) is RADAU5's table; s = 5 (order 9) is RADAU's (Hairer &
+   Wanner's variable-order code, the same construction), computed here with 40 digits (mpmath:
+   the nodes as the zeros of d^(s-1)/dx^(s-1) (x^(s-1) (x - 1)^s), A by integrating the Lagrange
+   basis, T from A^-1's eigenvectors scaled to T's last row (1, 1, 0, 1, 0)). */
+#define RADAU_SMAX 5
+typedef struct {
+  int s;
+  double c[RADAU_SMAX], ainv[RADAU_SMAX][RADAU_SMAX], b[RADAU_SMAX];
+  double gamma, alpha[2], beta[2]; /* the real eigenvalue; the (s - 1)/2 complex pairs */
+  double t[RADAU_SMAX][RADAU_SMAX], ti[RADAU_SMAX][RADAU_SMAX], dd[RADAU_SMAX];
+} RadauTableau;
+
 #define SQ6 2.449489742783178098197284
-static const double C1 = (4.0 - SQ6) / 10.0, C2 = (4.0 + SQ6) / 10.0;
-static const double AINV[3][3] = {{3.224744871391589, 1.1678400846904058, -0.2531972647421809},
-                                  {-3.5678400846904057, 0.7752551286084112, 1.053197264742181},
-                                  {5.531972647421811, -7.531972647421811, 5.0}};
-/* b_i = a_3i (stiffly accurate): the quadrature for the work integrals */
-static const double BQ[3] = {(16.0 - SQ6) / 36.0, (16.0 + SQ6) / 36.0, 1.0 / 9.0};
-static const double GAMMA = 3.6378342527444962, ALPHA = 2.6810828736277523, BETA = 3.0504301992474105;
-static const double T_[3][3] = {{9.1232394870892942792e-02, -0.14125529502095420843, -3.0029194105147424492e-02},
-                                {0.24171793270710701896, 0.20412935229379993199, 0.38294211275726193779},
-                                {0.96604818261509293619, 1.0, 0.0}};
-static const double TI[3][3] = {{4.3255798900631553510, 0.33919925181580986954, 0.54177053993587487119},
-                                {-4.1787185915519047273, -0.32768282076106238708, 0.47662355450055045196},
-                                {-0.50287263494578687595, 2.5719269498556054292, -0.59603920482822492497}};
-static const double DD[3] = {-(13.0 + 7.0 * SQ6) / 3.0, (-13.0 + 7.0 * SQ6) / 3.0, -1.0 / 3.0};
+static const RadauTableau radau_order5 = {
+    .s = 3,
+    .c = {(4.0 - SQ6) / 10.0, (4.0 + SQ6) / 10.0, 1.0},
+    .ainv = {{3.224744871391589, 1.1678400846904058, -0.2531972647421809},
+             {-3.5678400846904057, 0.7752551286084112, 1.053197264742181},
+             {5.531972647421811, -7.531972647421811, 5.0}},
+    .b = {(16.0 - SQ6) / 36.0, (16.0 + SQ6) / 36.0, 1.0 / 9.0},
+    .gamma = 3.6378342527444962,
+    .alpha = {2.6810828736277523},
+    .beta = {3.0504301992474105},
+    .t = {{9.1232394870892942792e-02, -0.14125529502095420843, -3.0029194105147424492e-02},
+          {0.24171793270710701896, 0.20412935229379993199, 0.38294211275726193779},
+          {0.96604818261509293619, 1.0, 0.0}},
+    .ti = {{4.3255798900631553510, 0.33919925181580986954, 0.54177053993587487119},
+           {-4.1787185915519047273, -0.32768282076106238708, 0.47662355450055045196},
+           {-0.50287263494578687595, 2.5719269498556054292, -0.59603920482822492497}},
+    .dd = {-(13.0 + 7.0 * SQ6) / 3.0, (-13.0 + 7.0 * SQ6) / 3.0, -1.0 / 3.0},
+};
+static const RadauTableau radau_order9 = {
+    .s = 5,
+    .c = {0.05710419611451768219312, 0.27684301363812382768, 0.5835904323689168200567, 0.8602401356562194478479,
+          1.0},
+    .ainv = {{8.755923977938361667632, 2.891942615380117404357, -0.8751863962002650264163, 0.3997052079399654826217,
+              -0.1337061638492158356717},
+             {-7.161380720145387027392, 1.80607772408364436353, 2.363797176068608369422, -0.8659007802831345191395,
+              0.2743380777751942021738},
+             {4.122165246243373781044, -4.496017125813394719849, 0.8567652453971776050862, 2.518320949211064374937,
+              -0.6570627571343601062552},
+             {-3.878663219724010333635, 3.393151918064954168693, -5.188340906407186879197, 0.5812330525808163637523,
+              2.809983655279712329602},
+             {8.412424223594288656407, -6.970256116656660967032, 8.777114204150473239214, -18.21928231108810092859,
+              13.0}},
+    .b = {0.1437135607912259413234, 0.2813560151494620601922, 0.3118265229757412540819, 0.2231039010835707444026,
+          0.04},
+    .gamma = 6.286704751729276645173,
+    .alpha = {5.70095329867178941917, 3.655694325463572258243},
+    .beta = {3.210265600308549888425, 6.543736899360077294021},
+    .t = {{0.01357686734494794324766, -0.01147851525522951470794, -0.01401985889287541028108,
+           -0.01024204781790882707009, 0.04767387729029572386318},
+          {0.001617900401719087476439, -0.007668830749180162885157, 0.02470857842651852681253,
+           0.05017286451737105816299, -0.09433181918161143698066},
+          {0.0791578533474472076449, 0.01939846399882895091122, 0.08180035370375117083639, -0.2305395340434179467214,
+           0.1027030453801258997922},
+          {0.4122560826804614519787, 0.4076011712801990666217, 0.1996824278868025259365, 0.3778939022488612495439,
+           0.4667441303324943592896},
+          {1.0, 1.0, 0.0, 1.0, 0.0}},
+    .ti = {{27.69769377568408840917, 12.783337911304406015, 3.208489386713429859798, -0.9514904122489162212717,
+            0.7415504960259896033537},
+           {-33.04188021351900000806, -17.37695347906356701945, -0.1721290632540055611515,
+            -0.09916977798254264258817, 0.5312281158383066671849},
+           {-8.6114439798752919777, 9.699991409528808231336, 1.914728639696874284851, 2.418692006084940026427,
+            -1.047463487935337418694},
+           {5.344186437834911598895, 4.593615567759161004454, -3.036360323459424298646, 1.05066019023145886386,
+            -0.2727786118642962705386},
+           {3.748059807439804860051, -3.984965736343884667252, -1.044415641608018792942, 1.184098568137948487231,
+            -0.4499177701567803688988}},
+    .dd = {-27.78093394406463730479, 3.641478498049213152712, -1.252547721169118720491, 0.5920031671845428725662,
+           -0.2},
+};
 
 /* RADAU5's defaults (IV.8; WORK(2..9) of the Fortran code): at most NIT Newton iterations, safety
    factor, step ratio bounds 1/8 <= h/hnew <= 5.
@@ -102,6 +170,10 @@ static const double DD[3] = {-(13.0 + 7.0 * SQ6) / 3.0, (-13.0 + 7.0 * SQ6) / 3.
 
 typedef struct {
   const fmbModel* m;
+  const RadauTableau* tab; /* the method: order 5 (s = 3) or 9 (s = 5) */
+  int s, npair;            /* stages; complex eigenvalue pairs of A^-1, (s - 1)/2 */
+  double expo;             /* the step controller's exponent, 1/(s + 1) (IV.8 (8.21)) */
+  double xnode[RADAU_SMAX + 1]; /* the dense output's nodes in (t - t_{n+1})/h: c_s - 1, ..., c_1 - 1, -1 */
   fmbWorkspace* w;
   const volatile sig_atomic_t* stop;
   int ny, nerr, nnewt; /* unknowns; components in the error norm (the first nerr); in the Newton norm */
@@ -109,18 +181,18 @@ typedef struct {
   double *atol, *scal, *ewt;
   double t, h, hold, t_end, hmax;
   double *y, *yp;               /* the state at t (last accepted step) */
-  double *z[3], *wt[3], *fz[3]; /* stage increments, transformed ones, residuals / right sides */
+  double *z[RADAU_SMAX], *wt[RADAU_SMAX], *fz[RADAU_SMAX]; /* stage increments, transformed ones, residuals / right sides */
   double *ys, *yps;             /* one stage's value and derivative */
-  double* cont[4];              /* dense output: y_{n+1} and the Newton-form differences */
-  double* e2rhs;                /* complex right side, interleaved (2 ny) */
+  double* cont[RADAU_SMAX + 1]; /* dense output: y_{n+1} and the Newton-form differences */
+  double* e2rhs[2];             /* the complex systems' right sides, interleaved (2 ny) */
   double *err, *err2;
   /* Jacobian parts on the model's CSC pattern, and the two iteration matrices */
-  double *jy, *jyp, *e1, *e2;
+  double *jy, *jyp, *e1, *e2[2];
   SuiteSparse_long *colptr, *rowind;
-  fmbKlu *lu1, *lu2; /* klu_full: E1 (real) and E2 (complex) on the whole pattern (klu.c) */
+  fmbKlu *lu1, *lu2[2]; /* klu_full: E1 (real) and the E2s (complex) on the whole pattern (klu.c) */
   /* solver.linear_solver: klu (default): both systems with the position rows eliminated
      (schur.c); klu_full: KLU on the whole matrices above */
-  fmbSchur *red1, *red2;
+  fmbSchur *red1, *red2[2];
   int fell_back; /* the reduced systems failed once: KLU on the whole matrices since */
   double h_lu;   /* the step the factorizations are for (0: none) */
   int need_jac;  /* the next step evaluates a new Jacobian (RADAU5: not after a fast Newton) */
@@ -131,8 +203,8 @@ typedef struct {
   /* work integrals */
   int nwork, nwork_err; /* work integrals; of them in the error test (applied forces') */
   double *work_old, *work_new, *work_out;
-  double *p0, *pst[3];    /* the powers at the last accepted step's start and stages (work_at) */
-  double *pend, *ptry[3]; /* at the current state, and at the stages of the step being tried */
+  double *p0, *pst[RADAU_SMAX];    /* the powers at the last accepted step's start and stages (work_at) */
+  double *pend, *ptry[RADAU_SMAX]; /* at the current state, and at the stages of the step being tried */
   double* work_atol;      /* per joint: the work's absolute tolerance, 0 = out of the error test */
   fmbStats st;
   long lu_reuses;
@@ -142,21 +214,25 @@ static void radau_destroy(void* self) {
   RadauRun* c = self;
   if (!c) return;
   fmb_klu_free(c->lu1);
-  fmb_klu_free(c->lu2);
   fmb_schur_free(c->red1);
-  fmb_schur_free(c->red2);
-  double** vs[] = {&c->atol,     &c->scal,     &c->ewt,  &c->y,        &c->yp,   &c->ys,       &c->yps,
-                   &c->e2rhs,    &c->err,      &c->err2, &c->jy,       &c->jyp,  &c->e1,       &c->e2,
-                   &c->work_old, &c->work_new, &c->p0,   &c->work_out, &c->pend, &c->work_atol};
+  for (int p = 0; p < 2; ++p) {
+    fmb_klu_free(c->lu2[p]);
+    fmb_schur_free(c->red2[p]);
+    free(c->e2[p]);
+    free(c->e2rhs[p]);
+  }
+  double** vs[] = {&c->atol, &c->scal,     &c->ewt,      &c->y,  &c->yp,       &c->ys,   &c->yps,
+                   &c->err,  &c->err2,     &c->jy,       &c->jyp, &c->e1,      &c->work_old, &c->work_new,
+                   &c->p0,   &c->work_out, &c->pend,     &c->work_atol};
   for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) free(*vs[i]);
-  for (int k = 0; k < 3; ++k) {
+  for (int k = 0; k < RADAU_SMAX; ++k) {
     free(c->z[k]);
     free(c->wt[k]);
     free(c->fz[k]);
     free(c->pst[k]);
     free(c->ptry[k]);
   }
-  for (int k = 0; k < 4; ++k) free(c->cont[k]);
+  for (int k = 0; k <= RADAU_SMAX; ++k) free(c->cont[k]);
   free(c->colptr);
   free(c->rowind);
   free(c);
@@ -182,11 +258,18 @@ static int powers(RadauRun* c, double t, const double* y, double* p) {
   return 0;
 }
 
-static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup* s, double t0, const double* y0,
+                              const double* yp0, fmbDiag* diag) {
   const fmbModel* m = s->m;
   const int ny = m->ny;
   RadauRun* c = calloc(1, sizeof *c);
   if (!c) goto oom;
+  c->tab = tab;
+  c->s = tab->s;
+  c->npair = (tab->s - 1) / 2;
+  c->expo = 1.0 / (tab->s + 1);
+  for (int j = 0; j < tab->s; ++j) c->xnode[j] = tab->c[tab->s - 1 - j] - 1.0;
+  c->xnode[tab->s] = -1.0;
   c->m = m;
   c->w = s->w;
   c->stop = s->stop;
@@ -199,35 +282,35 @@ static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* 
   c->yp = dalloc(n);
   c->ys = dalloc(n);
   c->yps = dalloc(n);
-  c->e2rhs = dalloc(2 * n);
   c->err = dalloc(n);
   c->err2 = dalloc(n);
   c->jy = dalloc(nnz);
   c->jyp = dalloc(nnz);
   c->e1 = dalloc(nnz);
-  c->e2 = dalloc(2 * nnz);
   c->colptr = calloc(n + 1, sizeof(SuiteSparse_long));
   c->rowind = calloc(nnz ? nnz : 1, sizeof(SuiteSparse_long));
-  int ok = c->atol && c->scal && c->ewt && c->y && c->yp && c->ys && c->yps && c->e2rhs && c->err && c->err2 && c->jy &&
-           c->jyp && c->e1 && c->e2 && c->colptr && c->rowind;
-  for (int k = 0; k < 3; ++k) {
+  int ok = c->atol && c->scal && c->ewt && c->y && c->yp && c->ys && c->yps && c->err && c->err2 && c->jy && c->jyp &&
+           c->e1 && c->colptr && c->rowind;
+  for (int p = 0; p < c->npair; ++p) ok = ok && (c->e2[p] = dalloc(2 * nnz)) && (c->e2rhs[p] = dalloc(2 * n));
+  for (int k = 0; k < c->s; ++k) {
     c->z[k] = dalloc(n);
     c->wt[k] = dalloc(n);
     c->fz[k] = dalloc(n);
     ok = ok && c->z[k] && c->wt[k] && c->fz[k];
   }
-  for (int k = 0; k < 4; ++k) ok = ok && (c->cont[k] = dalloc(n));
+  for (int k = 0; k <= c->s; ++k) ok = ok && (c->cont[k] = dalloc(n));
   if (!ok) goto oom;
   for (int i = 0; i <= ny; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
   for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
+  int lu_ok = 1;
   if (m->solver.linear_solver == FMB_LS_KLU) {
-    c->red1 = fmb_schur_new(m, 0);
-    c->red2 = fmb_schur_new(m, 1);
+    lu_ok = (c->red1 = fmb_schur_new(m, 0)) != NULL;
+    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new(m, 1));
   } else {
-    c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0);
-    c->lu2 = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX);
+    lu_ok = (c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0)) != NULL;
+    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->lu2[p] = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX));
   }
-  if (m->solver.linear_solver == FMB_LS_KLU ? !c->red1 || !c->red2 : !c->lu1 || !c->lu2) {
+  if (!lu_ok) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
     radau_destroy(c);
     return NULL;
@@ -273,7 +356,7 @@ static void* radau_create(const fmbIntegratorSetup* s, double t0, const double* 
     c->pend = dalloc(nw);
     c->work_atol = dalloc(nw);
     ok = c->work_old && c->work_new && c->p0 && c->work_out && c->pend && c->work_atol;
-    for (int k = 0; k < 3; ++k) ok = ok && (c->pst[k] = dalloc(nw)) && (c->ptry[k] = dalloc(nw));
+    for (int k = 0; k < c->s; ++k) ok = ok && (c->pst[k] = dalloc(nw)) && (c->ptry[k] = dalloc(nw));
     if (!ok) goto oom;
     /* Applied forces' work is in the error test, as in IDA (integrator_ida.c: a load law with a
        kink, a ramp or a table, is otherwise integrated across the kink by one polynomial: the
@@ -312,22 +395,28 @@ static int evaluate_jacobian(RadauRun* c) {
   return 0;
 }
 
-/* E1 = J_y + (gamma/h) J_y' and E2 = J_y + ((alpha + i beta)/h) J_y', factorized: 0 ok, 1
-   singular, -1 a reduced factorization failed outright (KLU, or the tests' fault injection) */
+/* E1 = J_y + (gamma/h) J_y' and, per complex pair p, E2_p = J_y + ((alpha_p + i beta_p)/h) J_y',
+   factorized: 0 ok, 1 singular, -1 a reduced factorization failed outright (KLU, or the tests'
+   fault injection) */
 static int decompose(RadauRun* c) {
   const long nnz = c->m->nnz;
-  const double g = GAMMA / c->h, a = ALPHA / c->h, b = BETA / c->h;
-  for (long k = 0; k < nnz; ++k) {
-    c->e1[k] = c->jy[k] + g * c->jyp[k];
-    c->e2[2 * k] = c->jy[k] + a * c->jyp[k];
-    c->e2[2 * k + 1] = b * c->jyp[k];
+  const double g = c->tab->gamma / c->h;
+  for (long k = 0; k < nnz; ++k) c->e1[k] = c->jy[k] + g * c->jyp[k];
+  for (int p = 0; p < c->npair; ++p) {
+    const double a = c->tab->alpha[p] / c->h, b = c->tab->beta[p] / c->h;
+    double* e2 = c->e2[p];
+    for (long k = 0; k < nnz; ++k) {
+      e2[2 * k] = c->jy[k] + a * c->jyp[k];
+      e2[2 * k + 1] = b * c->jyp[k];
+    }
   }
   int failed = 0;
   if (c->red1) {
     failed = fmb_schur_factor(c->red1, c->e1);
-    if (!failed) failed = fmb_schur_factor(c->red2, c->e2);
+    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_schur_factor(c->red2[p], c->e2[p]);
   } else {
-    failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK || fmb_klu_factor(c->lu2, c->e2) != FMB_KLU_OK;
+    failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK;
+    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_klu_factor(c->lu2[p], c->e2[p]) != FMB_KLU_OK;
   }
   if (failed) {
     c->h_lu = 0.0;
@@ -337,15 +426,15 @@ static int decompose(RadauRun* c) {
   return 0;
 }
 
-/* in place: b = E1^-1 b, and b = E2^-1 b with b complex (interleaved); 0 ok, 1 failed */
+/* in place: b = E1^-1 b, and b = E2_p^-1 b with b complex (interleaved); 0 ok, 1 failed */
 static int solve_real(RadauRun* c, double* b) {
   if (c->red1) return fmb_schur_solve(c->red1, b);
   return fmb_klu_solve(c->lu1, b);
 }
 
-static int solve_complex(RadauRun* c, double* b) {
-  if (c->red2) return fmb_schur_solve(c->red2, b);
-  return fmb_klu_solve(c->lu2, b);
+static int solve_complex(RadauRun* c, int p, double* b) {
+  if (c->red1) return fmb_schur_solve(c->red2[p], b);
+  return fmb_klu_solve(c->lu2[p], b);
 }
 
 /* y += J_y' x on the CSC pattern */
@@ -358,23 +447,35 @@ static void jyp_times(const RadauRun* c, const double* x, double* y) {
   }
 }
 
+/* out = sum_j a[j] v[j] over the s stages, summed from j = 0; by whole vectors (they vectorize) */
+static void stage_combination(const RadauRun* c, const double* a, double* const* v, double* restrict out) {
+  const int ny = c->ny;
+  const double a0 = a[0], *restrict v0 = v[0];
+  for (int k = 0; k < ny; ++k) out[k] = a0 * v0[k];
+  for (int j = 1; j < c->s; ++j) {
+    const double aj = a[j], *restrict vj = v[j];
+    for (int k = 0; k < ny; ++k) out[k] += aj * vj[k];
+  }
+}
+
 /* Y'_i = (1/h) sum_j (A^-1)_ij Z_j into out */
 static void stage_derivative(const RadauRun* c, int i, double h, double* out) {
-  const double a0 = AINV[i][0] / h, a1 = AINV[i][1] / h, a2 = AINV[i][2] / h;
-  const double *z0 = c->z[0], *z1 = c->z[1], *z2 = c->z[2];
-  for (int k = 0; k < c->ny; ++k) out[k] = a0 * z0[k] + a1 * z1[k] + a2 * z2[k];
+  double a[RADAU_SMAX] = {0.0};
+  for (int j = 0; j < c->s; ++j) a[j] = c->tab->ainv[i][j] / h;
+  stage_combination(c, a, c->z, out);
 }
 
 enum { NEWTON_OK = 0, NEWTON_SLOW = 1, NEWTON_DIVERGED = 2, NEWTON_FATAL = 3 };
 
 /* The simplified Newton iteration of IV.8 (8.12)-(8.16) on the stage increments, started from
-   the current c->z. NEWTON_SLOW sets *hfac, RADAU5's prediction of a step that converges. */
+   the current c->z: W = (T^-1 (x) I) Z, one real system for W_1 and one complex one per pair
+   (W_2p + i W_2p+1). NEWTON_SLOW sets *hfac, RADAU5's prediction of a step that converges. */
 static int newton(RadauRun* c, int* newt_out, double* hfac) {
   const fmbModel* m = c->m;
-  const int ny = c->ny;
+  const RadauTableau* tab = c->tab;
+  const int ny = c->ny, s = c->s;
   const double h = c->h;
-  for (int k = 0; k < ny; ++k)
-    for (int i = 0; i < 3; ++i) c->wt[i][k] = TI[i][0] * c->z[0][k] + TI[i][1] * c->z[1][k] + TI[i][2] * c->z[2][k];
+  for (int i = 0; i < s; ++i) stage_combination(c, tab->ti[i], c->z, c->wt[i]);
   c->faccon = pow(fmax(c->faccon, 2.220446049250313e-16), 0.8);
   c->theta = fabs(FMB_RADAU_THET);
   double dynold = 0.0, thqold = 0.0;
@@ -385,11 +486,10 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       return NEWTON_DIVERGED;
     }
     if (fmb_stop_requested(c->stop)) return NEWTON_FATAL;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < s; ++i) {
       for (int k = 0; k < ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
       stage_derivative(c, i, h, c->yps);
-      const double ci = i == 0 ? C1 : i == 1 ? C2 : 1.0;
-      const int rc = fmb_system_residual(m, c->w, c->t + ci * h, c->ys, c->yps, c->fz[i]);
+      const int rc = fmb_system_residual(m, c->w, c->t + tab->c[i] * h, c->ys, c->yps, c->fz[i]);
       c->st.residuals++;
       if (rc < 0) return NEWTON_FATAL;
       if (rc > 0) { /* not finite: a smaller step */
@@ -397,14 +497,20 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
         return NEWTON_DIVERGED;
       }
     }
-    /* right sides -(T^-1 (x) I) F: real part into fz[0], complex interleaved into e2rhs */
-    for (int k = 0; k < ny; ++k) {
-      const double f0 = c->fz[0][k], f1 = c->fz[1][k], f2 = c->fz[2][k];
-      c->fz[0][k] = -(TI[0][0] * f0 + TI[0][1] * f1 + TI[0][2] * f2);
-      c->e2rhs[2 * k] = -(TI[1][0] * f0 + TI[1][1] * f1 + TI[1][2] * f2);
-      c->e2rhs[2 * k + 1] = -(TI[2][0] * f0 + TI[2][1] * f1 + TI[2][2] * f2);
+    /* right sides -(T^-1 (x) I) F: pair p's interleaved into e2rhs[p], the real one into fz[0]
+       last (through ys, free here: fz[0] is an input to all of them) */
+    for (int p = 0; p < c->npair; ++p) {
+      double* restrict rhs = c->e2rhs[p];
+      stage_combination(c, tab->ti[1 + 2 * p], c->fz, c->yps);
+      for (int k = 0; k < ny; ++k) rhs[2 * k] = -c->yps[k];
+      stage_combination(c, tab->ti[2 + 2 * p], c->fz, c->yps);
+      for (int k = 0; k < ny; ++k) rhs[2 * k + 1] = -c->yps[k];
     }
-    if (solve_real(c, c->fz[0]) || solve_complex(c, c->e2rhs)) {
+    stage_combination(c, tab->ti[0], c->fz, c->ys);
+    for (int k = 0; k < ny; ++k) c->fz[0][k] = -c->ys[k];
+    int failed = solve_real(c, c->fz[0]);
+    for (int p = 0; p < c->npair && !failed; ++p) failed = solve_complex(c, p, c->e2rhs[p]);
+    if (failed) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }
@@ -412,10 +518,14 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
     c->st.newton_iters++;
     double dyno = 0.0;
     for (int k = 0; k < ny; ++k) {
-      const double e = c->ewt[k], a = c->fz[0][k] * e, b = c->e2rhs[2 * k] * e, d = c->e2rhs[2 * k + 1] * e;
-      dyno += a * a + b * b + d * d;
+      const double e = c->ewt[k], a = c->fz[0][k] * e;
+      dyno += a * a;
+      for (int p = 0; p < c->npair; ++p) {
+        const double b = c->e2rhs[p][2 * k] * e, d = c->e2rhs[p][2 * k + 1] * e;
+        dyno += b * b + d * d;
+      }
     }
-    dyno = sqrt(dyno / (3.0 * c->nnewt));
+    dyno = sqrt(dyno / ((double)s * c->nnewt));
     if (!isfinite(dyno)) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
@@ -440,14 +550,16 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       }
     }
     dynold = fmax(dyno, 2.220446049250313e-16);
-    for (int k = 0; k < ny; ++k) {
-      const double w0 = (c->wt[0][k] += c->fz[0][k]);
-      const double w1 = (c->wt[1][k] += c->e2rhs[2 * k]);
-      const double w2 = (c->wt[2][k] += c->e2rhs[2 * k + 1]);
-      c->z[0][k] = T_[0][0] * w0 + T_[0][1] * w1 + T_[0][2] * w2;
-      c->z[1][k] = T_[1][0] * w0 + T_[1][1] * w1 + T_[1][2] * w2;
-      c->z[2][k] = T_[2][0] * w0 + w1;
+    for (int k = 0; k < ny; ++k) c->wt[0][k] += c->fz[0][k];
+    for (int p = 0; p < c->npair; ++p) {
+      double *restrict wr = c->wt[1 + 2 * p], *restrict wi = c->wt[2 + 2 * p];
+      const double* restrict rhs = c->e2rhs[p];
+      for (int k = 0; k < ny; ++k) {
+        wr[k] += rhs[2 * k];
+        wi[k] += rhs[2 * k + 1];
+      }
     }
+    for (int i = 0; i < s; ++i) stage_combination(c, tab->t[i], c->wt, c->z[i]);
     if (c->faccon * dyno <= c->fnewt) break;
   }
   *newt_out = newt;
@@ -469,7 +581,8 @@ static double estimate_error(RadauRun* c) {
   const int ny = c->ny;
   const double h = c->h;
   double* delta = c->ys; /* (1/h) sum d_i Z_i */
-  for (int k = 0; k < ny; ++k) delta[k] = (DD[0] * c->z[0][k] + DD[1] * c->z[1][k] + DD[2] * c->z[2][k]) / h;
+  stage_combination(c, c->tab->dd, c->z, delta);
+  for (int k = 0; k < ny; ++k) delta[k] /= h;
   for (int k = 0; k < ny; ++k) {
     c->err[k] = 0.0;
     c->yps[k] = c->yp[k] + delta[k];
@@ -494,29 +607,43 @@ static double estimate_error(RadauRun* c) {
   return err;
 }
 
-/* the collocation polynomial of the step just accepted (IV.8 (8.26)), Newton form in s = (t -
-   t_{n+1})/h through s = 0, c2 - 1, c1 - 1 and -1 */
+/* the collocation polynomial of the step just accepted (IV.8 (8.26)), Newton form in x = (t -
+   t_{n+1})/h through the nodes x_j = c_{s-j} - 1 (Z_{s-j}, j < s) and x_s = -1 (y_n): cont[0] =
+   y_{n+1}, cont[l] the l-th divided difference */
 static void store_dense_output(RadauRun* c) {
+  const int s = c->s;
+  const double* x = c->xnode;
   for (int k = 0; k < c->ny; ++k) {
-    const double z1 = c->z[0][k], z2 = c->z[1][k], z3 = c->z[2][k];
+    double d[RADAU_SMAX + 1];
+    for (int j = 0; j < s; ++j) d[j] = c->z[s - 1 - j][k];
+    d[s] = 0.0;
+    for (int l = 1; l <= s; ++l)
+      for (int j = s; j >= l; --j) d[j] = (d[j] - d[j - 1]) / (x[j] - x[j - l]);
     c->cont[0][k] = c->y[k];
-    c->cont[1][k] = (z2 - z3) / (C2 - 1.0);
-    const double ak = (z1 - z2) / (C1 - C2);
-    const double acont3 = (ak - z1 / C1) / C2;
-    c->cont[2][k] = (ak - c->cont[1][k]) / (C1 - 1.0);
-    c->cont[3][k] = c->cont[2][k] - acont3;
+    for (int l = 1; l <= s; ++l) c->cont[l][k] = d[l];
   }
   c->have_cont = 1;
 }
 
+/* the polynomial's part after cont[0] at x, and its x-derivative: Horner on the Newton form */
+static void dense_terms(const RadauRun* c, int k, double x, double* p_out, double* dp_out) {
+  double p = c->cont[c->s][k], dp = 0.0;
+  for (int l = c->s - 1; l >= 1; --l) {
+    dp = p + (x - c->xnode[l]) * dp;
+    p = c->cont[l][k] + (x - c->xnode[l]) * p;
+  }
+  *p_out = p;
+  *dp_out = dp;
+}
+
 /* y and y' of the last step's polynomial at t (within it) */
 static void dense_output(const RadauRun* c, double t, double* y, double* yp) {
-  const double s = (t - c->t) / c->hold, a = C2 - 1.0, b = C1 - 1.0;
+  const double x = (t - c->t) / c->hold;
   for (int k = 0; k < c->ny; ++k) {
-    const double k1 = c->cont[1][k], k2 = c->cont[2][k], k3 = c->cont[3][k];
-    const double inner = k2 + (s - b) * k3;
-    y[k] = c->cont[0][k] + s * (k1 + (s - a) * inner);
-    yp[k] = (k1 + (s - a) * inner + s * (inner + (s - a) * k3)) / c->hold;
+    double p, dp;
+    dense_terms(c, k, x, &p, &dp);
+    y[k] = c->cont[0][k] + x * p;
+    yp[k] = (p + x * dp) / c->hold;
   }
 }
 
@@ -524,68 +651,85 @@ static void dense_output(const RadauRun* c, double t, double* y, double* yp) {
    the first step or after a failure where it cannot be trusted */
 static void starting_values(RadauRun* c, int zero) {
   if (zero || !c->have_cont) {
-    for (int i = 0; i < 3; ++i) memset(c->z[i], 0, sizeof(double) * (size_t)c->ny);
+    for (int i = 0; i < c->s; ++i) memset(c->z[i], 0, sizeof(double) * (size_t)c->ny);
     return;
   }
-  const double c3q = c->h / c->hold, cq[3] = {C1 * c3q, C2 * c3q, c3q}, a = C2 - 1.0, b = C1 - 1.0;
-  for (int k = 0; k < c->ny; ++k) {
-    const double k1 = c->cont[1][k], k2 = c->cont[2][k], k3 = c->cont[3][k];
-    for (int i = 0; i < 3; ++i) c->z[i][k] = cq[i] * (k1 + (cq[i] - a) * (k2 + (cq[i] - b) * k3));
+  const double ratio = c->h / c->hold;
+  for (int i = 0; i < c->s; ++i) {
+    const double xq = c->tab->c[i] * ratio;
+    for (int k = 0; k < c->ny; ++k) {
+      double p, dp;
+      dense_terms(c, k, xq, &p, &dp);
+      c->z[i][k] = xq * p;
+    }
   }
 }
 
-/* wgt[k] = int_0^theta l_k, l_k the Lagrange basis on the nodes 0, c1, c2, 1: the weights of the
-   cubic through a step's start and its three stages, by 3-point Gauss-Legendre (exact for it) */
-static void cubic_weights(double theta, double wgt[4]) {
+/* wgt[k] = int_0^theta l_k, l_k the Lagrange basis on the nodes 0, c_1, ..., c_s: the weights of
+   the polynomial through a step's start and its stages, by 3-point Gauss-Legendre (exact to
+   degree 5 >= s) */
+static void node_weights(const RadauRun* c, double theta, double wgt[RADAU_SMAX + 1]) {
   static const double gx[3] = {-0.7745966692414834, 0.0, 0.7745966692414834}, gw[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-  const double nodes[4] = {0.0, C1, C2, 1.0};
-  for (int k = 0; k < 4; ++k) wgt[k] = 0.0;
+  const int n = c->s + 1;
+  double nodes[RADAU_SMAX + 1];
+  nodes[0] = 0.0;
+  for (int i = 0; i < c->s; ++i) nodes[i + 1] = c->tab->c[i];
+  for (int k = 0; k < n; ++k) wgt[k] = 0.0;
   for (int g = 0; g < 3; ++g) {
     const double s = 0.5 * theta * (gx[g] + 1.0);
-    for (int k = 0; k < 4; ++k) {
+    for (int k = 0; k < n; ++k) {
       double l = 1.0;
-      for (int j = 0; j < 4; ++j)
+      for (int j = 0; j < n; ++j)
         if (j != k) l *= (s - nodes[j]) / (nodes[k] - nodes[j]);
       wgt[k] += 0.5 * theta * gw[g] * l;
     }
   }
 }
 
-/* work integrals at t within the last step: W_old + h int_0^theta p, p the cubic through the
-   powers at the step's start and its three stages */
+/* work integrals at t within the last step: W_old + h int_0^theta p, p the polynomial through the
+   powers at the step's start and its stages */
 static void work_at(RadauRun* c, double t, double* out) {
   const double t_old = c->t - c->hold, theta = (t - t_old) / c->hold;
-  double wgt[4];
-  cubic_weights(theta, wgt);
-  for (int j = 0; j < c->nwork; ++j)
-    out[j] = c->work_old[j] +
-             c->hold * (wgt[0] * c->p0[j] + wgt[1] * c->pst[0][j] + wgt[2] * c->pst[1][j] + wgt[3] * c->pst[2][j]);
+  double wgt[RADAU_SMAX + 1];
+  node_weights(c, theta, wgt);
+  for (int j = 0; j < c->nwork; ++j) {
+    double sum = wgt[0] * c->p0[j];
+    for (int i = 0; i < c->s; ++i) sum += wgt[i + 1] * c->pst[i][j];
+    out[j] = c->work_old[j] + c->hold * sum;
+  }
+}
+
+/* the step's quadrature sum_i b_i p_i of the powers at the stages */
+static double stage_quadrature(const RadauRun* c, double* const* pst, int j) {
+  double sum = c->tab->b[0] * pst[0][j];
+  for (int i = 1; i < c->s; ++i) sum += c->tab->b[i] * pst[i][j];
+  return sum;
 }
 
 /* The joints' powers at the stages of the step being tried (from c->t, c->y), and the work
    integrals' contribution to its error norm: sum over the joints in the test of the squared
-   weighted difference between the step's quadrature (Radau, order 5) and the cubic's through the
-   step's start and stages (cubic_weights(1), exact to degree 3), an estimate of order h^5 P^(4)
-   as the state's. *sum = -1 when a power is not finite. */
+   weighted difference between the step's quadrature (Radau, order 2s - 1) and the polynomial's
+   through the step's start and stages (node_weights(1), exact to degree s), an estimate of order
+   h^(s+2) P^(s+1), as the state's of order h^(s+1). *sum = -1 when a power is not finite. */
 static void try_work(RadauRun* c, double h, double* sum) {
   *sum = 0.0;
-  for (int i = 0; i < 3; ++i) {
+  for (int i = 0; i < c->s; ++i) {
     for (int k = 0; k < c->ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
-    const double ci = i == 0 ? C1 : i == 1 ? C2 : 1.0;
-    if (powers(c, c->t + ci * h, c->ys, c->ptry[i])) {
+    if (powers(c, c->t + c->tab->c[i] * h, c->ys, c->ptry[i])) {
       *sum = -1.0;
       return;
     }
   }
   if (!c->nwork_err) return;
-  double wc[4];
-  cubic_weights(1.0, wc);
+  double wc[RADAU_SMAX + 1];
+  node_weights(c, 1.0, wc);
   for (int j = 0; j < c->nwork; ++j) {
     if (c->work_atol[j] <= 0.0) continue;
-    const double radau = BQ[0] * c->ptry[0][j] + BQ[1] * c->ptry[1][j] + BQ[2] * c->ptry[2][j];
-    const double cubic = wc[0] * c->pend[j] + wc[1] * c->ptry[0][j] + wc[2] * c->ptry[1][j] + wc[3] * c->ptry[2][j];
+    const double radau = stage_quadrature(c, c->ptry, j);
+    double poly = wc[0] * c->pend[j];
+    for (int i = 0; i < c->s; ++i) poly += wc[i + 1] * c->ptry[i][j];
     const double w = c->work_new[j] + h * radau;
-    const double r = h * (radau - cubic) / (c->work_atol[j] + c->rtol * fmax(fabs(w), fabs(c->work_new[j])));
+    const double r = h * (radau - poly) / (c->work_atol[j] + c->rtol * fmax(fabs(w), fabs(c->work_new[j])));
     *sum += r * r;
   }
 }
@@ -594,10 +738,9 @@ static void try_work(RadauRun* c, double h, double* sum) {
 static void accept_work(RadauRun* c, double h) {
   memcpy(c->work_old, c->work_new, sizeof(double) * (size_t)c->nwork);
   memcpy(c->p0, c->pend, sizeof(double) * (size_t)c->nwork);
-  for (int i = 0; i < 3; ++i) memcpy(c->pst[i], c->ptry[i], sizeof(double) * (size_t)c->nwork);
-  memcpy(c->pend, c->ptry[2], sizeof(double) * (size_t)c->nwork);
-  for (int j = 0; j < c->nwork; ++j)
-    c->work_new[j] = c->work_old[j] + h * (BQ[0] * c->pst[0][j] + BQ[1] * c->pst[1][j] + BQ[2] * c->pst[2][j]);
+  for (int i = 0; i < c->s; ++i) memcpy(c->pst[i], c->ptry[i], sizeof(double) * (size_t)c->nwork);
+  memcpy(c->pend, c->ptry[c->s - 1], sizeof(double) * (size_t)c->nwork);
+  for (int j = 0; j < c->nwork; ++j) c->work_new[j] = c->work_old[j] + h * stage_quadrature(c, c->pst, j);
 }
 
 typedef enum { FAIL_NONE, FAIL_STEPS, FAIL_MIN_STEP, FAIL_SINGULAR, FAIL_RESIDUAL, FAIL_JACOBIAN, FAIL_POWER } FailKind;
@@ -712,7 +855,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     /* step size (IV.8 (8.21)-(8.25)): the safety factor shrinks with the Newton iterations used */
     const double cfac = FMB_RADAU_SAFE * (1 + 2 * FMB_RADAU_NIT);
     const double fac = fmin(FMB_RADAU_SAFE, cfac / (newt + 2 * FMB_RADAU_NIT));
-    double quot = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, pow(err, 0.25) / fac));
+    double quot = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, pow(err, c->expo) / fac));
     double hnew = c->h / quot;
     if (err >= 1.0) {
       c->st.error_test_fails++;
@@ -723,7 +866,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     }
     /* accepted; Gustafsson's predictive controller (IV.8 (8.25)) */
     if (c->st.steps > 0) {
-      double facgus = (c->hacc / c->h) * pow(err * err / c->erracc, 0.25) / FMB_RADAU_SAFE;
+      double facgus = (c->hacc / c->h) * pow(err * err / c->erracc, c->expo) / FMB_RADAU_SAFE;
       facgus = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, facgus));
       quot = fmax(quot, facgus);
       hnew = c->h / quot;
@@ -732,8 +875,8 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
     c->erracc = fmax(1e-2, err);
     const double t_old = c->t, h = c->h;
     /* y_{n+1} = y_n + Z_3 (stiffly accurate); y'_{n+1} = Y'_3 */
-    stage_derivative(c, 2, h, c->yp);
-    for (int k = 0; k < c->ny; ++k) c->y[k] += c->z[2][k];
+    stage_derivative(c, c->s - 1, h, c->yp);
+    for (int k = 0; k < c->ny; ++k) c->y[k] += c->z[c->s - 1][k];
     c->t = last ? c->t_end : t_old + h;
     c->hold = h;
     c->st.steps++;
@@ -761,21 +904,24 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
    up); 0 ok, 1 KLU could not analyze the whole pattern (the caller then reports the failure) */
 static int fall_back_to_full(RadauRun* c) {
   fmb_schur_free(c->red1);
-  fmb_schur_free(c->red2);
-  c->red1 = c->red2 = NULL;
+  c->red1 = NULL;
+  for (int p = 0; p < c->npair; ++p) {
+    fmb_schur_free(c->red2[p]);
+    c->red2[p] = NULL;
+  }
   c->fell_back = 1;
-  c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0);
-  c->lu2 = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX);
-  if (!c->lu1 || !c->lu2) return 1;
+  if (!(c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0))) return 1;
+  for (int p = 0; p < c->npair; ++p)
+    if (!(c->lu2[p] = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX))) return 1;
   if (c->hold > 0.0) c->h = c->hold;
   c->need_jac = 1;
   c->h_lu = 0.0;
   c->nsing = 0;
   c->reject = 1;
   fmb_warn(c->w,
-           "note: t = %.6g: radau5 failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
+           "note: t = %.6g: %s failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
            "from the last good step with klu_full (the whole matrices)",
-           c->t);
+           c->t, c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name);
   return 0;
 }
 
@@ -837,29 +983,56 @@ static void radau_stats(const void* self, fmbStats* st) {
   st->error_test_fails = c->st.error_test_fails;
   st->conv_fails = c->st.conv_fails;
   st->jacobians_reused = c->lu_reuses;
-  st->integrator = fmb_integrator_radau5.name;
+  st->integrator = c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name;
 }
 
 /* radau5's cross-key rules */
+/* radau5's and radau9's cross-key rules */
 static int radau_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
-  /* radau5 integrates the GGL system; the projected formulation has its own backend (CVODE) */
+  const char* name = m->solver.integrator ? m->solver.integrator->name : fmb_integrator_radau5.name;
+  /* radau integrates the GGL system; the projected formulation has its own backend (CVODE) */
   if (m->solver.formulation == FMB_FORM_PROJECTED)
     return fmb_parse_error(p, fmb_find_key(p, solver, "integrator"),
-                           "integrator: radau5 integrates the GGL formulation; formulation: projected has its own "
-                           "integrator (CVODE): drop one of the two keys");
-  /* radau5's systems are complex as well as real; SUNDIALS' dense LU is real only */
+                           "integrator: %s integrates the GGL formulation; formulation: projected has its own "
+                           "integrator (CVODE): drop one of the two keys",
+                           name);
+  /* radau's systems are complex as well as real; SUNDIALS' dense LU is real only */
   if (m->solver.linear_solver == FMB_LS_DENSE)
     return fmb_parse_error(p, fmb_find_key(p, solver, "linear_solver"),
-                           "integrator: radau5 solves with KLU: linear_solver klu (the position rows eliminated, "
-                           "default) or klu_full (the whole matrix); dense is IDA's only");
+                           "integrator: %s solves with KLU: linear_solver klu (the position rows eliminated, "
+                           "default) or klu_full (the whole matrix); dense is IDA's only",
+                           name);
   return 0;
+}
+
+static void* radau5_create(const fmbIntegratorSetup* s, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  return radau_create_tab(&radau_order5, s, t0, y0, yp0, diag);
+}
+
+static void* radau9_create(const fmbIntegratorSetup* s, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  return radau_create_tab(&radau_order9, s, t0, y0, yp0, diag);
 }
 
 const fmbIntegratorOps fmb_integrator_radau5 = {
     .name = "radau5",
     .projected = 0,
     .check = radau_check,
-    .create = radau_create,
+    .create = radau5_create,
+    .advance = radau_advance,
+    .work = radau_work,
+    .stats = radau_stats,
+    .after_row = NULL,
+    .destroy = radau_destroy,
+};
+
+/* Radau IIA of order 9 (5 stages, the order-9 member of Hairer & Wanner's RADAU): the same code
+   with one real and two complex systems per Newton iteration; the order the flexible pendulum's
+   resolved bending modes need (docs/performance.md, "Where it is hardest") */
+const fmbIntegratorOps fmb_integrator_radau9 = {
+    .name = "radau9",
+    .projected = 0,
+    .check = radau_check,
+    .create = radau9_create,
     .advance = radau_advance,
     .work = radau_work,
     .stats = radau_stats,
