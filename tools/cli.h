@@ -111,8 +111,12 @@ int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f);
 /* the modes at one speed (steady state, then modes): 0 with *out, or an exit code with *diag */
 typedef int (*fmbCliModesAt)(void* ctx, double speed, fmbModes** out, fmbDiag* diag);
-/* at(ctx, speeds[i]) for every i in child processes, `jobs` at once (tools/modes_pool.c): out[i]
-   for i < *done (the speeds before the first that failed, whose code and *diag are returned) */
-int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx, fmbModes** out,
+/* at(ctx, speeds[i]) for every i in child processes, `jobs` at once on this process and, with t
+   (farm.h: under mpirun/srun), on every rank (tools/modes_pool.c). On rank 0: out[i] for
+   i < *done (the speeds before the first that failed, whose code and *diag are returned; 4 when
+   *stop ended it). On the other ranks: 0 when rank 0 had no more speeds, *done 0. */
+struct fmbFarmTransport;
+int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx,
+                              const struct fmbFarmTransport* t, volatile sig_atomic_t* stop, fmbModes** out,
                               int* done, fmbDiag* diag);
 #endif

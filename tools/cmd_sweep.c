@@ -8,7 +8,7 @@
  * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
  * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
  * index) and, when built with HDF5, DIR/sweep.h5. Under mpirun/srun the ranks share the runs
- * (sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
+ * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
  * 4 interrupted (SIGINT/SIGTERM: every child killed, the journal flushed; run again to resume). */
 #define _GNU_SOURCE /* sched_getaffinity */
 #include <errno.h>
@@ -388,17 +388,11 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (make_ids(sw)) return bad("out of memory for %s runs", "the");
   /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
      libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
-  const int launched = fmb_sweep_launched_by_mpi();
-  const fmbSweepExtension* ext = fmb_sweep_extension_load(launched);
-  if (launched && !ext->has_mpi) { /* every rank would run the whole sweep into one journal */
-    const char* r = getenv("OMPI_COMM_WORLD_RANK");
-    if (!r) r = getenv("PMIX_RANK");
-    if (!r) r = getenv("PMI_RANK");
-    if (r && atoi(r) > 0) return 0;
-    fprintf(stderr, "flexmbd sweep: warning: started by mpirun/srun, but built without MPI: rank 0 runs the sweep "
-                    "alone, the other ranks leave\n");
-  }
-  if (!launched || !ext->has_mpi || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
+  fmbFarmTransport ranks;
+  const int mpi = fmb_farm_mpi_start("sweep", &ranks);
+  if (mpi < 0) return 0; /* built without MPI: rank 0 runs the sweep alone */
+  sw->rank = ranks.rank, sw->nranks = ranks.nranks;
+  const fmbSweepExtension* ext = fmb_sweep_extension_load(0);
 
   int rc = 0;
   if (sw->rank != 0 && dry) { /* rank 0 alone checks the plan */
@@ -435,10 +429,10 @@ int fmb_cmd_sweep(int argc, char** argv) {
   sigaction(SIGTERM, &sa, NULL);
   sw->progress = !sw->quiet && isatty(STDERR_FILENO);
   sw->t_start = fmb_pool_now();
-  if (sw->nranks > 1)
-    rc = ext->mpi_run(sw, rc);
-  else if (!rc)
-    rc = sw->serve ? fmb_sweep_serve(sw) : fmb_sweep_local(sw);
+  if (sw->nranks > 1) /* rank 0's verdict on the spec and the journal: every rank stops on it */
+    rc = ranks.bcast_int(rc);
+  const fmbFarmTransport* t = sw->nranks > 1 ? &ranks : NULL;
+  if (!rc) rc = sw->serve ? fmb_sweep_serve(sw, t) : fmb_sweep_farm(sw, t);
   if (sw->rank == 0 && sw->journal_fd >= 0) {
     fmb_sweep_progress(sw, 1);
     if (fmb_journal_write_table(sw)) fprintf(stderr, "flexmbd sweep: cannot write %s/table.csv\n", sw->dir);
