@@ -117,6 +117,6 @@ typedef int (*fmbCliModesAt)(void* ctx, double speed, fmbModes** out, fmbDiag* d
    *stop ended it). On the other ranks: 0 when rank 0 had no more speeds, *done 0. */
 struct fmbFarmTransport;
 int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx,
-                              const struct fmbFarmTransport* t, volatile sig_atomic_t* stop, fmbModes** out,
-                              int* done, fmbDiag* diag);
+                              const struct fmbFarmTransport* t, volatile sig_atomic_t* stop, fmbModes** out, int* done,
+                              fmbDiag* diag);
 #endif

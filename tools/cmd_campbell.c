@@ -204,8 +204,8 @@ int fmb_cmd_campbell(int argc, char** argv) {
   fmbDiag pre_diag;
   memset(&pre_diag, 0, sizeof pre_diag);
   if (pre)
-    pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, mpi ? &ranks : NULL, stop, pre,
-                                       &pre_done, &pre_diag);
+    pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, mpi ? &ranks : NULL, stop, pre, &pre_done,
+                                       &pre_diag);
   int failed_at = -1; /* the speed whose modes failed */
   for (int i = 0; !rc && i < nspeed; ++i) {
     if (*stop && (!pre || i >= pre_done)) { /* SIGINT/SIGTERM: the speeds done so far are written below */

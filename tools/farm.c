@@ -118,8 +118,7 @@ static int manager(const fmbFarm* f, const fmbFarmTransport* t) {
       t->send(source, FMB_FARM_TASK, reply, (int)sizeof reply);
     }
     if (f->tick) f->tick(f->ctx, fmb_pool_running(pool) + outstanding);
-    if (!more && fmb_pool_running(pool) == 0 && outstanding == 0 && hellos == nworkers && stops == worker_slots)
-      break;
+    if (!more && fmb_pool_running(pool) == 0 && outstanding == 0 && hellos == nworkers && stops == worker_slots) break;
     fmbChildResult r;
     if (wait_child(pool, t, &wait, active, &r)) {
       int rlen = 0;

@@ -30,9 +30,7 @@ typedef struct {
   int* have;
 } Farm;
 
-static void file_of(const Farm* f, long index, char* path, size_t len) {
-  snprintf(path, len, "%s/%ld", f->dir, index);
-}
+static void file_of(const Farm* f, long index, char* path, size_t len) { snprintf(path, len, "%s/%ld", f->dir, index); }
 
 /* in the child: the modes at one speed into a file: rc, diag, then (rc 0) the modes */
 static void child(void* arg) {
