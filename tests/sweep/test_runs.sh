@@ -14,7 +14,7 @@
 SCENE=$SRC/scenes/fourbar.yaml
 
 # 1. bit for bit against runs typed by hand
-"$F" sweep "$SCENE" -o "$D/s1" -j 2 --quiet --keep series --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
+"$F" sweep "$SCENE" -o "$D/s1" -j 2 --quiet --runner spawn --keep series --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
   --grid bodies.crank.mass=1,2 --metric crank.theta:max,end --metric motor.power:min,rms,max 2> "$D/s1.err" ||
   { cat "$D/s1.err"; fail "sweep s1 failed"; }
 [ "$(tail -n +2 "$D/s1/table.csv" | wc -l)" = 4 ] || fail "s1: expected 4 rows"
