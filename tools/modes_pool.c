@@ -1,11 +1,14 @@
 /* modes_pool.c — the modes at many speeds as tasks of the farm (farm.h): child processes of this
  * process (`campbell -j K`) and, under mpirun/srun, of every rank (rank 0 hands the speeds out one
- * at a time to whichever slot asks). Each child computes one speed's modes (the front-end's
- * function: steady state, then modes) and writes them to a file; the rank that ran it sends the
- * file's bytes to rank 0, which reads them back and keeps them by speed: following a mode from
- * speed to speed needs the speed before, so the diagram is made afterwards, in speed order. The
- * numbers are those of the same computation in one process, bit for bit (the same code, doubles
- * copied as bytes; tests/sweep/test_campbell_jobs.sh and test_campbell_mpi.sh: byte for byte). */
+ * at a time to whichever slot asks). Each child is this program again, `flexmbd campbell ...
+ * --speeds S --modes-out FILE` (cmd_campbell.c: steady state, then modes, at the one speed S),
+ * which writes the modes to a file; the rank that ran it sends the file's bytes to rank 0, which
+ * reads them back and keeps them by speed: following a mode from speed to speed needs the speed
+ * before, so the diagram is made afterwards, in speed order. A child is executed, not forked
+ * with the work in it: a rank that forks after MPI_Init may share registered memory with its
+ * child (Open MPI's warning about fork()), an exec shares nothing. The numbers are those of the
+ * same computation in one process, bit for bit (the same code, doubles copied as bytes, speeds as
+ * %.17g; tests/sweep/test_campbell_jobs.sh and test_campbell_mpi.sh: byte for byte). */
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,12 +19,12 @@
 #include "farm.h"
 
 typedef struct {
-  fmbCliModesAt at;
-  void* ctx;
+  char** argv; /* the child's command line; argv[speed_slot] and argv[out_slot] are set per speed */
+  int speed_slot, out_slot;
+  char speed_text[40];
   const double* speeds;
   int n;
   char dir[600]; /* this rank's temporary folder: one file per speed computed here */
-  long current;  /* the speed the child about to start computes */
   /* rank 0 */
   long next, fail_at; /* the next speed to hand out; the first that failed (n: none yet) */
   fmbModes** out;
@@ -32,18 +35,10 @@ typedef struct {
 
 static void file_of(const Farm* f, long index, char* path, size_t len) { snprintf(path, len, "%s/%ld", f->dir, index); }
 
-/* in the child: the modes at one speed into a file: rc, diag, then (rc 0) the modes */
-static void child(void* arg) {
-  const Farm* fa = arg;
-  char path[700];
-  file_of(fa, fa->current, path, sizeof path);
-  fmbModes* m = NULL;
-  fmbDiag diag;
-  memset(&diag, 0, sizeof diag);
-  int rc = fa->at(fa->ctx, fa->speeds[fa->current], &m, &diag);
+int fmb_cli_modes_save(const char* path, int rc, const fmbDiag* diag, const fmbModes* m) {
   FILE* f = fopen(path, "wb");
-  if (!f) _exit(1);
-  int ok = fwrite(&rc, sizeof rc, 1, f) == 1 && fwrite(&diag, sizeof diag, 1, f) == 1;
+  if (!f) return -1;
+  int ok = fwrite(&rc, sizeof rc, 1, f) == 1 && fwrite(diag, sizeof *diag, 1, f) == 1;
   if (ok && rc == 0) {
     const size_t n = (size_t)m->count, nq = (size_t)m->nq;
     ok = fwrite(m, sizeof *m, 1, f) == 1 && fwrite(m->frequency, sizeof(double), n, f) == n &&
@@ -52,7 +47,7 @@ static void child(void* arg) {
          fwrite(m->shape_im, sizeof(double), n * nq, f) == n * nq;
   }
   ok = fclose(f) == 0 && ok;
-  _exit(ok ? 0 : 1);
+  return ok ? 0 : -1;
 }
 
 /* the modes a child wrote (malloc'd as fmb_modes_free frees them), or NULL with *rc and *diag */
@@ -99,8 +94,13 @@ static int next_speed(void* ctx, fmbFarmTask* task) {
 
 static int start_speed(void* ctx, fmbPool* pool, const fmbFarmTask* task) {
   Farm* f = ctx;
-  f->current = task->index; /* read by the forked child from its copy */
-  const fmbChildSpec spec = {.fn = child, .arg = f, .tag = task->index};
+  if (!f->argv) return -1; /* no command line for the children (out of memory) */
+  char path[700];
+  file_of(f, task->index, path, sizeof path);
+  snprintf(f->speed_text, sizeof f->speed_text, "%.17g", f->speeds[task->index]);
+  f->argv[f->speed_slot] = f->speed_text;
+  f->argv[f->out_slot] = path; /* copied by the exec before fmb_pool_start returns */
+  const fmbChildSpec spec = {.argv = f->argv, .tag = task->index};
   return fmb_pool_start(pool, &spec);
 }
 
@@ -156,12 +156,13 @@ static void take_speed(void* ctx, const fmbChildResult* local, char* bytes, int 
   free(bytes);
 }
 
-int fmb_cli_modes_in_children(int jobs, const double* speeds, int n, fmbCliModesAt at, void* ctx,
+int fmb_cli_modes_in_children(int jobs, char** argv, int speed_slot, int out_slot, const double* speeds, int n,
                               const fmbFarmTransport* t, volatile sig_atomic_t* stop, fmbModes** out, int* done,
                               fmbDiag* diag) {
   *done = 0;
   memset(diag, 0, sizeof *diag);
-  Farm f = {.at = at, .ctx = ctx, .speeds = speeds, .n = n, .fail_at = n, .out = out};
+  Farm f = {
+      .argv = argv, .speed_slot = speed_slot, .out_slot = out_slot, .speeds = speeds, .n = n, .fail_at = n, .out = out};
   const char* tmp = getenv("TMPDIR");
   snprintf(f.dir, sizeof f.dir, "%s/flexmbd-modes-XXXXXX", tmp && *tmp ? tmp : "/tmp");
   const int master = !t || t->rank == 0;
