@@ -8,9 +8,9 @@
  * speeds done so far are written, the message names the speed that failed, and the exit code is
  * run's (2 bad input, 3 solver: also a crash). -j J: the speeds in J child processes; under
  * mpirun/srun on every rank too (farm.c: rank 0 hands them out, gathers the modes and alone
- * follows them and writes); each child is this command again with one speed and
- * `--modes-out FILE` (internal: the modes of that speed into FILE, tools/modes_pool.c). The diagram itself is the library's (fmb_campbell, engine/campbell.c);
- * this file parses, writes and plots. */
+ * follows them and writes); each child is this command again with one speed and `--modes-out
+ * FILE` (internal: the modes of that speed into FILE, tools/modes_pool.c). The diagram itself is
+ * the library's (fmb_campbell, engine/campbell.c); this file parses, writes and plots. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -226,11 +226,15 @@ int fmb_cmd_campbell(int argc, char** argv) {
   if (!c) snprintf(diag.msg, sizeof diag.msg, "out of memory");
   volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
   /* -j J or ranks: every speed's modes at once in child processes, then followed in order below */
-  fmbModes** pre = (jobs > 1 || mpi) && !rc ? calloc((size_t)nspeed, sizeof *pre) : NULL;
+  fmbModes** pre = jobs > 1 || mpi ? calloc((size_t)nspeed, sizeof *pre) : NULL;
   int pre_done = 0, pre_rc = 0;
   fmbDiag pre_diag;
   memset(&pre_diag, 0, sizeof pre_diag);
-  if (pre)
+  if (!pre && !rc && (jobs > 1 || mpi)) {
+    rc = FMB_EXIT_SOLVER;
+    snprintf(diag.msg, sizeof diag.msg, "out of memory");
+  }
+  if (mpi || (pre && !rc)) /* the other ranks wait for rank 0's word: it goes through the farm whatever */
     pre_rc = fmb_cli_modes_in_children(jobs, child, speeds_at, argc + 1, speeds, nspeed, mpi ? &ranks : NULL, stop, pre,
                                        &pre_done, &pre_diag);
   free(child);

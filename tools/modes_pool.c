@@ -24,7 +24,8 @@ typedef struct {
   char speed_text[40];
   const double* speeds;
   int n;
-  char dir[600]; /* this rank's temporary folder: one file per speed computed here */
+  char dir[600];    /* this rank's temporary folder: one file per speed computed here */
+  char cannot[700]; /* why no child can start here (no folder, no command line), "" none */
   /* rank 0 */
   long next, fail_at; /* the next speed to hand out; the first that failed (n: none yet) */
   fmbModes** out;
@@ -94,7 +95,7 @@ static int next_speed(void* ctx, fmbFarmTask* task) {
 
 static int start_speed(void* ctx, fmbPool* pool, const fmbFarmTask* task) {
   Farm* f = ctx;
-  if (!f->argv) return -1; /* no command line for the children (out of memory) */
+  if (f->cannot[0]) return -1; /* its result says why */
   char path[700];
   file_of(f, task->index, path, sizeof path);
   snprintf(f->speed_text, sizeof f->speed_text, "%.17g", f->speeds[task->index]);
@@ -123,7 +124,9 @@ static char* speed_result(void* ctx, const fmbChildResult* r, int attempt, int* 
       int rc = FMB_EXIT_SOLVER;
       fmbDiag d;
       memset(&d, 0, sizeof d);
-      if (r->signal)
+      if (f->cannot[0])
+        snprintf(d.msg, sizeof d.msg, "%s", f->cannot);
+      else if (r->signal)
         snprintf(d.msg, sizeof d.msg, "the computation crashed (killed by signal %d, %s)", r->signal,
                  strsignal(r->signal));
       else
@@ -146,9 +149,13 @@ static void take_speed(void* ctx, const fmbChildResult* local, char* bytes, int 
   Farm* f = ctx;
   long index = -1;
   if (bytes && len >= (int)sizeof index) memcpy(&index, bytes, sizeof index);
-  if (index >= 0 && index < f->n && !f->have[index]) {
+  if (f->have && index >= 0 && index < f->n && !f->have[index]) {
     FILE* in = fmemopen(bytes + sizeof index, (size_t)len - sizeof index, "rb");
-    f->out[index] = read_back(in, &f->rc[index], &f->diag[index]);
+    fmbModes* m = read_back(in, &f->rc[index], &f->diag[index]);
+    if (f->out)
+      f->out[index] = m;
+    else
+      fmb_modes_free(m); /* the caller could not keep them (out of memory): it fails anyway */
     if (in) fclose(in);
     f->have[index] = 1;
     if (f->rc[index] && index < f->fail_at) f->fail_at = index;
@@ -171,11 +178,14 @@ int fmb_cli_modes_in_children(int jobs, char** argv, int speed_slot, int out_slo
     f.diag = calloc((size_t)n, sizeof *f.diag);
     f.have = calloc((size_t)n, sizeof *f.have);
   }
-  if (!mkdtemp(f.dir) || (master && (!f.rc || !f.diag || !f.have))) {
-    free(f.rc), free(f.diag), free(f.have);
-    snprintf(diag->msg, sizeof diag->msg, "cannot start the children (a temporary folder in %s)", f.dir);
-    return FMB_EXIT_SOLVER;
-  }
+  /* whatever fails here, every rank still goes through the farm (the others wait for its word):
+     each speed it would compute then fails, saying why */
+  if (!argv)
+    snprintf(f.cannot, sizeof f.cannot, "cannot start the computation: out of memory");
+  else if (!mkdtemp(f.dir))
+    snprintf(f.cannot, sizeof f.cannot, "cannot start the computation: no temporary folder %s (TMPDIR)", f.dir);
+  const int kept = !master || (f.rc && f.diag && f.have);
+  if (!kept) free(f.rc), free(f.diag), free(f.have), f.rc = NULL, f.diag = NULL, f.have = NULL;
   const fmbFarm farm = {.jobs = jobs,
                         .stop = stop,
                         .ctx = &f,
@@ -184,6 +194,7 @@ int fmb_cli_modes_in_children(int jobs, char** argv, int speed_slot, int out_slo
                         .result = speed_result,
                         .take = take_speed};
   int rc = fmb_farm_run(&farm, t);
+  if (!rc && !kept) rc = FMB_EXIT_SOLVER;
   if (rc && rc != FMB_EXIT_INTERRUPTED)
     snprintf(diag->msg, sizeof diag->msg, "cannot start the children (out of memory)");
   /* the speeds in order up to the first without modes: its code and message */
@@ -198,13 +209,13 @@ int fmb_cli_modes_in_children(int jobs, char** argv, int speed_slot, int out_slo
       *done = i + 1;
     }
   }
-  if (master && rc == FMB_EXIT_INTERRUPTED)
+  if (master && kept && rc == FMB_EXIT_INTERRUPTED)
     while (*done < n && f.have[*done] && !f.rc[*done]) ++*done;
-  for (int i = *done; master && i < n; ++i) { /* only the speeds in order are the caller's */
+  for (int i = *done; master && out && i < n; ++i) { /* only the speeds in order are the caller's */
     fmb_modes_free(out[i]);
     out[i] = NULL;
   }
-  rmdir(f.dir);
+  if (!f.cannot[0]) rmdir(f.dir);
   free(f.rc), free(f.diag), free(f.have);
   return rc;
 }
