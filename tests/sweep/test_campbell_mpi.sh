@@ -73,9 +73,11 @@ for _ in $(seq 100); do # two ranks and a child of each (MPI start-up takes ~0.5
 done
 [ "$n" -ge 4 ] || { kill -TERM $pid; cat "$D/hang.out"; fail "the hanging speeds did not start on both ranks ($n processes)"; }
 kill -TERM $pid
-wait $pid || true
+rc=0
+wait $pid || rc=$?
 sleep 1
 lst=$(left "$D/hang.csv")
 [ -z "$lst" ] || { ps -o pid,ppid,pgid,args -p "$(echo $lst | tr ' ' ',')"; fail "processes left running after SIGTERM to mpirun"; }
-grep -q "interrupted" "$D/hang.out" || { cat "$D/hang.out"; fail "no word of the interrupt"; }
+# (which rank's MPI_Abort ends the job first is a race: rank 0's message may not get out)
+[ "$rc" != 0 ] || { cat "$D/hang.out"; fail "SIGTERM to mpirun: exit 0"; }
 echo "test_campbell_mpi: ok"
