@@ -105,8 +105,7 @@ static const RadauTableau radau_order5 = {
 };
 static const RadauTableau radau_order9 = {
     .s = 5,
-    .c = {0.05710419611451768219312, 0.27684301363812382768, 0.5835904323689168200567, 0.8602401356562194478479,
-          1.0},
+    .c = {0.05710419611451768219312, 0.27684301363812382768, 0.5835904323689168200567, 0.8602401356562194478479, 1.0},
     .ainv = {{8.755923977938361667632, 2.891942615380117404357, -0.8751863962002650264163, 0.3997052079399654826217,
               -0.1337061638492158356717},
              {-7.161380720145387027392, 1.80607772408364436353, 2.363797176068608369422, -0.8659007802831345191395,
@@ -117,8 +116,7 @@ static const RadauTableau radau_order9 = {
               2.809983655279712329602},
              {8.412424223594288656407, -6.970256116656660967032, 8.777114204150473239214, -18.21928231108810092859,
               13.0}},
-    .b = {0.1437135607912259413234, 0.2813560151494620601922, 0.3118265229757412540819, 0.2231039010835707444026,
-          0.04},
+    .b = {0.1437135607912259413234, 0.2813560151494620601922, 0.3118265229757412540819, 0.2231039010835707444026, 0.04},
     .gamma = 6.286704751729276645173,
     .alpha = {5.70095329867178941917, 3.655694325463572258243},
     .beta = {3.210265600308549888425, 6.543736899360077294021},
@@ -133,16 +131,15 @@ static const RadauTableau radau_order9 = {
           {1.0, 1.0, 0.0, 1.0, 0.0}},
     .ti = {{27.69769377568408840917, 12.783337911304406015, 3.208489386713429859798, -0.9514904122489162212717,
             0.7415504960259896033537},
-           {-33.04188021351900000806, -17.37695347906356701945, -0.1721290632540055611515,
-            -0.09916977798254264258817, 0.5312281158383066671849},
+           {-33.04188021351900000806, -17.37695347906356701945, -0.1721290632540055611515, -0.09916977798254264258817,
+            0.5312281158383066671849},
            {-8.6114439798752919777, 9.699991409528808231336, 1.914728639696874284851, 2.418692006084940026427,
             -1.047463487935337418694},
            {5.344186437834911598895, 4.593615567759161004454, -3.036360323459424298646, 1.05066019023145886386,
             -0.2727786118642962705386},
            {3.748059807439804860051, -3.984965736343884667252, -1.044415641608018792942, 1.184098568137948487231,
             -0.4499177701567803688988}},
-    .dd = {-27.78093394406463730479, 3.641478498049213152712, -1.252547721169118720491, 0.5920031671845428725662,
-           -0.2},
+    .dd = {-27.78093394406463730479, 3.641478498049213152712, -1.252547721169118720491, 0.5920031671845428725662, -0.2},
 };
 
 /* RADAU5's defaults (IV.8; WORK(2..9) of the Fortran code): at most NIT Newton iterations, safety
@@ -170,18 +167,20 @@ static const RadauTableau radau_order9 = {
 
 typedef struct {
   const fmbModel* m;
-  const RadauTableau* tab; /* the method: order 5 (s = 3) or 9 (s = 5) */
-  int s, npair;            /* stages; complex eigenvalue pairs of A^-1, (s - 1)/2 */
-  double expo;             /* the step controller's exponent, 1/(s + 1) (IV.8 (8.21)) */
-  double xnode[RADAU_SMAX + 1]; /* the dense output's nodes in (t - t_{n+1})/h: c_s - 1, ..., c_1 - 1, -1 */
+  const RadauTableau* tab;      /* the method: order 5 (s = 3) or 9 (s = 5) */
+  int s, npair;                 /* stages; complex eigenvalue pairs of A^-1, (s - 1)/2 */
+  double expo;                  /* the step controller's exponent, 1/(s + 1) (IV.8 (8.21)) */
+  double cnode[RADAU_SMAX + 1]; /* the dense output's nodes in (t - t_n)/h: c_s, ..., c_1, 0 */
+  double xnode[RADAU_SMAX + 1]; /* the same in (t - t_{n+1})/h: c_s - 1, ..., c_1 - 1, -1 */
   fmbWorkspace* w;
   const volatile sig_atomic_t* stop;
   int ny, nerr, nnewt; /* unknowns; components in the error norm (the first nerr); in the Newton norm */
   double rtol;         /* RADAU5's mapped tolerance */
   double *atol, *scal, *ewt;
   double t, h, hold, t_end, hmax;
-  double *y, *yp;               /* the state at t (last accepted step) */
-  double *z[RADAU_SMAX], *wt[RADAU_SMAX], *fz[RADAU_SMAX]; /* stage increments, transformed ones, residuals / right sides */
+  double *y, *yp; /* the state at t (last accepted step) */
+  double *z[RADAU_SMAX], *wt[RADAU_SMAX],
+      *fz[RADAU_SMAX];          /* stage increments, transformed ones, residuals / right sides */
   double *ys, *yps;             /* one stage's value and derivative */
   double* cont[RADAU_SMAX + 1]; /* dense output: y_{n+1} and the Newton-form differences */
   double* e2rhs[2];             /* the complex systems' right sides, interleaved (2 ny) */
@@ -205,7 +204,7 @@ typedef struct {
   double *work_old, *work_new, *work_out;
   double *p0, *pst[RADAU_SMAX];    /* the powers at the last accepted step's start and stages (work_at) */
   double *pend, *ptry[RADAU_SMAX]; /* at the current state, and at the stages of the step being tried */
-  double* work_atol;      /* per joint: the work's absolute tolerance, 0 = out of the error test */
+  double* work_atol;               /* per joint: the work's absolute tolerance, 0 = out of the error test */
   fmbStats st;
   long lu_reuses;
 } RadauRun;
@@ -221,9 +220,9 @@ static void radau_destroy(void* self) {
     free(c->e2[p]);
     free(c->e2rhs[p]);
   }
-  double** vs[] = {&c->atol, &c->scal,     &c->ewt,      &c->y,  &c->yp,       &c->ys,   &c->yps,
-                   &c->err,  &c->err2,     &c->jy,       &c->jyp, &c->e1,      &c->work_old, &c->work_new,
-                   &c->p0,   &c->work_out, &c->pend,     &c->work_atol};
+  double** vs[] = {&c->atol,     &c->scal,     &c->ewt,  &c->y,        &c->yp,   &c->ys,
+                   &c->yps,      &c->err,      &c->err2, &c->jy,       &c->jyp,  &c->e1,
+                   &c->work_old, &c->work_new, &c->p0,   &c->work_out, &c->pend, &c->work_atol};
   for (size_t i = 0; i < sizeof vs / sizeof vs[0]; ++i) free(*vs[i]);
   for (int k = 0; k < RADAU_SMAX; ++k) {
     free(c->z[k]);
@@ -268,8 +267,10 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   c->s = tab->s;
   c->npair = (tab->s - 1) / 2;
   c->expo = 1.0 / (tab->s + 1);
-  for (int j = 0; j < tab->s; ++j) c->xnode[j] = tab->c[tab->s - 1 - j] - 1.0;
-  c->xnode[tab->s] = -1.0;
+  for (int j = 0; j <= tab->s; ++j) {
+    c->cnode[j] = j < tab->s ? tab->c[tab->s - 1 - j] : 0.0;
+    c->xnode[j] = c->cnode[j] - 1.0;
+  }
   c->m = m;
   c->w = s->w;
   c->stop = s->stop;
@@ -308,7 +309,8 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
     for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new(m, 1));
   } else {
     lu_ok = (c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0)) != NULL;
-    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->lu2[p] = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX));
+    for (int p = 0; p < c->npair; ++p)
+      lu_ok = lu_ok && (c->lu2[p] = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX));
   }
   if (!lu_ok) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
@@ -519,11 +521,13 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
     double dyno = 0.0;
     for (int k = 0; k < ny; ++k) {
       const double e = c->ewt[k], a = c->fz[0][k] * e;
-      dyno += a * a;
+      double sum = a * a; /* summed as the s = 3 code did, (a^2 + b^2) + d^2: its runs stay bit for bit */
       for (int p = 0; p < c->npair; ++p) {
         const double b = c->e2rhs[p][2 * k] * e, d = c->e2rhs[p][2 * k + 1] * e;
-        dyno += b * b + d * d;
+        sum += b * b;
+        sum += d * d;
       }
+      dyno += sum;
     }
     dyno = sqrt(dyno / ((double)s * c->nnewt));
     if (!isfinite(dyno)) {
@@ -552,7 +556,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
     dynold = fmax(dyno, 2.220446049250313e-16);
     for (int k = 0; k < ny; ++k) c->wt[0][k] += c->fz[0][k];
     for (int p = 0; p < c->npair; ++p) {
-      double *restrict wr = c->wt[1 + 2 * p], *restrict wi = c->wt[2 + 2 * p];
+      double* restrict wr = c->wt[1 + 2 * p], * restrict wi = c->wt[2 + 2 * p];
       const double* restrict rhs = c->e2rhs[p];
       for (int k = 0; k < ny; ++k) {
         wr[k] += rhs[2 * k];
@@ -612,7 +616,8 @@ static double estimate_error(RadauRun* c) {
    y_{n+1}, cont[l] the l-th divided difference */
 static void store_dense_output(RadauRun* c) {
   const int s = c->s;
-  const double* x = c->xnode;
+  const double* x = c->cnode; /* node differences as differences of the c_i: the s = 3 code's
+                                 divisors (c2 - 1, c1 - c2, c1, ...) bit for bit */
   for (int k = 0; k < c->ny; ++k) {
     double d[RADAU_SMAX + 1];
     for (int j = 0; j < s; ++j) d[j] = c->z[s - 1 - j][k];

@@ -7,8 +7,8 @@
 #include "integrator.h"
 
 /* The one list of backends; solver.integrator names a GGL one or auto (the default, the rule below). */
-const fmbIntegratorOps* const fmb_integrators[] = {&fmb_integrator_ida, &fmb_integrator_radau5,
-                                                   &fmb_integrator_radau9, &fmb_integrator_projected, NULL};
+const fmbIntegratorOps* const fmb_integrators[] = {&fmb_integrator_ida, &fmb_integrator_radau5, &fmb_integrator_radau9,
+                                                   &fmb_integrator_projected, NULL};
 
 static const fmbIntegratorOps* projected_backend(void) {
   for (int i = 0; fmb_integrators[i]; ++i)
