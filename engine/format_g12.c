@@ -13,8 +13,8 @@
  * ~5e-9 of the last digit. Where that could decide the rounding (the digit's fraction within 1e-6
  * of one half) or where the scale is out of the exact range, the value goes to snprintf. So the
  * result is snprintf's whenever this code answers at all; tests/core/test_format.c compares the
- * two on 2 million values over the whole range and on the halfway cases. Without a 64-bit long
- * double (not x86) everything goes to snprintf. */
+ * two on 2 million values over the whole range and on the halfway cases. Off x86 (no 80-bit long
+ * double) everything goes to snprintf. */
 #include <float.h>
 #include <math.h>
 #include <stdio.h>
@@ -28,7 +28,7 @@
 static int fallback(double v, char* out) { return snprintf(out, 32, "%.12g", v); }
 
 int fmb_format_g12(double v, char* out) {
-#if LDBL_MANT_DIG < 64
+#if LDBL_MANT_DIG != 64 || !(defined(__x86_64__) || defined(__i386__)) /* the x87 80-bit format read below */
   return fallback(v, out);
 #else
   /* integers, so each literal is exact in a 64-bit mantissa */
@@ -41,7 +41,12 @@ int fmb_format_g12(double v, char* out) {
     return signbit(v) ? 2 : 1;
   }
   const long double a = fabsl((long double)v);
-  int x = (int)floor(log10((double)a)); /* the exponent, perhaps off by one: corrected below */
+  /* the decimal exponent from the binary one: |v| in [2^e2, 2^(e2+1)), so x = floor(e2 log10 2)
+     (78913 / 2^18, exact for |e2| < 1650) or one more, corrected below; no log10() call */
+  unsigned long long vbits = 0;
+  memcpy(&vbits, &v, sizeof vbits);
+  const int e2 = (int)((vbits >> 52) & 0x7ff) - 1023; /* subnormals: far outside 10^±27, to snprintf */
+  int x = (e2 * 78913) >> 18;                         /* an arithmetic shift: floor for e2 < 0 too */
   long double m = 0.0L;
   unsigned long long digits = 0;
   for (int attempt = 0; attempt < 3; ++attempt) {
@@ -56,9 +61,18 @@ int fmb_format_g12(double v, char* out) {
       ++x;
       continue;
     }
-    const long double fl = floorl(m), frac = m - fl;
-    if (fabsl(frac - 0.5L) < 1e-6L) return fallback(v, out); /* too close to halfway to decide */
-    digits = (unsigned long long)fl + (frac > 0.5L);
+    /* m rounded to the nearest integer without floorl() or a conversion, both of which switch
+       the x87 rounding mode (fldcw: 55 % of this function's cycles): 2^63 + m, with 1 as its
+       last place in a 64-bit mantissa, is rounded to nearest by the addition, and its mantissa
+       bits are then 2^63 + the integer (m < 10^12, exact below 2^63). */
+    const long double shifted = m + 9223372036854775808.0L;
+    unsigned long long bits = 0;
+    memcpy(&bits, &shifted, sizeof bits); /* x86's 80-bit format: the mantissa first */
+    const unsigned long long nearest = bits - 9223372036854775808ULL;
+    const long double off = m - (long double)nearest; /* in [-1/2, 1/2] (exact) when rounding to nearest */
+    /* too close to halfway to decide (or another rounding mode is set: snprintf knows it) */
+    if (fabsl(off) > 0.5L - 1e-6L) return fallback(v, out);
+    digits = nearest;
     break;
   }
   if (!digits) return fallback(v, out);
