@@ -161,6 +161,10 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   }
 
 done:
+  if (fmb_csv_flush(csv) && !rc) { /* the last rows gathered (output.c): a failure says so like any row's */
+    row_failed(m, d, -1, diag);
+    rc = FMB_EXIT_SOLVER;
+  }
   if (rc == FMB_EXIT_INTERRUPTED || (fmb_stop_requested(stop) && !rc)) {
     rc = FMB_EXIT_INTERRUPTED;
     memset(diag, 0, sizeof *diag);
