@@ -115,6 +115,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     return diag->code ? diag->code : FMB_EXIT_SOLVER;
   }
   d->quiet = quiet;
+  d->untimed = 1; /* st->cpu_s is the whole run's, read here at the start and the end */
   fmb_data_watch(d, stop);
   Progress progress = {opt && opt->progress && !quiet, isatty(fileno(stderr)), opt ? opt->progress_after_s : 0.0,
                        wall_seconds(), 0.0};
