@@ -256,12 +256,15 @@ static void beam_destroy(void* self) { free(self); }
 
 static int beam_ncoord(const void* self) { return 3 + ((const Beam*)self)->n; }
 
-/* residual_serial's F and csum (5 ne), one residual for beam_aux_initial (3 + 3 ne), and the dense
-   Jacobian's scratch (jacobian_nwork; also when banded: the engine may ask for the dense M) */
+/* residual_serial's F and csum (5 ne), one residual for beam_aux_initial (3 + 3 ne), the dense
+   Jacobian's scratch (jacobian_nwork; also when banded: the engine may ask for the dense M), then
+   the outputs' cache (output_cache) */
 static size_t jacobian_nwork(const Beam* b);
+static size_t output_cache_at(const Beam* b) { return (size_t)9 * (size_t)b->ne + 3 + jacobian_nwork(b); }
+static size_t output_cache_nwork(const Beam* b);
 static size_t beam_nwork(const void* self) {
   const Beam* b = self;
-  return (size_t)9 * (size_t)b->ne + 3 + jacobian_nwork(b);
+  return output_cache_at(b) + output_cache_nwork(b);
 }
 
 static void beam_initial(const void* self, double* q0, double* v0) {
@@ -1288,10 +1291,84 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   if (ptheta) *ptheta = pth;
 }
 
+/* ---------------------------------------------------------------------------------------------
+ * The outputs' cache: a row asks several outputs of one state (q, v). The energies and
+ * beam.ang_momentum come from one pass of beam_integrals, and the tip's u, x, y and u rate from
+ * one coupling integral over every element (coupling_at); each was computed once per column
+ * (the w15 spin-up's 2,001 rows: 84 M of its 405 M instructions in beam_integrals, half of them
+ * the second pass for ang_momentum). Kept after the Jacobian's scratch in the body's work,
+ * keyed by the state's bytes: a value comes from the cache only for the very (q, v) it was
+ * computed from, so every output is bit for bit what its own pass gives. The work is calloc'ed
+ * (system.c), so a new one holds no valid entry.
+ * ------------------------------------------------------------------------------------------- */
+enum {
+  CACHE_INTEGRALS, /* 1 when T, Ue, p_theta are the key state's */
+  CACHE_T,
+  CACHE_UE,
+  CACHE_PTHETA,
+  CACHE_GRAVITY, /* 1 when Ug is the key state's, for the gravity in CACHE_G0, CACHE_G1 */
+  CACHE_G0,
+  CACHE_G1,
+  CACHE_UG,
+  CACHE_DEFORMATION, /* 1 when the axial u, ud at x = CACHE_X (coupling included) are the key state's */
+  CACHE_X,
+  CACHE_U0,
+  CACHE_UD0,
+  CACHE_KEY /* then q and v (3 + n each) */
+};
+static size_t output_cache_nwork(const Beam* b) { return CACHE_KEY + 2 * (size_t)(3 + b->n); }
+
+/* the cache in work for the state (q, v): its entries dropped when the state is another one;
+   NULL without work (beam_model_range's call) */
+static double* output_cache(const Beam* b, const double* q, const double* v, double* work) {
+  if (!work) return NULL;
+  double* cache = work + output_cache_at(b);
+  const size_t nc = (size_t)(3 + b->n), bytes = sizeof(double) * nc;
+  double* key = cache + CACHE_KEY;
+  if (memcmp(key, q, bytes) != 0 || memcmp(key + nc, v, bytes) != 0) {
+    memcpy(key, q, bytes);
+    memcpy(key + nc, v, bytes);
+    cache[CACHE_INTEGRALS] = cache[CACHE_GRAVITY] = cache[CACHE_DEFORMATION] = 0.0;
+  }
+  return cache;
+}
+
+/* beam_integrals through the cache: T, Ue and p_theta do not depend on gravity, Ug does (env NULL:
+   no gravity, Ug = 0) */
+static void integrals_cached(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                             double* ptheta, double* work) {
+  double* cache = output_cache(b, q, v, work);
+  const int grav = env && env->has_gravity;
+  const double g0 = grav ? env->gravity[0] : 0.0, g1 = grav ? env->gravity[1] : 0.0;
+  if (cache && cache[CACHE_INTEGRALS] == 1.0 &&
+      (!en || (cache[CACHE_GRAVITY] == 1.0 && cache[CACHE_G0] == g0 && cache[CACHE_G1] == g1))) {
+    if (en) {
+      en->kinetic = cache[CACHE_T];
+      en->strain = cache[CACHE_UE];
+      en->gravity = cache[CACHE_UG];
+      en->spring = 0.0;
+    }
+    if (ptheta) *ptheta = cache[CACHE_PTHETA];
+    return;
+  }
+  fmbEnergy local;
+  double pth;
+  if (!en) en = &local;
+  beam_integrals(b, grav ? env : NULL, q, v, en, &pth);
+  if (ptheta) *ptheta = pth;
+  if (!cache) return;
+  cache[CACHE_INTEGRALS] = cache[CACHE_GRAVITY] = 1.0;
+  cache[CACHE_T] = en->kinetic;
+  cache[CACHE_UE] = en->strain;
+  cache[CACHE_PTHETA] = pth;
+  cache[CACHE_G0] = g0;
+  cache[CACHE_G1] = g1;
+  cache[CACHE_UG] = en->gravity;
+}
+
 static void beam_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                         double* work) {
-  (void)work;
-  beam_integrals(self, env, q, v, en, NULL);
+  integrals_cached(self, env, q, v, en, NULL, work);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -1314,8 +1391,12 @@ static int beam_output_lookup(const void* self, const char* quantity) {
   return fmb_beam_output_lookup(((const Beam*)self)->ne, quantity);
 }
 
-/* axial (with w_c in coupled models) and transverse deformation at reference (x, 0), rates */
-static void deformation_at(const Beam* b, const double* p, const double* pd, double x, double u[2], double ud[2]) {
+/* axial (with w_c in coupled models, when `axial`) and transverse deformation at reference (x, 0),
+   rates. The transverse ones need no coupling integral (beam.tip_v, and beam_model_range's check
+   after every advance); the axial ones come through the cache (work, may be NULL). */
+static void deformation_at(const Beam* b, const double* q, const double* v, double x, int axial, double u[2],
+                           double ud[2], double* work) {
+  const double *p = q + 3, *pd = v + 3;
   int e;
   double xi, ua[2], d[4], uda[2], dd[4], ns[4];
   locate(b, x, &e, &xi);
@@ -1326,11 +1407,23 @@ static void deformation_at(const Beam* b, const double* p, const double* pd, dou
   u[1] = dot4(ns, d);
   ud[0] = (1.0 - xi) * uda[0] + xi * uda[1];
   ud[1] = dot4(ns, dd);
-  if (b->model != BEAM_ZOAC && x > 0.0) {
+  if (axial && b->model != BEAM_ZOAC && x > 0.0) {
+    double* cache = output_cache(b, q, v, work);
+    if (cache && cache[CACHE_DEFORMATION] == 1.0 && cache[CACHE_X] == x) {
+      u[0] = cache[CACHE_U0];
+      ud[0] = cache[CACHE_UD0];
+      return;
+    }
     double wc, wcd;
     coupling_at(b, p, pd, e, xi, &wc, &wcd);
     u[0] += wc;
     ud[0] += wcd;
+    if (cache) {
+      cache[CACHE_DEFORMATION] = 1.0;
+      cache[CACHE_X] = x;
+      cache[CACHE_U0] = u[0];
+      cache[CACHE_UD0] = ud[0];
+    }
   }
 }
 
@@ -1346,8 +1439,7 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   } else if (id < 0 || id >= OUT_NTIP) {
     return -1;
   } else if (id == OUT_ANG_MOMENTUM) {
-    fmbEnergy en;
-    beam_integrals(b, NULL, q, v, &en, value);
+    integrals_cached(b, NULL, q, v, NULL, value, work);
     return 0;
   } else if (id == OUT_TIP_ANGLE) {
     const double tip[2] = {b->L, 0.0};
@@ -1357,7 +1449,7 @@ static int beam_output(const void* self, int id, const double* q, const double* 
     return 0;
   }
   double u[2], ud[2];
-  deformation_at(b, q + 3, v + 3, x, u, ud);
+  deformation_at(b, q, v, x, comp != OUT_TIP_V && comp != OUT_TIP_V_RATE, u, ud, work);
   double c = cos(q[2]), s = sin(q[2]);
   switch (comp) {
     case OUT_TIP_U: *value = u[0]; break;
