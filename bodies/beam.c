@@ -1206,6 +1206,14 @@ static int beam_marker(const void* self, const double* q, const double local[2],
  * ------------------------------------------------------------------------------------------- */
 /* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
    momentum about the frame origin for the complete model) in one pass */
+/* two doubles, one per lane (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on arm64) */
+typedef double dbl2 __attribute__((vector_size(2 * sizeof(double))));
+static inline dbl2 splat(double a) { return (dbl2){a, a}; }
+/* dot4(n, d) in each lane, in dot4's order */
+static inline dbl2 dot4v(const dbl2 n[4], const double d[4]) {
+  return n[0] * splat(d[0]) + n[1] * splat(d[1]) + n[2] * splat(d[2]) + n[3] * splat(d[3]);
+}
+
 static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                            double* ptheta) {
   const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
@@ -1231,49 +1239,70 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
       double cp[3], cv[3];
       slope_products(b, d, dd, cp, cv, pp, pv5);
     }
-    for (int g = 0; g < ng; ++g) {
-      double xi = b->xg[g], x = e * le + xi * le;
-      const double* ns = b->ns_out[g];
-      const double* nd = b->nd_out[g];
-      double n1[2] = {1.0 - xi, xi};
-      double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
-      double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
-      double wc = 0.0, wcd = 0.0;
+    /* two quadrature points at a time, one in each lane of a vector (lane 1 repeats the last point
+       when ng is odd, and is then not summed): the same operations in the same order per point as
+       one at a time, so bit for bit the same sums, in about half the instructions (this pass was
+       the largest part of the rows' cost, docs/performance.md "Row output") */
+    for (int g = 0; g < ng; g += 2) {
+      const int g1 = g + 1 < ng ? g + 1 : g;
+      const dbl2 xi = {b->xg[g], b->xg[g1]}, x = splat(e * le) + xi * splat(le);
+      dbl2 ns[4], nd[4];
+      for (int j = 0; j < 4; ++j) {
+        ns[j] = (dbl2){b->ns_out[g][j], b->ns_out[g1][j]};
+        nd[j] = (dbl2){b->nd_out[g][j], b->nd_out[g1][j]};
+      }
+      const dbl2 n1[2] = {splat(1.0) - xi, xi};
+      const dbl2 w1 = n1[0] * splat(ua[0]) + n1[1] * splat(ua[1]), w2 = dot4v(ns, d), w2s = dot4v(nd, d);
+      const dbl2 w1d = n1[0] * splat(uda[0]) + n1[1] * splat(uda[1]), w2d = dot4v(ns, dd), w2sd = dot4v(nd, dd);
+      dbl2 wc = splat(0.0), wcd = splat(0.0);
       if (coupled) {
-        wc = -0.5 * (Ipp + dot5(pp, b->pw_out[g]));
-        wcd = -(Ipv + dot5(pv5, b->pw_out[g]));
+        dbl2 pwp = splat(0.0), pwv = splat(0.0); /* dot5 with pw_out, term by term as dot5 adds them */
+        for (int k = 0; k < 5; ++k) {
+          const dbl2 pw = {b->pw_out[g][k], b->pw_out[g1][k]};
+          pwp = k ? pwp + splat(pp[k]) * pw : splat(pp[k]) * pw;
+          pwv = k ? pwv + splat(pv5[k]) * pw : splat(pv5[k]) * pw;
+        }
+        wc = splat(-0.5) * (splat(Ipp) + pwp);
+        wcd = -(splat(Ipv) + pwv);
       }
       /* The cross-section pair y = -r, +r (mass m each): every velocity and lever arm below is
          affine in y, X = X0 + y X1, so the pair sums in closed form as in the residual:
          sum m (A + yB).(C + yD) = M2 (A.C + r^2 B.D), M2 = 2m; terms linear in y cancel. */
-      const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
-      const double vR0[2] = {v0[0], v0[1] + x * om}, vR1[2] = {-om, 0.0};
-      const double vRD0[2] = {vR0[0] - w2 * om + w1d, vR0[1] + w1 * om + w2d};
-      const double vRD1[2] = {vR1[0] - w2sd, -w2s * om};
-      const double vC[2] = {wcd, wc * om};
+      const dbl2 M2 = splat(2.0 * mhalf) * (dbl2){b->wg[g], b->wg[g1]}, r2 = splat(b->r * b->r), omv = splat(om);
+      const dbl2 vR0[2] = {splat(v0[0]), splat(v0[1]) + x * omv}, vR1[2] = {splat(-om), splat(0.0)};
+      const dbl2 vRD0[2] = {vR0[0] - w2 * omv + w1d, vR0[1] + w1 * omv + w2d};
+      const dbl2 vRD1[2] = {vR1[0] - w2sd, -w2s * omv};
+      const dbl2 vC[2] = {wcd, wc * omv};
       /* d v / d theta' of the parts: I~(rho0 + u_D) = gRD0 + y gRD1, I~ rho0 = [-y, x] */
-      const double gRD0[2] = {-w2, x + w1}, gRD1[2] = {-1.0, -w2s};
+      const dbl2 gRD0[2] = {-w2, x + w1}, gRD1[2] = {splat(-1.0), -w2s};
+      dbl2 dT, dp;
       switch (model) {
         case BEAM_ZOAC:
-          T += 0.5 * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
-          pth += M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
+          dT = splat(0.5) * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
+          dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
           break;
         case BEAM_FOAC:
-          T += M2 * (0.5 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
-                     vR0[0] * vC[0] + vR0[1] * vC[1]);
-          pth += M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) +
-                       x * vC[1] + wc * vR0[1]);
+          dT = M2 *
+               (splat(0.5) * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
+                vR0[0] * vC[0] + vR0[1] * vC[1]);
+          dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) + x * vC[1] +
+                     wc * vR0[1]);
           break;
         default: {
-          const double vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
-          T += 0.5 * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
-          pth += M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
+          const dbl2 vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
+          dT = splat(0.5) * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
+          dp = M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
           break;
         }
       }
       /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
-      if (grav) Ug -= M2 * (f[0] * (x + w1 + wc) + f[1] * w2);
-      mtot += M2;
+      const dbl2 dUg = grav ? M2 * (splat(f[0]) * (x + w1 + wc) + splat(f[1]) * w2) : splat(0.0);
+      for (int lane = 0; lane < (g1 > g ? 2 : 1); ++lane) { /* in the order of the points */
+        T += dT[lane];
+        pth += dp[lane];
+        if (grav) Ug -= dUg[lane];
+        mtot += M2[lane];
+      }
     }
     if (coupled) {
       Ipp += dot5(pp, b->pw_full);
