@@ -1479,14 +1479,13 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   }
   double u[2], ud[2];
   deformation_at(b, q, v, x, comp != OUT_TIP_V && comp != OUT_TIP_V_RATE, u, ud, work);
-  double c = cos(q[2]), s = sin(q[2]);
   switch (comp) {
     case OUT_TIP_U: *value = u[0]; break;
     case OUT_TIP_V: *value = u[1]; break;
     case OUT_TIP_U_RATE: *value = ud[0]; break;
     case OUT_TIP_V_RATE: *value = ud[1]; break;
-    case OUT_TIP_X: *value = q[0] + c * (x + u[0]) - s * u[1]; break;
-    default: *value = q[1] + s * (x + u[0]) + c * u[1]; break;
+    case OUT_TIP_X: *value = q[0] + cos(q[2]) * (x + u[0]) - sin(q[2]) * u[1]; break; /* the frame's angle only here */
+    default: *value = q[1] + sin(q[2]) * (x + u[0]) + cos(q[2]) * u[1]; break;
   }
   return 0;
 }
