@@ -1215,7 +1215,7 @@ static inline dbl2 dot4v(const dbl2 n[4], const double d[4]) {
 }
 
 static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
-                           double* ptheta) {
+                           double* ptheta, double coupling_total[2]) {
   const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
   const double le = b->le;
   const double* p = q + 3;
@@ -1318,6 +1318,8 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   en->gravity = Ug;
   en->spring = 0.0;
   if (ptheta) *ptheta = pth;
+  coupling_total[0] = Ipp; /* int_0^L w2'^2 and int_0^L w2' w2d' (coupled models): the tip's w_c, rate */
+  coupling_total[1] = Ipv;
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -1339,6 +1341,8 @@ enum {
   CACHE_G0,
   CACHE_G1,
   CACHE_UG,
+  CACHE_IPP, /* with CACHE_INTEGRALS: the coupling integrals over the whole beam (beam_integrals) */
+  CACHE_IPV,
   CACHE_DEFORMATION, /* 1 when the axial u, ud at x = CACHE_X (coupling included) are the key state's */
   CACHE_X,
   CACHE_U0,
@@ -1381,9 +1385,9 @@ static void integrals_cached(const Beam* b, const fmbEnv* env, const double* q, 
     return;
   }
   fmbEnergy local;
-  double pth;
+  double pth, coupling_total[2];
   if (!en) en = &local;
-  beam_integrals(b, grav ? env : NULL, q, v, en, &pth);
+  beam_integrals(b, grav ? env : NULL, q, v, en, &pth, coupling_total);
   if (ptheta) *ptheta = pth;
   if (!cache) return;
   cache[CACHE_INTEGRALS] = cache[CACHE_GRAVITY] = 1.0;
@@ -1393,6 +1397,8 @@ static void integrals_cached(const Beam* b, const fmbEnv* env, const double* q, 
   cache[CACHE_G0] = g0;
   cache[CACHE_G1] = g1;
   cache[CACHE_UG] = en->gravity;
+  cache[CACHE_IPP] = coupling_total[0];
+  cache[CACHE_IPV] = coupling_total[1];
 }
 
 static void beam_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
@@ -1444,7 +1450,14 @@ static void deformation_at(const Beam* b, const double* q, const double* v, doub
       return;
     }
     double wc, wcd;
-    coupling_at(b, p, pd, e, xi, &wc, &wcd);
+    if (cache && cache[CACHE_INTEGRALS] == 1.0 && e == b->ne - 1 && xi == 1.0) {
+      /* the tip: coupling_at's sums over every element with the whole element's weights, which
+         the energy pass of this state has made in the same order (bit for bit) */
+      wc = -0.5 * cache[CACHE_IPP];
+      wcd = -cache[CACHE_IPV];
+    } else {
+      coupling_at(b, p, pd, e, xi, &wc, &wcd);
+    }
     u[0] += wc;
     ud[0] += wcd;
     if (cache) {
