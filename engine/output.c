@@ -1,7 +1,8 @@
 /* output.c — named outputs and the one CSV writer.
  * Columns are resolved once at load ("BODY.quantity", "JOINT.quantity", "energy.*",
  * "constraint.*"); a row computes only what its columns need (no energy pass unless an energy
- * column is asked for). Rows go to disk as they are written, so a run that stops keeps them. */
+ * column is asked for). A run that stops keeps the rows it wrote: into a temporary file they are
+ * gathered and written before it is renamed, to stdout or a FIFO each at once (the writer below). */
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
