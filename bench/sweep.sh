@@ -4,8 +4,8 @@
 # shared: medians and ratios, not single times):
 #   serial   one process, the library called in a loop (bench/sweep_serial.c): the bar
 #   xargs    `xargs -P2` over `flexmbd run` (the ideal local pool of separate processes)
-#   sweep    `flexmbd sweep -j 2` (a process per run)
-#   serve    `flexmbd sweep -j 2 --runner serve` (a persistent runner per slot)
+#   sweep    `flexmbd sweep -j 2 --runner spawn` (a process per run)
+#   serve    `flexmbd sweep -j 2`, the default runner (auto: a persistent runner per slot when alone)
 # on two workloads: 400 four-bar runs (~4 ms each) and 60 spin-up runs (omega0 = 10..15 of the
 # omega0 = 15 spin-up, ~45 ms each). The bar (issue 26): sweep >= 1.4x and >= 1.85x the serial loop.
 # Then the dispatch cost per run (sweep -j 1: wall time not spent inside a child, per run) and the
@@ -54,14 +54,14 @@ for wl in fourbar spinup; do
   for rep in $(seq "$REPS"); do
     echo "$wl,serial,$rep,$runs,$(timed "$W/serial" "$scene" "$plan" "$W/serial_$wl.csv")" >> "$RES/sweep.csv"
     echo "$wl,xargs-P2,$rep,$runs,$(timed xargs -P2 -L1 -a "$W/args_$wl" "$F" run "$scene" --quiet)" >> "$RES/sweep.csv"
-    echo "$wl,sweep-j2,$rep,$runs,$(timed "$F" sweep "$scene" -o "$W/s_$wl" --fresh --quiet -j 2 --grid "${GRID[$wl]}")" \
-      >> "$RES/sweep.csv"
-    echo "$wl,serve-j2,$rep,$runs,$(timed "$F" sweep "$scene" -o "$W/s_$wl" --fresh --quiet -j 2 --runner serve \
+    echo "$wl,sweep-j2,$rep,$runs,$(timed "$F" sweep "$scene" -o "$W/s_$wl" --fresh --quiet -j 2 --runner spawn \
+      --grid "${GRID[$wl]}")" >> "$RES/sweep.csv"
+    echo "$wl,serve-j2,$rep,$runs,$(timed "$F" sweep "$scene" -o "$W/s_$wl" --fresh --quiet -j 2 \
       --grid "${GRID[$wl]}")" >> "$RES/sweep.csv"
   done
   # dispatch cost: a sweep with one child; its own CPU per run (the manager's serial work: plan,
   # dispatch, journal, rows) from its summary line, and the wall time outside the children
-  t0=$(now); "$F" sweep "$scene" -o "$W/d_$wl" --fresh --quiet -j 1 --grid "${GRID[$wl]}" 2> "$W/d_$wl.err"; t1=$(now)
+  t0=$(now); "$F" sweep "$scene" -o "$W/d_$wl" --fresh --quiet -j 1 --runner spawn --grid "${GRID[$wl]}" 2> "$W/d_$wl.err"; t1=$(now)
   own=$(sed -n 's/.*this process: \([0-9.]*\) ms of CPU per run.*/\1/p' "$W/d_$wl.err")
   awk -F, -v total="$(echo "$t1 - $t0" | bc -l)" -v wl="$wl" -v own="$own" 'NR > 1 { s += $7; n++ }
     END { printf "%s: sweep -j 1: its own CPU %.3f ms per run; wall %.3f s, in children %.3f s: %.3f ms per run outside them\n",
@@ -79,9 +79,9 @@ done
     s=$(med serial 5); x=$(med xargs-P2 5); w=$(med sweep-j2 5); v=$(med serve-j2 5)
     cs=$(med serial 6); cx=$(med xargs-P2 6); cw=$(med sweep-j2 6); cv=$(med serve-j2 6)
     awk -v wl="$wl" -v s="$s" -v x="$x" -v w="$w" -v v="$v" -v cs="$cs" -v cx="$cx" -v cw="$cw" -v cv="$cv" 'BEGIN {
-      printf "%-8s median wall: serial %.3f s, xargs -P2 %.3f s, sweep -j 2 %.3f s, serve -j 2 %.3f s; over serial: xargs %.2fx, sweep %.2fx, serve %.2fx\n",
+      printf "%-8s median wall: serial %.3f s, xargs -P2 %.3f s, sweep --runner spawn %.3f s, sweep (default: runners) %.3f s; over serial: xargs %.2fx, spawn %.2fx, default %.2fx\n",
         wl, s, x, w, v, s / x, s / w, s / v
-      printf "%-8s median CPU (user+sys): serial %.3f s, xargs -P2 %.3f s, sweep -j 2 %.3f s, serve -j 2 %.3f s; on 2 free cores at most: xargs %.2fx, sweep %.2fx, serve %.2fx the serial loop\n",
+      printf "%-8s median CPU (user+sys): serial %.3f s, xargs -P2 %.3f s, sweep --runner spawn %.3f s, sweep (default: runners) %.3f s; on 2 free cores at most: xargs %.2fx, spawn %.2fx, default %.2fx the serial loop\n",
         wl, cs, cx, cw, cv, 2 * cs / cx, 2 * cs / cw, 2 * cs / cv }'
   done
   cat "$W/dispatch.txt"

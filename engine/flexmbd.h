@@ -528,6 +528,9 @@ FMB_API void fmb_describe(const fmbModel* m, FILE* f);
    joint name and row, and whether the start is a singular configuration. 0, or an exit code with
    *diag filled (joints that cannot be satisfied). */
 FMB_API int fmb_check_constraints(const fmbModel* m, FILE* f, fmbDiag* diag);
+/* the backend a run of this model starts on and why, as one line "solver: ..." (what
+   `integrator: auto` and `formulation: auto` pick, or what the scene names; `flexmbd check`). */
+FMB_API void fmb_describe_solver(const fmbModel* m, FILE* f);
 /* the outputs the engine itself gives, as NULL-terminated names (NULL for an unknown group):
    "frame" (BODY.x y theta omega vx vy, for every body with a frame: one whose marker places its
    origin), "power" (JOINT.power work, for a joint with constraint rows or a force), "reaction"

@@ -53,6 +53,30 @@ const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
   return m->solver.integrator ? m->solver.integrator : auto_integrator(m);
 }
 
+void fmb_describe_solver(const fmbModel* m, FILE* f) {
+  if (!m || !f) return;
+  const fmbIntegratorOps* ops = fmb_integrator_for(m);
+  const char* why;
+  if (ops->projected)
+    why = m->solver.formulation == FMB_FORM_PROJECTED
+              ? "formulation: projected"
+              : "formulation auto: the walk along the constraint manifold finds a singular position; "
+                "runs at rtol/300";
+  else if (m->solver.integrator)
+    why = "solver.integrator names it";
+  else if (m->solver.linear_solver == FMB_LS_DENSE)
+    why = "integrator auto: linear_solver dense is IDA's only";
+  else if (m->bdf_order_cap < 5)
+    why = "integrator auto: a body caps the BDF order below 5 (undamped structural modes); Radau IIA is L-stable "
+          "at order 5";
+  else
+    why = "integrator auto: rigid bodies, BDF up to order 5";
+  fprintf(f, "solver: %s%s (%s)%s\n", ops->name, ops->projected ? " formulation, CVODE with projections" : "", why,
+          !ops->projected && m->solver.formulation == FMB_FORM_AUTO && m->nc > 0
+              ? "; formulation auto: GGL, the projected one from where a singular position stops it"
+              : "");
+}
+
 /* solver.integrator: auto checks nothing here: it never picks radau5 with linear_solver: dense,
    and formulation: projected runs the projected backend whatever the integrator */
 int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver) {

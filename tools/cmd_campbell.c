@@ -5,26 +5,22 @@
  * then its modes. CSV columns: speed, mode1 ... modeK (rad/s; negative = divergent), the modes
  * followed from speed to speed by shape (greatest modal assurance criterion, MAC), not by order.
  * With -o FILE.csv a PNG is drawn beside it (FILE.png, or --plot) with gnuplot. On a failure the
- * speeds done so far are written and the exit code is run's (2 bad input, 3 solver). The diagram
- * itself is the library's (fmb_campbell, engine/campbell.c); this file parses, writes and plots. */
+ * speeds done so far are written, the message names the speed that failed, and the exit code is
+ * run's (2 bad input, 3 solver: also a crash). -j J: the speeds in J child processes; under
+ * mpirun/srun on every rank too (farm.c: rank 0 hands them out, gathers the modes and alone
+ * follows them and writes); each child is this command again with one speed and `--modes-out
+ * FILE` (internal: the modes of that speed into FILE, tools/modes_pool.c). The diagram itself is
+ * the library's (fmb_campbell, engine/campbell.c); this file parses, writes and plots. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "cli.h"
+#include "sweep.h"
 
 #define MAX_SPEEDS 10000
-
-/* one speed's modes, for the child processes of -j J (tools/modes_pool.c) */
-typedef struct {
-  const fmbSceneSource* scene;
-  const fmbCampbellOptions* opt;
-} Speed;
-static int modes_at(void* ctx, double speed, fmbModes** out, fmbDiag* diag) {
-  const Speed* c = ctx;
-  return fmb_campbell_modes_at(c->scene, c->opt, speed, out, diag);
-}
 
 /* "A:B:N" (N values from A to B) or "S1,S2,..."; returns the count or -1 */
 static int parse_speeds(const char* text, double* out) {
@@ -114,7 +110,10 @@ int fmb_cmd_campbell(int argc, char** argv) {
   an.count_max = FMB_CAMPBELL_MAX_MODES;
   an.opt.quiet = 1;
   const char *out = NULL, *png = NULL, *path = NULL, *speeds_text = NULL;
-  int jobs = 1; /* -j J: the speeds' modes computed in J child processes (tools/modes_pool.c) */
+  int jobs = 1; /* -j J: the speeds' modes computed in J child processes (per rank, tools/modes_pool.c) */
+  /* such a child: this command line with one speed and --modes-out FILE (its -j is not used) */
+  const char* modes_out = NULL;
+  int speeds_at = 0;
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
     int r = fmb_cli_take_scene_arg("campbell", argc, argv, &i, &s);
@@ -138,6 +137,9 @@ int fmb_cmd_campbell(int argc, char** argv) {
       }
     } else if (strcmp(a, "--speeds") == 0) {
       if (!(speeds_text = fmb_cli_value("campbell", argc, argv, &i, "A:B:N or S1,S2,..."))) return FMB_EXIT_BAD_INPUT;
+      speeds_at = i;
+    } else if (strcmp(a, "--modes-out") == 0) { /* internal: a child of -j or of a rank */
+      if (!(modes_out = fmb_cli_value("campbell", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
     } else {
       fprintf(stderr, "flexmbd campbell: unknown option '%s'\n", a);
       return FMB_EXIT_BAD_INPUT;
@@ -168,6 +170,53 @@ int fmb_cmd_campbell(int argc, char** argv) {
   }
   const fmbSceneSource scene = {s.scene, s.overrides, s.nover, fmb_cli_registry()};
   const fmbCampbellOptions opt = {path, count, an.method, an.opt};
+  if (modes_out) { /* a child of -j or of a rank: the modes at its one speed into the file */
+    if (nspeed != 1) {
+      fprintf(stderr, "flexmbd campbell: --modes-out goes with one speed\n");
+      free(speeds);
+      return FMB_EXIT_BAD_INPUT;
+    }
+    fmbModes* m = NULL;
+    fmbDiag d;
+    const int mrc = fmb_campbell_modes_at(&scene, &opt, speeds[0], &m, &d);
+    const int saved = fmb_cli_modes_save(modes_out, mrc, &d, m);
+    if (saved) fprintf(stderr, "flexmbd campbell: cannot write %s\n", modes_out);
+    fmb_modes_free(m);
+    free(speeds);
+    return saved ? FMB_EXIT_SOLVER : 0;
+  }
+  /* under mpirun/srun: the ranks share the speeds; only rank 0 writes (every rank has parsed the
+     same command line: a bad one ended them all above, alike) */
+  fmbFarmTransport ranks;
+  const int mpi = fmb_farm_mpi_start("campbell", &ranks);
+  if (mpi < 0) { /* built without MPI: rank 0 works alone */
+    free(speeds);
+    return 0;
+  }
+  /* the children's command line: this one and --modes-out FILE, the speed and the file set per
+     child (without it every speed fails to start, with a message: no rank waits) */
+  char exe[4096];
+  char** child = NULL;
+  if (jobs > 1 || mpi) {
+    const ssize_t el = readlink("/proc/self/exe", exe, sizeof exe - 1);
+    child = el > 0 ? calloc((size_t)argc + 3, sizeof *child) : NULL;
+    if (child) {
+      exe[el] = '\0';
+      child[0] = exe;
+      for (int k = 1; k < argc; ++k) child[k] = argv[k];
+      child[argc] = "--modes-out";
+    }
+  }
+  if (mpi && ranks.rank != 0) { /* a worker: the speeds rank 0 hands out, their modes to rank 0 */
+    fmbDiag wdiag;
+    int wdone;
+    const int wrc = fmb_cli_modes_in_children(jobs, child, speeds_at, argc + 1, speeds, nspeed, &ranks,
+                                              fmb_cli_catch_stop_signals(), NULL, &wdone, &wdiag);
+    free(child);
+    free(speeds);
+    fmb_sweep_extension_load(0)->mpi_finalize(wrc);
+    return wrc;
+  }
   /* fmb_campbell in its steps: each speed's modes (computable anywhere, e.g. in other processes),
      then followed in order */
   fmbCampbell* c = fmb_campbell_new(speeds, nspeed, count);
@@ -176,13 +225,20 @@ int fmb_cmd_campbell(int argc, char** argv) {
   int rc = c ? 0 : FMB_EXIT_SOLVER;
   if (!c) snprintf(diag.msg, sizeof diag.msg, "out of memory");
   volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
-  /* -j J: every speed's modes at once in child processes, then followed in order as below */
-  Speed ctx = {&scene, &opt};
-  fmbModes** pre = jobs > 1 && !rc ? calloc((size_t)nspeed, sizeof *pre) : NULL;
+  /* -j J or ranks: every speed's modes at once in child processes, then followed in order below */
+  fmbModes** pre = jobs > 1 || mpi ? calloc((size_t)nspeed, sizeof *pre) : NULL;
   int pre_done = 0, pre_rc = 0;
   fmbDiag pre_diag;
   memset(&pre_diag, 0, sizeof pre_diag);
-  if (pre) pre_rc = fmb_cli_modes_in_children(jobs, speeds, nspeed, modes_at, &ctx, pre, &pre_done, &pre_diag);
+  if (!pre && !rc && (jobs > 1 || mpi)) {
+    rc = FMB_EXIT_SOLVER;
+    snprintf(diag.msg, sizeof diag.msg, "out of memory");
+  }
+  if (mpi || (pre && !rc)) /* the other ranks wait for rank 0's word: it goes through the farm whatever */
+    pre_rc = fmb_cli_modes_in_children(jobs, child, speeds_at, argc + 1, speeds, nspeed, mpi ? &ranks : NULL, stop, pre,
+                                       &pre_done, &pre_diag);
+  free(child);
+  int failed_at = -1; /* the speed whose modes failed */
   for (int i = 0; !rc && i < nspeed; ++i) {
     if (*stop && (!pre || i >= pre_done)) { /* SIGINT/SIGTERM: the speeds done so far are written below */
       memset(&diag, 0, sizeof diag);
@@ -195,7 +251,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
     }
     fmbModes* modes = NULL;
     if (!pre) {
-      rc = modes_at(&ctx, speeds[i], &modes, &diag);
+      rc = fmb_campbell_modes_at(&scene, &opt, speeds[i], &modes, &diag);
     } else if (i < pre_done) {
       modes = pre[i];
       pre[i] = NULL;
@@ -203,6 +259,7 @@ int fmb_cmd_campbell(int argc, char** argv) {
       rc = pre_rc;
       diag = pre_diag;
     }
+    if (rc) failed_at = i;
     if (!rc && (rc = fmb_campbell_add(c, modes, &diag)) != 0)
       snprintf(diag.file, sizeof diag.file, "%s", s.scene); /* too few modes: the scene's */
   }
@@ -216,6 +273,9 @@ int fmb_cmd_campbell(int argc, char** argv) {
                 "flexmbd campbell: at speed %g mode %d matches its shape at the last speed poorly (MAC %.2f): "
                 "take finer speed steps\n",
                 speeds[i], k + 1, c->mac[(size_t)i * count + k]);
+  if (failed_at >= 0 && rc != FMB_EXIT_INTERRUPTED)
+    fprintf(stderr, "flexmbd campbell: no modes at speed %.17g (speed %d of %d); the %d speeds before it are kept:\n",
+            speeds[failed_at], failed_at + 1, nspeed, failed_at);
   if (rc) fmb_cli_print_diag(&diag);
   /* nothing done (a bad --speed, a scene that does not load): an earlier result stays as it was */
   const int wrc = c && done > 0 ? write_csv(out, c) : 0;
@@ -238,5 +298,6 @@ int fmb_cmd_campbell(int argc, char** argv) {
           done, nspeed, count);
   fmb_campbell_free(c);
   free(speeds);
+  fmb_sweep_extension_load(0)->mpi_finalize(rc);
   return rc ? rc : wrc;
 }

@@ -27,6 +27,7 @@ int fmb_cmd_check(int argc, char** argv) {
   }
   fmb_describe(m, stdout);
   int rc = fmb_check_constraints(m, stdout, &diag);
+  if (!rc) fmb_describe_solver(m, stdout);
   if (rc) fmb_cli_print_diag(&diag);
   fmb_free(m);
   return rc;

@@ -3,12 +3,12 @@
  *                 lognormal(m,s)]... [--count N] [--seed S] [--design mc|lhs] [--set PATH=VALUE]...
  *                 [--verb run|static|modes] [--metric COL:max,min,end,rms]... [--reference REF.csv
  *                 [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...] [--keep summary|series]
- *                 [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...`
+ *                 [--runner auto|spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...`
  *               `flexmbd sweep --status DIR`
  * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
  * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
  * index) and, when built with HDF5, DIR/sweep.h5. Under mpirun/srun the ranks share the runs
- * (sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
+ * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
  * 4 interrupted (SIGINT/SIGTERM: every child killed, the journal flushed; run again to resume). */
 #define _GNU_SOURCE /* sched_getaffinity */
 #include <errno.h>
@@ -177,7 +177,7 @@ static void usage(FILE* f) {
       "         [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)]... --count N [--seed S]\n"
       "         [--design mc|lhs] [--set PATH=VALUE]... [--verb run|static|modes] [--metric COL:max,min,end,rms]...\n"
       "         [--reference REF.csv [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...]\n"
-      "         [--keep summary|series] [--runner spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] "
+      "         [--keep summary|series] [--runner auto|spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] "
       "[--yes]\n"
       "         [--quiet] [--plugin x.so]...\n"
       "       flexmbd sweep --status DIR\n"
@@ -194,6 +194,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   sw->verb = "run";
   sw->jobs = 0;
   sw->timeout_s = 600.0;
+  sw->serve = -1; /* --runner auto, resolved once the verb is known */
   sw->journal_fd = sw->inflight_fd = -1;
   sw->stop = &stop_requested;
   const char* columns = NULL;
@@ -302,9 +303,10 @@ int fmb_cmd_sweep(int argc, char** argv) {
       if (strcmp(v, "summary") && strcmp(v, "series")) return bad("--keep expects summary or series, got '%s'", v);
       sw->keep_series = strcmp(v, "series") == 0;
     } else if (strcmp(a, "--runner") == 0) {
-      if (!(v = VALUE("spawn or serve"))) return FMB_EXIT_BAD_INPUT;
-      if (strcmp(v, "spawn") && strcmp(v, "serve")) return bad("--runner expects spawn or serve, got '%s'", v);
-      sw->serve = strcmp(v, "serve") == 0;
+      if (!(v = VALUE("auto, spawn or serve"))) return FMB_EXIT_BAD_INPUT;
+      if (strcmp(v, "auto") && strcmp(v, "spawn") && strcmp(v, "serve"))
+        return bad("--runner expects auto, spawn or serve, got '%s'", v);
+      sw->serve = strcmp(v, "auto") == 0 ? -1 : strcmp(v, "serve") == 0;
     } else if (strcmp(a, "--mem-limit") == 0) {
       char* end;
       if (!(v = VALUE("megabytes"))) return FMB_EXIT_BAD_INPUT;
@@ -335,7 +337,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (!sw->dir) return bad("no output folder given (-o DIR)%s", "");
   if (resume && fresh) return bad("--resume and --fresh exclude each other%s", "");
   if (fmb_cli_check_input(sw->scene, "scene")) return FMB_EXIT_BAD_INPUT;
-  if (sw->serve && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
+  if (sw->serve == 1 && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
   if (design_lhs >= 0 && !sw->plan.nrandom) return bad("--design goes with --random%s", "");
   if (seed_given && !sw->plan.nrandom) return bad("--seed goes with --random%s", "");
   sw->plan.count = count;
@@ -388,17 +390,17 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (make_ids(sw)) return bad("out of memory for %s runs", "the");
   /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
      libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
-  const int launched = fmb_sweep_launched_by_mpi();
-  const fmbSweepExtension* ext = fmb_sweep_extension_load(launched);
-  if (launched && !ext->has_mpi) { /* every rank would run the whole sweep into one journal */
-    const char* r = getenv("OMPI_COMM_WORLD_RANK");
-    if (!r) r = getenv("PMIX_RANK");
-    if (!r) r = getenv("PMI_RANK");
-    if (r && atoi(r) > 0) return 0;
-    fprintf(stderr, "flexmbd sweep: warning: started by mpirun/srun, but built without MPI: rank 0 runs the sweep "
-                    "alone, the other ranks leave\n");
-  }
-  if (!launched || !ext->has_mpi || ext->mpi_init(sw)) sw->rank = 0, sw->nranks = 1;
+  fmbFarmTransport ranks;
+  const int mpi = fmb_farm_mpi_start("sweep", &ranks);
+  if (mpi < 0) return 0; /* built without MPI: rank 0 runs the sweep alone */
+  sw->rank = ranks.rank, sw->nranks = ranks.nranks;
+  const fmbSweepExtension* ext = fmb_sweep_extension_load(0);
+  /* --runner auto (the default): alone, persistent runners for `--verb run`; a process per run otherwise. A runner
+   * still runs each run in a child (a crash or a hang costs that run's row and a fresh runner takes the slot, tested)
+   * and saves the ~3 ms exec and linking of every run: 1.28x -> 1.70x the serial loop on 400 four-bar runs on 2 cores
+   * (bench/sweep.sh, docs/performance.md "Sweeps"). Across ranks it stays a process per run: with runners on the
+   * workers, SIGTERM to Open MPI 4.1's mpirun left mpirun spinning after the ranks' MPI_Abort (seen in sweep_mpi). */
+  if (sw->serve < 0) sw->serve = sw->nranks == 1 && strcmp(sw->verb, "run") == 0;
 
   int rc = 0;
   if (sw->rank != 0 && dry) { /* rank 0 alone checks the plan */
@@ -435,10 +437,10 @@ int fmb_cmd_sweep(int argc, char** argv) {
   sigaction(SIGTERM, &sa, NULL);
   sw->progress = !sw->quiet && isatty(STDERR_FILENO);
   sw->t_start = fmb_pool_now();
-  if (sw->nranks > 1)
-    rc = ext->mpi_run(sw, rc);
-  else if (!rc)
-    rc = sw->serve ? fmb_sweep_serve(sw) : fmb_sweep_local(sw);
+  if (sw->nranks > 1) /* rank 0's verdict on the spec and the journal: every rank stops on it */
+    rc = ranks.bcast_int(rc);
+  const fmbFarmTransport* t = sw->nranks > 1 ? &ranks : NULL;
+  if (!rc) rc = sw->serve ? fmb_sweep_serve(sw, t) : fmb_sweep_farm(sw, t);
   if (sw->rank == 0 && sw->journal_fd >= 0) {
     fmb_sweep_progress(sw, 1);
     if (fmb_journal_write_table(sw)) fprintf(stderr, "flexmbd sweep: cannot write %s/table.csv\n", sw->dir);

@@ -57,7 +57,8 @@ static const Command commands[] = {
     {"campbell", fmb_cmd_campbell,
      "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j K] [-o campbell.csv] [--plot "
      "campbell.png]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC)",
+     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC);\n"
+     "      under mpirun/srun the ranks share the speeds",
      0},
     {"sweep", fmb_cmd_sweep,
      "sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log]|PATH=v1,v2,...]... [--zip ...] [--samples F.csv] [--random "

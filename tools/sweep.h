@@ -3,7 +3,8 @@
  *   sweep_plan.c     grids, zip, samples, random designs
  *   sweep_journal.c  DIR/runs.csv (append-only, one row per finished run), resume, DIR/table.csv
  *   sweep_exec.c     one run as a child (child_pool.c) and its row; the local loop
- *   sweep_mpi.c      rank 0 hands out runs one at a time to whichever rank asks (FLEXMBD_HAVE_MPI)
+ *   farm.c           rank 0 hands out runs one at a time to whichever rank (slot) asks
+ *   sweep_mpi.c      the farm's messages over MPI (FLEXMBD_HAVE_MPI)
  *   sweep_h5.c       DIR/sweep.h5 from the journal at the end (FLEXMBD_HAVE_HDF5) */
 #ifndef FLEXMBD_SWEEP_H
 #define FLEXMBD_SWEEP_H
@@ -12,6 +13,7 @@
 
 #include "child_pool.h"
 #include "csv_table.h"
+#include "farm.h"
 #include "sweep_plan.h"
 
 #define FMB_SWEEP_MAX_METRICS 64
@@ -123,10 +125,12 @@ void fmb_sweep_account(fmbSweep* sw, int status, double wall_s);
 void fmb_sweep_progress(fmbSweep* sw, int final);
 /* the runs still to do, in-flight ones (started, no row) first: *n_inflight of them; malloc'd */
 long* fmb_sweep_todo(fmbSweep* sw, long* n, long* n_inflight);
-/* the whole sweep in this process; 0, or FMB_EXIT_INTERRUPTED (resumable) */
-int fmb_sweep_local(fmbSweep* sw);
-/* the same with persistent runners (`--runner serve`, sweep_serve.c) */
-int fmb_sweep_serve(fmbSweep* sw);
+/* the whole sweep in this process (t NULL) or over the ranks of t (rank 0 plans, keeps the
+   journal and hands out runs, sweep_mpi.c); 0, or FMB_EXIT_INTERRUPTED (resumable) */
+int fmb_sweep_farm(fmbSweep* sw, const fmbFarmTransport* t);
+/* the same with persistent runners (`--runner serve`, sweep_serve.c): rank 0 with process per
+   run when there are other ranks, which use runners */
+int fmb_sweep_serve(fmbSweep* sw, const fmbFarmTransport* t);
 /* where the runners' runs come from and their rows go: the local journal, or rank 0 (MPI) */
 typedef struct fmbRunFeed {
   /* the next run: 1 with its index, attempt and time limit; 0 none now; -1 none any more */
@@ -150,22 +154,23 @@ int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n);
    LIBDIR/flexmbd (installed); without it the sweep is the local pool and writes no sweep.h5. */
 typedef struct fmbSweepExtension {
   int has_mpi, has_hdf5;
-  int (*mpi_init)(fmbSweep* sw); /* MPI_Init, rank and size; 0 or -1 */
-  /* the sweep over the ranks; rc0: rank 0's verdict on the spec and journal (0 go, else every
-     rank returns it); rank 0 returns what fmb_sweep_local would */
-  int (*mpi_run)(fmbSweep* sw, int rc0);
+  /* MPI_Init; *t: this rank, their number and the farm's messages (farm.h); 0 or -1 */
+  int (*mpi_init)(fmbFarmTransport* t);
   void (*mpi_finalize)(int rc); /* MPI_Finalize, or MPI_Abort when interrupted */
   /* DIR/sweep.h5 from DIR/plan.csv, DIR/table.csv and (--keep series) the series; 0 or -1 */
   int (*write_h5)(const fmbSweep* sw);
 } fmbSweepExtension;
 /* started by mpirun or srun (their environment variables: OMPI_COMM_WORLD_SIZE, PMIX_RANK, ...) */
 int fmb_sweep_launched_by_mpi(void);
+/* Under mpirun/srun, MPI started through the module (`who`: the command, for messages): 1 with
+   *t when there is more than one rank; 0 otherwise (this process alone); -1 when this rank has
+   nothing to do (built without MPI: rank 0 works alone, the others should leave at once) */
+int fmb_farm_mpi_start(const char* who, fmbFarmTransport* t);
 /* with `load`, the module's table (loaded once), or fallbacks (local pool, no HDF5) when it cannot
    be loaded; without, the fallbacks until it is */
 const fmbSweepExtension* fmb_sweep_extension_load(int load);
 /* in the module (sweep_mpi.c, sweep_h5.c) */
-int fmb_sweep_mpi_init(fmbSweep* sw);
-int fmb_sweep_mpi(fmbSweep* sw, int rc0);
+int fmb_sweep_mpi_init(fmbFarmTransport* t);
 void fmb_sweep_mpi_finalize(int rc);
 int fmb_sweep_write_h5(const fmbSweep* sw);
 #endif

@@ -358,31 +358,83 @@ int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n) {
   return *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
 }
 
-int fmb_sweep_local(fmbSweep* sw) {
-  long n = 0, ninf = 0;
-  long* todo = fmb_sweep_todo(sw, &n, &ninf);
-  if (!todo) return FMB_EXIT_BAD_INPUT;
-  sw->total_todo = sw->done + n;
-  int rc = fmb_sweep_rerun_inflight(sw, todo, ninf);
-  fmbPool* pool = rc ? NULL : fmb_pool_new(sw->jobs);
-  long next = ninf;
-  while (pool && !*sw->stop && (next < n || fmb_pool_running(pool))) {
-    while (fmb_pool_free_slots(pool) > 0 && next < n && !*sw->stop) {
-      const long i = todo[next++];
-      fmb_journal_started(sw, i);
-      if (fmb_sweep_start(sw, pool, i, fmb_sweep_timeout(sw)) != 0) {
-        fmbChildResult r = {.tag = i, .status = FMB_CHILD_CRASHED, .exit_code = -1};
-        finish(sw, &r); /* fork failed: the row says so (its stderr file does not exist) */
-      }
-    }
-    sw->running = fmb_pool_running(pool);
-    fmbChildResult r;
-    if (fmb_pool_wait(pool, 0.5, &r) == 1) finish(sw, &r);
-    sw->running = fmb_pool_running(pool);
-    fmb_sweep_progress(sw, 0);
+/* the sweep as a farm (farm.h): runs handed out from the to-do list, rows into the journal */
+typedef struct {
+  fmbSweep* sw;
+  const long* todo;
+  long next, n;
+} Feed;
+static int feed_next(void* ctx, fmbFarmTask* task) {
+  Feed* f = ctx;
+  if (f->next >= f->n) return 0;
+  const long i = f->todo[f->next++];
+  fmb_journal_started(f->sw, i);
+  task->index = i;
+  task->attempt = f->sw->starts[f->sw->first[i]];
+  task->timeout_s = fmb_sweep_timeout(f->sw);
+  return 1;
+}
+static int feed_start(void* ctx, fmbPool* pool, const fmbFarmTask* task) {
+  return fmb_sweep_start(((Feed*)ctx)->sw, pool, task->index, task->timeout_s);
+}
+static char* feed_result(void* ctx, const fmbChildResult* r, int attempt, int* len) {
+  char* row = fmb_sweep_row(((Feed*)ctx)->sw, r, attempt);
+  *len = row ? (int)strlen(row) : 0;
+  return row;
+}
+/* the n-th field of a row (after n commas), or NULL */
+static const char* row_field(const char* row, int n) {
+  for (int k = 0; k < n && row; ++k) row = strchr(row, ',') ? strchr(row, ',') + 1 : NULL;
+  return row;
+}
+/* a row into the journal; from another rank, its index, status and wall time are read from it */
+static void feed_take(void* ctx, const fmbChildResult* local, char* row, int len) {
+  fmbSweep* sw = ((Feed*)ctx)->sw;
+  long index = local ? local->tag : -1;
+  int status = local ? (int)local->status : -1;
+  double wall_s = local ? local->wall_s : 0.0;
+  if (!local && len > 0) { /* index,run_id,attempt,status,exit_code,signal,wall_s,... */
+    index = strtol(row, NULL, 10);
+    const char* st = row_field(row, 3);
+    char name[32] = "";
+    if (st) snprintf(name, sizeof name, "%.*s", (int)strcspn(st, ","), st);
+    status = fmb_child_status_of(name);
+    const char* wall = row_field(row, 6);
+    wall_s = wall ? strtod(wall, NULL) : 0.0;
   }
-  if (pool && *sw->stop) fmb_sweep_cancel(sw, pool);
-  fmb_pool_free(pool);
+  if (index >= 0 && index < sw->nrun && len > 0 && fmb_journal_append(sw, index, row) == 0)
+    fmb_sweep_account(sw, status, wall_s);
+  else
+    fprintf(stderr, "flexmbd sweep: cannot append to %s/runs.csv: the run will be done again on resume\n", sw->dir);
+  free(row);
+}
+static void feed_tick(void* ctx, long running) {
+  fmbSweep* sw = ((Feed*)ctx)->sw;
+  sw->running = running;
+  fmb_sweep_progress(sw, 0);
+}
+static void feed_cancelled(void* ctx, long index) { fmb_journal_cancelled(((Feed*)ctx)->sw, index); }
+
+int fmb_sweep_farm(fmbSweep* sw, const fmbFarmTransport* t) {
+  long n = 0, ninf = 0;
+  long* todo = NULL;
+  int rc = 0;
+  if (sw->rank == 0) {
+    if (!(todo = fmb_sweep_todo(sw, &n, &ninf))) return FMB_EXIT_BAD_INPUT;
+    sw->total_todo = sw->done + n;
+    rc = fmb_sweep_rerun_inflight(sw, todo, ninf); /* alone, before anything else runs */
+  }
+  Feed feed = {sw, todo, ninf, n};
+  const fmbFarm farm = {.jobs = sw->jobs,
+                        .stop = sw->stop,
+                        .ctx = &feed,
+                        .next = feed_next,
+                        .start = feed_start,
+                        .result = feed_result,
+                        .take = feed_take,
+                        .tick = feed_tick,
+                        .cancelled = feed_cancelled};
+  if (!rc) rc = fmb_farm_run(&farm, t);
   free(todo);
-  return rc ? rc : *sw->stop ? FMB_EXIT_INTERRUPTED : 0;
+  return rc == FMB_EXIT_SOLVER ? FMB_EXIT_BAD_INPUT : rc; /* out of memory: as before */
 }

@@ -8,7 +8,6 @@ const fmbSweepExtension* fmb_sweep_extension(void) {
 #ifdef FLEXMBD_HAVE_MPI
       .has_mpi = 1,
       .mpi_init = fmb_sweep_mpi_init,
-      .mpi_run = fmb_sweep_mpi,
       .mpi_finalize = fmb_sweep_mpi_finalize,
 #endif
 #ifdef FLEXMBD_HAVE_HDF5

@@ -1,4 +1,5 @@
-/* sweep_load.c — loads libflexmbd_sweep.so (MPI, HDF5) for `flexmbd sweep` only, and stands in
+/* sweep_load.c — loads libflexmbd_sweep.so (MPI, HDF5) for `flexmbd sweep` (and for `flexmbd
+ * campbell` under mpirun/srun) only, and stands in
  * for what it lacks: no MPI = the local pool, no HDF5 = no sweep.h5 (runs.csv and table.csv are
  * always written). RTLD_GLOBAL: Open MPI's own components, loaded later, need libmpi's symbols. */
 #include <dlfcn.h>
@@ -22,11 +23,10 @@ int fmb_sweep_launched_by_mpi(void) {
   return 0;
 }
 
-static int no_mpi_init(fmbSweep* sw) {
-  sw->rank = 0, sw->nranks = 1;
+static int no_mpi_init(fmbFarmTransport* t) {
+  t->rank = 0, t->nranks = 1;
   return 0;
 }
-static int no_mpi_run(fmbSweep* sw, int rc0) { return rc0 ? rc0 : fmb_sweep_local(sw); }
 static void no_mpi_finalize(int rc) { (void)rc; }
 static int no_h5(const fmbSweep* sw) {
   (void)sw;
@@ -34,7 +34,7 @@ static int no_h5(const fmbSweep* sw) {
 }
 
 const fmbSweepExtension* fmb_sweep_extension_load(int load) {
-  static fmbSweepExtension ext = {0, 0, no_mpi_init, no_mpi_run, no_mpi_finalize, no_h5};
+  static fmbSweepExtension ext = {0, 0, no_mpi_init, no_mpi_finalize, no_h5};
   static int loaded;
   if (loaded || !load) return &ext;
   loaded = 1;
@@ -58,9 +58,33 @@ const fmbSweepExtension* fmb_sweep_extension_load(int load) {
   const fmbSweepExtension* m = entry();
   if (m->has_mpi) {
     ext.has_mpi = 1;
-    ext.mpi_init = m->mpi_init, ext.mpi_run = m->mpi_run;
+    ext.mpi_init = m->mpi_init;
     ext.mpi_finalize = m->mpi_finalize;
   }
   if (m->has_hdf5) ext.has_hdf5 = 1, ext.write_h5 = m->write_h5;
   return &ext;
+}
+
+int fmb_farm_mpi_start(const char* who, fmbFarmTransport* t) {
+  memset(t, 0, sizeof *t);
+  t->nranks = 1;
+  if (!fmb_sweep_launched_by_mpi()) return 0;
+  const fmbSweepExtension* ext = fmb_sweep_extension_load(1);
+  if (!ext->has_mpi) { /* every rank would do the whole work into the same files */
+    const char* r = getenv("OMPI_COMM_WORLD_RANK");
+    if (!r) r = getenv("PMIX_RANK");
+    if (!r) r = getenv("PMI_RANK");
+    if (r && atoi(r) > 0) return -1;
+    fprintf(stderr,
+            "flexmbd %s: warning: started by mpirun/srun, but built without MPI: rank 0 works alone, the other ranks "
+            "leave\n",
+            who);
+    return 0;
+  }
+  if (ext->mpi_init(t) != 0) {
+    memset(t, 0, sizeof *t);
+    t->nranks = 1;
+    return 0;
+  }
+  return t->nranks > 1;
 }

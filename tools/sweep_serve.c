@@ -251,7 +251,30 @@ static void local_done(void* ctx, const fmbChildResult* res, char* row) {
 }
 static void local_cancelled(void* ctx, long index) { fmb_journal_cancelled(((Local*)ctx)->sw, index); }
 
-int fmb_sweep_serve(fmbSweep* sw) {
+/* a worker rank's feed: rank 0's tasks (farm.h), rows back to rank 0 */
+static int remote_next(void* ctx, long* index, int* attempt, double* timeout) {
+  fmbFarmTask task;
+  const int got = fmb_farm_inbox_next(ctx, &task);
+  if (got > 0) *index = task.index, *attempt = task.attempt, *timeout = task.timeout_s;
+  return got;
+}
+static void remote_done(void* ctx, const fmbChildResult* res, char* row) {
+  (void)res;
+  fmb_farm_inbox_reply(ctx, row, row ? (int)strlen(row) : 0);
+  free(row);
+}
+static int remote_pump(void* ctx) { return fmb_farm_inbox_pump(ctx); }
+
+int fmb_sweep_serve(fmbSweep* sw, const fmbFarmTransport* t) {
+  if (t && sw->rank == 0) return fmb_sweep_farm(sw, t); /* the journal's keeper: a process per run */
+  if (t) {
+    fmbFarmInbox* q = fmb_farm_inbox_new(t, sw->jobs);
+    if (!q) return FMB_EXIT_BAD_INPUT;
+    const fmbRunFeed feed = {remote_next, remote_done, remote_pump, NULL, q};
+    const int rc = fmb_sweep_serve_feed(sw, &feed);
+    fmb_farm_inbox_free(q);
+    return rc;
+  }
   long n = 0, ninf = 0;
   long* todo = fmb_sweep_todo(sw, &n, &ninf);
   if (!todo) return FMB_EXIT_BAD_INPUT;

@@ -11,7 +11,7 @@
 children_of() { pgrep -f -- "-o $1/series" || true; }
 
 # 1. 20 kills at random moments, then to the end
-SPEC="$SRC/scenes/fourbar.yaml -o $D/k --quiet -j 2 --grid solver.rtol=1e-5:1e-8:30:log --grid bodies.crank.mass=1,2"
+SPEC="$SRC/scenes/fourbar.yaml -o $D/k --quiet -j 2 --runner spawn --grid solver.rtol=1e-5:1e-8:30:log --grid bodies.crank.mass=1,2"
 seed=1
 kills=0
 while [ $kills -lt 20 ]; do
@@ -26,7 +26,7 @@ while [ $kills -lt 20 ]; do
   [ -z "$(children_of "$D/k")" ] || fail "children outlive a kill -9 of the sweep: $(children_of "$D/k")"
   # a sweep that finished before the kill: start it over so that every kill lands mid-sweep
   if [ -f "$D/k/table.csv" ] && [ "$(wc -l < "$D/k/table.csv")" = 61 ]; then
-    mv "$D/k" "$D/k.done.$kills"
+    mv "$D/k" "$D/k.done.$seed"
     echo "the sweep finished before kill $kills" >> "$D/k.err"
   fi
 done

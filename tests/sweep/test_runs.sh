@@ -14,7 +14,7 @@
 SCENE=$SRC/scenes/fourbar.yaml
 
 # 1. bit for bit against runs typed by hand
-"$F" sweep "$SCENE" -o "$D/s1" -j 2 --quiet --keep series --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
+"$F" sweep "$SCENE" -o "$D/s1" -j 2 --quiet --runner spawn --keep series --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
   --grid bodies.crank.mass=1,2 --metric crank.theta:max,end --metric motor.power:min,rms,max 2> "$D/s1.err" ||
   { cat "$D/s1.err"; fail "sweep s1 failed"; }
 [ "$(tail -n +2 "$D/s1/table.csv" | wc -l)" = 4 ] || fail "s1: expected 4 rows"
@@ -51,6 +51,11 @@ done
   --grid bodies.crank.mass=1,2 --metric crank.theta:max,end --metric motor.power:min,rms,max 2> /dev/null || fail "s1j1"
 strip() { cut -d, -f1-6,9-18,20- "$1"; }
 strip "$D/s1/table.csv" | cmp -s - "$(strip "$D/s1j1/table.csv" > "$D/t1"; echo "$D/t1")" || fail "-j 1 and -j 2 tables differ"
+# ... and s1j1 ran on the default runner (auto: persistent runners), s1 a process per run: the kept
+# series are the same bytes, so the default is bit for bit the direct runs too
+for f in "$D"/s1/series/*.csv; do
+  cmp -s "$f" "$D/s1j1/series/$(basename "$f")" || fail "default runner: series $(basename "$f") differs from the spawned run"
+done
 
 # --runner serve (persistent runners): the same table but timings
 "$F" sweep "$SCENE" -o "$D/s1serve" -j 2 --quiet --runner serve --set solver.t_end=1 --grid solver.rtol=1e-6,1e-8 \
