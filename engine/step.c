@@ -340,7 +340,8 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   }
   for (;;) {
     double tret = d->t, h = 0.0;
-    char why[1200] = "";
+    char why[1200]; /* not "= """: that zeroes all 1,200 bytes every advance (every output row) */
+    why[0] = '\0';
     const int flag = d->ops->advance(d->integ, t_out, &tret, d->y, d->yp, &h, why, sizeof why);
     d->t = tret;
     if (flag == FMB_ADVANCE_INTERRUPTED || (flag != FMB_ADVANCE_OK && fmb_stop_requested(d->stop)))
