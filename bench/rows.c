@@ -50,7 +50,7 @@ static double one_run(const fmbModel* m, int way, const char* out, long* steps, 
   if (!d) return -1.0;
   d->quiet = 1;
 #ifndef FMB_ROWS_BEFORE_UNTIMED /* defined to build this against a tree older than fmbData.untimed */
-  d->untimed = 1; /* as fmb_run: no CPU clock read per advance */
+  d->untimed = 1;               /* as fmb_run: no CPU clock read per advance */
 #endif
   fmbCsv* csv = way == WAY_CSV ? fmb_csv_open(out, &diag) : NULL;
   int rc = fmb_init(m, d, &diag);
