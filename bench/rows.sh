@@ -5,7 +5,7 @@
 # CSV writer), repeats interleaved, medians (bench/rows.c says how). The step counts of the three
 # must be equal (the outputs only read the state): the program fails otherwise.
 #
-#   bash bench/rows.sh [--reps N]        (default 9; ~10 s)
+#   bash bench/rows.sh [REPS]        (default 9; ~3 s)
 #
 # Cases: the w15 spin-up as shipped (2,001 rows, 10 outputs) and with a tenth of the rows
 # (output_step 0.1), the w4 spin-up as shipped, the flexible pendulum's first second (its own
@@ -13,19 +13,13 @@
 #   scene,rows,columns,steps,cpu_none_s,cpu_values_s,cpu_csv_s,rows_s,rows_share
 # (columns counts t; rows_s = cpu_csv_s - cpu_none_s, rows_share = rows_s / cpu_csv_s).
 set -euo pipefail
+REPS=${1:-9}
+case $REPS in
+  -h | --help) sed -n 2,16p "$0"; exit 0 ;;
+  *[!0-9]* | '' | 0) echo "rows.sh: expected a number of repeats, got '$REPS'" >&2; exit 2 ;;
+esac
 cd "$(dirname "$0")/.."
-ROOT=$PWD
-B=${BUILD_DIR:-build}
-RES=${RESULTS:-$ROOT/bench/results}
-REPS=9
-while [ $# -gt 0 ]; do
-  case $1 in
-    --reps) REPS=$2; shift ;;
-    -h|--help) sed -n 2,16p "$0"; exit 0 ;;
-    *) echo "rows.sh: unknown argument '$1'" >&2; exit 2 ;;
-  esac
-  shift
-done
+B=${BUILD_DIR:-build} RES=${RESULTS:-$PWD/bench/results}
 mkdir -p "$RES"
 cmake --build "$B" --target bench_rows >/dev/null
 OUT=$RES/rows.csv
