@@ -1204,8 +1204,6 @@ static int beam_marker(const void* self, const double* q, const double local[2],
 /* ---------------------------------------------------------------------------------------------
  * Energy: each model's own kinetic energy, strain energy 1/2 p^T K p, gravity -int rho g.r.
  * ------------------------------------------------------------------------------------------- */
-/* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
-   momentum about the frame origin for the complete model) in one pass */
 /* two doubles, one per lane (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on arm64) */
 typedef double dbl2 __attribute__((vector_size(2 * sizeof(double))));
 static inline dbl2 splat(double a) { return (dbl2){a, a}; }
@@ -1214,6 +1212,9 @@ static inline dbl2 dot4v(const dbl2 n[4], const double d[4]) {
   return n[0] * splat(d[0]) + n[1] * splat(d[1]) + n[2] * splat(d[2]) + n[3] * splat(d[3]);
 }
 
+/* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
+   momentum about the frame origin for the complete model) in one pass; with the coupling integrals
+   over the whole beam (coupled models) */
 static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                            double* ptheta, double coupling_total[2]) {
   const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
