@@ -3,7 +3,7 @@
 # default against the landed builds' best settings, side by side in one run (docs/performance.md,
 # "Where it is hardest").
 #
-#   bash bench/hardest.sh [--reps N]
+#   bash bench/hardest.sh [--reps N] [--case spinup|pendulum|all]   (default all; spinup: ~1 min)
 #
 # - The flexible pendulum (scenes/paper/pendulum.yaml, 16 elements, complete, 5 s): tip error
 #   1e-5 m. cf8540e (OLD_PEND, built beside the tree as bench/integrators.sh builds 0a88803) runs
@@ -19,7 +19,7 @@
 # measured setting whose error meets the target (no interpolation), and the ratio of the old
 # build's to this tree's. References: this tree's radau5 at rtol 1e-11, atol 1e-14 (the pendulum:
 # 8e-8 m from rtol 1e-12, atol 1e-15) and IDA at rtol 1e-12 (the spin-up: 3e-9 m from 1e-13 over
-# 5 s). Results: bench/results/hardest.csv.
+# 5 s). Results: bench/results/hardest.csv (--case X: hardest_X.csv).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -28,29 +28,34 @@ RES=${RESULTS:-$ROOT/bench/results}
 WORK=$(mktemp -d /tmp/flexmbd-hardest.XXXXXX)
 trap 'rm -rf "$WORK"' EXIT
 REPS=3
+CASE=all
 OLD_PEND=${OLD_PEND:-cf8540e}
 OLD_SPIN=${OLD_SPIN:-0a88803}
 while [ $# -gt 0 ]; do
   case $1 in
     --reps) REPS=$2; shift ;;
+    --case) CASE=$2; shift ;;
     -h|--help) sed -n 2,24p "$0"; exit 0 ;;
     *) echo "hardest.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
   shift
 done
+case $CASE in all | spinup | pendulum) ;; *) echo "hardest.sh: --case spinup, pendulum or all, not '$CASE'" >&2; exit 2 ;; esac
+want() { [ "$CASE" = all ] || [ "$CASE" = "$1" ]; }
 mkdir -p "$RES"
 . "$ROOT/bench/lib.sh" # median, stat_field, build_landed
-build_landed "$OLD_PEND" "/tmp/fmb-$OLD_PEND"
-build_landed "$OLD_SPIN" "/tmp/fmb-$OLD_SPIN"
+want pendulum && build_landed "$OLD_PEND" "/tmp/fmb-$OLD_PEND"
+want spinup && build_landed "$OLD_SPIN" "/tmp/fmb-$OLD_SPIN"
 
 PEND=scenes/paper/pendulum.yaml SPIN=scenes/paper/spinup_w15.yaml
-"$F" run "$PEND" -o "$WORK/pend_ref.csv" --quiet --set solver.integrator=radau5 --set solver.rtol=1e-11 --set solver.atol=1e-14
-"$F" run "$SPIN" -o "$WORK/spin_ref.csv" --quiet --set solver.integrator=ida --set solver.rtol=1e-12 --set solver.atol=auto
+want pendulum && "$F" run "$PEND" -o "$WORK/pend_ref.csv" --quiet --set solver.integrator=radau5 --set solver.rtol=1e-11 --set solver.atol=1e-14
+want spinup && "$F" run "$SPIN" -o "$WORK/spin_ref.csv" --quiet --set solver.integrator=ida --set solver.rtol=1e-12 --set solver.atol=auto
 
 # settings: case|build|label|arguments (the old builds run from their own tree, on their own copy of the scene)
 SETTINGS=$WORK/settings
 : > "$SETTINGS"
 for r in 1e-7 1e-8 1e-9; do
+  want pendulum || break
   echo "pendulum|new|default rtol $r|--set solver.rtol=$r" >> "$SETTINGS"
   for integ in radau5 ida; do
     [ "$integ" = ida ] && [ "$r" != 1e-7 ] && continue # IDA: > 3 s at 1e-8 for 6e-5 m (docs/performance.md)
@@ -60,10 +65,11 @@ for r in 1e-7 1e-8 1e-9; do
   done
 done
 # this tree's radau9 (order 9, solver.integrator: radau9), the pendulum's rtol where it crosses 1e-5 m
-for r in 1e-6 3e-7 1e-7; do echo "pendulum|new|radau9 rtol $r|--set solver.integrator=radau9 --set solver.rtol=$r" >> "$SETTINGS"; done
-for r in 1e-4 1e-5 1e-6 1e-7; do echo "spinup|new|default rtol $r|--set solver.rtol=$r" >> "$SETTINGS"; done
-for r in 1e-5 3e-6 1e-6; do echo "spinup|new|radau9 rtol $r|--set solver.integrator=radau9 --set solver.rtol=$r" >> "$SETTINGS"; done
+for r in 1e-6 3e-7 1e-7; do want pendulum && echo "pendulum|new|radau9 rtol $r|--set solver.integrator=radau9 --set solver.rtol=$r" >> "$SETTINGS"; done
+for r in 1e-4 1e-5 1e-6 1e-7; do want spinup && echo "spinup|new|default rtol $r|--set solver.rtol=$r" >> "$SETTINGS"; done
+for r in 1e-5 3e-6 1e-6; do want spinup && echo "spinup|new|radau9 rtol $r|--set solver.integrator=radau9 --set solver.rtol=$r" >> "$SETTINGS"; done
 for r in 1e-7 1e-8 1e-9 1e-10; do
+  want spinup || break
   for ec in full positions; do
     echo "spinup|$OLD_SPIN|ida $ec rtol $r atol rtol/100|--set solver.error_control=$ec --set solver.rtol=$r --set solver.atol=$(awk -v r=$r 'BEGIN { printf "%g", r / 100 }')" >> "$SETTINGS"
   done
@@ -93,6 +99,7 @@ for rep in $(seq "$REPS"); do
 done
 
 OUT=$RES/hardest.csv
+[ "$CASE" = all ] || OUT=$RES/hardest_$CASE.csv
 echo "case,build,setting,cpu_s_median,steps,tip_error_m" > "$OUT"
 n=0
 while IFS='|' read -r c b label args; do

@@ -256,12 +256,15 @@ static void beam_destroy(void* self) { free(self); }
 
 static int beam_ncoord(const void* self) { return 3 + ((const Beam*)self)->n; }
 
-/* residual_serial's F and csum (5 ne), one residual for beam_aux_initial (3 + 3 ne), and the dense
-   Jacobian's scratch (jacobian_nwork; also when banded: the engine may ask for the dense M) */
+/* residual_serial's F and csum (5 ne), one residual for beam_aux_initial (3 + 3 ne), the dense
+   Jacobian's scratch (jacobian_nwork; also when banded: the engine may ask for the dense M), then
+   the outputs' cache (output_cache) */
 static size_t jacobian_nwork(const Beam* b);
+static size_t output_cache_at(const Beam* b) { return (size_t)9 * (size_t)b->ne + 3 + jacobian_nwork(b); }
+static size_t output_cache_nwork(const Beam* b);
 static size_t beam_nwork(const void* self) {
   const Beam* b = self;
-  return (size_t)9 * (size_t)b->ne + 3 + jacobian_nwork(b);
+  return output_cache_at(b) + output_cache_nwork(b);
 }
 
 static void beam_initial(const void* self, double* q0, double* v0) {
@@ -1201,10 +1204,19 @@ static int beam_marker(const void* self, const double* q, const double local[2],
 /* ---------------------------------------------------------------------------------------------
  * Energy: each model's own kinetic energy, strain energy 1/2 p^T K p, gravity -int rho g.r.
  * ------------------------------------------------------------------------------------------- */
+/* two doubles, one per lane (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on arm64) */
+typedef double dbl2 __attribute__((vector_size(2 * sizeof(double))));
+static inline dbl2 splat(double a) { return (dbl2){a, a}; }
+/* dot4(n, d) in each lane, in dot4's order */
+static inline dbl2 dot4v(const dbl2 n[4], const double d[4]) {
+  return n[0] * splat(d[0]) + n[1] * splat(d[1]) + n[2] * splat(d[2]) + n[3] * splat(d[3]);
+}
+
 /* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
-   momentum about the frame origin for the complete model) in one pass */
+   momentum about the frame origin for the complete model) in one pass; with the coupling integrals
+   over the whole beam (coupled models) */
 static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
-                           double* ptheta) {
+                           double* ptheta, double coupling_total[2]) {
   const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
   const double le = b->le;
   const double* p = q + 3;
@@ -1228,49 +1240,70 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
       double cp[3], cv[3];
       slope_products(b, d, dd, cp, cv, pp, pv5);
     }
-    for (int g = 0; g < ng; ++g) {
-      double xi = b->xg[g], x = e * le + xi * le;
-      const double* ns = b->ns_out[g];
-      const double* nd = b->nd_out[g];
-      double n1[2] = {1.0 - xi, xi};
-      double w1 = n1[0] * ua[0] + n1[1] * ua[1], w2 = dot4(ns, d), w2s = dot4(nd, d);
-      double w1d = n1[0] * uda[0] + n1[1] * uda[1], w2d = dot4(ns, dd), w2sd = dot4(nd, dd);
-      double wc = 0.0, wcd = 0.0;
+    /* two quadrature points at a time, one in each lane of a vector (lane 1 repeats the last point
+       when ng is odd, and is then not summed): the same operations in the same order per point as
+       one at a time, so bit for bit the same sums, in about half the instructions (this pass was
+       the largest part of the rows' cost, docs/performance.md "Row output") */
+    for (int g = 0; g < ng; g += 2) {
+      const int g1 = g + 1 < ng ? g + 1 : g;
+      const dbl2 xi = {b->xg[g], b->xg[g1]}, x = splat(e * le) + xi * splat(le);
+      dbl2 ns[4], nd[4];
+      for (int j = 0; j < 4; ++j) {
+        ns[j] = (dbl2){b->ns_out[g][j], b->ns_out[g1][j]};
+        nd[j] = (dbl2){b->nd_out[g][j], b->nd_out[g1][j]};
+      }
+      const dbl2 n1[2] = {splat(1.0) - xi, xi};
+      const dbl2 w1 = n1[0] * splat(ua[0]) + n1[1] * splat(ua[1]), w2 = dot4v(ns, d), w2s = dot4v(nd, d);
+      const dbl2 w1d = n1[0] * splat(uda[0]) + n1[1] * splat(uda[1]), w2d = dot4v(ns, dd), w2sd = dot4v(nd, dd);
+      dbl2 wc = splat(0.0), wcd = splat(0.0);
       if (coupled) {
-        wc = -0.5 * (Ipp + dot5(pp, b->pw_out[g]));
-        wcd = -(Ipv + dot5(pv5, b->pw_out[g]));
+        dbl2 pwp = splat(0.0), pwv = splat(0.0); /* dot5 with pw_out, term by term as dot5 adds them */
+        for (int k = 0; k < 5; ++k) {
+          const dbl2 pw = {b->pw_out[g][k], b->pw_out[g1][k]};
+          pwp = k ? pwp + splat(pp[k]) * pw : splat(pp[k]) * pw;
+          pwv = k ? pwv + splat(pv5[k]) * pw : splat(pv5[k]) * pw;
+        }
+        wc = splat(-0.5) * (splat(Ipp) + pwp);
+        wcd = -(splat(Ipv) + pwv);
       }
       /* The cross-section pair y = -r, +r (mass m each): every velocity and lever arm below is
          affine in y, X = X0 + y X1, so the pair sums in closed form as in the residual:
          sum m (A + yB).(C + yD) = M2 (A.C + r^2 B.D), M2 = 2m; terms linear in y cancel. */
-      const double M2 = 2.0 * mhalf * b->wg[g], r2 = b->r * b->r;
-      const double vR0[2] = {v0[0], v0[1] + x * om}, vR1[2] = {-om, 0.0};
-      const double vRD0[2] = {vR0[0] - w2 * om + w1d, vR0[1] + w1 * om + w2d};
-      const double vRD1[2] = {vR1[0] - w2sd, -w2s * om};
-      const double vC[2] = {wcd, wc * om};
+      const dbl2 M2 = splat(2.0 * mhalf) * (dbl2){b->wg[g], b->wg[g1]}, r2 = splat(b->r * b->r), omv = splat(om);
+      const dbl2 vR0[2] = {splat(v0[0]), splat(v0[1]) + x * omv}, vR1[2] = {splat(-om), splat(0.0)};
+      const dbl2 vRD0[2] = {vR0[0] - w2 * omv + w1d, vR0[1] + w1 * omv + w2d};
+      const dbl2 vRD1[2] = {vR1[0] - w2sd, -w2s * omv};
+      const dbl2 vC[2] = {wcd, wc * omv};
       /* d v / d theta' of the parts: I~(rho0 + u_D) = gRD0 + y gRD1, I~ rho0 = [-y, x] */
-      const double gRD0[2] = {-w2, x + w1}, gRD1[2] = {-1.0, -w2s};
+      const dbl2 gRD0[2] = {-w2, x + w1}, gRD1[2] = {splat(-1.0), -w2s};
+      dbl2 dT, dp;
       switch (model) {
         case BEAM_ZOAC:
-          T += 0.5 * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
-          pth += M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
+          dT = splat(0.5) * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
+          dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
           break;
         case BEAM_FOAC:
-          T += M2 * (0.5 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
-                     vR0[0] * vC[0] + vR0[1] * vC[1]);
-          pth += M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) +
-                       x * vC[1] + wc * vR0[1]);
+          dT = M2 *
+               (splat(0.5) * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
+                vR0[0] * vC[0] + vR0[1] * vC[1]);
+          dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) + x * vC[1] +
+                     wc * vR0[1]);
           break;
         default: {
-          const double vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
-          T += 0.5 * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
-          pth += M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
+          const dbl2 vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
+          dT = splat(0.5) * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
+          dp = M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
           break;
         }
       }
       /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
-      if (grav) Ug -= M2 * (f[0] * (x + w1 + wc) + f[1] * w2);
-      mtot += M2;
+      const dbl2 dUg = grav ? M2 * (splat(f[0]) * (x + w1 + wc) + splat(f[1]) * w2) : splat(0.0);
+      for (int lane = 0; lane < (g1 > g ? 2 : 1); ++lane) { /* in the order of the points */
+        T += dT[lane];
+        pth += dp[lane];
+        if (grav) Ug -= dUg[lane];
+        mtot += M2[lane];
+      }
     }
     if (coupled) {
       Ipp += dot5(pp, b->pw_full);
@@ -1286,12 +1319,92 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   en->gravity = Ug;
   en->spring = 0.0;
   if (ptheta) *ptheta = pth;
+  coupling_total[0] = Ipp; /* int_0^L w2'^2 and int_0^L w2' w2d' (coupled models): the tip's w_c, rate */
+  coupling_total[1] = Ipv;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * The outputs' cache: a row asks several outputs of one state (q, v). The energies and
+ * beam.ang_momentum come from one pass of beam_integrals, and the tip's u, x, y and u rate from
+ * one coupling integral over every element (coupling_at); each was computed once per column
+ * (the w15 spin-up's 2,001 rows: 84 M of its 405 M instructions in beam_integrals, half of them
+ * the second pass for ang_momentum). Kept after the Jacobian's scratch in the body's work,
+ * keyed by the state's bytes: a value comes from the cache only for the very (q, v) it was
+ * computed from, so every output is bit for bit what its own pass gives. The work is calloc'ed
+ * (system.c), so a new one holds no valid entry.
+ * ------------------------------------------------------------------------------------------- */
+enum {
+  CACHE_INTEGRALS, /* 1 when T, Ue, p_theta are the key state's */
+  CACHE_T,
+  CACHE_UE,
+  CACHE_PTHETA,
+  CACHE_GRAVITY, /* 1 when Ug is the key state's, for the gravity in CACHE_G0, CACHE_G1 */
+  CACHE_G0,
+  CACHE_G1,
+  CACHE_UG,
+  CACHE_IPP, /* with CACHE_INTEGRALS: the coupling integrals over the whole beam (beam_integrals) */
+  CACHE_IPV,
+  CACHE_DEFORMATION, /* 1 when the axial u, ud at x = CACHE_X (coupling included) are the key state's */
+  CACHE_X,
+  CACHE_U0,
+  CACHE_UD0,
+  CACHE_KEY /* then q and v (3 + n each) */
+};
+static size_t output_cache_nwork(const Beam* b) { return CACHE_KEY + 2 * (size_t)(3 + b->n); }
+
+/* the cache in work for the state (q, v): its entries dropped when the state is another one;
+   NULL without work (beam_model_range's call) */
+static double* output_cache(const Beam* b, const double* q, const double* v, double* work) {
+  if (!work) return NULL;
+  double* cache = work + output_cache_at(b);
+  const size_t nc = (size_t)(3 + b->n), bytes = sizeof(double) * nc;
+  double* key = cache + CACHE_KEY;
+  if (memcmp(key, q, bytes) != 0 || memcmp(key + nc, v, bytes) != 0) {
+    memcpy(key, q, bytes);
+    memcpy(key + nc, v, bytes);
+    cache[CACHE_INTEGRALS] = cache[CACHE_GRAVITY] = cache[CACHE_DEFORMATION] = 0.0;
+  }
+  return cache;
+}
+
+/* beam_integrals through the cache: T, Ue and p_theta do not depend on gravity, Ug does (env NULL:
+   no gravity, Ug = 0) */
+static void integrals_cached(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                             double* ptheta, double* work) {
+  double* cache = output_cache(b, q, v, work);
+  const int grav = env && env->has_gravity;
+  const double g0 = grav ? env->gravity[0] : 0.0, g1 = grav ? env->gravity[1] : 0.0;
+  if (cache && cache[CACHE_INTEGRALS] == 1.0 &&
+      (!en || (cache[CACHE_GRAVITY] == 1.0 && cache[CACHE_G0] == g0 && cache[CACHE_G1] == g1))) {
+    if (en) {
+      en->kinetic = cache[CACHE_T];
+      en->strain = cache[CACHE_UE];
+      en->gravity = cache[CACHE_UG];
+      en->spring = 0.0;
+    }
+    if (ptheta) *ptheta = cache[CACHE_PTHETA];
+    return;
+  }
+  fmbEnergy local;
+  double pth, coupling_total[2];
+  if (!en) en = &local;
+  beam_integrals(b, grav ? env : NULL, q, v, en, &pth, coupling_total);
+  if (ptheta) *ptheta = pth;
+  if (!cache) return;
+  cache[CACHE_INTEGRALS] = cache[CACHE_GRAVITY] = 1.0;
+  cache[CACHE_T] = en->kinetic;
+  cache[CACHE_UE] = en->strain;
+  cache[CACHE_PTHETA] = pth;
+  cache[CACHE_G0] = g0;
+  cache[CACHE_G1] = g1;
+  cache[CACHE_UG] = en->gravity;
+  cache[CACHE_IPP] = coupling_total[0];
+  cache[CACHE_IPV] = coupling_total[1];
 }
 
 static void beam_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                         double* work) {
-  (void)work;
-  beam_integrals(self, env, q, v, en, NULL);
+  integrals_cached(self, env, q, v, en, NULL, work);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -1314,8 +1427,12 @@ static int beam_output_lookup(const void* self, const char* quantity) {
   return fmb_beam_output_lookup(((const Beam*)self)->ne, quantity);
 }
 
-/* axial (with w_c in coupled models) and transverse deformation at reference (x, 0), rates */
-static void deformation_at(const Beam* b, const double* p, const double* pd, double x, double u[2], double ud[2]) {
+/* axial (with w_c in coupled models, when `axial`) and transverse deformation at reference (x, 0),
+   rates. The transverse ones need no coupling integral (beam.tip_v, and beam_model_range's check
+   after every advance); the axial ones come through the cache (work, may be NULL). */
+static void deformation_at(const Beam* b, const double* q, const double* v, double x, int axial, double u[2],
+                           double ud[2], double* work) {
+  const double *p = q + 3, *pd = v + 3;
   int e;
   double xi, ua[2], d[4], uda[2], dd[4], ns[4];
   locate(b, x, &e, &xi);
@@ -1326,11 +1443,30 @@ static void deformation_at(const Beam* b, const double* p, const double* pd, dou
   u[1] = dot4(ns, d);
   ud[0] = (1.0 - xi) * uda[0] + xi * uda[1];
   ud[1] = dot4(ns, dd);
-  if (b->model != BEAM_ZOAC && x > 0.0) {
+  if (axial && b->model != BEAM_ZOAC && x > 0.0) {
+    double* cache = output_cache(b, q, v, work);
+    if (cache && cache[CACHE_DEFORMATION] == 1.0 && cache[CACHE_X] == x) {
+      u[0] = cache[CACHE_U0];
+      ud[0] = cache[CACHE_UD0];
+      return;
+    }
     double wc, wcd;
-    coupling_at(b, p, pd, e, xi, &wc, &wcd);
+    if (cache && cache[CACHE_INTEGRALS] == 1.0 && e == b->ne - 1 && xi == 1.0) {
+      /* the tip: coupling_at's sums over every element with the whole element's weights, which
+         the energy pass of this state has made in the same order (bit for bit) */
+      wc = -0.5 * cache[CACHE_IPP];
+      wcd = -cache[CACHE_IPV];
+    } else {
+      coupling_at(b, p, pd, e, xi, &wc, &wcd);
+    }
     u[0] += wc;
     ud[0] += wcd;
+    if (cache) {
+      cache[CACHE_DEFORMATION] = 1.0;
+      cache[CACHE_X] = x;
+      cache[CACHE_U0] = u[0];
+      cache[CACHE_UD0] = ud[0];
+    }
   }
 }
 
@@ -1346,8 +1482,7 @@ static int beam_output(const void* self, int id, const double* q, const double* 
   } else if (id < 0 || id >= OUT_NTIP) {
     return -1;
   } else if (id == OUT_ANG_MOMENTUM) {
-    fmbEnergy en;
-    beam_integrals(b, NULL, q, v, &en, value);
+    integrals_cached(b, NULL, q, v, NULL, value, work);
     return 0;
   } else if (id == OUT_TIP_ANGLE) {
     const double tip[2] = {b->L, 0.0};
@@ -1357,15 +1492,14 @@ static int beam_output(const void* self, int id, const double* q, const double* 
     return 0;
   }
   double u[2], ud[2];
-  deformation_at(b, q + 3, v + 3, x, u, ud);
-  double c = cos(q[2]), s = sin(q[2]);
+  deformation_at(b, q, v, x, comp != OUT_TIP_V && comp != OUT_TIP_V_RATE, u, ud, work);
   switch (comp) {
     case OUT_TIP_U: *value = u[0]; break;
     case OUT_TIP_V: *value = u[1]; break;
     case OUT_TIP_U_RATE: *value = ud[0]; break;
     case OUT_TIP_V_RATE: *value = ud[1]; break;
-    case OUT_TIP_X: *value = q[0] + c * (x + u[0]) - s * u[1]; break;
-    default: *value = q[1] + s * (x + u[0]) + c * u[1]; break;
+    case OUT_TIP_X: *value = q[0] + cos(q[2]) * (x + u[0]) - sin(q[2]) * u[1]; break; /* the frame's angle only here */
+    default: *value = q[1] + sin(q[2]) * (x + u[0]) + cos(q[2]) * u[1]; break;
   }
   return 0;
 }

@@ -45,6 +45,8 @@ struct fmbData {
   int interrupted;
   int failed;   /* the last init or advance failed (fmb_data_stats' status) */
   double cpu_s; /* CPU time of this thread in init and advance */
+  int untimed;  /* fmb_run's: it times the whole run itself, so init and advance read no CPU clock
+                   (two system calls an output row, ~5 % of the w15 spin-up) */
 };
 
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */

@@ -393,6 +393,8 @@ int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const d
 /* a body out of its model's range (fmbBodyType.model_range) named through fmb_warn, once: warned
    has nbody entries, 1 once a body was named */
 void fmb_warn_model_range(const fmbModel* m, fmbWorkspace* w, double t, const double* y, unsigned char* warned);
+/* the rows gathered so far to the file (a temporary one gathers them); 0, or -1 a write failed */
+int fmb_csv_flush(fmbCsv* c);
 /* puts a file with a header in place (rename), removes one without; -1 with errno on failure */
 int fmb_csv_close(fmbCsv* c);
 /* tables other than the scene's outputs (modes, Campbell): named columns, rows of values */

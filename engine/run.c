@@ -115,6 +115,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
     return diag->code ? diag->code : FMB_EXIT_SOLVER;
   }
   d->quiet = quiet;
+  d->untimed = 1; /* st->cpu_s is the whole run's, read here at the start and the end */
   fmb_data_watch(d, stop);
   Progress progress = {opt && opt->progress && !quiet, isatty(fileno(stderr)), opt ? opt->progress_after_s : 0.0,
                        wall_seconds(), 0.0};
@@ -161,6 +162,10 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   }
 
 done:
+  if (fmb_csv_flush(csv) && !rc) { /* the last rows gathered (output.c): a failure says so like any row's */
+    row_failed(m, d, -1, diag);
+    rc = FMB_EXIT_SOLVER;
+  }
   if (rc == FMB_EXIT_INTERRUPTED || (fmb_stop_requested(stop) && !rc)) {
     rc = FMB_EXIT_INTERRUPTED;
     memset(diag, 0, sizeof *diag);

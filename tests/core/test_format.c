@@ -3,7 +3,8 @@
  * 1e40 (random 53-bit mantissas, both signs), every power of ten and its neighbours (one ulp either
  * side), numbers at and next to the halfway points of the 12th digit (where one rounding decides),
  * the switch between fixed and exponential notation (1e-5, 1e-4, 1e11, 1e12 and 9.999...e11
- * rounding up), integers, zero of both signs, infinities and NaN. Any byte different fails. */
+ * rounding up), exact ties of the 12th digit, integers, zero of both signs, infinities and NaN. Any
+ * byte different fails. */
 #include <float.h>
 #include <stdint.h>
 #include <string.h>
@@ -49,6 +50,20 @@ int main(void) {
     const int e = (int)(next() % 40) - 20;
     const double v = ((double)base + 0.5) * pow(10.0, e - 11);
     one(v);
+    one(nextafter(v, 0.0));
+    one(nextafter(v, INFINITY));
+  }
+  /* exact ties of the 12th digit: |v| 10^k = N + 1/2 exactly with N of 12 digits, i.e.
+     v = m / 2^(k+1) with m = (2N + 1) / 5^k odd (printf rounds them to even) */
+  for (long i = 0; i < 200000; ++i) {
+    const int k = 1 + (int)(next() % 15);
+    long long p5 = 1;
+    for (int j = 0; j < k; ++j) p5 *= 5;
+    const long long lo = 200000000000LL / p5 + 1, hi = 2000000000000LL / p5;
+    const long long m = (lo + (long long)(next() % (unsigned long long)(hi - lo))) | 1;
+    const double v = ldexp((double)m, -(k + 1));
+    one(v);
+    one(-v);
     one(nextafter(v, 0.0));
     one(nextafter(v, INFINITY));
   }
