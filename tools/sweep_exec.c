@@ -299,7 +299,8 @@ void fmb_sweep_progress(fmbSweep* sw, int final) {
 }
 
 long* fmb_sweep_todo(fmbSweep* sw, long* n, long* n_inflight) {
-  long* todo = malloc((size_t)(sw->nrun + 1) * sizeof *todo);
+  /* FMB_TEST_SWEEP_NO_MEMORY: this allocation fails (test_mpi: the other ranks must not wait on rank 0) */
+  long* todo = getenv("FMB_TEST_SWEEP_NO_MEMORY") ? NULL : malloc((size_t)(sw->nrun + 1) * sizeof *todo);
   long k = 0;
   if (!todo) return NULL;
   for (int pass = 0; pass < 2; ++pass)
@@ -420,11 +421,11 @@ int fmb_sweep_farm(fmbSweep* sw, const fmbFarmTransport* t) {
   long* todo = NULL;
   int rc = 0;
   if (sw->rank == 0) {
-    if (!(todo = fmb_sweep_todo(sw, &n, &ninf))) return FMB_EXIT_BAD_INPUT;
+    if (!(todo = fmb_sweep_todo(sw, &n, &ninf))) rc = FMB_EXIT_BAD_INPUT, n = ninf = 0;
     sw->total_todo = sw->done + n;
-    rc = fmb_sweep_rerun_inflight(sw, todo, ninf); /* alone, before anything else runs */
+    if (!rc) rc = fmb_sweep_rerun_inflight(sw, todo, ninf); /* alone, before anything else runs */
   }
-  Feed feed = {sw, todo, ninf, n};
+  Feed feed = {sw, todo, ninf, rc ? ninf : n};
   const fmbFarm farm = {.jobs = sw->jobs,
                         .stop = sw->stop,
                         .ctx = &feed,
@@ -434,7 +435,10 @@ int fmb_sweep_farm(fmbSweep* sw, const fmbFarmTransport* t) {
                         .take = feed_take,
                         .tick = feed_tick,
                         .cancelled = feed_cancelled};
-  if (!rc) rc = fmb_farm_run(&farm, t);
+  /* after a failure above, rank 0 still runs the farm under MPI, with nothing to hand out: the
+     other ranks, waiting for their first task, are told to stop instead of waiting forever */
+  const int farm_rc = !rc || (t && t->nranks > 1) ? fmb_farm_run(&farm, t) : 0;
+  if (!rc) rc = farm_rc;
   free(todo);
   return rc == FMB_EXIT_SOLVER ? FMB_EXIT_BAD_INPUT : rc; /* out of memory: as before */
 }

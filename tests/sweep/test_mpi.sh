@@ -3,7 +3,9 @@
 #  1. rank-count independence: a random design run with -np 1, 2 and 4 (oversubscribed) and
 #     different -j gives the same table sorted by index, but timings (wall_s, rank, cpu_s), and
 #     rows from more than one rank; so do worker ranks with persistent runners (--runner serve);
-#  2. SIGTERM to mpirun while every rank's children hang: no child is left running.
+#  2. SIGTERM to mpirun while every rank's children hang: no child is left running;
+#  3. rank 0 failing before it hands anything out (no memory for its list, injected): every rank
+#     ends, with a non-zero exit, instead of the workers waiting forever.
 #   usage: test_mpi.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN MPIRUN
 . "$(dirname "$0")/lib.sh"
 MPIRUN=$5
@@ -49,4 +51,11 @@ wait $pid || true
 sleep 1
 left=$(pgrep -f -- "-o $D/term/series" || true)
 [ -z "$left" ] || { ps -o pid,ppid,pgid,args -p "$(echo $left | tr ' ' ',')"; fail "children left running after SIGTERM to mpirun"; }
+
+# 3. rank 0 cannot make its list of runs: the job ends (timeout 60 s: a hang fails the test)
+# shellcheck disable=SC2086
+rc=0
+timeout 60 $MPI -np 3 -x FMB_TEST_SWEEP_NO_MEMORY=1 "$F" sweep $SPEC -o "$D/nomem" -j 1 > "$D/nomem.out" 2>&1 || rc=$?
+[ "$rc" != 124 ] || { cat "$D/nomem.out"; fail "rank 0 failed early and the job hung"; }
+[ "$rc" != 0 ] || fail "rank 0 failed early and the job exited 0"
 echo "test_mpi: ok"
