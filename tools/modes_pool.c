@@ -36,9 +36,15 @@ typedef struct {
 
 static void file_of(const Farm* f, long index, char* path, size_t len) { snprintf(path, len, "%s/%ld", f->dir, index); }
 
+/* through the one safe writer (engine/safe_file.c): a temporary file beside PATH, renamed into place
+   only when whole, so a reader never takes a half-written result and no file is overwritten early */
 int fmb_cli_modes_save(const char* path, int rc, const fmbDiag* diag, const fmbModes* m) {
-  FILE* f = fopen(path, "wb");
-  if (!f) return -1;
+  fmbSafeFile* sf = fmb_safe_open(path, NULL, 0);
+  FILE* f = sf ? fmb_safe_stream(sf) : NULL;
+  if (!f) {
+    if (sf) fmb_safe_close(sf, 0);
+    return -1;
+  }
   int ok = fwrite(&rc, sizeof rc, 1, f) == 1 && fwrite(diag, sizeof *diag, 1, f) == 1;
   if (ok && rc == 0) {
     const size_t n = (size_t)m->count, nq = (size_t)m->nq;
@@ -47,8 +53,8 @@ int fmb_cli_modes_save(const char* path, int rc, const fmbDiag* diag, const fmbM
          fwrite(m->shape_re, sizeof(double), n * nq, f) == n * nq &&
          fwrite(m->shape_im, sizeof(double), n * nq, f) == n * nq;
   }
-  ok = fclose(f) == 0 && ok;
-  return ok ? 0 : -1;
+  ok = fflush(f) == 0 && ok;
+  return fmb_safe_close(sf, ok) == 0 && ok ? 0 : -1;
 }
 
 /* the modes a child wrote (malloc'd as fmb_modes_free frees them), or NULL with *rc and *diag */
