@@ -40,37 +40,47 @@ int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int
      reaches 8e-11 rad at rtol 1e-10 where radau5 stays at 4e-8 (its output rows between large
      steps come from the order-3 collocation polynomial).
    - linear_solver: dense is IDA's only (radau5's complex system), so it keeps IDA. */
-static const fmbIntegratorOps* auto_integrator(const fmbModel* m) {
-  if (m->solver.linear_solver == FMB_LS_DENSE) return &fmb_integrator_ida;
-  return m->bdf_order_cap < 5 ? &fmb_integrator_radau5 : &fmb_integrator_ida;
+static const fmbIntegratorOps* auto_integrator(const fmbModel* m, const char** why) {
+  if (m->solver.linear_solver == FMB_LS_DENSE) {
+    *why = "integrator auto: linear_solver dense is IDA's only";
+    return &fmb_integrator_ida;
+  }
+  if (m->bdf_order_cap < 5) {
+    *why = "integrator auto: a body caps the BDF order below 5 (undamped structural modes); Radau IIA is L-stable "
+           "at order 5";
+    return &fmb_integrator_radau5;
+  }
+  *why = "integrator auto: rigid bodies, BDF up to order 5";
+  return &fmb_integrator_ida;
+}
+
+/* the backend a run starts on, and in words why (fmb_describe_solver: `flexmbd check`) */
+static const fmbIntegratorOps* choose(const fmbModel* m, const char** why) {
+  if (m->solver.formulation == FMB_FORM_PROJECTED) {
+    *why = "formulation: projected";
+    return projected_backend();
+  }
+  if (m->solver.formulation == FMB_FORM_AUTO && fmb_needs_singular_method(m)) {
+    *why = "formulation auto: the walk along the constraint manifold finds a singular position; runs at rtol/300";
+    return projected_backend();
+  }
+  /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
+  if (m->solver.integrator) {
+    *why = "solver.integrator names it";
+    return m->solver.integrator;
+  }
+  return auto_integrator(m, why);
 }
 
 const fmbIntegratorOps* fmb_integrator_for(const fmbModel* m) {
-  if (m->solver.formulation == FMB_FORM_PROJECTED ||
-      (m->solver.formulation == FMB_FORM_AUTO && fmb_needs_singular_method(m)))
-    return projected_backend();
-  /* ggl and auto start on a GGL backend; auto leaves it at a singular configuration (fmb_run) */
-  return m->solver.integrator ? m->solver.integrator : auto_integrator(m);
+  const char* why;
+  return choose(m, &why);
 }
 
 void fmb_describe_solver(const fmbModel* m, FILE* f) {
   if (!m || !f) return;
-  const fmbIntegratorOps* ops = fmb_integrator_for(m);
   const char* why;
-  if (ops->projected)
-    why = m->solver.formulation == FMB_FORM_PROJECTED
-              ? "formulation: projected"
-              : "formulation auto: the walk along the constraint manifold finds a singular position; "
-                "runs at rtol/300";
-  else if (m->solver.integrator)
-    why = "solver.integrator names it";
-  else if (m->solver.linear_solver == FMB_LS_DENSE)
-    why = "integrator auto: linear_solver dense is IDA's only";
-  else if (m->bdf_order_cap < 5)
-    why = "integrator auto: a body caps the BDF order below 5 (undamped structural modes); Radau IIA is L-stable "
-          "at order 5";
-  else
-    why = "integrator auto: rigid bodies, BDF up to order 5";
+  const fmbIntegratorOps* ops = choose(m, &why);
   fprintf(f, "solver: %s%s (%s)%s\n", ops->name, ops->projected ? " formulation, CVODE with projections" : "", why,
           !ops->projected && m->solver.formulation == FMB_FORM_AUTO && m->nc > 0
               ? "; formulation auto: GGL, the projected one from where a singular position stops it"
