@@ -10,13 +10,12 @@
 
 #define FMB_CLI_MAX_OVERRIDES 256
 
-/* what a result records as the build that made it (CMakeLists.txt defines both for the files
-   that write them: regression references, sweep run ids, sweep.h5, `flexmbd --version`) */
+/* what a result records as the build that made it (CMakeLists.txt defines the version for the
+   files that write it: regression references, sweep run ids, sweep.h5, `flexmbd --version`; the
+   commit comes from the header written at every build, generated/flexmbd_commit.h, which those
+   that need it include) */
 #ifndef FLEXMBD_VERSION
 #define FLEXMBD_VERSION "unknown"
-#endif
-#ifndef FLEXMBD_COMMIT
-#define FLEXMBD_COMMIT "unknown"
 #endif
 
 /* a scene and its --set overrides, as `run`, `check` and the analysis commands take them */

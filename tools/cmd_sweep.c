@@ -22,6 +22,7 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "flexmbd_commit.h" /* generated at build time: FLEXMBD_COMMIT */
 #include "sweep.h"
 
 #define YES_LIMIT 1e6 /* a larger plan needs --yes */

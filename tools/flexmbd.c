@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "cli.h"
+#include "flexmbd_commit.h" /* generated at build time: FLEXMBD_COMMIT */
 
 typedef struct {
   const char* name;

@@ -12,6 +12,7 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#include "flexmbd_commit.h" /* generated at build time: FLEXMBD_COMMIT */
 #include "regress.h"
 
 const double regress_companion_rtol[REGRESS_NCOMPANION] = {0.97, 1.03};
