@@ -75,7 +75,8 @@
    1/gamma on f(y_n). s = 3 (order 5) is RADAU5's table; s = 5 (order 9) is RADAU's (Hairer &
    Wanner's variable-order code, the same construction), computed here with 40 digits (mpmath:
    the nodes as the zeros of d^(s-1)/dx^(s-1) (x^(s-1) (x - 1)^s), A by integrating the Lagrange
-   basis, T from A^-1's eigenvectors scaled to T's last row (1, 1, 0, 1, 0)). */
+   basis, T from A^-1's eigenvectors scaled to T's last row (1, 1, 0, 1, 0)); tools/radau_tableau.py
+   prints this table (and any other odd s) with 50 digits. */
 #define RADAU_SMAX 5
 typedef struct {
   int s;
