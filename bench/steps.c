@@ -27,8 +27,9 @@
 #include "data.h"
 
 static int usage(void) {
-  fprintf(stderr, "usage: steps SCENE.yaml -o OUT.csv [-s PATH=VALUE]... [-b BODY] [-k frame|axial|bending|all -f FACTOR] "
-                  "[-p PERIOD]\n");
+  fprintf(stderr,
+          "usage: steps SCENE.yaml -o OUT.csv [-s PATH=VALUE]... [-b BODY] [-k frame|axial|bending|all -f FACTOR] "
+          "[-p PERIOD]\n");
   return 2;
 }
 
