@@ -145,6 +145,14 @@ static const RadauTableau radau_order9 = {
 
 /* RADAU5's defaults (IV.8; WORK(2..9) of the Fortran code): at most NIT Newton iterations, safety
    factor, step ratio bounds 1/8 <= h/hnew <= 5.
+   NIT is RADAU5's 7 for 3 stages; with s stages the iteration may use 7 + 2.5 (s - 3) (RADAU's
+   rule: 12 for radau9), in its cap and in the prediction of slow convergence (newton()). The step
+   size's safety factor keeps RADAU5's NIT: it shrinks the next step by ~6 % per Newton iteration
+   beyond one, and the w15 spin-up's accuracy under radau9 depends on it (rtol 1e-6: 6.2e-7 m with
+   it, 3.1e-6 m with 12 there too). With 7 iterations radau9 failed to converge 331 and 427 times
+   on the 170-degree rigid pendulum (rtol 1e-6, 1e-8, atol rtol/100; 49 and 5 with 12, the error in
+   x at 1e-8 1.4e-5 -> 7.1e-7 m) while the smooth scenes never need the 8th iteration
+   (docs/performance.md, "Where it is hardest").
    THET: keep the Jacobian when Newton contracted by this factor or better. RADAU5's default is
    0.001 for cheap Jacobians and its documentation suggests 0.1 when they are expensive, as ours
    are (finite differences over the beam's dense blocks).
@@ -170,6 +178,7 @@ typedef struct {
   const fmbModel* m;
   const RadauTableau* tab;      /* the method: order 5 (s = 3) or 9 (s = 5) */
   int s, npair;                 /* stages; complex eigenvalue pairs of A^-1, (s - 1)/2 */
+  int nit;                      /* Newton iterations allowed (FMB_RADAU_NIT's comment) */
   double expo;                  /* the step controller's exponent, 1/(s + 1) (IV.8 (8.21)) */
   double cnode[RADAU_SMAX + 1]; /* the dense output's nodes in (t - t_n)/h: c_s, ..., c_1, 0 */
   double xnode[RADAU_SMAX + 1]; /* the same in (t - t_{n+1})/h: c_s - 1, ..., c_1 - 1, -1 */
@@ -268,6 +277,7 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   c->s = tab->s;
   c->npair = (tab->s - 1) / 2;
   c->expo = 1.0 / (tab->s + 1);
+  c->nit = FMB_RADAU_NIT + 5 * (tab->s - 3) / 2;
   for (int j = 0; j <= tab->s; ++j) {
     c->cnode[j] = j < tab->s ? tab->c[tab->s - 1 - j] : 0.0;
     c->xnode[j] = c->cnode[j] - 1.0;
@@ -484,7 +494,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
   double dynold = 0.0, thqold = 0.0;
   int newt = 0;
   for (;;) {
-    if (newt >= FMB_RADAU_NIT) {
+    if (newt >= c->nit) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }
@@ -535,17 +545,17 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
       *newt_out = newt;
       return NEWTON_DIVERGED;
     }
-    /* convergence rate theta and the predicted error after NIT iterations (IV.8 (8.13)-(8.14)) */
-    if (newt > 1 && newt < FMB_RADAU_NIT) {
+    /* convergence rate theta and the predicted error after nit iterations (IV.8 (8.13)-(8.14)) */
+    if (newt > 1 && newt < c->nit) {
       const double thq = dyno / dynold;
       c->theta = newt == 2 ? thq : sqrt(thq * thqold);
       thqold = thq;
       if (c->theta < 0.99) {
         c->faccon = c->theta / (1.0 - c->theta);
-        const double dyth = c->faccon * dyno * pow(c->theta, FMB_RADAU_NIT - 1 - newt) / c->fnewt;
+        const double dyth = c->faccon * dyno * pow(c->theta, c->nit - 1 - newt) / c->fnewt;
         if (dyth >= 1.0) {
           const double qnewt = fmax(1e-4, fmin(20.0, dyth));
-          *hfac = 0.8 * pow(qnewt, -1.0 / (4.0 + FMB_RADAU_NIT - 1 - newt));
+          *hfac = 0.8 * pow(qnewt, -1.0 / (4.0 + c->nit - 1 - newt));
           *newt_out = newt;
           return NEWTON_SLOW;
         }
@@ -858,7 +868,8 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       c->need_jac = !c->caljac;
       continue;
     }
-    /* step size (IV.8 (8.21)-(8.25)): the safety factor shrinks with the Newton iterations used */
+    /* step size (IV.8 (8.21)-(8.25)): the safety factor shrinks with the Newton iterations used,
+       by RADAU5's NIT for every s (FMB_RADAU_NIT's comment) */
     const double cfac = FMB_RADAU_SAFE * (1 + 2 * FMB_RADAU_NIT);
     const double fac = fmin(FMB_RADAU_SAFE, cfac / (newt + 2 * FMB_RADAU_NIT));
     double quot = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, pow(err, c->expo) / fac));
