@@ -12,7 +12,7 @@
  * vector (fmbData.atol) between fmb_data_new and fmb_init, so the bench sees the engine as shipped.
  *
  *   steps SCENE.yaml -o OUT.csv [-s PATH=VALUE]... [-b BODY] [-k KIND -f FACTOR] [-p PERIOD]
- * prints one line of key=value pairs: the stats (steps, newton_iters, jacobians, error_test_fails,
+ * prints one line of key=value pairs: the simulated span (t_end, from t0), the stats (steps, newton_iters, jacobians, error_test_fails,
  * cpu_s of the run, the CPU clock read at its start and end as fmb_run reads it) and
  * steps_per_period: the steps taken in each PERIOD seconds of simulated time (default 1), where in
  * the run they go. bench/steps.sh runs it and compares OUT.csv with a converged reference
@@ -88,6 +88,8 @@ int main(int argc, char** argv) {
   fmbCsv* csv = d ? fmb_csv_open(out, &diag) : NULL;
   if (!d || !csv) {
     fprintf(stderr, "steps: %s\n", diag.msg);
+    fmb_data_destroy(d);
+    fmb_free(m);
     return 3;
   }
   d->quiet = 1;
@@ -106,6 +108,7 @@ int main(int argc, char** argv) {
   const long nout = (long)ceil((t_end - t0) / dt - 1e-9);
   const int nper = (int)ceil((t_end - t0) / period - 1e-9);
   long* per = calloc((size_t)nper + 1, sizeof(long));
+  if (!per) rc = 1;
   long steps_before = 0;
   fmbStats st;
   for (long k = 1; !rc && k <= nout; ++k) {
@@ -128,9 +131,10 @@ int main(int argc, char** argv) {
     fmb_free(m);
     return 3;
   }
-  printf("kind=%s factor=%g coordinates=%d steps=%ld newton_iters=%ld jacobians=%ld error_test_fails=%ld cpu_s=%.4f "
+  printf("kind=%s factor=%g coordinates=%d t_end=%g steps=%ld newton_iters=%ld jacobians=%ld error_test_fails=%ld "
+         "cpu_s=%.4f "
          "steps_per_period=",
-         kind ? kind : "none", kind ? factor : 1.0, changed, st.steps, st.newton_iters, st.jacobians,
+         kind ? kind : "none", kind ? factor : 1.0, changed, t_end - t0, st.steps, st.newton_iters, st.jacobians,
          st.error_test_fails, cpu);
   for (int p = 0; p < nper; ++p) printf("%s%ld", p ? ":" : "", per[p]);
   printf("\n");

@@ -37,7 +37,7 @@ one() { # integrator rtol [kind factor]
   err=$("$F" compare "$WORK/run.csv" "$WORK/ref.csv" --columns beam.tip_v 2>&1 | stat_field max_abs)
   local steps
   steps=$(echo "$line" | stat_field steps)
-  echo "$integ,$rtol,${kind:-none},$factor,$steps,$(echo "$line" | stat_field newton_iters),$(echo "$line" | stat_field cpu_s),$err,$(awk -v s="$steps" 'BEGIN {printf "%.3e", 5.0 / s}'),$(echo "$line" | stat_field steps_per_period)" >> "$TMP"
+  echo "$integ,$rtol,${kind:-none},$factor,$steps,$(echo "$line" | stat_field newton_iters),$(echo "$line" | stat_field cpu_s),$err,$(awk -v s="$steps" -v T="$(echo "$line" | stat_field t_end)" 'BEGIN {printf "%.3e", T / s}'),$(echo "$line" | stat_field steps_per_period)" >> "$TMP"
 }
 one radau5 1e-8
 one radau5 1e-8 axial 1e2
