@@ -159,7 +159,10 @@ static void classify(const Slot* sl, int ws, fmbChildResult* r) {
   r->wall_s = fmb_pool_now() - sl->start;
   r->exit_code = WIFEXITED(ws) ? WEXITSTATUS(ws) : -1;
   r->signal = WIFSIGNALED(ws) ? WTERMSIG(ws) : 0;
-  if (sl->timed_out)
+  /* a child that ended by itself with one of its own results (0, 2, 3) as the deadline passed
+     finished its work: the TERM came too late to matter, and the row says what it did */
+  const int own_end = WIFEXITED(ws) && (r->exit_code == 0 || r->exit_code == 2 || r->exit_code == 3);
+  if (sl->timed_out && !own_end)
     r->status = FMB_CHILD_TIMEOUT;
   else if (sl->killed)
     r->status = FMB_CHILD_INTERRUPTED;

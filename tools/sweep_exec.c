@@ -70,7 +70,10 @@ double fmb_sweep_timeout(fmbSweep* sw) {
       }
       sw->median_at = sw->nok < 1000 ? sw->nok + 1 : 2 * sw->nok;
     }
-    return sw->timeout_factor * sw->median_wall;
+    /* never below 1 s: a wall time of a few ms is the scheduler's (on a loaded machine a 0.3 ms
+       median made 5x a 1.5 ms limit, and ok runs were killed); a hang still costs only 1 s */
+    const double t = sw->timeout_factor * sw->median_wall;
+    return t > 1.0 ? t : 1.0;
   }
   return sw->timeout_s;
 }

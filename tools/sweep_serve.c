@@ -194,25 +194,30 @@ int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed) {
     for (int k = 0; k < sw->jobs; ++k) {
       Runner* r = &runners[k];
       if (!r->alive) continue;
-      if (r->index >= 0 && r->deadline > 0 && now >= r->deadline && !r->timed_out) {
-        r->timed_out = 1;
-        fmb_pool_kill(pool, k); /* its pipe closes: ended() below */
-      }
+      /* the answer first, the deadline after: an answer that came while poll overslept the
+         deadline (it wakes up to 1 ms late) is the run's result, and a runner is only ever
+         killed with its run still in flight. Killing it and then taking the answer left a dead
+         runner idle, and the next run handed to it got a false `crashed` row. */
       ssize_t got = read(r->out, r->buf + r->n, sizeof r->buf - 1 - r->n);
-      if (got < 0 && (errno == EAGAIN || errno == EINTR)) continue;
-      if (got <= 0) {
+      if (got == 0 || (got < 0 && errno != EAGAIN && errno != EINTR)) {
         ended(sw, feed, pool, runners, k);
         continue;
       }
-      r->n += (size_t)got;
-      r->buf[r->n] = '\0';
-      char* nl = memchr(r->buf, '\n', r->n);
-      if (nl && r->index >= 0) {
-        *nl = '\0';
-        answered(sw, feed, r, r->buf);
-        r->n = 0;
-      } else if (r->n == sizeof r->buf - 1) {
-        r->n = 0; /* an answer too long to be ours: dropped, the runner is killed at its deadline */
+      if (got > 0 && !r->timed_out) { /* a killed runner's last words are not its run's result */
+        r->n += (size_t)got;
+        r->buf[r->n] = '\0';
+        char* nl = memchr(r->buf, '\n', r->n);
+        if (nl && r->index >= 0) {
+          *nl = '\0';
+          answered(sw, feed, r, r->buf);
+          r->n = 0;
+        } else if (r->n == sizeof r->buf - 1) {
+          r->n = 0; /* an answer too long to be ours: dropped, the runner is killed at its deadline */
+        }
+      }
+      if (r->index >= 0 && r->deadline > 0 && now >= r->deadline && !r->timed_out) {
+        r->timed_out = 1;
+        fmb_pool_kill(pool, k); /* its pipe closes: ended() on a later pass */
       }
     }
     fmb_sweep_progress(sw, 0);

@@ -132,6 +132,23 @@ awk -F, 'NR > 1 && $4 == "crashed" && $3 != 2 { exit 1 }' "$D/faults/table.csv" 
 awk -F, 'NR == 8 && $4 == "timeout" && $7 < 3.5 { found = 1 } END { exit !found }' "$D/rel/table.csv" ||
   { cat "$D/rel/table.csv"; fail "--timeout 5x: the hanging run should be killed within 5 x the median + 2 s"; }
 
+# runs that end about as their limit passes (the limit set to the median wall time of the same
+# runs without one, so that they straddle it on any machine): each row is the run's own end or
+# `timeout`, never a false `crashed` (serve once killed a runner at its deadline, then took its
+# answer and handed the dead runner the next run: 1 to 13 false rows of 200)
+EDGE="--grid solver.t_end=5:40:200"
+"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/edge_free" -j 2 --quiet $EDGE 2> "$D/edge.err" ||
+  { cat "$D/edge.err"; fail "deadline edge: the runs without a limit"; }
+limit=$(awk -F, 'NR > 1 { print $7 }' "$D/edge_free/table.csv" | sort -g | awk '{ w[NR] = $1 } END { print w[int((NR + 1) / 2)] }')
+for runner in serve spawn; do
+  "$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/edge_$runner" -j 2 --quiet --runner $runner \
+    --timeout "$limit" $EDGE 2> "$D/edge.err" || { cat "$D/edge.err"; fail "deadline edge ($runner)"; }
+  awk -F, 'NR > 1 && ($4 == "crashed" || ($4 == "timeout" && $5 == 0)) { bad = 1 } END { exit bad }' \
+    "$D/edge_$runner/table.csv" || { grep -E 'crashed|timeout,0,' "$D/edge_$runner/table.csv" | head; fail "runs at their deadline ($runner, --timeout $limit): a false crashed or timeout row"; }
+  grep -q ',ok,' "$D/edge_$runner/table.csv" && grep -q ',timeout,' "$D/edge_$runner/table.csv" ||
+    echo "note: deadline edge ($runner) did not straddle $limit s: $(tail -1 "$D/edge.err")"
+done
+
 # a refined grid with --resume runs only the new points (ids are content, not positions)
 "$F" sweep "$SCENE" -o "$D/refine" --quiet --set solver.t_end=0.5 --grid solver.rtol=1e-4:1e-8:5:log 2> /dev/null
 "$F" sweep "$SCENE" -o "$D/refine" --quiet --set solver.t_end=0.5 --grid solver.rtol=1e-4:1e-8:9:log 2> "$D/refine.err" &&
