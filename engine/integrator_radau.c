@@ -763,6 +763,7 @@ typedef enum { FAIL_NONE, FAIL_STEPS, FAIL_MIN_STEP, FAIL_SINGULAR, FAIL_RESIDUA
 
 static void describe_failure(const RadauRun* c, FailKind kind, char* why, size_t len) {
   const fmbSolverSettings* so = &c->m->solver;
+  const char* name = c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name;
   switch (kind) {
     case FAIL_STEPS:
       snprintf(
@@ -775,21 +776,21 @@ static void describe_failure(const RadauRun* c, FailKind kind, char* why, size_t
       snprintf(why, len,
                "the step fell to solver.min_step = %.3g (%s) after repeated Newton or error-test failures (Newton "
                "contraction %.3g): the solution is blowing up or jumps, or the mechanism passes a singular "
-               "configuration. Check the model; solver.integrator: ida may pass where radau5 stops [radau5]",
-               so->min_step, so->min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)", c->theta);
+               "configuration. Check the model; solver.integrator: ida may pass where %s stops [%s]",
+               so->min_step, so->min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)", c->theta, name, name);
       break;
     case FAIL_SINGULAR:
       snprintf(why, len,
                "the Newton matrix could not be factorized %d times in a row (it is singular): a singular mechanism "
-               "configuration (a dead point) or a mass matrix that lost definiteness [radau5]",
-               FMB_RADAU_MAX_SINGULAR);
+               "configuration (a dead point) or a mass matrix that lost definiteness [%s]",
+               FMB_RADAU_MAX_SINGULAR, name);
       break;
-    case FAIL_RESIDUAL: snprintf(why, len, "a plugin could not evaluate its equations [radau5]"); break;
+    case FAIL_RESIDUAL: snprintf(why, len, "a plugin could not evaluate its equations [%s]", name); break;
     case FAIL_JACOBIAN:
-      snprintf(why, len, "the Newton matrix could not be evaluated at the last good state [radau5]");
+      snprintf(why, len, "the Newton matrix could not be evaluated at the last good state [%s]", name);
       break;
-    case FAIL_POWER: snprintf(why, len, "a joint's power (the work outputs) is not finite [radau5]"); break;
-    default: snprintf(why, len, "the integrator stopped [radau5]"); break;
+    case FAIL_POWER: snprintf(why, len, "a joint's power (the work outputs) is not finite [%s]", name); break;
+    default: snprintf(why, len, "the integrator stopped [%s]", name); break;
   }
 }
 

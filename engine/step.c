@@ -73,6 +73,7 @@ static void add_stats(fmbStats* to, const fmbStats* from) {
   to->error_test_fails += from->error_test_fails;
   to->conv_fails += from->conv_fails;
   to->jacobians_reused += from->jacobians_reused;
+  if (from->integrator) to->integrator = from->integrator; /* the latest backend names the run */
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -468,7 +469,9 @@ int fmb_data_stats(const fmbData* d, fmbStats* st) {
   if (!live(d) || !st) return FMB_EXIT_BAD_INPUT;
   memset(st, 0, sizeof *st);
   if (d->integ) d->ops->stats(d->integ, st);
+  const char* running = st->integrator; /* the live backend, not an earlier one retired */
   add_stats(st, &d->before);
+  if (running) st->integrator = running;
   st->t_reached = d->t;
   st->status_ok = d->initialised && !d->failed;
   st->interrupted = d->interrupted;

@@ -157,6 +157,9 @@ int main(int argc, char** argv) {
         prefix + 1);
   double t_reached = runcli_stat(&r, "t_reached");
   CHECK(strstr(r.err, "stats: status=failed ") != NULL, "no stats line with status=failed");
+  /* a backend that took steps before it stopped is named on the stats line (it once said none) */
+  CHECK(runcli_stat(&r, "steps") <= 0 || strstr(r.err, " integrator=none ") == NULL,
+        "the stats line names no integrator although %g steps were taken", runcli_stat(&r, "steps"));
   CHECK(t_reached >= c->t_lo && t_reached <= c->t_hi, "stopped at t = %.10g, expected within [%g, %g]", t_reached,
         c->t_lo, c->t_hi);
   if (msg) {
