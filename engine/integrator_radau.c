@@ -777,7 +777,8 @@ static void describe_failure(const RadauRun* c, FailKind kind, char* why, size_t
                "the step fell to solver.min_step = %.3g (%s) after repeated Newton or error-test failures (Newton "
                "contraction %.3g): the solution is blowing up or jumps, or the mechanism passes a singular "
                "configuration. Check the model; solver.integrator: ida may pass where %s stops [%s]",
-               so->min_step, so->min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)", c->theta, name, name);
+               so->min_step, so->min_step_given ? "as given" : "the default, 1e-12 x (t_end - t0)", c->theta, name,
+               name);
       break;
     case FAIL_SINGULAR:
       snprintf(why, len,
