@@ -852,7 +852,6 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       c->st.conv_fails++;
       c->h *= nr == NEWTON_SLOW ? hfac : 0.5;
       c->reject = 1;
-      zero_start = 1; /* the extrapolated start may be what failed */
       c->need_jac = !c->caljac;
       continue;
     }
