@@ -30,16 +30,20 @@ int fmb_integrator_choices(const char** names, const fmbIntegratorOps** ops, int
 /* solver.integrator: auto (the default). The rule, from the matrix of every shipped scene x
    integrator x rtol (bench/auto.sh, docs/performance.md "Integrator auto"):
    - a model with a body that caps the BDF order below 5 (fmbBodyType.max_bdf_order: undamped
-     structural modes, i.e. every beam model) runs radau5. BDF is held at order 2 there and buys
-     accuracy at the second-order rate, while Radau IIA is L-stable at order 5: at each beam
-     scene's former settings radau5 was 15-1600x more accurate (the ω0 = 15 spin-up at rtol 1e-6:
-     6.2e-7 against 1.8e-4 m in 0.027 against 0.044 s; the flexible pendulum 4.4e-5 against
-     6.6e-4 m), and at equal error it is the cheaper one on every beam scene from an error of
-     ~1e-4 of the output's range down (the exact beam: IDA is cheaper only above that).
+     structural modes, i.e. every beam model) runs radau9, Radau IIA with 5 stages (order 9).
+     BDF is held at order 2 there and buys accuracy at the second-order rate, while Radau IIA is
+     L-stable at any order: radau5 was 15-1600x more accurate than IDA at each beam scene's
+     former settings (the ω0 = 15 spin-up at rtol 1e-6: 6.2e-7 against 1.8e-4 m). radau9 against
+     radau5 at each beam scene's own settings (error against converged runs; docs/performance.md
+     "radau9 as auto's beam backend"): spin-ups ω0 = 1/4/15 9.0e-8/2.7e-7/6.2e-7 m against
+     2.2e-7/2.5e-7/6.2e-7 m in a third of the steps, the exact spin-up 1.6e-7 against 1.7e-7 m
+     (343 against 827 steps), the slider-crank 1.2e-4 against 3.5e-4 m/s, the flexible pendulum
+     1.2e-7 against 1.2e-6 m, the rotor 4.1e-8 against 3.7e-8 m: as accurate or more for about
+     the same CPU, and ahead at tighter tolerances (issue 23, "Where it is hardest").
    - a model of rigid bodies runs IDA: BDF up to order 5 has no such cap, and on the four-bar it
      reaches 8e-11 rad at rtol 1e-10 where radau5 stays at 4e-8 (its output rows between large
      steps come from the order-3 collocation polynomial).
-   - linear_solver: dense is IDA's only (radau5's complex system), so it keeps IDA. */
+   - linear_solver: dense is IDA's only (radau's complex systems), so it keeps IDA. */
 static const fmbIntegratorOps* auto_integrator(const fmbModel* m, const char** why) {
   if (m->solver.linear_solver == FMB_LS_DENSE) {
     *why = "integrator auto: linear_solver dense is IDA's only";
@@ -47,8 +51,8 @@ static const fmbIntegratorOps* auto_integrator(const fmbModel* m, const char** w
   }
   if (m->bdf_order_cap < 5) {
     *why = "integrator auto: a body caps the BDF order below 5 (undamped structural modes); Radau IIA is L-stable "
-           "at order 5";
-    return &fmb_integrator_radau5;
+           "at order 9";
+    return &fmb_integrator_radau9;
   }
   *why = "integrator auto: rigid bodies, BDF up to order 5";
   return &fmb_integrator_ida;
@@ -87,7 +91,7 @@ void fmb_describe_solver(const fmbModel* m, FILE* f) {
               : "");
 }
 
-/* solver.integrator: auto checks nothing here: it never picks radau5 with linear_solver: dense,
+/* solver.integrator: auto checks nothing here: it never picks radau5 or radau9 with linear_solver: dense,
    and formulation: projected runs the projected backend whatever the integrator */
 int fmb_integrator_check(const fmbModel* m, fmbParser* p, fmbNode solver) {
   const fmbIntegratorOps* ggl = m->solver.integrator;
