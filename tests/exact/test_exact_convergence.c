@@ -10,7 +10,7 @@
  * with rtol), and under 2e-6 m. At
  * omega0 = 15 the exact beam reaches 1e-5 m at 20 elements, and the complete model's deviation
  * from the reference (its linear curvature) is over 100 times the exact model's 16-element error.
- * The runs name IDA, on which these factors were calibrated: the beams' default, radau5, maps rtol
+ * The runs name IDA, on which these factors were calibrated: radau5 (the beams' default then), maps rtol
  * to 0.1 rtol^(2/3) and its time error falls ~3x per decade (rtol 1e-9 against 1e-8 at 32
  * elements, ω0 = 4: 0.30, at the bound), and its 64-element reference costs 6.5 s at ω0 = 15.
  */

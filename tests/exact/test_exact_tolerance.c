@@ -16,7 +16,7 @@
  * equal, since the velocities, whose size in m/s does not change with s, take atol / scale too).
  * The same runs with a copy of the exact table without the op: 2.2e-3, 5.9e-3, 7.1e-3, a spread
  * of 3.2x, checked to be over 1.5x so that the test sees what the op changes. The runs name IDA,
- * on which the figures were measured: under the beams' default, radau5, rtol 1e-6 errs below the
+ * on which the figures were measured: under radau5 (the beams' default then; radau9 now), rtol 1e-6 errs below the
  * 1e-4 this test needs to see the tolerance decide.
  */
 #include <string.h>

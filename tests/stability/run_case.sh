@@ -58,7 +58,7 @@ set +e
 # default (positions, atol from rtol, issue 16), which leaves velocity errors untested: the drift
 # then reaches 3e-6 to 3e-5 on omega30, stiff_E100, elements128/256, slender_I1e-6. The cases keep
 # the settings they were built for; an override of the case itself still wins (it comes later).
-# They were built on IDA, and keep it now that a beam scene's default is radau5 (solver.integrator:
+# They were built on IDA, and keep it now that a beam scene's default is Radau (radau5, now radau9; solver.integrator:
 # auto, issue 23): radau5 under full control with the small explicit atol of tight_fine (1e-11, 64
 # elements) crawls through Newton failures (253k steps, 66k Jacobians, 146 s CPU against IDA's
 # 0.7 s; docs/performance.md, "Integrator auto", limits).
