@@ -663,8 +663,9 @@ static void dense_output(const RadauRun* c, double t, double* y, double* yp) {
   }
 }
 
-/* the Newton start: the last step's polynomial extrapolated to the new stages (RADAU5), zero on
-   the first step or after a failure where it cannot be trusted */
+/* the Newton start: the last step's polynomial extrapolated to the new stages (RADAU5), also
+   after a rejected step; zero only on the first step, where there is no polynomial yet. (A zero
+   restart after a Newton failure stalled the slider-crank's rigid limit: test_slider_crank.) */
 static void starting_values(RadauRun* c, int zero) {
   if (zero || !c->have_cont) {
     for (int i = 0; i < c->s; ++i) memset(c->z[i], 0, sizeof(double) * (size_t)c->ny);
@@ -761,9 +762,14 @@ static void accept_work(RadauRun* c, double h) {
 
 typedef enum { FAIL_NONE, FAIL_STEPS, FAIL_MIN_STEP, FAIL_SINGULAR, FAIL_RESIDUAL, FAIL_JACOBIAN, FAIL_POWER } FailKind;
 
+/* the backend's name, as solver.integrator spells it */
+static const char* radau_name(const RadauRun* c) {
+  return c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name;
+}
+
 static void describe_failure(const RadauRun* c, FailKind kind, char* why, size_t len) {
   const fmbSolverSettings* so = &c->m->solver;
-  const char* name = c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name;
+  const char* name = radau_name(c);
   switch (kind) {
     case FAIL_STEPS:
       snprintf(
@@ -939,7 +945,7 @@ static int fall_back_to_full(RadauRun* c) {
   fmb_warn(c->w,
            "note: t = %.6g: %s failed with the reduced Newton solve (solver.linear_solver: klu); continuing "
            "from the last good step with klu_full (the whole matrices)",
-           c->t, c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name);
+           c->t, radau_name(c));
   return 0;
 }
 
@@ -1001,7 +1007,7 @@ static void radau_stats(const void* self, fmbStats* st) {
   st->error_test_fails = c->st.error_test_fails;
   st->conv_fails = c->st.conv_fails;
   st->jacobians_reused = c->lu_reuses;
-  st->integrator = c->s == 5 ? fmb_integrator_radau9.name : fmb_integrator_radau5.name;
+  st->integrator = radau_name(c);
 }
 
 /* radau5's cross-key rules */
