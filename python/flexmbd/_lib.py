@@ -5,12 +5,15 @@ Nothing here computes anything: every number comes from a call into the library.
 
 Where the library is found (the first that exists wins):
 
-1. the file named by the environment variable ``FLEXMBD_LIBRARY``;
-2. the path recorded beside the package at ``cmake --install`` (``_location.py``: the installed
+1. the file named by the environment variable ``FLEXMBD_LIBRARY`` (asked for explicitly: that file
+   or an error, never a fallback; nothing sets it for an installed package);
+2. the copy inside the package, ``flexmbd/_libs/libflexmbd.so.ABI``, that ``pip install .`` builds
+   and ships (setup.py);
+3. the path recorded beside the package at ``cmake --install`` (``_location.py``: the installed
    ``PREFIX/LIBDIR/libflexmbd.so.ABI`` relative to ``PREFIX/lib/python3/dist-packages/flexmbd``);
-3. the build tree of a source checkout: ``build/libflexmbd.so.ABI`` beside ``python/`` (what
+4. the build tree of a source checkout: ``build/libflexmbd.so.ABI`` beside ``python/`` (what
    ``tools/build.sh`` makes), so that ``PYTHONPATH=python python3`` works from the repository root;
-4. the system loader (``libflexmbd.so.ABI`` on ``LD_LIBRARY_PATH`` or in the loader's cache).
+5. the system loader (``libflexmbd.so.ABI`` on ``LD_LIBRARY_PATH`` or in the loader's cache).
 
 ctypes releases the GIL around every call into a ``CDLL``: runs in two threads proceed in parallel.
 """
@@ -192,6 +195,9 @@ def _candidates() -> list:
     env = os.environ.get("FLEXMBD_LIBRARY")
     if env:
         return [env]  # asked for explicitly: that file or an error, never a silent fallback
+    bundled = os.path.join(here, "_libs", name)  # pip install . (setup.py)
+    if os.path.exists(bundled):
+        found.append(bundled)
     try:
         from . import _location  # written by cmake --install
 

@@ -459,6 +459,7 @@ def _run_whole(model: Model, check: bool, cancel: Optional[Cancel], warn) -> "Re
         stats["status"] = "ok" if error is None else ("interrupted" if isinstance(error, _lib.Interrupted) else "failed")
         sim.close()
     result = Result(names, values[:nrow], stats)
+    result._scene = (model._source[1], list(model.overrides), list(model.plugins))  # for flexmbd.view
     if error is not None:
         result.error = error
         error.result = result
@@ -549,3 +550,9 @@ class Result:
         from .plot import plot_result
 
         return plot_result(self, columns, ax=ax, label=label, **style)
+
+    def _repr_html_(self) -> Optional[str]:
+        """In a notebook: the run's animation, the page of `flexmbd view` (flexmbd.view)."""
+        from .view_page import inline
+
+        return inline(self)
