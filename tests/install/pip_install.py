@@ -76,7 +76,7 @@ print("same_csv", open("py.csv", "rb").read() == open({cli!r}, "rb").read())
 c = flexmbd.compare("py.csv", {cli!r}, rtol=0.0, atol=0.0)
 print("compare", c.ok, c["bob.theta"]["max_abs"] if "bob.theta" in c else c)
 page = flexmbd.load({scene!r}, set={{"solver.t_end": 0.2}}).run()._repr_html_()
-print("view", page.startswith("<iframe srcdoc=") and "FMB_VIEW_DATA" not in page and "&quot;bodies&quot;" in page)
+print("view", page.startswith("<iframe srcdoc=") and "/*FMB_VIEW_DATA*/null" not in page and "&quot;bodies&quot;" in page)
 """
 
 
