@@ -224,9 +224,10 @@ def _tolerance(name: str, value: Optional[float]) -> Optional[float]:
 
 
 def _table(r: RunLike, which: str) -> _Table:
-    if isinstance(r, Result):
-        return _from_result(r, f"<{which} Result>")
-    return read_csv(r)
+    try:
+        return _from_result(r, f"<{which} Result>") if isinstance(r, Result) else read_csv(r)
+    except ValueError as e:
+        raise ValueError(f"flexmbd compare: {e}") from None
 
 
 def _c_double(x: float, fmt: str) -> str:
