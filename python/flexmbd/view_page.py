@@ -185,8 +185,12 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
                 else "its deformation is drawn at scale 1 only")
         notes.append(f"{v.name}: no {', '.join(lack)}: {cost}")
     if drawable == 0:
-        raise ValueError(f"flexmbd view: nothing to draw: no body of the scene has its columns in the run "
-                         f"(add BODY.x, BODY.y, BODY.theta or BODY.shape to its outputs)")
+        # the run's outputs as a scene lists them (a body's shape columns folded back), plus what is missing
+        listed = [n if not _is_shape_column(n) else n[:n.rfind(".")] + ".shape" for n in names[1:]
+                  if not _is_shape_column(n) or n[n.rfind(".") + 1:] == "shape0_x"]
+        missing = [q for note in notes for q in note.split(": ")[1][3:].split(", ")]
+        raise ValueError(f"flexmbd view: nothing to draw: {'; '.join(notes)}; to draw everything, load the scene "
+                         f"with set={{'outputs': '[{', '.join(listed + missing)}]'}}")
     geometric = set()
     for v in bodies:
         geometric.update(c for c in v.frame if c)
