@@ -92,3 +92,23 @@ def test_plot_has_units(out):
     assert flexmbd.unit("beam.omega") == "rad/s" and flexmbd.unit("energy.total") == "J"
     assert flexmbd.unit("beam.node3_v") == "m" and flexmbd.unit("constraint.position") is None
     ax.figure.savefig(os.path.join(out, "tip.png"))
+
+
+def test_cmake_installed_package_has_version_and_view_template(out):
+    """cmake --install gives the package what pip install . gives it: __version__ (CMakeLists.txt's
+    project version) and flexmbd view's page template as package data"""
+    import re
+
+    prefix = os.path.join(out, "prefix")
+    subprocess.run(["cmake", "--install", BUILD, "--prefix", prefix], check=True, capture_output=True)
+    site = os.path.join(prefix, "lib", "python3", "dist-packages")
+    env = {k: v for k, v in os.environ.items() if not k.startswith("FLEXMBD_") and k != "PYTHONPATH"}
+    env["PYTHONPATH"] = site
+    code = "import flexmbd, flexmbd._source as s; print(flexmbd.__version__); print(s.view_template())"
+    p = subprocess.run([sys.executable, "-c", code], env=env, cwd=out, capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    version, template = p.stdout.split()
+    with open(os.path.join(SRC, "CMakeLists.txt")) as f:
+        assert version == re.search(r"project\(flexmbd VERSION ([0-9.]+)", f.read()).group(1)
+    assert template == os.path.join(site, "flexmbd", "_data", "view.html")
+    assert open(template, "rb").read() == open(os.path.join(SRC, "tools", "view.html"), "rb").read()
