@@ -211,7 +211,8 @@ def _column_scale(tb: _Table, c: int) -> Tuple[float, float]:
     x = x[~np.isnan(x)]
     if len(x) == 0:
         return -math.inf, 0.0
-    return float(x.max() - x.min()), max(0.0, float(np.abs(x).max()))
+    with np.errstate(invalid="ignore"):  # inf - inf: NaN, as in C
+        return float(x.max() - x.min()), max(0.0, float(np.abs(x).max()))
 
 
 def _tolerance(name: str, value: Optional[float]) -> Optional[float]:
@@ -231,7 +232,10 @@ def _table(r: RunLike, which: str) -> _Table:
 
 
 def _c_double(x: float, fmt: str) -> str:
-    """printf's text of a double (Python's % gives C's digits; C writes inf and nan the same way)"""
+    """printf's text of a double: Python's % gives C's digits and inf, but drops a NaN's sign, which
+    glibc prints ("-nan", e.g. 0 * -inf on x86)"""
+    if math.isnan(x):
+        return "-nan" if math.copysign(1.0, x) < 0 else "nan"
     return fmt % x
 
 
