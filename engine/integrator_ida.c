@@ -97,7 +97,8 @@ static int residual_fn(sunrealtype t, N_Vector y, N_Vector yp, N_Vector F, void*
   IdaRun* c = ud;
   /* an interrupt ends the step in progress: IDA returns the last completed step */
   if (stop_requested(c)) return -1;
-  return fmb_system_residual(c->m, c->w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp), N_VGetArrayPointer(F));
+  return fmb_system_residual_eliminated(c->m, c->w, t, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),
+                                        N_VGetArrayPointer(F));
 }
 
 void fmb_sparse_pattern_into(const fmbModel* m, SUNMatrix J) {
@@ -110,12 +111,16 @@ void fmb_sparse_pattern_into(const fmbModel* m, SUNMatrix J) {
 static int jacobian_fn(sunrealtype t, sunrealtype cj, N_Vector y, N_Vector yp, N_Vector r, SUNMatrix J, void* ud,
                        N_Vector t1, N_Vector t2, N_Vector t3) {
   (void)r;
-  (void)t1;
   (void)t2;
   (void)t3;
   IdaRun* c = ud;
   const fmbModel* m = c->m;
   IDAGetErrWeights(c->ida, c->ewt);
+  if (m->nz > 0) { /* the auxiliary unknowns, placeholders in the residual, made consistent (system.c) */
+    N_VScale(1.0, y, t1);
+    if (fmb_system_aux_eliminate(m, c->w, N_VGetArrayPointer(t1), N_VGetArrayPointer(yp))) return 1;
+    y = t1;
+  }
   const int reuse = reuse_body_blocks(c);
   if (m->solver.linear_solver == FMB_LS_DENSE)
     return fmb_system_jacobian(m, c->w, t, cj, N_VGetArrayPointer(y), N_VGetArrayPointer(yp),

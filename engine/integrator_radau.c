@@ -398,6 +398,8 @@ oom:
    cj = 0 with fresh derivatives, then cj = 1 reassembling the same bodies' blocks */
 static int evaluate_jacobian(RadauRun* c) {
   const fmbModel* m = c->m;
+  /* the auxiliary unknowns, placeholders between Jacobians, made consistent (system.c) */
+  if (m->nz > 0 && fmb_system_aux_eliminate(m, c->w, c->y, c->yp)) return 1;
   int rc = fmb_system_jacobian(m, c->w, c->t, 0.0, c->y, c->yp, c->ewt, 0, c->jy, NULL);
   if (rc) return rc;
   rc = fmb_system_jacobian(m, c->w, c->t, 1.0, c->y, c->yp, c->ewt, 1, c->jyp, NULL);
@@ -502,7 +504,7 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
     for (int i = 0; i < s; ++i) {
       for (int k = 0; k < ny; ++k) c->ys[k] = c->y[k] + c->z[i][k];
       stage_derivative(c, i, h, c->yps);
-      const int rc = fmb_system_residual(m, c->w, c->t + tab->c[i] * h, c->ys, c->yps, c->fz[i]);
+      const int rc = fmb_system_residual_eliminated(m, c->w, c->t + tab->c[i] * h, c->ys, c->yps, c->fz[i]);
       c->st.residuals++;
       if (rc < 0) return NEWTON_FATAL;
       if (rc > 0) { /* not finite: a smaller step */
@@ -612,7 +614,7 @@ static double estimate_error(RadauRun* c) {
       c->err2[k] = c->y[k] + c->err[k];
       c->yps[k] = -delta[k];
     }
-    const int rc = fmb_system_residual(c->m, c->w, c->t, c->err2, c->yps, c->err);
+    const int rc = fmb_system_residual_eliminated(c->m, c->w, c->t, c->err2, c->yps, c->err);
     c->st.residuals++;
     if (rc) return -1.0;
     for (int k = 0; k < ny; ++k) c->err[k] = -c->err[k];

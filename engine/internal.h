@@ -270,6 +270,14 @@ int fmb_type_output_id(int (*output_lookup)(const void*, const char*), const voi
                        const char* quantity);
 /* F(t, y, yp) of the stabilized index-2 (GGL) system; returns 0, >0 recoverable, <0 fatal */
 int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F);
+/* The same F with the bodies' auxiliary unknowns eliminated: each such body's rows from its
+   `residual` (z eliminated), its Rz rows 0, so the z in y are placeholders. What the integrators
+   iterate on (system.c says why), with the Newton matrix evaluated where z is consistent. */
+int fmb_system_residual_eliminated(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
+                                   double* F);
+/* The bodies' auxiliary unknowns in y (its slice at m->zoff) set to the z that satisfy Rz = 0 at
+   (q, v, a = v' from yp), by aux_initial: 0 ok, nonzero not finite */
+int fmb_system_aux_eliminate(const fmbModel* m, fmbWorkspace* w, double* y, const double* yp);
 /* J = dF/dy + cj dF/dyp into a CSC matrix with the model's pattern (data only), or a dense
    column-major ny x ny matrix when dense != NULL. ewt: IDA's error weights (for FD steps).
    reuse_blocks: assemble with the bodies' K, C, M from the last fresh call (only cj changed). */

@@ -367,7 +367,8 @@ static int all_finite(const double* x, int n) {
   return 1;
 }
 
-int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F) {
+static int system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F,
+                           int eliminate_aux) {
   const int nq = m->nq, nc = m->nc;
   const double *q = y, *v = y + nq, *lam = y + 2 * nq, *mu = y + 2 * nq + nc;
   const double *qp = yp, *vp = yp + nq;
@@ -376,11 +377,12 @@ int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const doub
   for (int i = 0; i < nq; ++i) Fq[i] = qp[i] - v[i];
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    int rc = bi->nz > 0 ? bi->type->residual_aux(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr,
-                                                 y + m->zoff + bi->zadr, Fv + bi->qadr, F + m->zoff + bi->zadr,
-                                                 w->plugin + bi->workadr)
-                        : bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr,
-                                             Fv + bi->qadr, w->plugin + bi->workadr);
+    if (bi->nz > 0 && eliminate_aux) memset(F + m->zoff + bi->zadr, 0, sizeof(double) * (size_t)bi->nz);
+    int rc = bi->nz > 0 && !eliminate_aux ? bi->type->residual_aux(bi->self, &m->env, q + bi->qadr, v + bi->qadr,
+                                                                   vp + bi->qadr, y + m->zoff + bi->zadr, Fv + bi->qadr,
+                                                                   F + m->zoff + bi->zadr, w->plugin + bi->workadr)
+                                          : bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr,
+                                                               vp + bi->qadr, Fv + bi->qadr, w->plugin + bi->workadr);
     if (rc) return rc;
   }
   for (int j = 0; j < m->njoint; ++j) {
@@ -414,6 +416,38 @@ int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const doub
     }
   }
   return all_finite(F, m->ny) ? 0 : 1;
+}
+
+int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F) {
+  return system_residual(m, w, t, y, yp, F, 0);
+}
+
+/* Why the integrators eliminate the auxiliary unknowns. Their simplified Newton iteration
+   freezes the Newton matrix at the step's start. Carried as unknowns of their own, the z start
+   from an extrapolation inconsistent with the stages' q, v and a, and the matrix's z columns
+   (the beam's dR/dT_e = -F_e, the coupling forces, which carry the inertia of modes far faster
+   than the step) are stale at the stages, so the z error contracted by only 2-4x per iteration
+   where the coordinates' fell by 1e-5 (radau5, pendulum, 64 elements banded), and Newton failed
+   to converge on most steps. Evaluating R with z eliminated (the body's `residual`) and Rz = 0
+   makes z mere placeholders; the banded Newton matrix, evaluated where z is consistent
+   (fmb_system_aux_eliminate), then gives through its q, v part the Schur complement of its z
+   block, which is the dense assembly's Newton matrix: the iteration is the dense assembly's,
+   at the banded factorization's cost (docs/performance.md, "Fine meshes"). */
+int fmb_system_residual_eliminated(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
+                                   double* F) {
+  return system_residual(m, w, t, y, yp, F, 1);
+}
+
+int fmb_system_aux_eliminate(const fmbModel* m, fmbWorkspace* w, double* y, const double* yp) {
+  const int nq = m->nq;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (bi->nz <= 0) continue;
+    const int rc = bi->type->aux_initial(bi->self, &m->env, y + bi->qadr, y + nq + bi->qadr, yp + nq + bi->qadr,
+                                         y + m->zoff + bi->zadr, w->plugin + bi->workadr);
+    if (rc) return rc;
+  }
+  return 0;
 }
 
 /* ---------------------------------------------------------------------------------------------
