@@ -810,6 +810,12 @@ FMB_API const char* fmb_safe_write_path(const fmbSafeFile* f);
 /* keep != 0: put the content in place (rename); 0: discard it. 0, or -1 with errno on failure */
 FMB_API int fmb_safe_close(fmbSafeFile* f, int keep);
 
+/* "did you mean": of words[0..n) (NULL entries skipped), the nearest to `typed` when `typed` is
+   a typo of it (an edit distance, with adjacent transpositions, of 1 in a word of up to 4
+   letters, 2 from 5 on), else NULL. The scene loader's unknown keys and the program's unknown
+   commands are matched by this one rule. */
+FMB_API const char* fmb_nearest_word(const char* typed, const char* const* words, int n);
+
 #ifdef __cplusplus
 }
 #endif

@@ -216,6 +216,9 @@ extern const char* const fmb_scene_keys[];
    NULL; `complete` when together they name every key it may have; `what` names the mapping in
    messages (kept as a pointer: it must live while the mapping is read). Reset by fmbp_begin_item. */
 void fmbp_expect(fmbParser* p, const char* what, const char* const* keys, const fmbParam* params, int complete);
+/* the keys every body and joint item takes besides its type's (scene.c): name, type, material,
+   section; NULL-terminated */
+extern const char* const fmb_item_keys[];
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what);
 int fmbp_is_map(fmbParser* p, fmbNode n);
 int fmbp_is_seq(fmbParser* p, fmbNode n);

@@ -31,6 +31,9 @@ typedef struct fmbCliScene {
    fmb_cli_registry() at once) or (when no scene was given yet) the scene file; returns 1 when
    taken (advancing *i past an argument), 0 when not ours, or FMB_EXIT_BAD_INPUT after printing why (prefixed by `cmd`). */
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
+/* a --set value `ov` has the form PATH=VALUE: 0, else FMB_EXIT_BAD_INPUT after saying so in the
+   option's terms (`next`, the argument after it or NULL, shows `--set PATH VALUE`, a space for =) */
+int fmb_cli_check_set(const char* cmd, const char* ov, const char* next);
 /* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
 /* file:line:col: error: msg (or the shorter forms when no location is known), on stderr or in buf */
