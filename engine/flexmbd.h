@@ -349,6 +349,11 @@ FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 /* the current value of this joint's input (its `input` op said 1): the scene's `value:` until a
    program sets it with fmb_set_input; NaN for a joint without an input */
 FMB_API double fmb_eval_input(const fmbJointEval* ev);
+/* its rate d/dt at the evaluation's time and (accel not NULL) its second rate: what the program
+   gave with fmb_set_input_motion, 0 for a value held (fmb_set_input); NaN without an input. A
+   prescribed motion reads them for its f' and f'' (a drive whose rate is 0 throws the motion
+   between settings away) */
+FMB_API double fmb_eval_input_rate(const fmbJointEval* ev, double* accel);
 
 /* ---------------------------------------------------------------------------------------------
  * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
@@ -605,11 +610,19 @@ FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
 FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
 /* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
    a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
-   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from time() on, as a step (piecewise
-   constant) that the next advance starts from. */
+   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from
+   time() on, as a step (piecewise constant, rate 0) that the next advance starts from.
+   fmb_set_input_motion gives its rate and second rate too: from time() on the input is
+   value + rate tau + accel tau^2 / 2 (tau = t - time()) until the next setting, so a drive fed a
+   smooth motion moves with it (velocities and accelerations follow the rate) instead of coming to
+   rest at every setting. A drive's setting that lands away from where its previous one led (a
+   jump: always, when a moving drive is held by fmb_set_input) restarts the integrator from a
+   state projected onto the new motion, and the first such jump of each input is warned about. */
 FMB_API int fmb_ninput(const fmbModel* m);
 FMB_API const char* fmb_input_name(const fmbModel* m, int i);
 FMB_API int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value);
+FMB_API int fmb_set_input_motion(const fmbModel* m, fmbData* d, const char* name, double value, double rate,
+                                 double accel);
 /* the current value of input `name`: 0, or FMB_EXIT_BAD_INPUT */
 FMB_API int fmb_get_input(const fmbModel* m, const fmbData* d, const char* name, double* value);
 

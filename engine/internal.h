@@ -151,11 +151,21 @@ struct fmbJointEval {
   double t;
   const double* q; /* whole coordinate vector */
   const double* v;
-  double* work;        /* plugin scratch (body markers) */
-  double* mk;          /* 3 x max body ncoord: marker derivatives before scattering */
-  double* js;          /* 2 x max joint columns: the joint's own scratch */
-  const double* input; /* the inputs' current values (the workspace's, set by fmb_set_input) */
+  double* work;                        /* plugin scratch (body markers) */
+  double* mk;                          /* 3 x max body ncoord: marker derivatives before scattering */
+  double* js;                          /* 2 x max joint columns: the joint's own scratch */
+  const struct fmbInputSetting* input; /* the inputs' settings (the workspace's, fmb_set_input) */
 };
+
+/* An input's setting (fmb_set_input, fmb_set_input_motion): from t_set on it is
+   value + rate tau + accel tau^2 / 2, tau = t - t_set; rate and accel are 0 unless the program
+   gave them (a load or drive held between settings). */
+typedef struct fmbInputSetting {
+  double value, rate, accel, t_set;
+  int jumps; /* times a drive's setting has jumped away from where its last one led (warned once) */
+} fmbInputSetting;
+/* the setting's value and its rate and second rate at time t */
+void fmb_input_at(const fmbInputSetting* s, double t, double* value, double* rate, double* accel);
 
 /* ---- registry.c: a growable registry of types; plugin.c: loading plugins ---- */
 struct fmbRegistry {
@@ -249,8 +259,10 @@ typedef struct fmbWorkspace fmbWorkspace;
 fmbWorkspace* fmb_workspace_new(const fmbModel* m);
 void fmb_workspace_free(fmbWorkspace* w);
 double* fmb_workspace_plugin(fmbWorkspace* w);
-/* the inputs' current values (m->ninput; the scene's `value:` when the workspace is made) */
-double* fmb_workspace_inputs(fmbWorkspace* w);
+/* the inputs' settings (m->ninput; the scene's `value:` at rest when the workspace is made, and
+   again after fmb_workspace_inputs_reset) */
+fmbInputSetting* fmb_workspace_inputs(fmbWorkspace* w);
+void fmb_workspace_inputs_reset(const fmbModel* m, fmbWorkspace* w);
 /* where messages of the run on this workspace go (fn NULL: the thread's default, warn.c) */
 typedef struct {
   fmbWarnFn fn;
