@@ -790,7 +790,8 @@ typedef struct fmbModelsResult {
   fmbDiag diag[FMB_MODELS_MAX]; /* why a model's run stopped (code 0: it did not) */
 } fmbModelsResult;
 /* opt->csv_path (required, a file: not "-") receives the merged table; each run takes quiet and
-   stop from opt. Every model is loaded before any runs (a misspelt model is bad input, not a late
+   stop from opt, and its animation goes to MODEL/ below opt->vtk_dir (else below the scene's `vtk`
+   key; none without either), of every opt->vtk_every-th row. A model named twice is bad input. Every model is loaded before any runs (a misspelt model is bad input, not a late
    failure). Returns 0, or the largest exit code of the runs, or an exit code for the scene, the
    models or the merged file with *diag saying why; *res (may be NULL) says what each run did. */
 FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int nbody, const char* const* models,

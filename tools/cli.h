@@ -65,10 +65,10 @@ void fmb_cli_warn_end(void);
 fmbRegistry* fmb_cli_registry(void);
 
 /* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c
-   over the library's fmb_run_models); *stop (SIGINT) ends it after the model in progress, whose
+   over the library's fmb_run_models), with vtk (or NULL) each model's animation in vtk/MODEL; *stop (SIGINT) ends it after the model in progress, whose
    rows and those of the models before it are written */
-int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet,
-                       volatile sig_atomic_t* stop);
+int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet, const char* vtk,
+                       int vtk_every, volatile sig_atomic_t* stop);
 
 /* `compare`'s work on parsed options (tools/cmd_compare.c), also `run --reference`'s: one line per
    column on stdout; returns compare's exit code */
