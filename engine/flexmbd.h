@@ -712,7 +712,9 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
 /* a table of named numeric columns (row-major values), through the one CSV writer; nrow >= 0
-   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). With the names "t" and
+   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). The CSV has no quoting: a name
+   that is empty, holds a comma, a quote or a control character (a line break), has blanks at its
+   ends, or starts the header with '#' is FMB_EXIT_BAD_INPUT, nothing written. With the names "t" and
    fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                             fmbDiag* diag);

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 
@@ -294,7 +295,18 @@ int regress_reference_load(const char* path, RegressRef* r, char* why, size_t le
       r->sets = ns;
       ++r->nsets;
     } else if ((v = meta_value(m, "status"))) {
-      r->status_ok = strcmp(v, "ok") == 0;
+      /* written as `ok` or `stopped`; an edited `OK ` is the same word, anything else is refused
+         (it once counted as stopped, and a good run then failed for completing) */
+      size_t n = strlen(v);
+      while (n > 0 && (v[n - 1] == ' ' || v[n - 1] == '\t')) --n;
+      if (n == 2 && strncasecmp(v, "ok", 2) == 0)
+        r->status_ok = 1;
+      else if (n == 7 && strncasecmp(v, "stopped", 7) == 0)
+        r->status_ok = 0;
+      else {
+        regress_say(why, len, "%s:%d: expected '# status: ok' or '# status: stopped', got '#%.200s'", path, i + 1, m);
+        return -1;
+      }
     } else if ((v = meta_value(m, "t_reached"))) {
       r->t_reached = strtod(v, NULL);
       has_t_reached = 1;

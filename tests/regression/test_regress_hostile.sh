@@ -9,7 +9,8 @@
 #  silently wrong: a reference cut short, one whose rows lie outside the run's time span, and one
 #    with a second (looser) tolerance line for a column fail; scenes deep down and behind links
 #    run, scenes without a reference are reported, a folder beyond the search's depth is refused;
-#    a.yml blessed after a.yaml is refused; a bad --set is bad input (exit 2);
+#    a.yml blessed after a.yaml is refused; a bad --set is bad input (exit 2); '# status: OK' is ok
+#    and an unknown status is refused;
 #  misleading: a crashed run's message quotes its last stderr line, not a file already deleted.
 #   usage: test_regress_hostile.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
 . "$(dirname "$0")/../sweep/lib.sh" # F SRC D PLUGIN, fail()
@@ -136,6 +137,17 @@ cmp -s "$D/twin2/a.ref.csv" "$D/twin2/before" || fail "a.yml's bless touched a.y
   { cat "$D/out.txt" "$D/err.txt"; fail "a bad --set value is not bad input"; }
 [ "$(reg "$S/fourbar.yaml" --set solver.rtol 1e-6)" = 2 ] && grep -q "solver.rtol: expected PATH=VALUE in one argument" "$D/err.txt" ||
   { cat "$D/err.txt"; fail "--set PATH VALUE (a space for =) is not named"; }
+
+# '# status: OK ' (a reference edited by hand) is ok, not "stopped" (a good run then failed for
+# completing); a status that is neither is a malformed reference
+mkdir "$D/status"
+cp "$S/fourbar.yaml" "$D/status/"
+sed 's/^# status: ok$/# status: OK  /' "$S/fourbar.ref.csv" > "$D/status/fourbar.ref.csv"
+grep -q "^# status: OK  $" "$D/status/fourbar.ref.csv" || fail "the status edit did not take"
+[ "$(reg "$D/status/fourbar.yaml")" = 0 ] || { cat "$D/out.txt"; fail "'# status: OK' fails a good run"; }
+sed -i 's/^# status: OK  $/# status: finished/' "$D/status/fourbar.ref.csv"
+[ "$(reg "$D/status/fourbar.yaml")" = 2 ] && grep -q "expected '# status: ok' or '# status: stopped'" "$D/out.txt" ||
+  { cat "$D/out.txt"; fail "an unknown status is not refused"; }
 
 # a crash: the message quotes the run's last stderr line (the file itself is gone with the tmp folder)
 mkdir "$D/crash"
