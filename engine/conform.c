@@ -247,7 +247,8 @@ static void check_params(Report* r, const char* path, const char* type, const fm
     const size_t n = strcspn(list, ",)");
     char key[64];
     snprintf(key, sizeof key, "%.*s", (int)n, list);
-    int known = strcmp(key, "name") == 0 || strcmp(key, "type") == 0;
+    int known = 0;
+    for (const char* const* k = fmb_item_keys; !known && *k; ++k) known = strcmp(*k, key) == 0;
     for (const fmbParam* p = params; !known && p->key; ++p) known = strcmp(p->key, key) == 0;
     if (!known) snprintf(undeclared + strlen(undeclared), sizeof undeclared - strlen(undeclared), " %s", key);
     list += n;

@@ -349,6 +349,11 @@ FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
 /* the current value of this joint's input (its `input` op said 1): the scene's `value:` until a
    program sets it with fmb_set_input; NaN for a joint without an input */
 FMB_API double fmb_eval_input(const fmbJointEval* ev);
+/* its rate d/dt at the evaluation's time and (accel not NULL) its second rate: what the program
+   gave with fmb_set_input_motion, 0 for a value held (fmb_set_input); NaN without an input. A
+   prescribed motion reads them for its f' and f'' (a drive whose rate is 0 throws the motion
+   between settings away) */
+FMB_API double fmb_eval_input_rate(const fmbJointEval* ev, double* accel);
 
 /* ---------------------------------------------------------------------------------------------
  * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
@@ -605,11 +610,19 @@ FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
 FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
 /* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
    a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
-   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from time() on, as a step (piecewise
-   constant) that the next advance starts from. */
+   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from
+   time() on, as a step (piecewise constant, rate 0) that the next advance starts from.
+   fmb_set_input_motion gives its rate and second rate too: from time() on the input is
+   value + rate tau + accel tau^2 / 2 (tau = t - time()) until the next setting, so a drive fed a
+   smooth motion moves with it (velocities and accelerations follow the rate) instead of coming to
+   rest at every setting. A drive's setting that lands away from where its previous one led (a
+   jump: always, when a moving drive is held by fmb_set_input) restarts the integrator from a
+   state projected onto the new motion, and the first such jump of each input is warned about. */
 FMB_API int fmb_ninput(const fmbModel* m);
 FMB_API const char* fmb_input_name(const fmbModel* m, int i);
 FMB_API int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value);
+FMB_API int fmb_set_input_motion(const fmbModel* m, fmbData* d, const char* name, double value, double rate,
+                                 double accel);
 /* the current value of input `name`: 0, or FMB_EXIT_BAD_INPUT */
 FMB_API int fmb_get_input(const fmbModel* m, const fmbData* d, const char* name, double* value);
 
@@ -699,7 +712,9 @@ FMB_API int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, 
 FMB_API int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const fmbModes* modes, int k,
                                      double amplitude, int frames, const char* dir, fmbDiag* diag);
 /* a table of named numeric columns (row-major values), through the one CSV writer; nrow >= 0
-   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). With the names "t" and
+   (a negative count is FMB_EXIT_BAD_INPUT, not an empty table). The CSV has no quoting: a name
+   that is empty, holds a comma, a quote or a control character (a line break), has blanks at its
+   ends, or starts the header with '#' is FMB_EXIT_BAD_INPUT, nothing written. With the names "t" and
    fmb_output_name's and rows of [time, fmb_outputs], the very bytes fmb_run writes */
 FMB_API int fmb_write_table(const char* path, int ncol, const char* const* names, int nrow, const double* values,
                             fmbDiag* diag);
@@ -777,7 +792,8 @@ typedef struct fmbModelsResult {
   fmbDiag diag[FMB_MODELS_MAX]; /* why a model's run stopped (code 0: it did not) */
 } fmbModelsResult;
 /* opt->csv_path (required, a file: not "-") receives the merged table; each run takes quiet and
-   stop from opt. Every model is loaded before any runs (a misspelt model is bad input, not a late
+   stop from opt, and its animation goes to MODEL/ below opt->vtk_dir (else below the scene's `vtk`
+   key; none without either), of every opt->vtk_every-th row. A model named twice is bad input. Every model is loaded before any runs (a misspelt model is bad input, not a late
    failure). Returns 0, or the largest exit code of the runs, or an exit code for the scene, the
    models or the merged file with *diag saying why; *res (may be NULL) says what each run did. */
 FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int nbody, const char* const* models,
@@ -809,6 +825,12 @@ FMB_API int fmb_safe_is_temporary(const fmbSafeFile* f);
 FMB_API const char* fmb_safe_write_path(const fmbSafeFile* f);
 /* keep != 0: put the content in place (rename); 0: discard it. 0, or -1 with errno on failure */
 FMB_API int fmb_safe_close(fmbSafeFile* f, int keep);
+
+/* "did you mean": of words[0..n) (NULL entries skipped), the nearest to `typed` when `typed` is
+   a typo of it (an edit distance, with adjacent transpositions, of 1 in a word of up to 4
+   letters, 2 from 5 on), else NULL. The scene loader's unknown keys and the program's unknown
+   commands are matched by this one rule. */
+FMB_API const char* fmb_nearest_word(const char* typed, const char* const* words, int n);
 
 #ifdef __cplusplus
 }

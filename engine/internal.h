@@ -151,11 +151,21 @@ struct fmbJointEval {
   double t;
   const double* q; /* whole coordinate vector */
   const double* v;
-  double* work;        /* plugin scratch (body markers) */
-  double* mk;          /* 3 x max body ncoord: marker derivatives before scattering */
-  double* js;          /* 2 x max joint columns: the joint's own scratch */
-  const double* input; /* the inputs' current values (the workspace's, set by fmb_set_input) */
+  double* work;                        /* plugin scratch (body markers) */
+  double* mk;                          /* 3 x max body ncoord: marker derivatives before scattering */
+  double* js;                          /* 2 x max joint columns: the joint's own scratch */
+  const struct fmbInputSetting* input; /* the inputs' settings (the workspace's, fmb_set_input) */
 };
+
+/* An input's setting (fmb_set_input, fmb_set_input_motion): from t_set on it is
+   value + rate tau + accel tau^2 / 2, tau = t - t_set; rate and accel are 0 unless the program
+   gave them (a load or drive held between settings). */
+typedef struct fmbInputSetting {
+  double value, rate, accel, t_set;
+  int jumps; /* times a drive's setting has jumped away from where its last one led (warned once) */
+} fmbInputSetting;
+/* the setting's value and its rate and second rate at time t */
+void fmb_input_at(const fmbInputSetting* s, double t, double* value, double* rate, double* accel);
 
 /* ---- registry.c: a growable registry of types; plugin.c: loading plugins ---- */
 struct fmbRegistry {
@@ -216,6 +226,9 @@ extern const char* const fmb_scene_keys[];
    NULL; `complete` when together they name every key it may have; `what` names the mapping in
    messages (kept as a pointer: it must live while the mapping is read). Reset by fmbp_begin_item. */
 void fmbp_expect(fmbParser* p, const char* what, const char* const* keys, const fmbParam* params, int complete);
+/* the keys every body and joint item takes besides its type's (scene.c): name, type, material,
+   section; NULL-terminated */
+extern const char* const fmb_item_keys[];
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what);
 int fmbp_is_map(fmbParser* p, fmbNode n);
 int fmbp_is_seq(fmbParser* p, fmbNode n);
@@ -246,8 +259,10 @@ typedef struct fmbWorkspace fmbWorkspace;
 fmbWorkspace* fmb_workspace_new(const fmbModel* m);
 void fmb_workspace_free(fmbWorkspace* w);
 double* fmb_workspace_plugin(fmbWorkspace* w);
-/* the inputs' current values (m->ninput; the scene's `value:` when the workspace is made) */
-double* fmb_workspace_inputs(fmbWorkspace* w);
+/* the inputs' settings (m->ninput; the scene's `value:` at rest when the workspace is made, and
+   again after fmb_workspace_inputs_reset) */
+fmbInputSetting* fmb_workspace_inputs(fmbWorkspace* w);
+void fmb_workspace_inputs_reset(const fmbModel* m, fmbWorkspace* w);
 /* where messages of the run on this workspace go (fn NULL: the thread's default, warn.c) */
 typedef struct {
   fmbWarnFn fn;

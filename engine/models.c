@@ -7,6 +7,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "internal.h"
@@ -134,6 +135,15 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
                    k + 1, MODEL_NAME_MAX);
       return FMB_EXIT_BAD_INPUT;
     }
+  /* two runs of one model would give two columns of one name (NAME@MODEL twice) */
+  for (int k = 0; k < nmodel; ++k)
+    for (int j = 0; j < k; ++j)
+      if (strcmp(models[j], models[k]) == 0) {
+        fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0,
+                     "fmb_run_models: model '%s' is named twice (models %d and %d): each model runs once", models[k],
+                     j + 1, k + 1);
+        return FMB_EXIT_BAD_INPUT;
+      }
   /* overrides: the scene's, then one per body for this model */
   const int nov = scene->noverrides + nbody;
   const char** ov = calloc((size_t)nov, sizeof(char*));
@@ -177,7 +187,25 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
       res->ran = k + 1;
       break;
     }
-    const fmbRunOptions o = {.csv_path = file, .quiet = opt->quiet, .stop = opt->stop};
+    /* an animation (opt->vtk_dir, else the scene's `vtk` key) per model, in MODEL/ below it: one
+       folder for all would hold the last model's frames under the first's collection */
+    const char* vtk_base = opt->vtk_dir ? opt->vtk_dir : (m->vtk_dir[0] ? m->vtk_dir : NULL);
+    char vtk[1200] = "";
+    if (vtk_base && mkdir(vtk_base, 0777) != 0 && errno != EEXIST) {
+      fmb_diag_set(&res->diag[k], FMB_EXIT_BAD_INPUT, vtk_base, 0, 0, "cannot create the VTK directory: %s",
+                   strerror(errno));
+      *diag = res->diag[k];
+      rc = res->code[k] = FMB_EXIT_BAD_INPUT;
+      res->ran = k + 1;
+      fmb_free(m);
+      break;
+    }
+    if (vtk_base && snprintf(vtk, sizeof vtk, "%s/%s", vtk_base, models[k]) >= (int)sizeof vtk) vtk[0] = '\0';
+    const fmbRunOptions o = {.csv_path = file,
+                             .quiet = opt->quiet,
+                             .stop = opt->stop,
+                             .vtk_dir = vtk[0] ? vtk : NULL,
+                             .vtk_every = opt->vtk_every};
     res->code[k] = fmb_run(m, &o, &res->stats[k], &res->diag[k]);
     res->ran = k + 1;
     fmb_free(m);

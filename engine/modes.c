@@ -823,6 +823,26 @@ int fmb_write_table(const char* path, int ncol, const char* const* names, int nr
                  "fmb_write_table: no columns, a NULL name, no values or a negative row count");
     return FMB_EXIT_BAD_INPUT;
   }
+  /* A name is written as it is (the CSV has no quoting: flexmbd's readers split the header at
+     commas, csv_table.c, and take a first line starting with '#' as a comment): one that holds a
+     comma, a quote or a control character (a line break), is empty, has blanks at its ends, or
+     would turn the header into a comment, would misalign every later column or row; refused. */
+  for (int i = 0; i < ncol; ++i) {
+    const char* n = names[i];
+    const size_t len = strlen(n);
+    const char* why = len == 0                           ? "is empty"
+                      : strpbrk(n, ",\"")                ? "holds a comma or a quote"
+                      : n[0] == ' ' || n[len - 1] == ' ' ? "has blanks at its ends"
+                      : i == 0 && n[0] == '#'            ? "starts the header with '#' (a comment line)"
+                                                         : NULL;
+    for (size_t k = 0; !why && k < len; ++k)
+      if ((unsigned char)n[k] < 0x20 || n[k] == 0x7f) why = "holds a control character (a line break, a tab)";
+    if (why) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path ? path : "", 0, 0,
+                   "fmb_write_table: column %d's name %s: a CSV name may not (it has no quoting)", i + 1, why);
+      return FMB_EXIT_BAD_INPUT;
+    }
+  }
   fmbCsv* c = fmb_csv_open(path, diag);
   if (!c) return FMB_EXIT_BAD_INPUT;
   fmb_csv_header_names(c, ncol, names);

@@ -133,7 +133,10 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
 /* `materials:` and `sections:`: mappings of named entries, each a mapping of keys that the
    items naming it (`material: steel`, `section: bar`) take unless they give the key themselves */
 static const char* const library_keys[2] = {"materials", "sections"};
-static const char* const reference_keys[2] = {"material", "section"};
+/* the keys every body and joint item takes besides its type's own: the list an item's keys are
+   accepted from and "expected one of" prints (yaml_get.c), and conform's declared keys */
+const char* const fmb_item_keys[] = {"name", "type", "material", "section", NULL};
+static const char* const* const reference_keys = fmb_item_keys + 2; /* material, section */
 
 static int check_library(fmbParser* p, fmbNode lib, const char* what) {
   if (lib < 0) return 0;
@@ -154,8 +157,8 @@ static int resolve_references(fmbParser* p, fmbNode item) {
   fmbNode root = fmbp_root(p);
   for (int k = 0; k < 2; ++k) {
     p->inherited[k] = -1;
-    /* material and section stay out of the item's "expected one of" list: every item takes
-       them, and the list is about the type's own keys (docs/scenes.md lists these) */
+    /* looked up here, before the type's keys: kept out of `looked`, so that the type's keys come
+       first in "expected one of" (material and section follow from fmb_item_keys) */
     const int looked = p->nlooked;
     fmbNode ref = fmb_find_key(p, item, reference_keys[k]);
     p->nlooked = looked;
@@ -203,7 +206,7 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   *self = NULL;
   if (!fmbp_is_map(p, item)) return fmb_parse_error(p, item, "expected a mapping for a %s (with name and type)", kind);
   fmbp_begin_item(p);
-  static const char* const item_keys[] = {"name", "type", NULL};
+  const char* const* item_keys = fmb_item_keys;
   fmbp_expect(p, kind, item_keys, NULL, 0); /* its type's keys are known once `type` is read */
   if (fmbp_get_name(p, item, "name", name)) return -1;
   if (name_taken(m, name))

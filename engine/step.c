@@ -233,7 +233,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   d->switched.why[0] = '\0';
   memset(d->work_before, 0, sizeof(double) * (size_t)(m->njoint + 1));
   memset(fmb_workspace_work(w), 0, sizeof(double) * (size_t)(m->njoint + 1));
-  if (m->ninput > 0) memcpy(fmb_workspace_inputs(w), m->input_initial, sizeof(double) * (size_t)m->ninput);
+  fmb_workspace_inputs_reset(m, w);
   d->t = m->solver.t0;
   int rc = fmb_initial_conditions(m, w, d->y, d->yp, &d->ic, diag);
   if (!rc) {
@@ -495,34 +495,66 @@ static int input_index(const fmbModel* m, const char* name) {
   return -1;
 }
 
-int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value) {
+/* fmb_set_input and fmb_set_input_motion: the input `name` is value + rate tau + accel tau^2 / 2
+   from time() on */
+static int set_input(const fmbModel* m, fmbData* d, const char* fn, const char* name, double value, double rate,
+                     double accel) {
   fmbDiag diag;
   memset(&diag, 0, sizeof diag);
-  if (misused(m, d, "fmb_set_input", &diag)) return FMB_EXIT_BAD_INPUT;
+  if (misused(m, d, fn, &diag)) return FMB_EXIT_BAD_INPUT;
   const int i = input_index(m, name);
-  if (i < 0 || !isfinite(value)) {
-    if (i < 0)
-      fmb_warn(d->w,
-               "fmb_set_input: no input named '%s' (%d inputs: a drive with `profile: input` or a load with "
-               "`law: input` is one, named by its joint)",
-               name ? name : "(NULL)", m->ninput);
-    else
-      fmb_warn(d->w, "fmb_set_input: input '%s' = %g: not a finite number", name, value);
+  if (i < 0) {
+    fmb_warn(d->w,
+             "%s: no input named '%s' (%d inputs: a drive with `profile: input` or a load with `law: input` is one, "
+             "named by its joint)",
+             fn, name ? name : "(NULL)", m->ninput);
     return FMB_EXIT_BAD_INPUT;
   }
-  double* input = fmb_workspace_inputs(d->w);
-  if (input[i] == value) return 0; /* no jump: the step history stays valid */
-  input[i] = value;
-  /* the equations change at time(): a BDF or Radau history across the jump would be wrong, so
-     the next advance starts afresh from a state made consistent with the new value */
+  if (!isfinite(value) || !isfinite(rate) || !isfinite(accel)) {
+    fmb_warn(d->w, "%s: input '%s' = %g (rate %g, second rate %g): not a finite number", fn, name, value, rate, accel);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmbInputSetting* in = &fmb_workspace_inputs(d->w)[i];
+  double now_value, now_rate, now_accel;
+  fmb_input_at(in, d->t, &now_value, &now_rate, &now_accel);
+  if (now_value == value && now_rate == rate && now_accel == accel) return 0; /* no change: the history holds */
+  /* A drive's motion that jumps (in position or in rate, beyond the solver's tolerance on that
+     scale) is projected anew, and the motion its last setting led to is lost: a drive held by
+     fmb_set_input comes to rest at every change. Said once per input, with what to do instead. */
+  const fmbJointInst* j = &m->joint[m->input_joint[i]];
+  const double tol = m->solver.atol + m->solver.rtol * fmax(fabs(value), fabs(now_value));
+  const double h = fmax(d->t - in->t_set, 0.0); /* how long the last setting held */
+  const double jump = fabs(value - now_value), rate_jump = fabs(rate - now_rate);
+  if (j->nrows > 0 && (jump > tol || rate_jump * h > tol) && in->jumps++ == 0)
+    fmb_warn(d->w,
+             "warning: %s: drive input '%s' jumps at t = %.6g by %.3g (rate %.3g -> %.3g): the velocities are "
+             "projected onto the new setting%s (further jumps of this input are not reported)",
+             fn, name, d->t, value - now_value, now_rate, rate,
+             rate == 0.0 ? "; a drive set by value alone is at rest between settings: give the motion's rate with "
+                           "fmb_set_input_motion (docs/api.md)"
+                         : "");
+  in->value = value;
+  in->rate = rate;
+  in->accel = accel;
+  in->t_set = d->t;
+  /* the equations change at time(): a BDF or Radau history across the change would be wrong, so
+     the next advance starts afresh from a state made consistent with the new setting */
   retire_backend(d, 1);
   return 0;
+}
+
+int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value) {
+  return set_input(m, d, "fmb_set_input", name, value, 0.0, 0.0);
+}
+
+int fmb_set_input_motion(const fmbModel* m, fmbData* d, const char* name, double value, double rate, double accel) {
+  return set_input(m, d, "fmb_set_input_motion", name, value, rate, accel);
 }
 
 int fmb_get_input(const fmbModel* m, const fmbData* d, const char* name, double* value) {
   if (misused(m, d, "fmb_get_input", NULL) || !value) return FMB_EXIT_BAD_INPUT;
   const int i = input_index(m, name);
   if (i < 0) return FMB_EXIT_BAD_INPUT;
-  *value = fmb_workspace_inputs(d->w)[i];
+  fmb_input_at(&fmb_workspace_inputs(d->w)[i], d->t, value, NULL, NULL);
   return 0;
 }

@@ -50,8 +50,8 @@ struct fmbWorkspace {
   void* attached;
   void (*attached_free)(void*);
   double spring_energy0;
-  double* input;    /* m->ninput: the inputs' current values */
-  fmbWarnSink warn; /* where this run's messages go */
+  fmbInputSetting* input; /* m->ninput: the inputs' settings */
+  fmbWarnSink warn;       /* where this run's messages go */
 };
 
 #define FMB_BLOCK_CACHE_BYTES ((size_t)256 << 20)
@@ -110,8 +110,8 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->work_done = calloc((size_t)m->njoint + 1, sizeof(double));
   w->redundant = calloc((size_t)m->nc + 1, 1);
   w->nredundant_cap = m->nc;
-  w->input = calloc((size_t)m->ninput + 1, sizeof(double));
-  if (w->input && m->ninput > 0) memcpy(w->input, m->input_initial, (size_t)m->ninput * sizeof(double));
+  w->input = calloc((size_t)m->ninput + 1, sizeof *w->input);
+  if (w->input) fmb_workspace_inputs_reset(m, w);
   if (!w->redundant || !w->input) {
     fmb_workspace_free(w);
     return NULL;
@@ -171,7 +171,22 @@ int fmb_model_has_sparse_body(const fmbModel* m) {
 
 double* fmb_workspace_plugin(fmbWorkspace* w) { return w->plugin; }
 double* fmb_workspace_work(fmbWorkspace* w) { return w->work_done; }
-double* fmb_workspace_inputs(fmbWorkspace* w) { return w->input; }
+fmbInputSetting* fmb_workspace_inputs(fmbWorkspace* w) { return w->input; }
+
+void fmb_workspace_inputs_reset(const fmbModel* m, fmbWorkspace* w) {
+  for (int i = 0; i < m->ninput; ++i) {
+    const fmbInputSetting at_rest = {m->input_initial[i], 0.0, 0.0, m->solver.t0, 0};
+    w->input[i] = at_rest;
+  }
+}
+
+void fmb_input_at(const fmbInputSetting* s, double t, double* value, double* rate, double* accel) {
+  const double tau = t - s->t_set;
+  /* a held setting is its value exactly, wherever t is (no 0 * tau rounding) */
+  *value = s->rate == 0.0 && s->accel == 0.0 ? s->value : s->value + tau * (s->rate + 0.5 * tau * s->accel);
+  if (rate) *rate = s->rate + tau * s->accel;
+  if (accel) *accel = s->accel;
+}
 fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w) { return &w->warn; }
 unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
   if (count) {
@@ -218,7 +233,16 @@ int fmb_eval_col0(const fmbJointEval* ev, int k) {
   return k == 1 ? fmb_eval_ncoord(ev, 0) : 0;
 }
 double fmb_eval_input(const fmbJointEval* ev) {
-  return (ev && ev->j->input >= 0 && ev->input) ? ev->input[ev->j->input] : NAN;
+  double value = NAN;
+  if (ev && ev->j->input >= 0 && ev->input) fmb_input_at(&ev->input[ev->j->input], ev->t, &value, NULL, NULL);
+  return value;
+}
+
+double fmb_eval_input_rate(const fmbJointEval* ev, double* accel) {
+  double value, rate = NAN, a = NAN;
+  if (ev && ev->j->input >= 0 && ev->input) fmb_input_at(&ev->input[ev->j->input], ev->t, &value, &rate, &a);
+  if (accel) *accel = a;
+  return rate;
 }
 
 int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle, double* dpos_dq,

@@ -123,8 +123,10 @@ fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key) {
 }
 
 /* The keys the current mapping may have, in one list: those looked up so far (in the order the
-   loader reads them), then the declared ones (fmbp_expect) not yet among them. `material` and
-   `section` stay out (every item takes them; docs/scenes.md lists them). Returns the count. */
+   loader reads them), then the declared ones (fmbp_expect: for an item, its name, type, material
+   and section, scene.c's fmb_item_keys) not yet among them, then the type's params. The list that
+   "expected one of" prints is the list a key is accepted from (key_expected), so neither can
+   leave out what the other has. Returns the count. */
 #define FMB_EXPECTED_MAX 96
 static int expected_keys(const fmbParser* p, const char* out[FMB_EXPECTED_MAX]) {
   int n = 0;
@@ -134,7 +136,7 @@ static int expected_keys(const fmbParser* p, const char* out[FMB_EXPECTED_MAX]) 
     for (int i = 0; n < FMB_EXPECTED_MAX; ++i) {
       const char* k = l < 2 ? (lists[l] && i < counts[l] ? lists[l][i] : NULL) : (p->params ? p->params[i].key : NULL);
       if (!k) break;
-      int dup = strcmp(k, "material") == 0 || strcmp(k, "section") == 0;
+      int dup = 0;
       for (int j = 0; j < n && !dup; ++j) dup = strcmp(out[j], k) == 0;
       if (!dup) out[n++] = k;
     }
@@ -169,20 +171,27 @@ static int is_typo_of(const char* typed, const char* key) {
   return d > 0 && d <= (len >= 5 ? 2 : 1);
 }
 
+const char* fmb_nearest_word(const char* typed, const char* const* words, int n) {
+  const char* nearest = NULL;
+  int best = 1 << 20;
+  for (int i = 0; typed && words && i < n; ++i) {
+    if (!words[i]) continue;
+    const int d = key_distance(typed, words[i]);
+    if (is_typo_of(typed, words[i]) && d < best) best = d, nearest = words[i];
+  }
+  return nearest;
+}
+
 /* the unknown-key message, with the nearest expected key when it is a typo of it */
 static int unknown_key_error(fmbParser* p, fmbNode key, const char* k, const char* what) {
   const char* exp[FMB_EXPECTED_MAX];
   const int n = expected_keys(p, exp);
   char expected[900] = "";
   size_t used = 0;
-  const char* nearest = NULL;
-  int best = 1 << 20;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < n; ++i)
     if (used + 40 < sizeof expected)
       used += (size_t)snprintf(expected + used, sizeof expected - used, "%s%s", i ? ", " : "", exp[i]);
-    const int d = key_distance(k, exp[i]);
-    if (is_typo_of(k, exp[i]) && d < best) best = d, nearest = exp[i];
-  }
+  const char* nearest = fmb_nearest_word(k, exp, n);
   if (nearest)
     return fmb_parse_error(p, key, "unknown key '%s' in %s: did you mean '%s'? (expected one of: %s)", k, what, nearest,
                            expected);
@@ -195,7 +204,7 @@ static int key_expected(const fmbParser* p, const char* k) {
   const int n = expected_keys(p, exp);
   for (int i = 0; i < n; ++i)
     if (strcmp(exp[i], k) == 0) return 1;
-  return strcmp(k, "material") == 0 || strcmp(k, "section") == 0;
+  return 0;
 }
 
 int fmbp_check_unknown(fmbParser* p, fmbNode map, const char* what) {

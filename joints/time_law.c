@@ -178,8 +178,10 @@ fmbLawValue fmbj_law_eval(const fmbTimeLaw* law, double t) {
 
 fmbLawValue fmbj_law_at(const fmbTimeLaw* law, const fmbJointEval* ev) {
   if (law->kind != FMB_LAW_INPUT) return fmbj_law_eval(law, fmb_eval_time(ev));
-  /* piecewise constant: no rate; the integral is not used (an input motion is a position law) */
-  const fmbLawValue v = {fmb_eval_input(ev), 0.0, 0.0, NAN};
+  /* as the program set it: held (rate 0, fmb_set_input) or moving (fmb_set_input_motion); the
+     integral is not used (an input motion is a position law) */
+  fmbLawValue v = {fmb_eval_input(ev), 0.0, 0.0, NAN};
+  v.rate = fmb_eval_input_rate(ev, &v.accel);
   return v;
 }
 

@@ -9,7 +9,7 @@
  *   table     s piecewise linear through [t, value] rows, held at the end values outside
  *             (a load's); a prescribed motion's table is smooth instead (see fmbMotion)
  *   input     s set by a program between steps (fmb_set_input; the joint's `input` op), constant
- *             between two settings; `value:` is its value until then (issue 24, docs/api.md)
+ *             between two settings, or moving with the rate the program gave (fmb_set_input_motion); `value:` is its value until then (issue 24, docs/api.md)
  * A load multiplies its force and torque by s(t); a prescribed motion (fmbMotion) is either a
  * magnitude times the integral of s (constant, ramp, spinup: laws of the speed) or a magnitude
  * times s itself (harmonic, table: laws of the position). */
@@ -67,7 +67,8 @@ const char* fmbj_law_name(const fmbTimeLaw* law);
                                     so a rigid drive can follow it (a piecewise-linear angle
                                     jumps in speed at every row: an impulse no solver steps over);
                                     exact for f quadratic in t
-     input    (value):              f set by a program between steps, held between settings */
+     input    (value):              f set by a program between steps, held between settings or
+                                    moving with the rate it gave (fmb_set_input_motion) */
 typedef struct {
   fmbTimeLaw law;
   double magnitude;

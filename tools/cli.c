@@ -55,6 +55,19 @@ const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const 
   return argv[++*i];
 }
 
+int fmb_cli_check_set(const char* cmd, const char* ov, const char* next) {
+  (void)cmd; /* the message has the library's form for a --set (engine/yaml_get.c): the option, then why */
+  const char* eq = strchr(ov, '=');
+  if (eq && eq > ov) return 0;
+  if (!eq && next && next[0] != '-' && strchr(ov, '.') && !strchr(next, '='))
+    /* `--set solver.rtol 1e-6`: the value became the next argument */
+    fprintf(stderr, "--set: error: %s: expected PATH=VALUE in one argument, not '%s %s' (write --set %s=%s)\n", ov, ov,
+            next, ov, next);
+  else
+    fprintf(stderr, "--set: error: %s: expected PATH=VALUE, e.g. solver.rtol=1e-8\n", ov);
+  return FMB_EXIT_BAD_INPUT;
+}
+
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s) {
   const char* a = argv[*i];
   const char* ov = NULL;
@@ -84,6 +97,7 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
     fprintf(stderr, "flexmbd %s: one scene file at a time (got '%s' and '%s')\n", cmd, s->scene, a);
     return FMB_EXIT_BAD_INPUT;
   }
+  if (fmb_cli_check_set(cmd, ov, *i + 1 < argc ? argv[*i + 1] : NULL)) return FMB_EXIT_BAD_INPUT;
   if (s->nover == FMB_CLI_MAX_OVERRIDES) {
     fprintf(stderr, "flexmbd %s: more than %d --set overrides\n", cmd, FMB_CLI_MAX_OVERRIDES);
     return FMB_EXIT_BAD_INPUT;

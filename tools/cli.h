@@ -31,6 +31,9 @@ typedef struct fmbCliScene {
    fmb_cli_registry() at once) or (when no scene was given yet) the scene file; returns 1 when
    taken (advancing *i past an argument), 0 when not ours, or FMB_EXIT_BAD_INPUT after printing why (prefixed by `cmd`). */
 int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
+/* a --set value `ov` has the form PATH=VALUE: 0, else FMB_EXIT_BAD_INPUT after saying so in the
+   option's terms (`next`, the argument after it or NULL, shows `--set PATH VALUE`, a space for =) */
+int fmb_cli_check_set(const char* cmd, const char* ov, const char* next);
 /* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
 const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
 /* file:line:col: error: msg (or the shorter forms when no location is known), on stderr or in buf */
@@ -62,10 +65,10 @@ void fmb_cli_warn_end(void);
 fmbRegistry* fmb_cli_registry(void);
 
 /* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c
-   over the library's fmb_run_models); *stop (SIGINT) ends it after the model in progress, whose
+   over the library's fmb_run_models), with vtk (or NULL) each model's animation in vtk/MODEL; *stop (SIGINT) ends it after the model in progress, whose
    rows and those of the models before it are written */
-int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet,
-                       volatile sig_atomic_t* stop);
+int fmb_cli_run_models(const fmbCliScene* s, const char* models, const char* out, int quiet, const char* vtk,
+                       int vtk_every, volatile sig_atomic_t* stop);
 
 /* `compare`'s work on parsed options (tools/cmd_compare.c), also `run --reference`'s: one line per
    column on stdout; returns compare's exit code */

@@ -9,8 +9,8 @@
  * Each scene runs in a child process (a crash or a hang fails that scene only; -j N runs N at once)
  * with the overrides its reference records; every column is compared at the reference's rows with
  * |run - ref| <= atol + rtol * range(ref column). One table row per scene on stdout.
- * Exit 0 all pass, 1 any fails, 2 bad input (a missing path or reference, a malformed reference, or
- * with --bless a scene that does not load), 4 interrupted (every child stopped, nothing left behind).
+ * Exit 0 all pass, 1 any fails, 2 bad input (a missing path or reference, a malformed reference, a
+ * --set that is not PATH=VALUE or does not apply to a scene, or with --bless a scene that does not load), 4 interrupted (every child stopped, nothing left behind).
  * The parts: regress_ref.c (scenes, references, --bless), regress_jobs.c (children, the check),
  * regress_report.c (table, JUnit). */
 #include <dirent.h>
@@ -116,9 +116,12 @@ static int parse_arguments(int argc, char** argv, RegressOptions* op, RegressLis
         return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (strcmp(a, "--set") == 0) {
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "PATH=VALUE"))) return_code(FMB_EXIT_BAD_INPUT);
+      if (!(v = fmb_cli_value("regress", argc, argv, &i, "PATH=VALUE")) ||
+          fmb_cli_check_set("regress", v, i + 1 < argc ? argv[i + 1] : NULL))
+        return_code(FMB_EXIT_BAD_INPUT);
       op->sets[o.nsets++] = v;
     } else if (strncmp(a, "--set=", 6) == 0) {
+      if (fmb_cli_check_set("regress", a + 6, i + 1 < argc ? argv[i + 1] : NULL)) return_code(FMB_EXIT_BAD_INPUT);
       op->sets[o.nsets++] = a + 6;
     } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
       usage(stdout);
@@ -142,7 +145,11 @@ static int parse_arguments(int argc, char** argv, RegressOptions* op, RegressLis
     }
     if (S_ISDIR(st.st_mode)) {
       int before = scenes.n;
-      regress_walk(p, 0, o.bless, &scenes, notes);
+      char why[1400];
+      if (regress_walk(p, o.bless, &scenes, notes, why, sizeof why)) {
+        fprintf(stderr, "flexmbd regress: %s\n", why);
+        return_code(FMB_EXIT_BAD_INPUT);
+      }
       if (scenes.n == before) {
         fprintf(stderr, "flexmbd regress: no scene %sunder %s%s\n", o.bless ? "" : "with a reference ", p,
                 o.bless ? "" : " (make references with: flexmbd regress --bless PATH)");
@@ -190,8 +197,19 @@ int fmb_cmd_regress(int argc, char** argv) {
   return rc;
 }
 
-/* two scenes that would share one reference (a.yaml and a.yml): -1 after saying so */
+/* two scenes that would share one reference (a.yaml and a.yml): -1 after saying so. The twin is
+   looked for beside each scene, not only among the scenes named: `regress --bless a.yml` after
+   `--bless a.yaml` would otherwise check a.yml against a.yaml's reference and call it unchanged. */
 static int shared_reference(RegressJob* const* jobs, int n) {
+  for (int i = 0; i < n; ++i) {
+    char* twin = regress_twin_scene(jobs[i]->scene);
+    if (twin) {
+      fprintf(stderr, "flexmbd regress: %s and %s would share one reference %s: rename one of them\n", jobs[i]->scene,
+              twin, jobs[i]->ref_path);
+      free(twin);
+      return -1;
+    }
+  }
   for (int i = 0; i < n; ++i)
     for (int k = i + 1; k < n; ++k)
       if (strcmp(jobs[i]->ref_path, jobs[k]->ref_path) == 0) {

@@ -82,7 +82,7 @@ int fmb_cmd_run(int argc, char** argv) {
   if (!bad) bad = fmb_cli_check_output_not_input(out, inputs, ninputs);
   if (bad) return bad; /* nothing ran: no stats line */
   volatile sig_atomic_t* stop = fmb_cli_catch_stop_signals();
-  if (models) return fmb_cli_run_models(&s, models, out, quiet, stop);
+  if (models) return fmb_cli_run_models(&s, models, out, quiet, vtk, vtk_every, stop);
   fmbModel* m = fmb_load(s.scene, s.overrides, s.nover, fmb_cli_registry(), &diag);
   if (!m) {
     fmb_cli_print_diag(&diag);

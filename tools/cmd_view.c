@@ -2,7 +2,8 @@
  *                [--set PATH=VALUE]... [--plugin x.so]...`
  * One self-contained HTML file (no network, no external script: tools/view.html, embedded at
  * build time) that animates the run: the mechanism drawn row by row, play/pause, a time slider,
- * speed, a deformation scale for beams, traces, and a plot of chosen columns with a time cursor.
+ * speed, a deformation scale for beams, traces, and a plot of chosen columns (default: the one that
+ * moves most, default_column) with a time cursor.
  *
  * `--model M` draws the run of model M in a `run --models` CSV (its NAME@M columns).
  * What is drawn is the library's drawing of the scene (fmb_drawing_new, the same points and cells
@@ -78,6 +79,48 @@ static int output_name_length(const char* name) {
   const char* at = strrchr(name, '@');
   if (!view_model) return (int)strlen(name);
   return at && strcmp(at + 1, view_model) == 0 ? (int)(at - name) : 0;
+}
+
+/* The column the plot opens on: the one that moves most. A column's motion is its range against
+   the run's scale of its unit (the largest |value| of any column in that unit, fmb_output_unit;
+   a column of unknown unit is its own scale), so round-off about zero (a beam's x of +-1e-26 m
+   where its shape spans metres) is no motion, while an angle or an energy that sweeps its own
+   range is. A column that is not the drawing's (frame pose, shape stations) comes first when one
+   moves; ties go to the first. */
+static int default_column(const fmbTable* tb, const ViewBody* vb, int nb) {
+  const int n = tb->ncol;
+  const char** unit = calloc((size_t)n, sizeof *unit);
+  double *range = calloc((size_t)n, sizeof *range), *absmax = calloc((size_t)n, sizeof *absmax);
+  double* scale = calloc((size_t)n, sizeof *scale);
+  int* group = calloc((size_t)n, sizeof *group); /* the first column of its unit: the unit's scale lives there */
+  int best = 1;
+  if (!unit || !range || !absmax || !scale || !group) goto out;
+  const char* units[64]; /* the distinct units seen, and the column each first appeared in */
+  int unit_col[64], nunits = 0;
+  for (int c = 1; c < n; ++c) {
+    unit[c] = fmb_output_unit_in(fmb_cli_registry(), tb->name[c]);
+    fmb_table_column_scale(tb, c, &range[c], &absmax[c]);
+    group[c] = c; /* unknown unit (or more than 64 units): its own scale */
+    for (int u = 0; unit[c] && u < nunits && group[c] == c; ++u)
+      if (strcmp(units[u], unit[c]) == 0) group[c] = unit_col[u];
+    if (unit[c] && group[c] == c && nunits < 64) units[nunits] = unit[c], unit_col[nunits++] = c;
+    if (isfinite(absmax[c])) scale[group[c]] = fmax(scale[group[c]], absmax[c]);
+  }
+  double best_motion = 0.0;
+  for (int pass = 0; pass < 2 && best_motion == 0.0; ++pass)
+    for (int c = 1; c < n; ++c) {
+      int drawing = is_shape_column(tb->name[c]);
+      for (int b = 0; b < nb && !drawing; ++b)
+        for (int k = 0; k < 3; ++k) drawing |= vb[b].frame[k] == c;
+      if (drawing != pass) continue; /* first the plot's own columns, then the drawing's */
+      const double sc = scale[group[c]];
+      /* a range below 1e-9 of its scale is round-off, not motion */
+      const double motion = isfinite(range[c]) && sc > 0.0 && range[c] > 1e-9 * sc ? range[c] / sc : 0.0;
+      if (motion > best_motion) best_motion = motion, best = c;
+    }
+out:
+  free(unit), free(range), free(absmax), free(scale), free(group);
+  return best;
 }
 
 /* "a,b,c": the table columns named, into cols (0-based data indices); -1 after a message */
@@ -446,14 +489,8 @@ int fmb_cmd_view(int argc, char** argv) {
   if (!rc && columns) {
     nplot = parse_columns(columns, &tb, plot, 64);
     if (nplot < 0) rc = FMB_EXIT_BAD_INPUT;
-  } else if (!rc) { /* the first column that is not a drawing's */
-    for (int c = 1; c < tb.ncol && !nplot; ++c) {
-      int geometric = is_shape_column(tb.name[c]);
-      for (int b = 0; b < nb && !geometric; ++b)
-        for (int k = 0; k < 3; ++k) geometric |= vb[b].frame[k] == c;
-      if (!geometric) plot[nplot++] = c - 1;
-    }
-    if (!nplot && tb.ncol > 1) plot[nplot++] = 0;
+  } else if (!rc && tb.ncol > 1) {
+    plot[nplot++] = default_column(&tb, vb, nb) - 1;
   }
   if (!rc) {
     char title[1200], ferr[300] = "";

@@ -99,6 +99,8 @@ int fmb_table_load_keyed(const char* path, fmbTable* tb, const char* first, char
   for (;;) {
     n = read_line(f, &line, &cap);
     ++lineno;
+    /* a byte-order mark (a spreadsheet's "CSV UTF-8") is no part of the first name or comment */
+    if (lineno == 1 && n >= 3 && memcmp(line, "\xEF\xBB\xBF", 3) == 0) memmove(line, line + 3, (size_t)(n -= 3) + 1);
     if (n < 0 || line[0] != '#') break;
     if (push_string(&tb->meta, &tb->nmeta, line + 1)) goto nomem;
   }
@@ -152,7 +154,9 @@ int fmb_table_load_keyed(const char* path, fmbTable* tb, const char* first, char
     char* s = line;
     for (int k = 0; k < tb->ncol; ++k) {
       char* end;
-      row[k] = strtod(s, &end);
+      row[k] = strtod(s, &end); /* blanks before a number are skipped, */
+      if (end != s)
+        while (*end == ' ' || *end == '\t') ++end; /* and after it (a spreadsheet's padded cells) */
       const char want = k < tb->ncol - 1 ? ',' : '\0';
       if (end == s || *end != want) {
         say(err, errlen, "%s:%ld: expected %d comma-separated numbers (the header's columns)", path, lineno, tb->ncol);

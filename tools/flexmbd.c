@@ -108,6 +108,14 @@ int main(int argc, char** argv) {
       }
       return commands[i].main(argc, argv);
     }
+  const char* names[NCOMMANDS];
+  for (int i = 0; i < NCOMMANDS; ++i) names[i] = commands[i].name;
+  const char* nearest = fmb_nearest_word(cmd, names, NCOMMANDS);
+  if (nearest) { /* a typo: the one command meant, not the whole usage */
+    fprintf(stderr, "flexmbd: unknown command '%s'; did you mean '%s'? (flexmbd --help lists the commands)\n", cmd,
+            nearest);
+    return FMB_EXIT_BAD_INPUT;
+  }
   fprintf(stderr, "flexmbd: unknown command '%s'\n", cmd);
   usage(stderr);
   return FMB_EXIT_BAD_INPUT;

@@ -23,7 +23,7 @@
 #define REGRESS_NCOMPANION 2
 extern const double regress_companion_rtol[REGRESS_NCOMPANION];
 #define REGRESS_DEFAULT_ROWS 201
-#define REGRESS_MAX_DEPTH 32
+#define REGRESS_MAX_DEPTH 256 /* folders below a searched PATH; a deeper one is refused */
 
 typedef struct {
   char name[160];
@@ -46,6 +46,7 @@ typedef struct {
 /* what a child process reports about its run */
 typedef struct {
   int loaded;    /* 0: the scene did not load (msg says why) */
+  int bad_set;   /* it did not load because of a command-line --set: bad input, not a failed scene */
   int exit_code; /* fmb_run's */
   int status_ok;
   double t_reached, cpu_s;
@@ -95,10 +96,15 @@ int regress_list_push(RegressList* l, char* s);
 int regress_file_exists(const char* p);
 /* SCENE.ref.csv beside SCENE.yaml (or .yml); NULL when out of memory */
 char* regress_reference_path(const char* scene);
-/* Every scene below dir (with `all`, every .yaml or .yml scene, otherwise those with a reference) into
-   out; what it passes over that a user may have meant (links, folders deeper than
-   REGRESS_MAX_DEPTH, scenes without a reference) is listed in `skipped` with the reason. */
-void regress_walk(const char* dir, int depth, int all, RegressList* out, RegressList* skipped);
+/* the scene beside `scene` that has the same reference (SCENE.yml beside SCENE.yaml and the other
+   way round) when it exists, or NULL; the caller frees it */
+char* regress_twin_scene(const char* scene);
+/* Every scene below dir (with `all`, every .yaml or .yml scene, otherwise those with a reference)
+   into out, following symbolic links (each folder searched once); what it passes over that a user
+   may have meant (scenes without a reference, links to nothing or to a folder searched already,
+   unreadable folders) is listed in `skipped` with the reason. 0, or -1 with why when a folder lies
+   more than REGRESS_MAX_DEPTH below dir (it is not searched: bad input, never a quiet pass). */
+int regress_walk(const char* dir, int all, RegressList* out, RegressList* skipped, char* why, size_t len);
 /* 0, or -1 with why (a malformed reference is bad input); `warn` gets notes about what it ignores */
 int regress_reference_load(const char* path, RegressRef* r, char* why, size_t len, RegressList* warn);
 void regress_reference_free(RegressRef* r);

@@ -49,6 +49,12 @@ static void child_run(void* argp) {
     m = fmb_load(job->scene, sets, nsets + 1, fmb_cli_registry(), &diag);
   }
   if (!m) {
+    /* an override's message starts with the override itself: the command line's own is the
+       caller's mistake (exit 2), a reference's `# set:` one is the scene's (it no longer loads) */
+    for (int i = 0; strcmp(diag.file, "--set") == 0 && i < o->nsets; ++i) {
+      const size_t n = strlen(o->sets[i]);
+      if (strncmp(diag.msg, o->sets[i], n) == 0 && diag.msg[n] == ':') res.bad_set = 1;
+    }
     if (diag.line > 0)
       regress_say(res.msg, sizeof res.msg, "%s:%d:%d: %s", diag.file, diag.line, diag.col, diag.msg);
     else
@@ -164,6 +170,11 @@ int regress_run_all(RegressJob* jobs, int n, const RegressOptions* o) {
 void regress_check_job(RegressJob* job) {
   const RegressRef* ref = &job->ref;
   const RegressRun* run = &job->run;
+  if (!run->loaded && run->bad_set) {
+    job->bad_input = 1;
+    regress_say(job->why, sizeof job->why, "--set does not apply to this scene: %s", run->msg);
+    return;
+  }
   if (!run->loaded) {
     job->failed = 1;
     regress_say(job->why, sizeof job->why, "the scene no longer loads: %s", run->msg);

@@ -9,6 +9,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <strings.h>
 #include <sys/stat.h>
 #include <time.h>
 
@@ -69,6 +70,20 @@ char* regress_reference_path(const char* scene) {
   return r;
 }
 
+char* regress_twin_scene(const char* scene) {
+  const int yaml = has_suffix(scene, ".yaml");
+  if (!yaml && !has_suffix(scene, ".yml")) return NULL;
+  const size_t stem = strlen(scene) - (yaml ? 5 : 4);
+  char* twin = malloc(stem + 6);
+  if (!twin) return NULL;
+  memcpy(twin, scene, stem);
+  strcpy(twin + stem, yaml ? ".yml" : ".yaml");
+  struct stat st;
+  if (lstat(twin, &st) == 0) return twin; /* whatever it is (a link too): the names clash */
+  free(twin);
+  return NULL;
+}
+
 int regress_file_exists(const char* p) {
   struct stat st;
   return stat(p, &st) == 0 && S_ISREG(st.st_mode);
@@ -76,57 +91,136 @@ int regress_file_exists(const char* p) {
 
 static int by_name(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
 
-/* symbolic links are not followed (no loops, no files outside the tree), but reported */
-void regress_walk(const char* dir, int depth, int all, RegressList* out, RegressList* skipped) {
+/* the folders a walk has searched (device, inode): each once, so that a link to a folder above
+   it (a loop) or two links to one folder cost nothing */
+typedef struct {
+  dev_t* dev;
+  ino_t* ino;
+  int n, cap;
+} Visited;
+
+static int visit(Visited* v, const struct stat* st) {
+  for (int i = 0; i < v->n; ++i)
+    if (v->dev[i] == st->st_dev && v->ino[i] == st->st_ino) return 0;
+  if (v->n == v->cap) {
+    const int cap = v->cap ? 2 * v->cap : 64;
+    dev_t* nd = realloc(v->dev, (size_t)cap * sizeof *nd);
+    if (nd) v->dev = nd;
+    ino_t* ni = realloc(v->ino, (size_t)cap * sizeof *ni);
+    if (ni) v->ino = ni;
+    if (!nd || !ni) return 1; /* out of memory: searched again rather than skipped */
+    v->cap = cap;
+  }
+  v->dev[v->n] = st->st_dev;
+  v->ino[v->n++] = st->st_ino;
+  return 1;
+}
+
+/* what one regress_walk carries through its folders */
+typedef struct {
+  int all;
+  RegressList *out, *skipped;
+  Visited seen;
+  RegressList links; /* links to folders, searched after every real folder (a real name first) */
+  RegressList link_depth;
+  char* why;
+  size_t len;
+} Walk;
+
+/* Symbolic links to scenes and folders are followed (a scene's reference lies beside the name it
+   was found under); a folder is searched once, however many links lead to it, under its real name
+   when the tree has one (links are searched last). Nothing below dir is passed over silently: a
+   folder deeper than REGRESS_MAX_DEPTH is an error, what else is left out gets a note. */
+static int walk(Walk* w, const char* dir, int depth) {
   if (depth > REGRESS_MAX_DEPTH) {
-    note(skipped, "%s: more than %d folders deep: not searched", dir, REGRESS_MAX_DEPTH);
-    return;
+    regress_say(w->why, w->len, "%s: more than %d folders deep: not searched (name a folder further down)", dir,
+                REGRESS_MAX_DEPTH);
+    return -1;
   }
   DIR* d = opendir(dir);
   if (!d) {
-    note(skipped, "%s: cannot be read: %s", dir, strerror(errno));
-    return;
+    note(w->skipped, "%s: cannot be read: %s", dir, strerror(errno));
+    return 0;
   }
   RegressList here = {0};
   struct dirent* e;
   while ((e = readdir(d)) != NULL) {
     if (e->d_name[0] == '.') continue; /* ., .., hidden folders such as .git */
-    size_t len = strlen(dir) + strlen(e->d_name) + 2;
-    char* p = malloc(len);
+    size_t plen = strlen(dir) + strlen(e->d_name) + 2;
+    char* p = malloc(plen);
     if (!p) continue;
-    snprintf(p, len, "%s%s%s", dir, has_suffix(dir, "/") ? "" : "/", e->d_name);
+    snprintf(p, plen, "%s%s%s", dir, has_suffix(dir, "/") ? "" : "/", e->d_name);
     if (regress_list_push(&here, p)) free(p);
   }
   closedir(d);
   if (here.n > 1) qsort(here.v, (size_t)here.n, sizeof *here.v, by_name);
+  int rc = 0;
   for (int i = 0; i < here.n; ++i) {
-    struct stat st;
+    struct stat st, lst;
     char* p = here.v[i];
+    here.v[i] = NULL;
     const int scene_name = is_scene_name(strrchr(p, '/') + 1);
-    if (lstat(p, &st) != 0) {
+    if (lstat(p, &lst) != 0) {
       free(p);
       continue;
     }
-    if (S_ISDIR(st.st_mode)) {
-      regress_walk(p, depth + 1, all, out, skipped);
+    const int link = S_ISLNK(lst.st_mode);
+    if (link && stat(p, &st) != 0) {
+      if (scene_name) note(w->skipped, "%s: a symbolic link to nothing (%s)", p, strerror(errno));
       free(p);
-    } else if (S_ISLNK(st.st_mode)) {
-      struct stat target;
-      if (scene_name || (stat(p, &target) == 0 && S_ISDIR(target.st_mode)))
-        note(skipped, "%s: a symbolic link: not followed (name the file itself to run it)", p);
+      continue;
+    }
+    if (!link) st = lst;
+    if (S_ISDIR(st.st_mode) && link) {
+      char depth_text[16];
+      snprintf(depth_text, sizeof depth_text, "%d", depth + 1);
+      char* dt = strdup(depth_text);
+      if (dt && regress_list_push(&w->links, p) == 0) {
+        if (regress_list_push(&w->link_depth, dt) == 0) continue;
+        --w->links.n;
+      }
+      free(dt);
+      free(p);
+    } else if (S_ISDIR(st.st_mode)) {
+      if (visit(&w->seen, &st) && !rc) rc = walk(w, p, depth + 1);
       free(p);
     } else if (S_ISREG(st.st_mode) && scene_name) {
       char* r = regress_reference_path(p);
       int has_ref = r && regress_file_exists(r);
-      if (!has_ref && !all) note(skipped, "%s: no reference (make it with: flexmbd regress --bless %s)", p, p);
+      if (!has_ref && !w->all) note(w->skipped, "%s: no reference (make it with: flexmbd regress --bless %s)", p, p);
       free(r);
-      if ((all || has_ref) && regress_list_push(out, p) == 0) continue;
+      if ((w->all || has_ref) && regress_list_push(w->out, p) == 0) continue;
       free(p);
     } else {
       free(p);
     }
   }
+  for (int i = 0; i < here.n; ++i) free(here.v[i]);
   free(here.v);
+  return rc;
+}
+
+int regress_walk(const char* dir, int all, RegressList* out, RegressList* skipped, char* why, size_t len) {
+  Walk w = {.all = all, .out = out, .skipped = skipped, .why = why, .len = len};
+  struct stat st;
+  if (stat(dir, &st) == 0) visit(&w.seen, &st);
+  int rc = walk(&w, dir, 0);
+  /* the links to folders, in the order found (a link's own folder may add more) */
+  for (int i = 0; i < w.links.n; ++i) {
+    const char* p = w.links.v[i];
+    if (!rc && stat(p, &st) == 0) {
+      if (visit(&w.seen, &st))
+        rc = walk(&w, p, atoi(w.link_depth.v[i]));
+      else
+        note(skipped, "%s: a symbolic link to a folder searched already", p);
+    }
+  }
+  for (int i = 0; i < w.links.n; ++i) free(w.links.v[i]), free(w.link_depth.v[i]);
+  free(w.links.v);
+  free(w.link_depth.v);
+  free(w.seen.dev);
+  free(w.seen.ino);
+  return rc;
 }
 
 /* ------------------------------------------------------------------------------------------------
@@ -201,7 +295,18 @@ int regress_reference_load(const char* path, RegressRef* r, char* why, size_t le
       r->sets = ns;
       ++r->nsets;
     } else if ((v = meta_value(m, "status"))) {
-      r->status_ok = strcmp(v, "ok") == 0;
+      /* written as `ok` or `stopped`; an edited `OK ` is the same word, anything else is refused
+         (it once counted as stopped, and a good run then failed for completing) */
+      size_t n = strlen(v);
+      while (n > 0 && (v[n - 1] == ' ' || v[n - 1] == '\t')) --n;
+      if (n == 2 && strncasecmp(v, "ok", 2) == 0)
+        r->status_ok = 1;
+      else if (n == 7 && strncasecmp(v, "stopped", 7) == 0)
+        r->status_ok = 0;
+      else {
+        regress_say(why, len, "%s:%d: expected '# status: ok' or '# status: stopped', got '#%.200s'", path, i + 1, m);
+        return -1;
+      }
     } else if ((v = meta_value(m, "t_reached"))) {
       r->t_reached = strtod(v, NULL);
       has_t_reached = 1;

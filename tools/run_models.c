@@ -1,7 +1,7 @@
 /* run_models.c — `flexmbd run SCENE --models zoac,foac,complete,exact -o OUT.csv`: the same scene
  * once per beam model (every body of type beam gets `model: M` through --set), the outputs side by
  * side in one CSV as `beam.tip_v@complete`, ..., and one stats line per model
- * (`stats: model=M status=...`). A model whose run stops (ZOAC diverging, FOAC losing its mass's
+ * (`stats: model=M status=...`); with --vtk DIR, each model's animation in DIR/MODEL. A model whose run stops (ZOAC diverging, FOAC losing its mass's
  * definiteness) keeps its rows; later rows of its columns are `nan`, and the exit code is 3.
  * The runs and the merge are the library's (fmb_run_models, engine/models.c); this file parses the
  * list, picks the beams and prints. */
@@ -23,8 +23,8 @@ static void print_model_stats(const char* model, const fmbStats* st) {
   free(text);
 }
 
-int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet,
-                       volatile sig_atomic_t* stop) {
+int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, int quiet, const char* vtk,
+                       int vtk_every, volatile sig_atomic_t* stop) {
   if (!out || strcmp(out, "-") == 0) {
     fprintf(stderr, "flexmbd run: --models needs the CSV in a file (-o OUT.csv)\n");
     return FMB_EXIT_BAD_INPUT;
@@ -44,6 +44,11 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
               FMB_MODELS_MAX, list);
       return FMB_EXIT_BAD_INPUT;
     }
+    for (int k = 0; k < nmodel; ++k)
+      if (strcmp(model[k], tok) == 0) {
+        fprintf(stderr, "flexmbd run: --models names '%s' twice ('%s'): each model runs once\n", tok, list);
+        return FMB_EXIT_BAD_INPUT;
+      }
     model[nmodel++] = tok;
   }
   if (nmodel == 0) {
@@ -88,7 +93,7 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
     return FMB_EXIT_BAD_INPUT;
   }
   const fmbSceneSource scene = {s->scene, s->overrides, s->nover, fmb_cli_registry()};
-  const fmbRunOptions opt = {.csv_path = out, .quiet = quiet, .stop = stop};
+  const fmbRunOptions opt = {.csv_path = out, .quiet = quiet, .stop = stop, .vtk_dir = vtk, .vtk_every = vtk_every};
   fmbModelsResult* res = calloc(1, sizeof *res);
   if (!res) {
     fprintf(stderr, "flexmbd run: out of memory\n");

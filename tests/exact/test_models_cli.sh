@@ -59,4 +59,22 @@ while [ $i -le 33 ]; do sets="$sets --set bodies.b$i.model=zoac"; i=$((i + 1)); 
 check "33 beams: exit 0, b33.tip_v@zoac equals an all-ZOAC run's and differs from @complete" \
   "[ $rc -eq 0 ] && [ \"\$(cut -d, -f5 '$OUT/many.csv' | tail -n +2)\" = \"\$(cut -d, -f3 '$OUT/many_zoac.csv' | tail -n +2)\" ] &&
    [ \"\$(cut -d, -f5 '$OUT/many.csv' | tail -n +2)\" != \"\$(cut -d, -f3 '$OUT/many.csv' | tail -n +2)\" ]"
+# a model named twice (issue 36): two columns of one name once; now bad input before anything runs
+rm -f "$OUT/dup.csv"
+"$F" run scenes/paper/spinup_w1.yaml --models complete,complete -o "$OUT/dup.csv" 2>"$OUT/dup.err"; rc=$?
+check "--models complete,complete: exit 2 naming the model, nothing written" \
+  "[ $rc -eq 2 ] && grep -q \"names 'complete' twice\" '$OUT/dup.err' && [ ! -e '$OUT/dup.csv' ] &&
+   ! grep -q '^stats:' '$OUT/dup.err'"
+# --vtk with --models (issue 36): was ignored; now each model's animation in DIR/MODEL, the very
+# frames of that model's own run with --vtk
+rm -rf "$OUT/vtk" "$OUT/vtk_exact"
+"$F" run scenes/paper/spinup_w1.yaml --models complete,exact -o "$OUT/v.csv" --set solver.t_end=0.2 --quiet \
+  --vtk "$OUT/vtk" --vtk-every 5 2>"$OUT/v.err"; rc=$?
+"$F" run scenes/paper/spinup_w1.yaml -o "$OUT/ve.csv" --set solver.t_end=0.2 --set bodies.beam.model=exact --quiet \
+  --vtk "$OUT/vtk_exact" --vtk-every 5 2>/dev/null
+check "--models with --vtk: exit 0, a collection per model" \
+  "[ $rc -eq 0 ] && [ -f '$OUT/vtk/complete/spinup_w1.pvd' ] && [ -f '$OUT/vtk/exact/spinup_w1.pvd' ]"
+check "--models --vtk-every 5: the exact model's frames are those of its own run" \
+  "[ \$(ls '$OUT/vtk/exact' | wc -l) -eq \$(ls '$OUT/vtk_exact' | wc -l) ] &&
+   cmp -s '$OUT/vtk/exact/spinup_w1_000004.vtu' '$OUT/vtk_exact/spinup_w1_000004.vtu'"
 exit $fail

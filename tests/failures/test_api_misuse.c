@@ -15,6 +15,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "builtin.h"
 #include "check.h"
@@ -175,6 +176,25 @@ static void analysis_misuse(const char* scene, const char* dir) {
   ENSURE(fmb_write_table(path, 2, NULL, 2, values, NULL) == FMB_EXIT_BAD_INPUT);
   ENSURE(fmb_write_table(path, 1, names, -2, values, &d) == FMB_EXIT_BAD_INPUT);
   ENSURE(fmb_write_table(NULL, 0, NULL, 0, NULL, NULL) == FMB_EXIT_BAD_INPUT);
+  /* names the header cannot hold (no quoting: issue 36): refused, nothing written, and a good
+     table is read back by the program's reader column for column */
+  {
+    const char* bad[][2] = {{"t", "a,b"}, {"t", "two\nlines"}, {"t", "cr\r"}, {"t", "quote\"d"},
+                            {"t", ""},    {"t", " padded"},    {"#t", "a"},   {"t", "tab\there"}};
+    for (size_t k = 0; k < sizeof bad / sizeof bad[0]; ++k) {
+      remove(path);
+      memset(&d, 0, sizeof d);
+      ENSURE(fmb_write_table(path, 2, bad[k], 2, values, &d) == FMB_EXIT_BAD_INPUT &&
+             strstr(d.msg, "a CSV name may not"));
+      ENSURE(access(path, F_OK) != 0);
+    }
+    const char* good[2] = {"t", "bob.x@complete"};
+    ENSURE(fmb_write_table(path, 2, good, 2, values, &d) == 0);
+    FILE* f = fopen(path, "r");
+    char line[256] = "";
+    ENSURE(f && fgets(line, sizeof line, f) && strcmp(line, "t,bob.x@complete\n") == 0);
+    if (f) fclose(f);
+  }
   ENSURE(fmb_safe_note_input(NULL) == -1 && fmb_safe_input_at(NULL) == NULL);
   fmb_safe_forget_input(NULL);
 

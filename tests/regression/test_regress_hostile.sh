@@ -7,8 +7,10 @@
 #  hangs: a per-scene time limit (--timeout); SIGINT kills every child and removes the temporary
 #    folder (exit 4);
 #  silently wrong: a reference cut short, one whose rows lie outside the run's time span, and one
-#    with a second (looser) tolerance line for a column fail; scenes deeper than 32 folders, scene
-#    links and scenes without a reference are reported;
+#    with a second (looser) tolerance line for a column fail; scenes deep down and behind links
+#    run, scenes without a reference are reported, a folder beyond the search's depth is refused;
+#    a.yml blessed after a.yaml is refused; a bad --set is bad input (exit 2); '# status: OK' is ok
+#    and an unknown status is refused;
 #  misleading: a crashed run's message quotes its last stderr line, not a file already deleted.
 #   usage: test_regress_hostile.sh FLEXMBD SOURCE_DIR WORKDIR FAULTY_PLUGIN
 . "$(dirname "$0")/../sweep/lib.sh" # F SRC D PLUGIN, fail()
@@ -84,7 +86,9 @@ sed "s|^$line\$|$line\n# tolerance: crank.theta atol=1e+06 rtol=1 override|" "$S
 [ "$(reg "$D/dup/fourbar.yaml")" = 2 ] && grep -q "a second tolerance line for column 'crank.theta'" "$D/out.txt" ||
   { cat "$D/out.txt"; fail "a duplicated tolerance line is accepted"; }
 
-# reported, not skipped silently: a folder 33 deep, a link to a scene, a scene without a reference
+# not skipped: a folder 34 deep is searched, links to scenes and folders are followed (each folder
+# once, under its real name first, a loop noted), a scene without a reference is reported, and a
+# folder deeper than the search goes (256) is refused rather than passed over
 mkdir "$D/tree"
 cp "$S/fourbar.yaml" "$S/fourbar.ref.csv" "$D/tree/"
 deep=$D/tree
@@ -92,11 +96,58 @@ for i in $(seq 34); do deep=$deep/d; done
 mkdir -p "$deep"
 cp "$S/fourbar.yaml" "$S/fourbar.ref.csv" "$deep/"
 ln -s "$D/tree/fourbar.yaml" "$D/tree/link.yaml"
+ln -s "$D/tree/fourbar.yaml" "$D/tree/linked.yaml"
+cp "$S/fourbar.ref.csv" "$D/tree/linked.ref.csv"
+ln -s "$D/tree" "$D/tree/d/loop"
+mkdir "$D/elsewhere"
+cp "$S/fourbar.yaml" "$S/fourbar.ref.csv" "$D/elsewhere/"
+ln -s "$D/elsewhere" "$D/tree/shared"
 cp "$S/fourbar.yaml" "$D/tree/noref.yaml"
-[ "$(reg "$D/tree")" = 0 ] || { cat "$D/out.txt"; fail "the tree's one scene with a reference should pass"; }
-grep -q "note: .*more than 32 folders deep" "$D/out.txt" || fail "the deep folder is not reported"
-grep -q "note: .*link.yaml: a symbolic link" "$D/out.txt" || fail "the scene link is not reported"
+[ "$(reg "$D/tree")" = 0 ] || { cat "$D/out.txt" "$D/err.txt"; fail "the tree's scenes with a reference should pass"; }
+grep -q "regress: 4 passed, 0 failed" "$D/out.txt" || { cat "$D/out.txt"; fail "not every scene of the tree ran"; }
+grep -q "^$deep/fourbar.yaml " "$D/out.txt" || fail "the scene 34 folders deep did not run"
+grep -q "^$D/tree/linked.yaml " "$D/out.txt" || fail "the link to a scene with a reference did not run"
+grep -q "^$D/tree/shared/fourbar.yaml " "$D/out.txt" || fail "the scene in a linked folder did not run"
+grep -q "note: .*link.yaml: no reference" "$D/out.txt" || fail "the link without a reference is not reported"
+grep -q "note: .*loop: a symbolic link to a folder searched already" "$D/out.txt" || fail "the loop is not reported"
 grep -q "note: .*noref.yaml: no reference" "$D/out.txt" || fail "the scene without a reference is not reported"
+mkdir "$D/abyss"
+abyss=$D/abyss
+for i in $(seq 258); do abyss=$abyss/d; done
+mkdir -p "$abyss"
+cp "$S/fourbar.yaml" "$S/fourbar.ref.csv" "$abyss/"
+[ "$(reg "$D/abyss")" = 2 ] && grep -q "more than 256 folders deep: not searched" "$D/err.txt" ||
+  { cat "$D/out.txt" "$D/err.txt"; fail "a scene beyond the search's depth is passed over"; }
+
+# a.yml blessed after a.yaml: one reference for two scenes, refused however they are named
+mkdir "$D/twin2"
+cp "$S/fourbar.yaml" "$D/twin2/a.yaml"
+[ "$(reg --bless "$D/twin2/a.yaml")" = 0 ] || fail "--bless of a lone a.yaml"
+cp "$D/twin2/a.ref.csv" "$D/twin2/before"
+sed 's/speed: 2.0/speed: 2.5/' "$S/fourbar.yaml" > "$D/twin2/a.yml"
+for cmdline in "--bless $D/twin2/a.yml" "$D/twin2/a.yml" "--bless $D/twin2/a.yaml" "$D/twin2/a.yaml"; do
+  # shellcheck disable=SC2086
+  [ "$(reg $cmdline)" = 2 ] && grep -q "would share one reference" "$D/err.txt" ||
+    { cat "$D/out.txt" "$D/err.txt"; fail "regress $cmdline beside its twin not refused"; }
+done
+cmp -s "$D/twin2/a.ref.csv" "$D/twin2/before" || fail "a.yml's bless touched a.yaml's reference"
+
+# a --set that is the caller's mistake: exit 2 (bad input), not 1 (a failed scene)
+[ "$(reg "$S/fourbar.yaml" --set solver.rtol=abc)" = 2 ] && grep -q "set does not apply to this scene" "$D/out.txt" ||
+  { cat "$D/out.txt" "$D/err.txt"; fail "a bad --set value is not bad input"; }
+[ "$(reg "$S/fourbar.yaml" --set solver.rtol 1e-6)" = 2 ] && grep -q "solver.rtol: expected PATH=VALUE in one argument" "$D/err.txt" ||
+  { cat "$D/err.txt"; fail "--set PATH VALUE (a space for =) is not named"; }
+
+# '# status: OK ' (a reference edited by hand) is ok, not "stopped" (a good run then failed for
+# completing); a status that is neither is a malformed reference
+mkdir "$D/status"
+cp "$S/fourbar.yaml" "$D/status/"
+sed 's/^# status: ok$/# status: OK  /' "$S/fourbar.ref.csv" > "$D/status/fourbar.ref.csv"
+grep -q "^# status: OK  $" "$D/status/fourbar.ref.csv" || fail "the status edit did not take"
+[ "$(reg "$D/status/fourbar.yaml")" = 0 ] || { cat "$D/out.txt"; fail "'# status: OK' fails a good run"; }
+sed -i 's/^# status: OK  $/# status: finished/' "$D/status/fourbar.ref.csv"
+[ "$(reg "$D/status/fourbar.yaml")" = 2 ] && grep -q "expected '# status: ok' or '# status: stopped'" "$D/out.txt" ||
+  { cat "$D/out.txt"; fail "an unknown status is not refused"; }
 
 # a crash: the message quotes the run's last stderr line (the file itself is gone with the tmp folder)
 mkdir "$D/crash"

@@ -90,4 +90,18 @@ tail -n 1 "$D/runref.err" | grep -q "^stats: status=ok" || fail "run --reference
 "$F" run "$SC" -o "$D/run3.csv" --quiet --set solver.t_end=0.5 --set solver.rtol=1e-3 --reference "$D/run.csv" \
   --columns bob.x > "$D/runref3.txt" 2> /dev/null || fail "run --reference (rtol 1e-3) exited $?"
 awk -v e="$(field "$D/runref3.txt" bob.x max_abs)" 'BEGIN { exit !(e > 1e-8) }' || fail "a looser run shows no error"
+# a spreadsheet's save of the reference (issue 36): a UTF-8 byte-order mark before 't', blanks and
+# a tab around the cells, CRLF line ends: the same numbers, so zero error; a cell with text after
+# its number is still refused
+{ printf '\357\273\277'; sed 's/,/ ,\t/g; s/$/  \r/' "$D/ref.csv"; } > "$D/excel.csv"
+head -c 3 "$D/excel.csv" | od -An -tx1 | grep -q "ef bb bf" || fail "the byte-order mark was not written"
+"$F" compare "$D/excel.csv" "$D/ref.csv" > "$D/excel.txt" 2> "$D/excel.err" || fail "BOM/blanks: exit $?: $(cat "$D/excel.err")"
+for c in a b energy.total; do
+  [ "$(field "$D/excel.txt" "$c" max_abs)" = "0.000000e+00" ] || fail "BOM/blanks: $c max_abs not 0"
+  [ "$(field "$D/excel.txt" "$c" rows)" = "101" ] || fail "BOM/blanks: $c rows"
+done
+sed '3s/$/x/' "$D/ref.csv" > "$D/junk.csv"
+rc=0
+"$F" compare "$D/junk.csv" "$D/ref.csv" > /dev/null 2> "$D/junk.err" || rc=$?
+[ "$rc" = 2 ] && grep -q "junk.csv:3: expected 4 comma-separated numbers" "$D/junk.err" || fail "text after a number accepted (exit $rc)"
 echo "compare: all checks passed"
