@@ -50,6 +50,9 @@ PATTERNS = [
                          r"larger|smaller|cheaper|speed-?up|overhead|at|on|with|from|for|in|over)\b))", re.M)),
     ("ratio", re.compile(RANGE + r"\s+times\s+(?:faster|slower|more|less|fewer|as|the)\b", re.I)),
 ]
+TAKES = re.compile(r"\b(?:takes|took|needs|needed)\s+(?:about\s+|~\s*)?" + N
+                   + r"(?!\d|[.,]\d)(?!\s?(?:s|ms|µs|us|seconds|min|m|rad|elements?|%|×|x)\b)(?=\s*(?:[,.;)]|at\b|with\b|$))"
+                   + r"|\b(?:and|against)\s+" + N + r"(?=\s+at\b)")
 # a time, a percentage or an error counts only in a sentence about a run's cost or error
 TIME = re.compile(RANGE + r"\s?(?:s|ms|µs|us|seconds|min)\b")
 PERCENT = re.compile(RANGE + r"\s?%")
@@ -90,6 +93,10 @@ def run_numbers(text):
                 if BOUND.search(plain[:m.start()]) or re.match(r"\s*(?:per|each)\b", plain[m.end():]):
                     continue
                 found += [(g, kind) for g in m.groups()[:2] if g]
+        if re.search(r"\b" + COUNTS + r"\b", plain, re.I):
+            # in a sentence about steps: "the spring-damper takes 2851", "and 11991 at 1 ms"
+            for m in TAKES.finditer(plain):
+                found += [(g, "count") for g in m.groups()[:2] if g]
         cost, error = COST_WORDS.search(plain), ERROR_WORDS.search(plain)
         if cost:
             for m in TIME.finditer(plain):
@@ -284,6 +291,7 @@ def self_test():
     saved = SRC, HAVE_GIT, list(unchecked)
     cases = [  # (page, how many failures)
         ("The controller took 70,400 steps where the spring-damper took 48,600.\n", 2),
+        ("It takes 70,400 steps where the spring-damper takes 48,600, and 88,100 at 1 ms.\n", 3),
         ("```console\n$ ./ctl\ncontroller: 8993 ±5% steps\n```\n\nIt takes 8,993 steps.\n", 0),
         ("```console\n$ ./ctl\ncontroller: 8993 ±5% steps\n```\n\nIt takes 70,400 steps.\n", 1),
         ("```console norun\n$ ./ctl\ncontroller: 8993 ±5% steps\n```\n\nIt takes 8,993 steps.\n", 1),
