@@ -33,7 +33,7 @@ def blocks(path):
 # The tolerance is part of the page: the reader sees how far the number may move.
 NUMBER = r"[-+]?\d+(?:\.\d+)?(?:[eE][-+]?\d+)?"
 # a number in shown text: not inside a name (w15, x1), an exponent (the 05 of e-05) or a version
-SHOWN_NUMBER = re.compile(r"(?<![\w.\-+])(" + NUMBER + r")(\s*±\s*(\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)\s*(%?))?")
+SHOWN_NUMBER = re.compile(r"(?<![\w.\-+])(" + NUMBER + r")(\s*±\s*(\d+(?:\.\d+)?(?:[eE][-+]?\d+)?)(?:\s*(%))?)?")
 PRINTS = re.compile(r"#[^#]*?\bprints:\s*(.*)$")
 # the pages whose ```python blocks tests/python/test_docs.py runs (and so compares their `# prints:`)
 PYTHON_PAGES = ("docs/python.md", "README.md")
