@@ -1,7 +1,8 @@
 """docs/python.md (and README.md's ```python blocks) run as written: docs/python.md's ```python blocks in order in one session (one namespace)
 and its ```sh blocks with bash, in a scratch folder that links the repository's folders (as the
 docs_commands test does for the other pages; docs_commands delegates docs/python.md here). `python3`
-in the sh blocks is this interpreter; `sh norun` / `python norun` blocks are shown only."""
+in the sh blocks is this interpreter; `sh norun` / `python norun` blocks are shown only. A
+`# prints: TEXT` comment in a python block is checked against what the block printed."""
 import contextlib
 import io
 import os
@@ -12,13 +13,13 @@ import warnings
 from conftest import BUILD, SRC
 
 sys.path.insert(0, os.path.join(SRC, "tests"))
-from markdown_blocks import blocks  # noqa: E402  (tests/markdown_blocks.py, shared with tests/ux/test_docs.py)
+from markdown_blocks import PRINTS, blocks, match_shown  # noqa: E402  (tests/markdown_blocks.py, shared with tests/ux/test_docs.py)
 
 PAGE = os.path.join(SRC, "docs", "python.md")
 def test_python_md_runs(out):
     assert run_page(PAGE, out) >= 10
     for png in ("w15_tip.png", "w15_models.png", "campbell.png"):
-        assert os.path.getsize(os.path.join(out, png)) > 10000, png
+        assert os.path.getsize(os.path.join(out, "out", png)) > 10000, png
 
 
 def test_readme_python_blocks_run(out):
@@ -29,7 +30,7 @@ def run_page(page, out, langs=("sh", "bash", "python")):
     """run the page's blocks in `out`; returns how many ran"""
     doc = os.path.relpath(page, SRC)
     for entry in os.listdir(SRC):
-        if entry not in ("build", ".git") and not entry.startswith("."):
+        if entry not in ("build", ".git", "out") and not entry.startswith("."):  # out/: the page writes there
             os.symlink(os.path.join(SRC, entry), os.path.join(out, entry))
     os.symlink(BUILD, os.path.join(out, "build"))
     shim = os.path.join(out, ".bin")
@@ -60,6 +61,18 @@ def run_page(page, out, langs=("sh", "bash", "python")):
                     except Exception as e:
                         raise AssertionError(f"{where}: {type(e).__name__}: {e}\noutput so far:\n{buf.getvalue()}")
                 print(f"--- {where}\n{buf.getvalue()}")
+                # what a `# prints: ...` comment shows is printed by its block, in order, each
+                # number within its stated tolerance (docs/regression.md, "Numbers in the docs")
+                printed = buf.getvalue().split("\n")
+                for k, text in enumerate(code):
+                    shown = PRINTS.search(text)
+                    if not shown:
+                        continue
+                    why = match_shown(shown.group(1), "\n".join(printed))
+                    assert why is None, f"{doc}:{line + 1 + k}: # prints: {shown.group(1)}: {why}"
+                    # later annotations match later lines
+                    first = next(i for i, l in enumerate(printed) if match_shown(shown.group(1), l) is None)
+                    printed = printed[first + 1:]
             else:
                 continue
             ran += 1

@@ -3,9 +3,10 @@
 
 1. Every command in README.md and docs/*.md runs. A fenced block tagged `sh` (or `bash`) is a
    script; in a block tagged `console`, the lines starting with `$ ` are commands and the others
-   their output, which is checked: each output line must be produced verbatim (on stdout or
-   stderr) by the command above it, where `…` stands for any text (numbers that change with the
-   machine: `cpu_s=…`). So a quoted message or a header of columns (`$ head -n 1 out.csv`) shown
+   their output, which is checked: each output line must be produced (on stdout or stderr) by the
+   command above it, its text verbatim, where `…` stands for any text (numbers that change with the
+   machine: `cpu_s=…`), and each number within the tolerance written after it (`8993 ±5%`) or as
+   rounded (tests/markdown_blocks.py, match_shown; docs/regression.md, "Numbers in the docs"). So a quoted message or a header of columns (`$ head -n 1 out.csv`) shown
    in a console block cannot drift from what the program prints. A block that must not run (it installs packages, takes minutes, needs a file
    the reader brings) is tagged `sh norun` / `console norun`: the convention is explicit, so an
    untagged block that holds a command is an error too. Each document's commands run in order
@@ -39,10 +40,9 @@ os.makedirs(out)
 docs = ["README.md"] + sorted("docs/" + f for f in os.listdir(os.path.join(src, "docs")) if f.endswith(".md"))
 failures = []
 COMMANDISH = re.compile(r"^\s*(\$ )?(\./)?(build/)?(flexmbd|bash|sh|cmake|ctest|tools/|bench/)\b")
-def expected_regex(text):
-    """an output line as shown, `…` (or `...`) standing for any text: a grep -E pattern"""
-    parts = re.split(r"…|\.\.\.", text.strip())
-    return ".*".join(re.sub(r"([][\\.^$*+?(){}|/])", r"\\\1", p) for p in parts)
+# an output line shown under a command is checked by markdown_blocks.match_shown (its text, `…`
+# for any text, numbers within their stated tolerance), run as a program from the script
+CHECK = (sys.executable, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "markdown_blocks.py"))
 
 
 def console_script(doc, line, body):
@@ -58,10 +58,8 @@ def console_script(doc, line, body):
         # the command's stdout and stderr together; set -e still stops on its failure
         out.append(f"{{ {cmd}\n}} >.console_out 2>&1 || {{ cat .console_out >&2; exit 1; }}")
         for e in expect:
-            pat = expected_regex(e).replace("'", "'\\''")
             shown = e.strip().replace("'", "'\\''")
-            out.append(f"grep -Eq -- '{pat}' .console_out || {{ echo '### {doc}:{line}' >&2; "
-                       f"echo 'not printed: {shown}' >&2; exit 1; }}")
+            out.append(f"'{CHECK[0]}' '{CHECK[1]}' .console_out '{shown}' || {{ echo '### {doc}:{line}' >&2; exit 1; }}")
 
     for l in body:
         if l.startswith("$ "):
@@ -123,7 +121,7 @@ for doc in docs:
     work = os.path.join(out, doc.replace("/", "_").replace(".md", ""))
     os.makedirs(work)
     for entry in os.listdir(src):
-        if entry in ("build", ".git") or entry.startswith("."):
+        if entry in ("build", ".git", "out") or entry.startswith("."):  # out/: the pages write there, in the scratch folder
             continue
         os.symlink(os.path.join(src, entry), os.path.join(work, entry))
     os.symlink(build, os.path.join(work, "build"))
