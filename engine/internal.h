@@ -142,6 +142,9 @@ struct fmbModel {
   int ninput;
   int* input_joint;
   double* input_initial;
+  /* the files this model was read from (scene, table files, the scene's plugins): no writer of its
+     runs may replace one (engine/safe_file.c, fmb_model_inputs) */
+  fmbInputs* inputs;
 };
 
 /* evaluation context a joint sees */
@@ -388,6 +391,8 @@ int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;
 /* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
+/* the same, refusing a path that is one of `inputs` (a model's files, fmb_model_inputs) */
+fmbCsv* fmb_csv_open_guarded(const char* path, const fmbInputs* inputs, fmbDiag* diag);
 int fmb_csv_header(fmbCsv* c, const fmbModel* m); /* 0 ok, -1 write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
 /* a body out of its model's range (fmbBodyType.model_range) named through fmb_warn, once: warned

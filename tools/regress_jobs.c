@@ -48,6 +48,7 @@ static void child_run(void* argp) {
     sets[nsets] = set;
     m = fmb_load(job->scene, sets, nsets + 1, fmb_cli_registry(), &diag);
   }
+  fmb_cli_note_model(m); /* no reference or report may replace a file it read */
   if (!m) {
     if (diag.line > 0)
       regress_say(res.msg, sizeof res.msg, "%s:%d:%d: %s", diag.file, diag.line, diag.col, diag.msg);
