@@ -555,7 +555,9 @@ FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
  *   }
  *   fmb_data_free(d);
  *
- * Return codes: 0; FMB_EXIT_SOLVER (the state is the last good one and diag says when and why);
+ * Return codes: 0; FMB_EXIT_SOLVER (the state is the last good one and diag says when and why:
+ * the backend's last step, or, when it left values that are not finite, where the advance started;
+ * a later advance restarts from it, e.g. once the input that caused it is set back);
  * FMB_EXIT_INTERRUPTED (fmb_data_cancel); FMB_EXIT_BAD_INPUT for misuse: a NULL argument, a data
  * object of another model or already freed, advance before init, t_out NaN, before time() or
  * beyond the scene's t_end. A misused call changes nothing.
@@ -605,8 +607,10 @@ FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
 FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
 /* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
    a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
-   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from time() on, as a step (piecewise
-   constant) that the next advance starts from. */
+   unknown name, NaN or infinity, misuse, or a value a scene's `value:` would be refused for: a drive
+   angle or slide that puts the coordinates where a double cannot resolve the joints' tolerance, or
+   that the joints cannot follow; why goes to the run's warn handler, and the input keeps its value);
+   the value holds from time() on, as a step (piecewise constant) that the next advance starts from. */
 FMB_API int fmb_ninput(const fmbModel* m);
 FMB_API const char* fmb_input_name(const fmbModel* m, int i);
 FMB_API int fmb_set_input(const fmbModel* m, fmbData* d, const char* name, double value);

@@ -366,6 +366,9 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
 /* a consistent state at t from y's q and v (projected onto the constraints), for a restart after
    an input changed (step.c); 0 or an exit code with diag set */
 int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag);
+/* how closely the joints hold at t0 and after a restart; coordinates whose double cannot resolve
+   it (|q| DBL_EPSILON above it) are refused, in a scene (ic.c) as from fmb_set_input (step.c) */
+#define FMB_IC_PHI_TOL 1e-10 /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
 
 /* ---- static.c ---- */
 /* the poses q at time t against the joints, as a run checks them (ic.c): joints that cannot be
