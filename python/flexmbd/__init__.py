@@ -9,7 +9,20 @@
 Everything is computed by the C library (libflexmbd, found as flexmbd._lib describes) through
 ctypes; this package converts arguments and results, nothing more. docs/python.md is the guide.
 """
-from ._lib import FlexmbdError, FlexmbdWarning, Interrupted, SceneError, SolverError, library_path
+try:
+    import numpy as _numpy  # noqa: F401  (every result is a NumPy array)
+except ImportError as _e:  # a python3 other than Debian's, without NumPy: say what to install
+    import sys as _sys
+
+    raise ImportError(
+        f"flexmbd needs NumPy, which this Python ({_sys.executable}, {_sys.version.split()[0]}) cannot import "
+        f"({_e}). With Debian's python3: `sudo apt install python3-numpy` and run /usr/bin/python3. In a venv: make "
+        "it with `python3 -m venv --system-site-packages` over Debian's python3 (it then sees python3-numpy), or "
+        "install numpy into it (`python -m pip install numpy`). With pyenv or conda: install numpy into that "
+        "interpreter (`pip install numpy` / `conda install numpy`)."
+    ) from _e
+
+from ._lib import ArgumentError, KeyboardInterrupted, FlexmbdError, FlexmbdWarning, Interrupted, SceneError, SolverError, library_path
 from ._scene import scene_text
 from .model import Cancel, Model, Result, Simulation, load, output_times
 from .analysis import CampbellResult, ModesResult, StaticResult, campbell, modes, static
@@ -18,6 +31,7 @@ from .plot import axis_label, unit
 from .study import metric, study
 
 __all__ = ["load", "Model", "Result", "Simulation", "Cancel", "output_times", "FlexmbdWarning", "SceneError", "SolverError", "Interrupted", "FlexmbdError",
+           "ArgumentError", "KeyboardInterrupted",
            "scene_text", "library_path",
            "static", "modes", "campbell", "StaticResult", "ModesResult", "CampbellResult", "compare", "Comparison",
            "study", "metric", "unit", "axis_label"]
