@@ -4,6 +4,7 @@
  * with flexmbd, add its file to CMakeLists.txt and one line here. */
 #include "builtin.h"
 
+#include <pthread.h>
 #include <stddef.h>
 #include <stdio.h>
 
@@ -33,16 +34,23 @@ static const fmbPlugin builtin_plugin = {
 
 const fmbPlugin* fmb_builtin_plugin(void) { return &builtin_plugin; }
 
-const fmbRegistry* fmb_builtin_registry(void) {
-  static fmbRegistry* reg; /* built once, kept for the process: tests and tools share it */
-  if (!reg) {
-    fmbDiag d;
-    reg = fmb_registry_new();
-    if (reg && fmb_registry_add(reg, &builtin_plugin, "built-in", &d)) {
-      fprintf(stderr, "flexmbd: the built-in types do not register: %s\n", d.msg);
-      fmb_registry_free(reg);
-      reg = NULL;
-    }
+/* built once for the process (tests and tools share it), under pthread_once: two threads asking
+   first at the same time get the same registry, fully made (issue 35 item 3). It is never changed
+   after, so reading it from any thread is safe. */
+static fmbRegistry* builtin_reg;
+static pthread_once_t builtin_reg_once = PTHREAD_ONCE_INIT;
+static void make_builtin_registry(void) {
+  fmbDiag d;
+  fmbRegistry* reg = fmb_registry_new();
+  if (reg && fmb_registry_add(reg, &builtin_plugin, "built-in", &d)) {
+    fprintf(stderr, "flexmbd: the built-in types do not register: %s\n", d.msg);
+    fmb_registry_free(reg);
+    reg = NULL;
   }
-  return reg;
+  builtin_reg = reg;
+}
+
+const fmbRegistry* fmb_builtin_registry(void) {
+  pthread_once(&builtin_reg_once, make_builtin_registry);
+  return builtin_reg;
 }

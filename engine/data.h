@@ -27,11 +27,13 @@ struct fmbData {
   fmbStats before;       /* counters of the backends retired so far */
   double* work_before;   /* njoint: work done before the current backend started */
   double* redundant_phi; /* nc: the redundant rows' residuals, checked after every advance */
-  /* formulation: auto: the state at the start of the advance in progress, which a switch to the
-     projected formulation starts from, and where and why IDA gave up */
+  /* the state at the start of the advance in progress (the last good one): a switch to the
+     projected formulation (formulation: auto) starts from it, and a failure that left values that
+     are not finite puts it back (flexmbd.h: "the state is the last good one"); work: the joints'
+     work there (njoint). Between advances, fmb_set_input's scratch for its trial projection. */
   int may_switch;
   struct {
-    double t, *y, *yp;
+    double t, *y, *yp, *work;
   } start;
   struct {
     double t, h;

@@ -560,7 +560,9 @@ FMB_API void fmb_print_stats(const fmbStats* s, FILE* f);
  *   }
  *   fmb_data_free(d);
  *
- * Return codes: 0; FMB_EXIT_SOLVER (the state is the last good one and diag says when and why);
+ * Return codes: 0; FMB_EXIT_SOLVER (the state is the last good one and diag says when and why:
+ * the backend's last step, or, when it left values that are not finite, where the advance started;
+ * a later advance restarts from it, e.g. once the input that caused it is set back);
  * FMB_EXIT_INTERRUPTED (fmb_data_cancel); FMB_EXIT_BAD_INPUT for misuse: a NULL argument, a data
  * object of another model or already freed, advance before init, t_out NaN, before time() or
  * beyond the scene's t_end. A misused call changes nothing.
@@ -610,9 +612,11 @@ FMB_API void fmb_data_set_warn(fmbData* d, fmbWarnFn fn, void* user);
 FMB_API void fmb_set_warn(fmbWarnFn fn, void* user);
 /* inputs: values a program sets between steps (a drive's angle or position with `profile: input`,
    a load with `law: input`), named by their joint. fmb_set_input: 0, or FMB_EXIT_BAD_INPUT (an
-   unknown name, NaN or infinity, misuse; why goes to the run's warn handler); the value holds from
-   time() on, as a step (piecewise constant, rate 0) that the next advance starts from.
-   fmb_set_input_motion gives its rate and second rate too: from time() on the input is
+   unknown name, NaN or infinity, misuse, or a value a scene's `value:` would be refused for: a drive
+   angle or slide that puts the coordinates where a double cannot resolve the joints' tolerance, or
+   that the joints cannot follow; why goes to the run's warn handler, and the input keeps its value);
+   the value holds from time() on, as a step (piecewise constant, rate 0) that the next advance
+   starts from. fmb_set_input_motion gives its rate and second rate too: from time() on the input is
    value + rate tau + accel tau^2 / 2 (tau = t - time()) until the next setting, so a drive fed a
    smooth motion moves with it (velocities and accelerations follow the rate) instead of coming to
    rest at every setting. A drive's setting that lands away from where its previous one led (a
@@ -806,16 +810,29 @@ FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodie
  * written straight through and never removed. The caller owns the handle until fmb_safe_close.
  * ------------------------------------------------------------------------------------------- */
 typedef struct fmbSafeFile fmbSafeFile;
-/* NULL with the reason (e.g. strerror's) in err on failure */
-/* The files this process reads (the scene and its table files, noted by fmb_load; plugins, noted
-   when loaded; whatever a program notes): fmb_safe_open refuses to replace one, whatever name or
-   link leads to it (same device and inode), until the process ends or the noted name no longer
-   leads to that file (deleted or replaced since: its inode may be reused). Notes are counted:
-   each note is undone by one forget. note: 0, or -1 (not a regular file, or out of memory). input_at: the
-   noted path of the input that `path` is, or NULL. Not thread-safe: note from one thread. */
-FMB_API int fmb_safe_note_input(const char* path);
-FMB_API void fmb_safe_forget_input(const char* path);
-FMB_API const char* fmb_safe_input_at(const char* path);
+/* A set of input files that a writer must not replace (fmbInputs): whatever name or link leads to
+   one (same device and inode), until the noted name no longer leads to that file (deleted or
+   replaced since: its inode may be reused). There is no process-wide list: each model keeps the
+   set of the files fmb_load read for it (the scene, its table files, the scene's plugins;
+   fmb_model_inputs) and the writers of its runs check against it; a program that reads more
+   (samples, references, plugins it loads itself) keeps a set of its own and opens its files with
+   fmb_safe_open_guarded. A set has its own lock: it may be shared by threads.
+   note: 0, or -1 (not a regular file, or out of memory); notes are counted, each undone by one
+   forget. add: every file of `from` noted in `to` (0, or -1). at: 1 when `path` is one of the set's
+   files, with the name it was noted under in name[namelen] (may be NULL), else 0. */
+typedef struct fmbInputs fmbInputs;
+FMB_API fmbInputs* fmb_inputs_new(void); /* NULL when out of memory */
+FMB_API void fmb_inputs_free(fmbInputs* in);
+FMB_API int fmb_inputs_note(fmbInputs* in, const char* path);
+FMB_API void fmb_inputs_forget(fmbInputs* in, const char* path);
+FMB_API int fmb_inputs_add(fmbInputs* to, const fmbInputs* from);
+FMB_API int fmb_inputs_at(const fmbInputs* in, const char* path, char* name, size_t namelen);
+FMB_API int fmb_inputs_count(const fmbInputs* in);
+/* the files fmb_load read for m (valid while m is); NULL for a NULL model */
+FMB_API const fmbInputs* fmb_model_inputs(const fmbModel* m);
+/* NULL with the reason in err on failure, among them a target that is one of `inputs` (may be NULL:
+   nothing refused on that ground; fmb_safe_open is fmb_safe_open_guarded with NULL) */
+FMB_API fmbSafeFile* fmb_safe_open_guarded(const char* path, const fmbInputs* inputs, char* err, size_t errlen);
 FMB_API fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen);
 FMB_API FILE* fmb_safe_stream(fmbSafeFile* f); /* a stdio stream over it (closed by fmb_safe_close) */
 FMB_API int fmb_safe_fd(const fmbSafeFile* f);

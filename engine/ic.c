@@ -22,7 +22,6 @@
 #include "internal.h"
 #include "klu_policy.h"
 
-#define FMB_IC_PHI_TOL 1e-10  /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
 #define FMB_ASSEMBLY_TOL 1e-6 /* m or rad: a larger initial correction changes the mechanism */
 
 static double max_abs(const double* x, int n) {

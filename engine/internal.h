@@ -142,6 +142,9 @@ struct fmbModel {
   int ninput;
   int* input_joint;
   double* input_initial;
+  /* the files this model was read from (scene, table files, the scene's plugins): no writer of its
+     runs may replace one (engine/safe_file.c, fmb_model_inputs) */
+  fmbInputs* inputs;
 };
 
 /* evaluation context a joint sees */
@@ -386,6 +389,9 @@ int fmb_initial_conditions(const fmbModel* m, fmbWorkspace* w, double* y, double
 /* a consistent state at t from y's q and v (projected onto the constraints), for a restart after
    an input changed (step.c); 0 or an exit code with diag set */
 int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y, double* yp, fmbDiag* diag);
+/* how closely the joints hold at t0 and after a restart; coordinates whose double cannot resolve
+   it (|q| DBL_EPSILON above it) are refused, in a scene (ic.c) as from fmb_set_input (step.c) */
+#define FMB_IC_PHI_TOL 1e-10 /* m or rad: joints hold to 0.1 nm, 0.1 nrad at t0 */
 
 /* ---- static.c ---- */
 /* the poses q at time t against the joints, as a run checks them (ic.c): joints that cannot be
@@ -411,6 +417,8 @@ int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;
 /* "-"/NULL = stdout; a regular file is written beside the target and renamed by close */
 fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag);
+/* the same, refusing a path that is one of `inputs` (a model's files, fmb_model_inputs) */
+fmbCsv* fmb_csv_open_guarded(const char* path, const fmbInputs* inputs, fmbDiag* diag);
 int fmb_csv_header(fmbCsv* c, const fmbModel* m); /* 0 ok, -1 write failed */
 int fmb_csv_row(fmbCsv* c, const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp);
 /* a body out of its model's range (fmbBodyType.model_range) named through fmb_warn, once: warned

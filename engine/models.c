@@ -159,11 +159,25 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
   for (int i = 0; !rc && i < scene->noverrides; ++i) ov[i] = scene->overrides[i];
   for (int b = 0; b < nbody && !rc; ++b) ov[scene->noverrides + b] = sets + (size_t)b * SET_MAX;
   /* every model must load before any runs */
+  /* the files the models read (scene, table files, plugins): the merged table may replace none */
+  fmbInputs* inputs = fmb_inputs_new();
+  if (!rc && !inputs) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, path, 0, 0, "out of memory");
+    rc = FMB_EXIT_SOLVER;
+  }
   for (int k = 0; k < nmodel && !rc; ++k) {
     set_model(sets, bodies, nbody, models[k]);
     fmbModel* m = fmb_load(scene->path, ov, nov, scene->reg, diag);
     if (!m) rc = diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
+    if (m) fmb_inputs_add(inputs, fmb_model_inputs(m));
     fmb_free(m);
+  }
+  /* refused before any run, not after all of them */
+  char input[512];
+  if (!rc && fmb_inputs_at(inputs, opt->csv_path, input, sizeof input)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, opt->csv_path, 0, 0,
+                 "cannot write the merged table: it is the input '%s': refusing to overwrite it", input);
+    rc = FMB_EXIT_BAD_INPUT;
   }
   /* each model's own CSV, in a folder of this call's (nothing of the caller's is touched) */
   if (!rc) {
@@ -224,7 +238,7 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
   const int interrupted = res->ran > 0 && res->code[res->ran - 1] == FMB_EXIT_INTERRUPTED;
   if (!rc && read > 0 && (read == nmodel || interrupted)) {
     char err[300] = "";
-    fmbSafeFile* sf = fmb_safe_open(opt->csv_path, err, sizeof err); /* beside it, renamed into place */
+    fmbSafeFile* sf = fmb_safe_open_guarded(opt->csv_path, inputs, err, sizeof err); /* beside it, renamed in */
     FILE* f = fmb_safe_stream(sf);
     if (!f || merge(f, part, models, read)) {
       fmb_safe_close(sf, 0);
@@ -243,6 +257,7 @@ int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int n
   }
   for (int k = 0; k < nmodel; ++k) lines_free(&part[k]);
   if (dir[0]) rmdir(dir);
+  fmb_inputs_free(inputs);
   free(ov);
   free(sets);
   return rc > worst ? rc : worst;

@@ -866,7 +866,7 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
     return FMB_EXIT_BAD_INPUT;
   }
   fmbWorkspace* w = fmb_workspace_new(m);
-  fmbCsv* c = w ? fmb_csv_open(path, diag) : NULL;
+  fmbCsv* c = w ? fmb_csv_open_guarded(path, m->inputs, diag) : NULL;
   int rc = 0;
   if (!c) {
     if (!w) fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory");

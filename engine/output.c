@@ -443,10 +443,12 @@ static int csv_line_done(fmbCsv* c, size_t len) {
   return fmb_csv_flush(c);
 }
 
-fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) {
+fmbCsv* fmb_csv_open(const char* path, fmbDiag* diag) { return fmb_csv_open_guarded(path, NULL, diag); }
+
+fmbCsv* fmb_csv_open_guarded(const char* path, const fmbInputs* inputs, fmbDiag* diag) {
   fmbCsv* c = calloc(1, sizeof *c);
   char err[700];
-  if (c) c->file = fmb_safe_open(path ? path : "-", err, sizeof err);
+  if (c) c->file = fmb_safe_open_guarded(path ? path : "-", inputs, err, sizeof err);
   if (!c || !c->file) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the output file: %s", c ? err : "out of memory");
     free(c);

@@ -51,8 +51,8 @@ int fmb_registry_load(fmbRegistry* reg, const char* path, fmbDiag* diag) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "%s() returned no descriptor", FMB_PLUGIN_ENTRY);
     return -1;
   }
-  /* its code is never unloaded, and no output of this process may replace the file */
-  fmb_safe_note_input(path);
+  /* its code is never unloaded; the file is an input of whoever loaded it (a scene's plugins:
+     its model's, fmb_scene_plugins; a program's: its own set) */
   return fmb_registry_add(reg, desc, path, diag);
 }
 
@@ -79,6 +79,7 @@ int fmb_scene_plugins(fmbParser* p, fmbNode list) {
       snprintf(path, sizeof path, "%.*s%s", dirlen, p->path, file);
     fmbDiag d;
     if (fmb_registry_load(p->own_reg, path, &d)) return fmb_parse_error(p, item, "plugin %s: %s", d.file, d.msg);
+    if (p->model) fmb_inputs_note(p->model->inputs, path); /* no output of its runs may replace it */
   }
   return 0;
 }

@@ -99,7 +99,7 @@ int fmb_run(const fmbModel* m, const fmbRunOptions* opt, fmbStats* st, fmbDiag* 
   st->t_reached = m->solver.t0;
   const int quiet = opt && opt->quiet;
   const volatile sig_atomic_t* stop = opt ? opt->stop : NULL;
-  fmbCsv* csv = fmb_csv_open(opt ? opt->csv_path : NULL, diag);
+  fmbCsv* csv = fmb_csv_open_guarded(opt ? opt->csv_path : NULL, m->inputs, diag);
   if (!csv) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
   const char* vtk_dir = (opt && opt->vtk_dir) ? opt->vtk_dir : (m->vtk_dir[0] ? m->vtk_dir : NULL);
   fmbVtk* vtk = NULL;

@@ -6,15 +6,16 @@
  *    through and never removed;
  *  - a symbolic link is followed: the file it names is the target, the link stays; the old file's
  *    permissions are kept (a new one gets 0666 less the umask, as fopen would give).
- *  - a target that is one of the process's inputs (same device and inode, whatever the name or
- *    link that leads to it) is refused: fmb_load notes the scene and its table files, plugin
- *    loading the shared objects, a command the files it reads (fmb_safe_note_input), so no
- *    writer anywhere can replace what the run was computed from. A note lasts until the process
- *    ends (a command that loads a scene once per speed and writes at the end is still covered)
- *    or until a program undoes it (fmb_safe_forget_input).
+ *  - a target that is one of the inputs the writer is given (an fmbInputs: same device and inode,
+ *    whatever the name or link that leads to it) is refused (fmb_safe_open_guarded): each model
+ *    keeps the set of what fmb_load read (the scene, its table files, its plugins) and every
+ *    writer of a run checks against it; the CLI keeps one set for the whole command (tools/cli.c:
+ *    its scene, samples, references, --plugin files and every model it loaded). There is no
+ *    process-wide list: two threads loading and writing share nothing here (issue 35 item 3).
  * The CSV writer (output.c), the VTK files, references, JUnit reports and plots all use it. */
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -32,7 +33,8 @@ struct fmbSafeFile {
   FILE* stream; /* fmb_safe_stream's, over fd */
 };
 
-/* the inputs noted so far, by device and inode; refs: how many notes (a model's, a command's) */
+/* a set of input files, by device and inode; refs: how many notes (a model's, a command's).
+   Its own lock: one set may be shared by threads (a command's, noted from its workers). */
 typedef struct {
   dev_t dev;
   ino_t ino;
@@ -40,40 +42,51 @@ typedef struct {
   char* path; /* as the program named it, for messages */
   char* real; /* its absolute name when noted (realpath), to tell a stale note */
 } InputFile;
-static InputFile* input_file;
-static int ninput_file, cap_input_file;
+struct fmbInputs {
+  pthread_mutex_t lock;
+  InputFile* file;
+  int n, cap;
+};
 
-static InputFile* input_same_as(const struct stat* st) {
-  for (int i = 0; i < ninput_file; ++i)
-    if (input_file[i].dev == st->st_dev && input_file[i].ino == st->st_ino) return &input_file[i];
+fmbInputs* fmb_inputs_new(void) {
+  fmbInputs* in = calloc(1, sizeof *in);
+  if (in && pthread_mutex_init(&in->lock, NULL) != 0) {
+    free(in);
+    return NULL;
+  }
+  return in;
+}
+
+void fmb_inputs_free(fmbInputs* in) {
+  if (!in) return;
+  for (int i = 0; i < in->n; ++i) {
+    free(in->file[i].path);
+    free(in->file[i].real);
+  }
+  free(in->file);
+  pthread_mutex_destroy(&in->lock);
+  free(in);
+}
+
+static InputFile* input_same_as(const fmbInputs* in, const struct stat* st) {
+  for (int i = 0; i < in->n; ++i)
+    if (in->file[i].dev == st->st_dev && in->file[i].ino == st->st_ino) return &in->file[i];
   return NULL;
 }
 
-static void forget_all_inputs(void) { /* at exit: valgrind counts what is still reachable */
-  for (int i = 0; i < ninput_file; ++i) {
-    free(input_file[i].path);
-    free(input_file[i].real);
-  }
-  free(input_file);
-  input_file = NULL;
-  ninput_file = cap_input_file = 0;
-}
-
-int fmb_safe_note_input(const char* path) {
-  struct stat st;
-  if (!path || strcmp(path, "-") == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) return -1;
-  InputFile* in = input_same_as(&st);
-  if (in) {
-    in->refs++;
+/* under in->lock */
+static int note_locked(fmbInputs* in, const char* path, const struct stat* st, int refs) {
+  InputFile* have = input_same_as(in, st);
+  if (have) {
+    have->refs += refs;
     return 0;
   }
-  if (ninput_file == cap_input_file) {
-    const int cap = cap_input_file ? 2 * cap_input_file : 16;
-    InputFile* grown = realloc(input_file, (size_t)cap * sizeof *grown);
+  if (in->n == in->cap) {
+    const int cap = in->cap ? 2 * in->cap : 8;
+    InputFile* grown = realloc(in->file, (size_t)cap * sizeof *grown);
     if (!grown) return -1;
-    if (!input_file) atexit(forget_all_inputs);
-    input_file = grown;
-    cap_input_file = cap;
+    in->file = grown;
+    in->cap = cap;
   }
   char* copy = strdup(path);
   char* real = realpath(path, NULL);
@@ -82,35 +95,76 @@ int fmb_safe_note_input(const char* path) {
     free(real);
     return -1;
   }
-  input_file[ninput_file++] = (InputFile){st.st_dev, st.st_ino, 1, copy, real};
+  in->file[in->n++] = (InputFile){st->st_dev, st->st_ino, refs, copy, real};
   return 0;
 }
 
-void fmb_safe_forget_input(const char* path) {
-  if (!path) return;
+int fmb_inputs_note(fmbInputs* in, const char* path) {
   struct stat st;
-  InputFile* in = stat(path, &st) == 0 ? input_same_as(&st) : NULL;
-  for (int i = 0; !in && i < ninput_file; ++i) /* a file renamed or replaced since: by its name */
-    if (strcmp(input_file[i].path, path) == 0) in = &input_file[i];
-  if (!in || --in->refs > 0) return;
-  free(in->path);
-  free(in->real);
-  *in = input_file[--ninput_file];
-  if (ninput_file == 0) { /* nothing noted: nothing held (valgrind counts what is still reachable) */
-    free(input_file);
-    input_file = NULL;
-    cap_input_file = 0;
-  }
+  if (!in || !path || strcmp(path, "-") == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) return -1;
+  pthread_mutex_lock(&in->lock);
+  const int rc = note_locked(in, path, &st, 1);
+  pthread_mutex_unlock(&in->lock);
+  return rc;
 }
 
-const char* fmb_safe_input_at(const char* path) {
+int fmb_inputs_add(fmbInputs* to, const fmbInputs* from) {
+  if (!to || !from) return -1;
+  if (to == from) return 0;
+  /* from's names are copied under its lock, then noted under to's: one lock held at a time, so
+     two threads adding two sets into each other cannot deadlock */
+  fmbInputs* src = (fmbInputs*)from;
+  pthread_mutex_lock(&src->lock);
+  const int n = src->n;
+  char** names = calloc((size_t)n + 1, sizeof *names);
+  int rc = names ? 0 : -1;
+  for (int i = 0; names && i < n; ++i)
+    if (!(names[i] = strdup(src->file[i].path))) rc = -1;
+  pthread_mutex_unlock(&src->lock);
+  for (int i = 0; names && i < n; ++i) /* a file deleted since is no longer an input to keep */
+    if (names[i] && fmb_inputs_note(to, names[i]) != 0 && access(names[i], F_OK) == 0) rc = -1;
+  for (int i = 0; names && i < n; ++i) free(names[i]);
+  free(names);
+  return rc;
+}
+
+void fmb_inputs_forget(fmbInputs* in, const char* path) {
+  if (!in || !path) return;
+  struct stat st;
+  pthread_mutex_lock(&in->lock);
+  InputFile* have = stat(path, &st) == 0 ? input_same_as(in, &st) : NULL;
+  for (int i = 0; !have && i < in->n; ++i) /* a file renamed or replaced since: by its name */
+    if (strcmp(in->file[i].path, path) == 0) have = &in->file[i];
+  if (have && --have->refs <= 0) {
+    free(have->path);
+    free(have->real);
+    *have = in->file[--in->n];
+  }
+  pthread_mutex_unlock(&in->lock);
+}
+
+int fmb_inputs_count(const fmbInputs* in) {
+  if (!in) return 0;
+  fmbInputs* lk = (fmbInputs*)in;
+  pthread_mutex_lock(&lk->lock);
+  const int n = in->n;
+  pthread_mutex_unlock(&lk->lock);
+  return n;
+}
+
+int fmb_inputs_at(const fmbInputs* in, const char* path, char* name, size_t namelen) {
   struct stat st, noted;
-  if (!path || strcmp(path, "-") == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) return NULL;
-  const InputFile* in = input_same_as(&st);
+  if (name && namelen) name[0] = '\0';
+  if (!in || !path || strcmp(path, "-") == 0 || stat(path, &st) != 0 || !S_ISREG(st.st_mode)) return 0;
+  fmbInputs* lk = (fmbInputs*)in;
+  pthread_mutex_lock(&lk->lock);
+  const InputFile* have = input_same_as(in, &st);
   /* a note whose own name no longer leads to that file is stale: the input was deleted or
      replaced since, and its inode may now belong to an unrelated file */
-  if (!in || stat(in->real, &noted) != 0 || noted.st_dev != st.st_dev || noted.st_ino != st.st_ino) return NULL;
-  return in->path;
+  const int is = have && stat(have->real, &noted) == 0 && noted.st_dev == st.st_dev && noted.st_ino == st.st_ino;
+  if (is && name && namelen) snprintf(name, namelen, "%s", have->path);
+  pthread_mutex_unlock(&lk->lock);
+  return is;
 }
 
 static fmbSafeFile* fail(fmbSafeFile* f, char* err, size_t errlen, const char* path, const char* what) {
@@ -121,6 +175,10 @@ static fmbSafeFile* fail(fmbSafeFile* f, char* err, size_t errlen, const char* p
 }
 
 fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen) {
+  return fmb_safe_open_guarded(path, NULL, err, errlen);
+}
+
+fmbSafeFile* fmb_safe_open_guarded(const char* path, const fmbInputs* inputs, char* err, size_t errlen) {
   if (!path) return fail(NULL, err, errlen, path, "no file name");
   fmbSafeFile* f = calloc(1, sizeof *f);
   if (!f) return fail(NULL, err, errlen, path, "out of memory");
@@ -144,8 +202,8 @@ fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen) {
     f->target = strdup(path); /* never removed: only the temporary file ever is */
     return f;
   }
-  const char* input = exists ? fmb_safe_input_at(path) : NULL;
-  if (input) {
+  char input[512];
+  if (exists && fmb_inputs_at(inputs, path, input, sizeof input)) {
     if (err && errlen) snprintf(err, errlen, "it is the input '%s': refusing to overwrite it", input);
     fmb_safe_close(f, 0);
     return NULL;

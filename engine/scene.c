@@ -480,12 +480,17 @@ fmbModel* fmb_load(const char* path, const char* const* overrides, int noverride
     return NULL;
   }
   snprintf(m->path, sizeof m->path, "%s", path);
+  if (!(m->inputs = fmb_inputs_new())) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "out of memory");
+    free(m);
+    return NULL;
+  }
   fmbParser p;
   memset(&p, 0, sizeof p);
   p.model = m;
   p.reg = reg;
   int rc = fmbp_open(&p, path, overrides, noverrides, diag);
-  if (rc == 0) fmb_safe_note_input(path); /* no output of this process may replace it */
+  if (rc == 0) fmb_inputs_note(m->inputs, path); /* no output of this model's runs may replace it */
   if (rc == 0) rc = parse_scene(&p, m);
   fmbp_close(&p);
   fmb_registry_free(p.own_reg); /* the types stay: their code is never unloaded */
@@ -510,8 +515,11 @@ void fmb_free(fmbModel* m) {
   free(m->input_joint);
   free(m->input_initial);
   free(m->output);
+  fmb_inputs_free(m->inputs);
   free(m);
 }
+
+const fmbInputs* fmb_model_inputs(const fmbModel* m) { return m ? m->inputs : NULL; }
 
 int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
   if (!m || !out) return -1;

@@ -16,6 +16,7 @@
  * refuses, without reading freed memory (so AddressSanitizer accepts the test of that path), and
  * a double free is ignored. (Box2D's ids carry a generation for the same purpose; a pointer API
  * cannot, so the memory itself is held back.) */
+#include <float.h>
 #include <math.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -81,7 +82,8 @@ static void add_stats(fmbStats* to, const fmbStats* from) {
 static void release(fmbData* d) {
   if (d->integ) d->ops->destroy(d->integ);
   d->integ = NULL;
-  double* bufs[] = {d->y, d->yp, d->atol, d->row, d->work_before, d->redundant_phi, d->start.y, d->start.yp};
+  double* bufs[] = {d->y,       d->yp,       d->atol,      d->row, d->work_before, d->redundant_phi,
+                    d->start.y, d->start.yp, d->start.work};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
   free(d->range_warned);
   fmb_workspace_free(d->w);
@@ -112,12 +114,11 @@ fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
   d->redundant_phi = calloc((size_t)m->nc + 1, sizeof(double));
   d->range_warned = calloc((size_t)m->nbody + 1, 1);
   d->may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
-  if (d->may_switch) {
-    d->start.y = calloc(ny, sizeof(double));
-    d->start.yp = calloc(ny, sizeof(double));
-  }
+  d->start.y = calloc(ny, sizeof(double));
+  d->start.yp = calloc(ny, sizeof(double));
+  d->start.work = calloc((size_t)m->njoint + 1, sizeof(double));
   if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi || !d->range_warned ||
-      (d->may_switch && (!d->start.y || !d->start.yp))) {
+      !d->start.y || !d->start.yp || !d->start.work) {
     release(d);
     free(d);
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
@@ -329,15 +330,39 @@ static int interrupted(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   return FMB_EXIT_INTERRUPTED;
 }
 
+/* every value of the state and the work integrals finite */
+static int state_finite(const fmbModel* m, const fmbData* d) {
+  if (!isfinite(d->t)) return 0;
+  for (int i = 0; i < m->ny; ++i)
+    if (!isfinite(d->y[i]) || !isfinite(d->yp[i])) return 0;
+  const double* work = fmb_workspace_work(d->w);
+  for (int j = 0; m->need_work && j < m->njoint; ++j)
+    if (!isfinite(work[j])) return 0;
+  return 1;
+}
+
+/* A backend that gave up on values that are not finite (a load of 1e300, a runaway) may leave
+   them in y and yp (IDA does, at the time of its last step): the state goes back to where the
+   advance started, the last good one, so the outputs are finite, fmb_data_state is usable and a
+   later advance (after the cause is removed, e.g. the input set back) restarts from there. */
+static void back_to_start(const fmbModel* m, fmbData* d) {
+  d->t = d->start.t;
+  memcpy(d->y, d->start.y, sizeof(double) * (size_t)m->ny);
+  memcpy(d->yp, d->start.yp, sizeof(double) * (size_t)m->ny);
+  if (m->need_work && m->njoint > 0)
+    memcpy(fmb_workspace_work(d->w), d->start.work, sizeof(double) * (size_t)m->njoint);
+}
+
 static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   fmbWorkspace* w = d->w;
   const size_t ny = (size_t)m->ny;
   int rc = ensure_backend(m, d, diag);
   if (rc) return rc;
-  if (d->may_switch && !d->ops->projected) {
+  {
     d->start.t = d->t;
     memcpy(d->start.y, d->y, sizeof(double) * ny);
     memcpy(d->start.yp, d->yp, sizeof(double) * ny);
+    if (m->need_work && m->njoint > 0) memcpy(d->start.work, fmb_workspace_work(w), sizeof(double) * (size_t)m->njoint);
   }
   for (;;) {
     double tret = d->t, h = 0.0;
@@ -386,6 +411,7 @@ static int step_to(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
         fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "solver failed at t = %.6g (step size %.3g): %s", tret, h,
                      why);
       update_work(m, d);
+      if (!state_finite(m, d)) back_to_start(m, d);
       retire_backend(d, 1);
       return FMB_EXIT_SOLVER;
     }
@@ -435,6 +461,10 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   if (t_out == d->t) return 0;
   const double c0 = d->untimed ? 0.0 : thread_cpu_seconds();
   const int rc = step_to(m, d, t_out, diag);
+  if (rc == FMB_EXIT_SOLVER && !state_finite(m, d)) { /* a check after the step found it so */
+    back_to_start(m, d);
+    retire_backend(d, 1); /* its history is of the values dropped: the next advance restarts */
+  }
   d->failed = rc != 0;
   d->interrupted = rc == FMB_EXIT_INTERRUPTED;
   if (!d->untimed) d->cpu_s += thread_cpu_seconds() - c0;
@@ -495,6 +525,32 @@ static int input_index(const fmbModel* m, const char* name) {
   return -1;
 }
 
+/* A value a scene's `value:` would be refused for: one that puts the mechanism where a double
+   cannot resolve the joints' tolerance (a drive's angle or a slide of 1e300: the scene's rule,
+   ic.c), or that the joints cannot follow. Only a value that large could do so (a coordinate it
+   sets is the value itself, give or take the mechanism's size), so only then is the restart's
+   projection tried, on a copy (the start buffers are free between advances): a load of any
+   finite size is accepted, as a scene accepts it. 1 after saying why (d's warn handler). */
+static int refused_value(const fmbModel* m, fmbData* d, const char* fn, const char* name, double value) {
+  const size_t ny = (size_t)m->ny;
+  memcpy(d->start.y, d->y, sizeof(double) * ny);
+  memcpy(d->start.yp, d->yp, sizeof(double) * ny);
+  fmbDiag diag;
+  memset(&diag, 0, sizeof diag);
+  double qmax = 0.0;
+  const int rc = fmb_consistent_state(m, d->w, d->t, d->start.y, d->start.yp, &diag);
+  for (int k = 0; !rc && k < m->nq; ++k) qmax = fmax(qmax, fabs(d->start.y[k]));
+  if (!rc && isfinite(qmax) && qmax * DBL_EPSILON <= FMB_IC_PHI_TOL) return 0;
+  if (rc)
+    fmb_warn(d->w, "%s: input '%s' = %g refused: %s", fn, name, value, diag.msg);
+  else
+    fmb_warn(d->w,
+             "%s: input '%s' = %g refused: the coordinates would reach %.3g (m or rad), where a double "
+             "resolves only %.2g, coarser than the joints' tolerance %g (a scene's `value:` is refused the same)",
+             fn, name, value, qmax, qmax * DBL_EPSILON, FMB_IC_PHI_TOL);
+  return 1;
+}
+
 /* fmb_set_input and fmb_set_input_motion: the input `name` is value + rate tau + accel tau^2 / 2
    from time() on */
 static int set_input(const fmbModel* m, fmbData* d, const char* fn, const char* name, double value, double rate,
@@ -525,6 +581,16 @@ static int set_input(const fmbModel* m, fmbData* d, const char* fn, const char* 
   const double tol = m->solver.atol + m->solver.rtol * fmax(fabs(value), fabs(now_value));
   const double h = fmax(d->t - in->t_set, 0.0); /* how long the last setting held */
   const double jump = fabs(value - now_value), rate_jump = fabs(rate - now_rate);
+  const fmbInputSetting before = *in;
+  in->value = value;
+  in->rate = rate;
+  in->accel = accel;
+  in->t_set = d->t;
+  /* a value a scene's `value:` would be refused for is refused here too (refused_value) */
+  if (d->ic_done && fabs(value) * DBL_EPSILON > FMB_IC_PHI_TOL && refused_value(m, d, fn, name, value)) {
+    *in = before;
+    return FMB_EXIT_BAD_INPUT;
+  }
   if (j->nrows > 0 && (jump > tol || rate_jump * h > tol) && in->jumps++ == 0)
     fmb_warn(d->w,
              "warning: %s: drive input '%s' jumps at t = %.6g by %.3g (rate %.3g -> %.3g): the velocities are "
@@ -533,10 +599,6 @@ static int set_input(const fmbModel* m, fmbData* d, const char* fn, const char* 
              rate == 0.0 ? "; a drive set by value alone is at rest between settings: give the motion's rate with "
                            "fmb_set_input_motion (docs/api.md)"
                          : "");
-  in->value = value;
-  in->rate = rate;
-  in->accel = accel;
-  in->t_set = d->t;
   /* the equations change at time(): a BDF or Radau history across the change would be wrong, so
      the next advance starts afresh from a state made consistent with the new setting */
   retire_backend(d, 1);

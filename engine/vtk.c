@@ -100,7 +100,7 @@ fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag) {
   char path[1200];
   snprintf(path, sizeof path, "%s/%s.pvd", dir, v->stem);
   char err[300] = "";
-  v->pvd_file = fmb_safe_open(path, err, sizeof err);
+  v->pvd_file = fmb_safe_open_guarded(path, m->inputs, err, sizeof err);
   v->pvd = fmb_safe_stream(v->pvd_file);
   if (!v->pvd) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, path, 0, 0, "cannot write the VTK collection: %s",
@@ -190,7 +190,7 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
     offset[k] = at;
     at += sizeof(uint64_t) + count[k] * array_spec[k].size;
   }
-  fmbSafeFile* sf = fmb_safe_open(path, NULL, 0);
+  fmbSafeFile* sf = fmb_safe_open_guarded(path, m->inputs, NULL, 0);
   FILE* f = fmb_safe_stream(sf);
   if (!f) {
     fmb_safe_close(sf, 0);

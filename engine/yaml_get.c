@@ -608,8 +608,8 @@ static int table_file(fmbParser* p, fmbNode n, const char* key, double** x, doub
   }
   fclose(f);
   *count = rows;
-  /* an input: no output of this process may replace it (engine/safe_file.c) */
-  if (!rc) fmb_safe_note_input(path);
+  /* an input: no output of this model's runs may replace it (engine/safe_file.c) */
+  if (!rc && p->model) fmb_inputs_note(p->model->inputs, path);
   return rc;
 }
 

@@ -1,6 +1,7 @@
 #!/bin/sh
 # tools/ci_robustness.sh — the robustness steps of CI (issue 5), called from .ci/run:
-#   1. the test suite under ASan + UBSan + LSan (tools/sanitize.sh; all tests but `long`)
+#   1. the test suite under ASan + UBSan + LSan (tools/sanitize.sh; all tests but `long`), and the
+#      8-thread test under ThreadSanitizer (tools/tsan.sh)
 #   2. both libFuzzer harnesses side by side for FUZZ_SECONDS (default 60) (tools/fuzz.sh)
 #   3. valgrind memcheck on the paper scenes and the error paths (tools/valgrind_paper.sh)
 #   4. the scene regression suite under other compilers and optimization levels (tools/regress_builds.sh)
@@ -21,6 +22,9 @@ step() {
 
 step "sanitizers: build and ctest -LE long"
 sh "$src/tools/sanitize.sh" "$root/build-ci-sanitize" || failed="$failed sanitize"
+
+step "ThreadSanitizer: 8 threads loading, running and stepping (test_threads)"
+sh "$src/tools/tsan.sh" "$root/build-ci-tsan" || failed="$failed tsan"
 
 step "fuzzing: ${fuzz_secs} s per harness"
 sh "$src/tools/fuzz.sh" "$fuzz_secs" "$root/build-ci-fuzz" || failed="$failed fuzz"

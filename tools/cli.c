@@ -3,6 +3,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <pthread.h>
 #include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,6 +17,33 @@ static fmbRegistry* cli_registry; /* the built-ins, then every --plugin in comma
 static void free_cli_registry(void) {
   fmb_registry_free(cli_registry);
   cli_registry = NULL;
+}
+
+/* The files this command reads (its scene, samples, references, --plugin files, and the files of
+   every model it loaded: fmb_cli_note_model): no output of the command may replace one. The
+   command is the process, so its set may live for the process; the library keeps none (each
+   model has its own, engine/safe_file.c). Made before main's threads start (fmb_cli_inputs is
+   first called while the arguments are read) and locked inside, so workers may note into it. */
+static fmbInputs* cli_inputs;
+static void free_cli_inputs(void) {
+  fmb_inputs_free(cli_inputs);
+  cli_inputs = NULL;
+}
+static pthread_once_t cli_inputs_once = PTHREAD_ONCE_INIT;
+static void make_cli_inputs(void) {
+  cli_inputs = fmb_inputs_new();
+  if (cli_inputs) atexit(free_cli_inputs);
+}
+fmbInputs* fmb_cli_inputs(void) {
+  pthread_once(&cli_inputs_once, make_cli_inputs);
+  return cli_inputs;
+}
+int fmb_cli_note_input(const char* path) { return fmb_inputs_note(fmb_cli_inputs(), path); }
+void fmb_cli_note_model(const fmbModel* m) {
+  if (m) fmb_inputs_add(fmb_cli_inputs(), fmb_model_inputs(m));
+}
+fmbSafeFile* fmb_cli_safe_open(const char* path, char* err, size_t errlen) {
+  return fmb_safe_open_guarded(path, fmb_cli_inputs(), err, errlen);
 }
 
 fmbRegistry* fmb_cli_registry(void) {
@@ -80,6 +108,7 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
       fmb_cli_print_diag(&d);
       return FMB_EXIT_BAD_INPUT;
     }
+    fmb_cli_note_input(so); /* its code runs in this process: no output may replace the file */
     if (s->nplugins < (int)(sizeof s->plugins / sizeof s->plugins[0])) s->plugins[s->nplugins++] = so;
     return 1;
   }
@@ -91,7 +120,7 @@ int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCl
     return 0; /* an option of the command's own */
   } else if (!s->scene) {
     s->scene = a;
-    fmb_safe_note_input(a); /* no output of this command may replace it (engine/safe_file.c) */
+    fmb_cli_note_input(a); /* no output of this command may replace it (fmb_cli_inputs) */
     return 1;
   } else {
     fprintf(stderr, "flexmbd %s: one scene file at a time (got '%s' and '%s')\n", cmd, s->scene, a);
@@ -126,12 +155,12 @@ int fmb_cli_check_input(const char* path, const char* what) {
 }
 
 int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n) {
-  /* the inputs are noted once for the whole process, so every later write (fmb_safe_open) is
-     checked against them too, besides the scene, table files and plugins the library notes */
+  /* the inputs are noted for the whole command, so every later write (fmb_cli_safe_open) is
+     checked against them too, besides the scene, --plugin files and loaded models' files */
   for (int i = 0; i < n; ++i)
-    if (inputs[i]) fmb_safe_note_input(inputs[i]);
-  const char* input = fmb_safe_input_at(out);
-  if (!input) return 0;
+    if (inputs[i]) fmb_cli_note_input(inputs[i]);
+  char input[512];
+  if (!fmb_inputs_at(fmb_cli_inputs(), out, input, sizeof input)) return 0;
   fprintf(stderr, "%s: error: the output file is the input '%s': refusing to overwrite it\n", out, input);
   return FMB_EXIT_BAD_INPUT;
 }

@@ -44,8 +44,8 @@ int fmb_run_serve(const fmbCliScene* s);
 /* an input file (what: "scene", "reference", ...) exists, is a regular file and can be read;
    else prints "PATH: error: cannot open the WHAT: why" and returns FMB_EXIT_BAD_INPUT */
 int fmb_cli_check_input(const char* path, const char* what);
-/* Notes the n inputs for the whole process (engine/safe_file.c: no later write, by any writer,
-   may replace one; the library notes scenes, their table files and plugins itself), then
+/* Notes the n inputs for the whole command (fmb_cli_inputs: no later write through
+   fmb_cli_safe_open may replace one; each model guards its own files, engine/safe_file.c), then
    FMB_EXIT_BAD_INPUT after saying so when `out` is one of the noted inputs (device and inode,
    whatever the names), else 0. "-", non-regular files and files that do not exist are never inputs. */
 int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, int n);
@@ -63,6 +63,13 @@ void fmb_cli_warn(void* user, const char* message);
 void fmb_cli_warn_end(void);
 /* the registry every command loads scenes with: the built-ins and the --plugin files */
 fmbRegistry* fmb_cli_registry(void);
+/* the files this command reads, for the whole process (tools/cli.c): note one (the command's
+   scene and --plugin files are noted by fmb_cli_take_scene_arg), every file a loaded model read, and
+   open an output through the safe path refusing any of them */
+fmbInputs* fmb_cli_inputs(void);
+int fmb_cli_note_input(const char* path);
+void fmb_cli_note_model(const fmbModel* m);
+fmbSafeFile* fmb_cli_safe_open(const char* path, char* err, size_t errlen);
 
 /* `run --models a,b,...`: the scene once per beam model, outputs side by side (tools/run_models.c
    over the library's fmb_run_models), with vtk (or NULL) each model's animation in vtk/MODEL; *stop (SIGINT) ends it after the model in progress, whose

@@ -47,7 +47,7 @@ static int parse_speeds(const char* text, double* out) {
    `flexmbd plot`: its CSV reader takes run outputs, whose first column is t.) */
 static void plot(const char* csv, const char* png, int count, const char* title) {
   /* gnuplot writes beside the figure; the figure is replaced only by a finished plot */
-  fmbSafeFile* fig = fmb_safe_open(png, NULL, 0);
+  fmbSafeFile* fig = fmb_cli_safe_open(png, NULL, 0);
   const char* fig_path = fmb_safe_write_path(fig);
   FILE* g = fig_path ? popen("gnuplot 2>/dev/null", "w") : NULL;
   if (!g) {

@@ -376,7 +376,7 @@ int fmb_cmd_plot(int argc, char** argv) {
   const char* fig_path = NULL;
   if (!rc) {
     char ferr[300] = "";
-    fig = fmb_safe_open(a.out, ferr, sizeof ferr);
+    fig = fmb_cli_safe_open(a.out, ferr, sizeof ferr);
     fig_path = fmb_safe_write_path(fig);
     if (!fig_path) {
       fprintf(stderr, "flexmbd plot: cannot write '%s': %s\n", a.out, ferr[0] ? ferr : "not a file");

@@ -88,6 +88,7 @@ int fmb_cmd_run(int argc, char** argv) {
     fmb_cli_print_diag(&diag);
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
+  fmb_cli_note_model(m); /* its table files and plugins: inputs of the whole command */
   /* the progress line: on a terminal once a run has taken 2 s; --progress asks for it anywhere
      and from the start; --quiet wins over both */
   fmbRunOptions opt = {.csv_path = out,

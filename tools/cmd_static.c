@@ -59,7 +59,9 @@ int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fm
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
                          double** yp, fmbStaticResult* res, fmbDiag* diag) {
   const fmbSceneSource scene = {s->scene, s->overrides, nover, fmb_cli_registry()};
-  return fmb_load_steady(&scene, NULL, opt, m, y, yp, res, diag);
+  const int rc = fmb_load_steady(&scene, NULL, opt, m, y, yp, res, diag);
+  if (m && *m) fmb_cli_note_model(*m); /* its table files: inputs of the whole command */
+  return rc;
 }
 
 void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* f) {

@@ -362,6 +362,7 @@ int fmb_cmd_view(int argc, char** argv) {
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   /* the scene's table files are inputs too, known now that it is loaded */
+  fmb_cli_note_model(m);
   if (fmb_cli_check_output_not_input(out, NULL, 0)) {
     fmb_free(m);
     fmb_table_free(&tb);
@@ -500,7 +501,7 @@ int fmb_cmd_view(int argc, char** argv) {
       snprintf(note, sizeof note, "deformation scale %g", scale);
       notes[nnotes++] = strdup(note);
     }
-    fmbSafeFile* sf = fmb_safe_open(out, ferr, sizeof ferr);
+    fmbSafeFile* sf = fmb_cli_safe_open(out, ferr, sizeof ferr);
     FILE* f = fmb_safe_stream(sf);
     const int ok =
         f && write_page(f, title, &tb, vb, nb, d, m, plot, nplot, scale, (const char* const*)notes, nnotes) == 0;

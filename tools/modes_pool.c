@@ -39,7 +39,7 @@ static void file_of(const Farm* f, long index, char* path, size_t len) { snprint
 /* through the one safe writer (engine/safe_file.c): a temporary file beside PATH, renamed into place
    only when whole, so a reader never takes a half-written result and no file is overwritten early */
 int fmb_cli_modes_save(const char* path, int rc, const fmbDiag* diag, const fmbModes* m) {
-  fmbSafeFile* sf = fmb_safe_open(path, NULL, 0);
+  fmbSafeFile* sf = fmb_cli_safe_open(path, NULL, 0);
   FILE* f = sf ? fmb_safe_stream(sf) : NULL;
   if (!f) {
     if (sf) fmb_safe_close(sf, 0);

@@ -48,6 +48,7 @@ static void child_run(void* argp) {
     sets[nsets] = set;
     m = fmb_load(job->scene, sets, nsets + 1, fmb_cli_registry(), &diag);
   }
+  fmb_cli_note_model(m); /* no reference or report may replace a file it read */
   if (!m) {
     /* an override's message starts with the override itself: the command line's own is the
        caller's mistake (exit 2), a reference's `# set:` one is the scene's (it no longer loads) */

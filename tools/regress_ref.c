@@ -541,7 +541,7 @@ int regress_bless_job(RegressJob* job, const RegressOptions* o) {
   }
   /* beside it and renamed into place: never a half-written reference */
   char werr[300] = "";
-  fmbSafeFile* sf = fmb_safe_open(job->ref_path, werr, sizeof werr);
+  fmbSafeFile* sf = fmb_cli_safe_open(job->ref_path, werr, sizeof werr);
   FILE* f = fmb_safe_stream(sf);
   const int wrote = f && fwrite(text, 1, n, f) == n;
   if (sf && !werr[0] && !wrote) snprintf(werr, sizeof werr, "%s", strerror(errno));

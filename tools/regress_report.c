@@ -9,7 +9,7 @@
 
 int regress_write_junit(const char* path, RegressJob* const* jobs, int n) {
   char err[300] = "";
-  fmbSafeFile* sf = fmb_safe_open(path, err, sizeof err);
+  fmbSafeFile* sf = fmb_cli_safe_open(path, err, sizeof err);
   FILE* f = fmb_safe_stream(sf);
   if (!f) {
     fprintf(stderr, "flexmbd regress: cannot write %s: %s\n", path, err[0] ? err : strerror(errno));

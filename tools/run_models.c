@@ -63,6 +63,7 @@ int fmb_cli_run_models(const fmbCliScene* s, const char* list, const char* out, 
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   /* the scene's table files are inputs now too: refuse before any run, not after all of them */
+  fmb_cli_note_model(m);
   if (fmb_cli_check_output_not_input(out, NULL, 0)) {
     fmb_free(m);
     return FMB_EXIT_BAD_INPUT;

@@ -9,23 +9,25 @@
 Everything is computed by the C library (libflexmbd, found as flexmbd._lib describes) through
 ctypes; this package converts arguments and results, nothing more. docs/python.md is the guide.
 """
-import sys as _sys
-
 try:
     import numpy as _numpy  # noqa: F401  (every result is a NumPy array)
-except ImportError as _e:
+except ImportError as _e:  # a python3 other than Debian's, without NumPy: say what to install
+    import sys as _sys
+
     raise ImportError(
-        f"flexmbd needs NumPy, which this Python ({_sys.executable}) cannot import: {_e}. Install it for "
-        f"this interpreter ('{_sys.executable} -m pip install numpy'), or use Debian's /usr/bin/python3 with "
-        "python3-numpy (apt install python3-numpy), or a venv made with "
-        "'/usr/bin/python3 -m venv --system-site-packages', which sees Debian's NumPy") from _e
+        f"flexmbd needs NumPy, which this Python ({_sys.executable}, {_sys.version.split()[0]}) cannot import "
+        f"({_e}). With Debian's python3: `sudo apt install python3-numpy` and run /usr/bin/python3. In a venv: make "
+        "it with `python3 -m venv --system-site-packages` over Debian's python3 (it then sees python3-numpy), or "
+        "install numpy into it (`python -m pip install numpy`). With pyenv or conda: install numpy into that "
+        "interpreter (`pip install numpy` / `conda install numpy`)."
+    ) from _e
 
 from ._source import version as _version
 
 #: the project's version (CMakeLists.txt's project(VERSION), recorded at the build)
 __version__ = _version()
 
-from ._lib import FlexmbdError, FlexmbdWarning, Interrupted, SceneError, SolverError, library_path
+from ._lib import ArgumentError, KeyboardInterrupted, FlexmbdError, FlexmbdWarning, Interrupted, SceneError, SolverError, library_path
 from ._scene import scene_text
 from .model import Cancel, Model, Result, Simulation, load, output_times
 from .analysis import CampbellResult, ModesResult, StaticResult, campbell, modes, static
@@ -35,6 +37,7 @@ from .study import metric, study
 from .view_page import view
 
 __all__ = ["load", "Model", "Result", "Simulation", "Cancel", "output_times", "FlexmbdWarning", "SceneError", "SolverError", "Interrupted", "FlexmbdError",
+           "ArgumentError", "KeyboardInterrupted",
            "scene_text", "library_path",
            "static", "modes", "campbell", "StaticResult", "ModesResult", "CampbellResult", "compare", "Comparison",
            "study", "metric", "unit", "axis_label", "view"]

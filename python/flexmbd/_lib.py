@@ -80,6 +80,27 @@ class Interrupted(FlexmbdError):
     result = None
 
 
+class KeyboardInterrupted(Interrupted, KeyboardInterrupt):
+    """A run stopped by Ctrl-C (SIGINT): an Interrupted with the rows so far in ``result``
+    (``result.status == "interrupted"``), and a KeyboardInterrupt, so that a script's
+    ``except KeyboardInterrupt`` (or none: the program ends) sees it as Python code does."""
+
+
+class ArgumentError(SceneError, ValueError):
+    """A bad argument to a call of this package (a ValueError), named in Python's terms: the
+    method and parameter, what was given and what is allowed. Also a SceneError (exit code 2, as
+    the command line gives bad input), for code written before it existed."""
+
+    def __init__(self, message: str) -> None:
+        super().__init__(EXIT_BAD_INPUT, "", 0, 0, message)
+
+    def __str__(self) -> str:  # the call and parameter name it: no file to point at
+        return self.message
+
+    def __reduce__(self):
+        return (type(self), (self.message,))
+
+
 class Diag(ctypes.Structure):
     """fmbDiag"""
     _fields_ = [("code", ctypes.c_int), ("file", ctypes.c_char * 512), ("line", ctypes.c_int),

@@ -66,7 +66,8 @@ def static(scene: ModelLike, *, at: Optional[float] = None, set: Overrides = Non
                              tol=tol, quiet=1)
     res = _lib.StaticResult()
     diag = _lib.Diag()
-    rc = lib.fmb_static(m.handle, ctypes.byref(opt), _dptr(y), _dptr(yp), ctypes.byref(res), ctypes.byref(diag))
+    with m._use() as h:  # kept allocated during the call, whoever closes m meanwhile
+        rc = lib.fmb_static(h, ctypes.byref(opt), _dptr(y), _dptr(yp), ctypes.byref(res), ctypes.byref(diag))
     if rc:
         raise m._error(diag, rc)
     return StaticResult(m, y, yp, res, _state_outputs(m, res.t, y, yp))
@@ -79,7 +80,8 @@ def _state_outputs(m: Model, t: float, y: np.ndarray, yp: np.ndarray) -> Dict[st
     os.close(fd)
     try:
         diag = _lib.Diag()
-        rc = lib.fmb_write_state_row(m.handle, path.encode(), t, _dptr(y), _dptr(yp), ctypes.byref(diag))
+        with m._use() as h:
+            rc = lib.fmb_write_state_row(h, path.encode(), t, _dptr(y), _dptr(yp), ctypes.byref(diag))
         if rc:
             raise m._error(diag, rc)
         r = Result.from_csv(path)
@@ -131,8 +133,9 @@ def _modes_at(m: Model, state: StaticResult, count: int, method: int) -> ctypes.
     lib = _lib.library()
     out = ctypes.POINTER(_lib.Modes)()
     diag = _lib.Diag()
-    rc = lib.fmb_modes(m.handle, state.t, _dptr(state.y), _dptr(state.yp), count, method, ctypes.byref(out),
-                       ctypes.byref(diag))
+    with m._use() as h:
+        rc = lib.fmb_modes(h, state.t, _dptr(state.y), _dptr(state.yp), count, method, ctypes.byref(out),
+                           ctypes.byref(diag))
     if rc:
         raise m._error(diag, rc)
     return out

@@ -5,6 +5,7 @@ import contextlib
 import ctypes
 import math
 import os
+import signal
 import tempfile
 import threading
 import weakref
@@ -115,23 +116,78 @@ def _scene_file(text: str):
 
 class _Owned:
     """An object of the library this Python object owns (``_ptr``), freed by ``_free`` (the name
-    of the library's function) on close(), at the end of a ``with`` block, or when collected."""
+    of the library's function) on close(), at the end of a ``with`` block, or when collected.
+
+    Every call into the library holds a use of the pointer (``with self._use() as ptr``), counted
+    under a lock: close() from another thread while a call runs (a model closed during its run)
+    does not free the object under it; the last use frees it, and new calls raise ValueError. So
+    no close, from any thread, can make the library read freed memory (issue 36)."""
 
     _ptr: Optional[int] = None
     _free = ""
+    _uses = 0
+    _closing = False
+    _guard: Optional[threading.Lock] = None
+
+    def _own(self, ptr: int) -> None:
+        self._guard = threading.Lock()
+        self._uses = 0
+        self._closing = False
+        self._ptr = ptr
+
+    def _closed_error(self) -> ValueError:
+        return ValueError(f"flexmbd: the {type(self).__name__} was closed")
 
     @property
     def handle(self) -> int:
-        """The library's pointer (fmbModel*, fmbData*), for calls this package does not wrap."""
-        if not self._ptr:
-            raise ValueError(f"flexmbd: the {type(self).__name__} was closed")
+        """The library's pointer (fmbModel*, fmbData*), for calls this package does not wrap
+        (valid until close(): hold it only while this object is open)."""
+        if not self._ptr or self._closing:
+            raise self._closed_error()
         return self._ptr
 
-    def close(self) -> None:
-        """Free the library's object now (also done when this one is collected)."""
+    @contextlib.contextmanager
+    def _use(self):
+        """The pointer, kept from being freed until the block ends."""
+        guard = self._guard
+        if guard is None:
+            raise self._closed_error()
+        with guard:
+            if not self._ptr or self._closing:
+                raise self._closed_error()
+            self._uses += 1
+            ptr = self._ptr
+        try:
+            yield ptr
+        finally:
+            with guard:
+                self._uses -= 1
+                last = self._closing and self._uses == 0
+            if last:
+                self._release()
+
+    def _release(self) -> None:
         ptr, self._ptr = self._ptr, None
         if ptr:
             getattr(_lib.library(), self._free)(ptr)
+            self._released()
+
+    def _released(self) -> None:
+        """after the library's object is freed (a Simulation lets go of its model)"""
+
+    def close(self) -> None:
+        """Free the library's object now, or, while a call into the library is using it (another
+        thread's run), as soon as that call returns. Also done when this one is collected."""
+        guard = self._guard
+        if guard is None:
+            return
+        with guard:
+            if self._closing:
+                return
+            self._closing = True
+            busy = self._uses > 0
+        if not busy:
+            self._release()
 
     def __del__(self) -> None:
         try:
@@ -177,7 +233,7 @@ class Model(_Owned):
         if not ptr:
             raise _lib.error_from(diag, rename)
         m = cls()
-        m._ptr = ptr
+        m._own(ptr)
         m._rename = rename
         m._reg = reg
         m.path = None if shown else path
@@ -202,8 +258,24 @@ class Model(_Owned):
         where = self.path or self._rename.get(next(iter(self._rename), ""), "?")
         return f"<flexmbd.Model {where} bodies={list(self.bodies)} t_end={self.solver['t_end']:g}>"
 
+    # -- copies: a Model owns its fmbModel; a copy is the scene loaded again (an owner of its own) --
+    def __copy__(self) -> "Model":
+        """A new Model of the same scene, overrides and plugins, loaded again: it owns its own
+        library model (two Python objects never free one)."""
+        return self.reload()
+
+    def __deepcopy__(self, memo) -> "Model":
+        return self.reload()
+
+    def __reduce__(self):
+        """Pickled as what it was loaded from (the scene's path, text or dict, the overrides and
+        plugins): unpickling loads it again (in another process too, as flexmbd.study does)."""
+        self.handle  # a closed model cannot be copied: ValueError
+        return (_model_from_source, (self._source, self._shown_path, list(self.overrides), list(self.plugins)))
+
     def reload(self, set: Overrides = None) -> "Model":
         """The same scene loaded again with more overrides (later ones win)."""
+        self.handle  # ValueError when closed
         kind, what = self._source
         extra = _overrides(set)
         if kind == "path":
@@ -260,6 +332,15 @@ class Model(_Owned):
         return Simulation(self, warn=warn, cancel=cancel)
 
 
+def _model_from_source(source, shown: str, overrides: List[str], plugins: List[str]) -> Model:
+    """A pickled Model loaded again (Model.__reduce__)."""
+    kind, what = source
+    if kind == "path":
+        return Model._load(what, None, overrides, tuple(plugins), source)
+    text = scene_text(what) if kind == "dict" else what
+    return Model._from_text(text, shown, overrides, tuple(plugins), source)
+
+
 class Cancel:
     """A flag that stops runs from another thread: ``c = flexmbd.Cancel()``, pass it to
     ``Model.run(cancel=c)`` or ``Model.start(cancel=c)``, then ``c.set()``. The advance in progress
@@ -268,17 +349,29 @@ class Cancel:
     def __init__(self) -> None:
         self._set = False
         self._sims: "weakref.WeakSet[Simulation]" = weakref.WeakSet()
+        self._others: "weakref.WeakSet[Cancel]" = weakref.WeakSet()
         self._lock = threading.Lock()
 
     def set(self) -> None:
         with self._lock:
             self._set = True
             sims = list(self._sims)
+            others = list(self._others)
         for sim in sims:
             sim.cancel()
+        for other in others:
+            other.set()
 
     def is_set(self) -> bool:
         return self._set
+
+    def _also(self, other: "Cancel") -> None:
+        """set() sets `other` too (a run's own flag, which Ctrl-C also sets)."""
+        with self._lock:
+            self._others.add(other)
+            already = self._set
+        if already:
+            other.set()
 
     def _watch(self, sim: "Simulation") -> None:
         with self._lock:
@@ -314,9 +407,12 @@ class Simulation(_Owned):
     takes effect from the current time as a step and the integrator restarts there (no history
     across the jump). ``outputs()`` gives the scene's outputs now (the values a CSV row at this time
     holds), ``sim[name]`` one of them, ``state()`` the DAE state (y, y'), ``stats`` the counters so
-    far. Errors: SolverError (the state stays at the last good step), Interrupted (``cancel()``,
-    from any thread), SceneError for misuse (t_out before t, NaN or beyond t_end; an unknown input).
-    Each call into the library releases the GIL."""
+    far. Errors: SolverError (the state stays at the last good one: a later advance goes on from
+    it), Interrupted (``cancel()``, from any thread), and for a bad argument a ValueError
+    (flexmbd.ArgumentError) naming the call and the parameter: t_out before t, NaN or beyond t_end;
+    an unknown input, or a value a scene would refuse. Each call into the library releases the
+    GIL. A Simulation holds its model open: ``model.close()`` meanwhile frees it only after the
+    Simulation is closed. It cannot be copied or pickled (start another with ``model.start()``)."""
 
     _free = "fmb_data_free"
 
@@ -324,42 +420,84 @@ class Simulation(_Owned):
                  cancel: Optional[Cancel] = None) -> None:
         lib = _lib.library()
         self.model = model
+        # the model stays allocated while this run exists, whoever closes it meanwhile
+        self._model_use = model._use()
+        self._mptr = self._model_use.__enter__()
         diag = _lib.Diag()
         _lib.route_warnings()
-        self._ptr = lib.fmb_data_new(model.handle, ctypes.byref(diag))
-        if not self._ptr:
+        ptr = lib.fmb_data_new(self._mptr, ctypes.byref(diag))
+        if not ptr:
+            self._released()
             raise model._error(diag)
+        self._own(ptr)
         # this run's messages go to `warn` or Python's warnings whichever thread advances it
         self._warn = _lib.WarnFn(lambda user, msg: _lib.deliver(msg, warn)) if warn is not None else _lib.WARN_TO_PYTHON
         lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
         self.output_names: List[str] = model.output_names
+        self._t_end = model.solver["t_end"]
         self._row = np.zeros(len(self.output_names))
         self._row_ptr = self._row.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         if cancel is not None:
             cancel._watch(self)
         self.restart()
 
+    def _released(self) -> None:
+        use, self._model_use = getattr(self, "_model_use", None), None
+        if use is not None:
+            use.__exit__(None, None, None)
+
+    def __reduce__(self):
+        raise TypeError("flexmbd: a Simulation (a run in progress, the library's fmbData) cannot be pickled or "
+                        "copied; start another with model.start() (and restart() or advance() it to where you want)")
+
+    def __copy__(self):
+        self.__reduce__()
+
+    def __deepcopy__(self, memo):
+        self.__reduce__()
+
     def restart(self) -> None:
         """Back to the consistent state at t0 (fmb_init), inputs at their scene values."""
         diag = _lib.Diag()
-        rc = _lib.library().fmb_init(self.model.handle, self.handle, ctypes.byref(diag))
+        with self._use() as d:
+            rc = _lib.library().fmb_init(self._mptr, d, ctypes.byref(diag))
         if rc:
             raise self.model._error(diag, rc)
 
     @property
     def t(self) -> float:
         """The time the state is at."""
-        return _lib.library().fmb_data_time(self.handle)
+        with self._use() as d:
+            return _lib.library().fmb_data_time(d)
 
     def advance(self, t_out: float) -> None:
-        """Integrate to t_out (raises SolverError, Interrupted, or SceneError for misuse)."""
+        """Integrate to t_out, t ≤ t_out ≤ the scene's t_end (raises SolverError, Interrupted, or
+        ValueError for a t_out outside that range)."""
+        try:
+            t_out = float(t_out)
+        except (TypeError, ValueError):
+            raise _lib.ArgumentError(f"Simulation.advance(t_out={t_out!r}): t_out must be a number (seconds)") from None
+        t = self.t
+        if math.isnan(t_out) or t_out < t:
+            raise _lib.ArgumentError(
+                f"Simulation.advance(t_out={t_out!r}): t_out is before the simulation's time t = {t!r}; a run goes "
+                "forward (sim.restart() starts it again at t0)")
+        if t_out > self._t_end:
+            raise _lib.ArgumentError(
+                f"Simulation.advance(t_out={t_out!r}): t_out is beyond the scene's t_end = {self._t_end!r} (load it "
+                "with set={'solver.t_end': ...} for a longer run)")
         diag = _lib.Diag()
-        rc = _lib.library().fmb_advance(self.model.handle, self.handle, float(t_out), ctypes.byref(diag))
+        with self._use() as d:
+            rc = _lib.library().fmb_advance(self._mptr, d, t_out, ctypes.byref(diag))
+        if rc == _lib.EXIT_BAD_INPUT:  # a misuse the checks above did not foresee: still the caller's
+            raise _lib.ArgumentError(f"Simulation.advance(t_out={t_out!r}): " +
+                                     diag.msg.decode("utf-8", "replace").replace("fmb_advance: ", ""))
         if rc:
             raise self.model._error(diag, rc)
 
     def _outputs_into(self, out) -> int:
-        return _lib.library().fmb_outputs(self.model.handle, self.handle, out)
+        with self._use() as d:
+            return _lib.library().fmb_outputs(self._mptr, d, out)
 
     def outputs(self) -> Dict[str, float]:
         """The scene's outputs at time t, name → value (a non-finite value raises SolverError)."""
@@ -384,8 +522,9 @@ class Simulation(_Owned):
         """(y, y') of the DAE: [q, v, λ, μ, z] and its rate (copies)."""
         n = self.model.state_size
         y, yp = np.zeros(n), np.zeros(n)
-        _lib.library().fmb_data_state(self.handle, y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
-                                      yp.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+        with self._use() as d:
+            _lib.library().fmb_data_state(d, y.ctypes.data_as(ctypes.POINTER(ctypes.c_double)),
+                                          yp.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
         return y, yp
 
     @property
@@ -393,72 +532,147 @@ class Simulation(_Owned):
         """The names of the inputs set_load can change (joints with profile/law: input)."""
         return self.model.inputs
 
+    def _no_input(self, call: str, name: str) -> _lib.ArgumentError:
+        have = ", ".join(repr(n) for n in self.inputs) if self.inputs else "none"
+        return _lib.ArgumentError(
+            f"{call}: no input named {name!r}; this scene's inputs: {have} (an input is a joint with "
+            "`profile: input` (a drive, a prismatic joint) or `law: input` (a force), named by the joint)")
+
     def set_load(self, name: str, value: float) -> None:
         """Set input `name` (a load with `law: input`, a drive with `profile: input`) from now on
-        (fmb_set_input): piecewise constant, the next advance starts from it."""
-        with _lib.captured_messages() as said:
-            rc = _lib.library().fmb_set_input(self.model.handle, self.handle, name.encode(), float(value))
+        (fmb_set_input): piecewise constant, the next advance starts from it. A bad name or value
+        (not finite, or one a scene's `value:` would be refused for) raises ValueError naming it."""
+        call = f"Simulation.set_load({name!r}, {value!r})"
+        if not isinstance(name, str):
+            raise _lib.ArgumentError(f"{call}: the input's name must be a str")
+        if name not in self.inputs:
+            raise self._no_input(call, name)
+        try:
+            value = float(value)
+        except (TypeError, ValueError):
+            raise _lib.ArgumentError(f"{call}: the value must be a number") from None
+        with _lib.captured_messages() as said, self._use() as d:
+            rc = _lib.library().fmb_set_input(self._mptr, d, name.encode(), value)
         if rc:
-            raise _lib.SceneError(rc, "", 0, 0, "; ".join(said) or f"set_load('{name}', {value!r}) refused")
+            why = "; ".join(m.replace("fmb_set_input: ", "") for m in said) or "refused"
+            raise _lib.ArgumentError(f"{call}: {why}")
 
     def get_load(self, name: str) -> float:
         """The current value of input `name`."""
         v = ctypes.c_double()
-        if _lib.library().fmb_get_input(self.model.handle, self.handle, name.encode(), ctypes.byref(v)):
-            raise KeyError(f"no input '{name}' (inputs: {', '.join(self.inputs)})")
+        with self._use() as d:
+            rc = _lib.library().fmb_get_input(self._mptr, d, name.encode(), ctypes.byref(v))
+        if rc:
+            raise KeyError(str(self._no_input(f"Simulation.get_load({name!r})", name)))
         return v.value
 
     @property
     def stats(self) -> dict:
         """The counters so far, as the stats line's fields (status says ok: the run goes on)."""
         buf = ctypes.create_string_buffer(_lib.STATS_BYTES)
-        _lib.library().fmb_data_stats(self.handle, buf)
+        with self._use() as d:
+            _lib.library().fmb_data_stats(d, buf)
         return _lib.stats_dict(buf)
 
     def cancel(self) -> None:
         """Stop the advance in progress (or the next one) with Interrupted; safe from any thread."""
-        ptr = self._ptr
-        if ptr:
-            _lib.library().fmb_data_cancel(ptr)
+        try:
+            with self._use() as d:
+                _lib.library().fmb_data_cancel(d)
+        except ValueError:  # closed: nothing runs
+            pass
 
     def __repr__(self) -> str:
-        return f"<flexmbd.Simulation t={self.t:g} of {self.model!r}>" if self._ptr else "<flexmbd.Simulation closed>"
+        return f"<flexmbd.Simulation t={self.t:g} of {self.model!r}>" if self._ptr and not self._closing else "<flexmbd.Simulation closed>"
+
+
+def _ctrl_c_waits(work: Callable[[], None], on_ctrl_c: Callable[[], None]) -> bool:
+    """work() so that Ctrl-C stops it at once: in the main thread with Python's own SIGINT handler,
+    work runs in a helper thread and this one waits; SIGINT raises KeyboardInterrupt here (a wait is
+    interrupted by signals, a call into the library is not), which calls on_ctrl_c (it cancels the
+    advance in progress: fmb_data_cancel, after the step being taken) and waits on for work to
+    return. Elsewhere (another thread, a handler of the program's own) work runs here. True when
+    Ctrl-C was pressed."""
+    if (threading.current_thread() is not threading.main_thread()
+            or signal.getsignal(signal.SIGINT) is not signal.default_int_handler):
+        work()
+        return False
+    failed: List[BaseException] = []
+    done = threading.Event()
+
+    def body() -> None:
+        try:
+            work()
+        except BaseException as e:  # handed to the waiting thread
+            failed.append(e)
+        finally:
+            done.set()
+
+    helper = threading.Thread(target=body, name="flexmbd-run", daemon=True)
+    helper.start()
+    pressed = False
+    # an Event, not Thread.join: a join that KeyboardInterrupt breaks into may report the thread
+    # ended while it runs on (CPython 3.11); Event.wait cleans up after an interruption
+    while not done.is_set():
+        try:
+            done.wait(0.05)
+        except KeyboardInterrupt:
+            pressed = True
+            on_ctrl_c()
+    helper.join()
+    if failed:
+        raise failed[0]
+    return pressed
 
 
 def _run_whole(model: Model, check: bool, cancel: Optional[Cancel], warn) -> "Result":
     """fmb_run's loop (engine/run.c) on the stepping API: the row at t0 after fmb_init, then one
-    fmb_advance and one row per output time; the rows go straight into one NumPy array."""
+    fmb_advance and one row per output time; the rows go straight into one NumPy array. Ctrl-C
+    stops it after the step in progress (not the output row: the advance is cancelled inside the
+    library) and keeps the rows so far, status "interrupted" (_ctrl_c_waits)."""
     nout, time_of = _output_grid(model.solver)
     names = ["t"] + model.output_names
-    values = np.zeros((min(nout + 1, 4096), len(names)))  # grown by doubling: t_end may be far
-    nrow = 0
-    error: Optional[FlexmbdError] = None
-    sim = None
-    try:
-        sim = Simulation(model, warn=warn, cancel=cancel)
-        for k in range(nout + 1):
-            if k > 0:
-                sim.advance(time_of(k))
-            if k == len(values):
-                values = np.concatenate([values, np.zeros_like(values)])
-            row = values[k]
-            row[0] = sim.t
-            rc = sim._outputs_into(row[1:].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
-            if rc:  # fmb_run stops here too, without the row
-                raise _lib.SolverError(rc, model._shown_path, 0, 0,
-                                       f"stopped at t = {sim.t:.6g}: an output is not finite (the solution blew up)")
-            nrow = k + 1
-            if cancel is not None and cancel.is_set() and k < nout:
-                raise _lib.Interrupted(_lib.EXIT_INTERRUPTED, model._shown_path, 0, 0,
-                                       f"interrupted at t = {sim.t:.6g} (Cancel.set()): the {nrow} rows so far are kept")
-    except (_lib.SolverError, _lib.Interrupted) as e:
-        error = e
+    box: Dict[str, Any] = {"values": np.zeros((min(nout + 1, 4096), len(names))), "nrow": 0, "error": None,
+                           "sim": None}
+    stop = Cancel()  # set by Ctrl-C, and by the caller's Cancel
+    if cancel is not None:
+        cancel._also(stop)
+
+    def work() -> None:
+        try:
+            sim = box["sim"] = Simulation(model, warn=warn, cancel=stop)
+            values = box["values"]
+            for k in range(nout + 1):
+                if k > 0:
+                    sim.advance(time_of(k))
+                if k == len(values):
+                    values = box["values"] = np.concatenate([values, np.zeros_like(values)])
+                row = values[k]
+                row[0] = sim.t
+                rc = sim._outputs_into(row[1:].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
+                if rc:  # fmb_run stops here too, without the row
+                    raise _lib.SolverError(rc, model._shown_path, 0, 0,
+                                           f"stopped at t = {sim.t:.6g}: an output is not finite (the solution blew up)")
+                box["nrow"] = k + 1
+                if stop.is_set() and k < nout:
+                    raise _lib.Interrupted(_lib.EXIT_INTERRUPTED, model._shown_path, 0, 0, "")
+        except (_lib.SolverError, _lib.Interrupted) as e:
+            box["error"] = e
+
+    pressed = _ctrl_c_waits(work, stop.set)
+    error, sim, nrow = box["error"], box["sim"], box["nrow"]
+    if isinstance(error, _lib.Interrupted) or (pressed and error is None and nrow < nout + 1):
+        t_stop = sim.t if sim is not None and sim._ptr else model.solver["t0"]
+        how = "Ctrl-C (SIGINT)" if pressed else "Cancel.set()"
+        cls = _lib.KeyboardInterrupted if pressed else _lib.Interrupted
+        error = cls(_lib.EXIT_INTERRUPTED, model._shown_path, 0, 0,
+                    f"interrupted at t = {t_stop:.6g} ({how}): the {nrow} rows so far are kept in .result")
     stats = {}
     if sim is not None:
         stats = sim.stats
         stats["status"] = "ok" if error is None else ("interrupted" if isinstance(error, _lib.Interrupted) else "failed")
         sim.close()
-    result = Result(names, values[:nrow], stats)
+    result = Result(names, box["values"][:nrow], stats)
     result._scene = (model._source[1], list(model.overrides), list(model.plugins))  # for flexmbd.view
     if error is not None:
         result.error = error

@@ -195,8 +195,17 @@ static void analysis_misuse(const char* scene, const char* dir) {
     ENSURE(f && fgets(line, sizeof line, f) && strcmp(line, "t,bob.x@complete\n") == 0);
     if (f) fclose(f);
   }
-  ENSURE(fmb_safe_note_input(NULL) == -1 && fmb_safe_input_at(NULL) == NULL);
-  fmb_safe_forget_input(NULL);
+  ENSURE(fmb_inputs_note(NULL, path) == -1 && fmb_inputs_at(NULL, path, NULL, 0) == 0);
+  ENSURE(fmb_inputs_add(NULL, NULL) == -1 && fmb_inputs_count(NULL) == 0 && fmb_model_inputs(NULL) == NULL);
+  fmb_inputs_forget(NULL, path);
+  fmb_inputs_free(NULL);
+  {
+    fmbInputs* in = fmb_inputs_new();
+    ENSURE(in && fmb_inputs_note(in, NULL) == -1 && fmb_inputs_note(in, "-") == -1 && fmb_inputs_note(in, dir) == -1);
+    ENSURE(fmb_inputs_at(in, NULL, NULL, 0) == 0);
+    fmb_inputs_forget(in, NULL);
+    fmb_inputs_free(in);
+  }
 
   /* the pendulum turned 0.5 rad down from horizontal (horizontal is a dead point for statics) */
   const char* turned[] = {"bodies.bob.position=[0.8775825618903728, -0.479425538604203]", "bodies.bob.angle=-0.5"};
