@@ -47,6 +47,11 @@ typedef struct Modal {
   double* ec;        /* [e][i][3] its slope w2' on e as a quadratic in xi */
   double* Snode;     /* [node][i][j] S at the nodes (Eq. R2) */
   double* G;         /* nb x nb Gram matrix (Eq. R5) */
+  /* The fields' 0 parts (F0) only ever hold the line functions 1, x, a, b, S and their 1 parts
+     (F1, the cross-section's y terms) only 1 and c: G restricted to each set (n0, n1 of them, the
+     indices in i0, i1), so `gram` multiplies only what can be nonzero */
+  int n0, n1, *i0, *i1;
+  double *G0, *G1;
 } Modal;
 
 /* the line functions' indices (Eq. R4) */
@@ -236,6 +241,22 @@ static int build_tensors(Modal* m) {
   for (int i = 0; i < nb; ++i)
     for (int j = 0; j < i; ++j) m->G[(size_t)i * nb + j] = m->G[(size_t)j * nb + i];
   free(phi);
+  m->i0 = malloc(sizeof(int) * (size_t)nb);
+  m->i1 = malloc(sizeof(int) * (size_t)nb);
+  if (!m->i0 || !m->i1) return -1;
+  m->n0 = m->n1 = 0;
+  for (int i = 0; i < nb; ++i) {
+    const int is_c = i >= IC(m, 0) && i < IC(m, 0) + k;
+    if (!is_c) m->i0[m->n0++] = i;
+    if (is_c || i == I_ONE) m->i1[m->n1++] = i;
+  }
+  m->G0 = malloc(sizeof(double) * (size_t)m->n0 * m->n0);
+  m->G1 = malloc(sizeof(double) * (size_t)m->n1 * m->n1);
+  if (!m->G0 || !m->G1) return -1;
+  for (int i = 0; i < m->n0; ++i)
+    for (int j = 0; j < m->n0; ++j) m->G0[(size_t)i * m->n0 + j] = m->G[(size_t)m->i0[i] * nb + m->i0[j]];
+  for (int i = 0; i < m->n1; ++i)
+    for (int j = 0; j < m->n1; ++j) m->G1[(size_t)i * m->n1 + j] = m->G[(size_t)m->i1[i] * nb + m->i1[j]];
   return 0;
 }
 
@@ -246,6 +267,7 @@ static void modal_destroy(void* self) {
   Modal* m = self;
   if (!m) return;
   free(m->omega2), free(m->ea), free(m->ed), free(m->ec), free(m->Snode), free(m->G);
+  free(m->i0), free(m->i1), free(m->G0), free(m->G1);
   free(m);
 }
 
@@ -324,11 +346,13 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
 
 static int modal_ncoord(const void* self) { return 3 + ((const Modal*)self)->k; }
 
-/* scratch: 16 coefficient fields of 4 nb, plus 2 k */
-enum { NFIELDS = 16 };
+/* scratch: 17 coefficient fields of 4 nb (a gram output is followed by its compressed input), plus 2 k */
+enum { NFIELDS = 17, CACHE_HEAD = 7 };
+static size_t scratch_size(const Modal* m) { return (size_t)NFIELDS * 4 * (size_t)m->nb + 2 * (size_t)m->k; }
+/* then the energies' cache (integrals_cached): a head and the state (q, v) they belong to */
 static size_t modal_nwork(const void* self) {
   const Modal* m = self;
-  return (size_t)NFIELDS * 4 * (size_t)m->nb + 2 * (size_t)m->k;
+  return scratch_size(m) + CACHE_HEAD + 2 * (3 + (size_t)m->k);
 }
 
 static void modal_initial(const void* self, double* q0, double* v0) {
@@ -384,17 +408,32 @@ static void field_accel(const Modal* m, double* a, const double* s, const double
   if (g0) a[I_ONE] += g0[0], a[nb + I_ONE] += g0[1];
 }
 
+/* GF = G F, component by component, over the line functions each part can hold (Modal.i0, i1):
+   the entries outside them stay zero in F and are not needed of GF (ip, ip_rot read them only
+   against zeros) */
 static void gram(const Modal* m, const double* F, double* GF) {
   const int nb = m->nb;
+  double* fc = GF + 4 * (size_t)nb; /* the compressed input: every GF has a field's room after it */
+  memset(GF, 0, sizeof(double) * 4 * (size_t)nb);
   for (int c = 0; c < 4; ++c) {
+    const int n = c < 2 ? m->n0 : m->n1;
+    const int* idx = c < 2 ? m->i0 : m->i1;
+    const double* Gs = c < 2 ? m->G0 : m->G1;
     const double* f = F + (size_t)c * nb;
     double* out = GF + (size_t)c * nb;
-    memset(out, 0, sizeof(double) * (size_t)nb);
-    for (int j = 0; j < nb; ++j) {
-      if (f[j] == 0.0) continue;
-      const double* col = m->G + (size_t)j * nb;
-      const double fj = f[j];
-      for (int i = 0; i < nb; ++i) out[i] += col[i] * fj;
+    for (int j = 0; j < n; ++j) fc[j] = f[idx[j]];
+    for (int i = 0; i < n; ++i) {
+      const double* row = Gs + (size_t)i * n;
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0; /* four sums: independent, so they pipeline */
+      int j = 0;
+      for (; j + 4 <= n; j += 4) {
+        s0 += row[j] * fc[j];
+        s1 += row[j + 1] * fc[j + 1];
+        s2 += row[j + 2] * fc[j + 2];
+        s3 += row[j + 3] * fc[j + 3];
+      }
+      for (; j < n; ++j) s0 += row[j] * fc[j];
+      out[idx[i]] = (s0 + s1) + (s2 + s3);
     }
   }
 }
@@ -468,7 +507,7 @@ static int modal_residual(const void* self, const fmbEnv* env, const double* q, 
   Fields f;
   state_fields(m, eta, etad, etadd, work, &f);
   double *FR = work + 7 * fs, *FD = work + 8 * fs, *FC = work + 9 * fs, *tmp = work + 10 * fs;
-  double *GR = work + 11 * fs, *GD = work + 12 * fs, *GC = work + 13 * fs;
+  double *GR = work + 11 * fs, *GD = work + 13 * fs, *GC = work + 15 * fs; /* each with room for gram after it */
   const double c = cos(q[2]), s = sin(q[2]), om = v[2], al = a[2];
   double g0[2] = {c * a[0] + s * a[1], -s * a[0] + c * a[1]}; /* A^T r0'' - f */
   if (env && env->has_gravity) {
@@ -609,8 +648,8 @@ static void modal_integrals(const Modal* m, const fmbEnv* env, const double* q, 
   const size_t fs = 4 * (size_t)nb;
   Fields f;
   state_fields(m, q + 3, v + 3, NULL, work, &f);
-  double *vRD = work + 7 * fs, *vC = work + 8 * fs, *vR = work + 9 * fs, *Gv = work + 10 * fs, *Gw = work + 11 * fs;
-  double *tmp = work + 12 * fs, *Gt = work + 13 * fs;
+  double *vRD = work + 7 * fs, *vC = work + 8 * fs, *vR = work + 9 * fs, *Gv = work + 10 * fs, *Gw = work + 12 * fs;
+  double *tmp = work + 14 * fs, *Gt = work + 15 * fs;
   const double c = cos(q[2]), s = sin(q[2]), om = v[2];
   const double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
   /* v = v0 + om I~ s + sd, part by part */
@@ -658,9 +697,32 @@ static void modal_integrals(const Modal* m, const fmbEnv* env, const double* q, 
   if (ptheta) *ptheta = pth;
 }
 
+/* A row asks energy.kinetic, .strain, .total and beam.ang_momentum of one state: one pass of
+   modal_integrals serves them all. The values are kept after the scratch, keyed by the state's
+   bytes and the gravity they were computed with (the work is calloc'ed: head 0 = empty). */
+static void integrals_cached(const Modal* m, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                             double* ptheta, double* work) {
+  double* c = work + scratch_size(m);
+  const size_t bytes = sizeof(double) * (3 + (size_t)m->k);
+  const int grav = env && env->has_gravity;
+  const double g0 = grav ? env->gravity[0] : 0.0, g1 = grav ? env->gravity[1] : 0.0;
+  const int hit = c[0] == 1.0 && memcmp(c + CACHE_HEAD, q, bytes) == 0 &&
+                  memcmp(c + CACHE_HEAD + 3 + m->k, v, bytes) == 0 && (!en || (c[1] == g0 && c[2] == g1));
+  if (!hit) {
+    fmbEnergy e;
+    double pth;
+    modal_integrals(m, env, q, v, &e, &pth, work);
+    c[0] = 1.0, c[1] = g0, c[2] = g1, c[3] = e.kinetic, c[4] = e.strain, c[5] = e.gravity, c[6] = pth;
+    memcpy(c + CACHE_HEAD, q, bytes);
+    memcpy(c + CACHE_HEAD + 3 + m->k, v, bytes);
+  }
+  if (en) en->kinetic = c[3], en->strain = c[4], en->gravity = c[5], en->spring = 0.0;
+  if (ptheta) *ptheta = c[6];
+}
+
 static void modal_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                          double* work) {
-  modal_integrals(self, env, q, v, en, NULL, work);
+  integrals_cached(self, env, q, v, en, NULL, work);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -682,7 +744,7 @@ static int modal_output(const void* self, int id, const double* q, const double*
   } else if (id < 0 || id >= FMB_BEAM_NTIP) {
     return -1;
   } else if (id == FMB_BEAM_ANG_MOMENTUM) {
-    modal_integrals(m, NULL, q, v, NULL, value, work);
+    integrals_cached(m, NULL, q, v, NULL, value, work);
     return 0;
   }
   double u[2] = {0.0, 0.0}, ud[2] = {0.0, 0.0}, slope = 0.0;
