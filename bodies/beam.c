@@ -1578,7 +1578,8 @@ static int beam_velocity_error_test(const void* self) {
 /* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
 static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
 
-static const fmbParam beam_params[] = {
+/* the keys of type beam, whichever file reads them (beam_modal.c's table declares these too) */
+const fmbParam fmb_beam_params[] = {
     FMB_BEAM_SECTION_PARAMS(MAX_ELEMENTS),
     {.key = "model",
      .kind = FMB_PARAM_CHOICE,
@@ -1646,7 +1647,7 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   .energy = beam_energy, .output_names = fmb_beam_output_names, .output_units = fmb_beam_output_units,               \
   .output_lookup = beam_output_lookup, .output = beam_output, .describe = beam_describe,                             \
   .indefinite_mass = beam_indefinite_mass, .max_bdf_order = beam_max_bdf_order, .invalid_state = beam_invalid_state, \
-  .velocity_error_test = beam_velocity_error_test, .params = beam_params,                                            \
+  .velocity_error_test = beam_velocity_error_test, .params = fmb_beam_params,                                        \
   .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"         \
              "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",                                                          \
   .example_damped = "damping: 0.05\n", .centreline = beam_centreline, .variant = beam_variant, .naux = beam_naux,    \

@@ -847,41 +847,8 @@ static int modal_centreline(const void* self, int n, double* local) {
   return fmb_beam_centreline(m->L, m->ne, n, local);
 }
 
-static const char* const modal_all_models[] = {"zoac", "foac", "complete", "exact", NULL};
-static const fmbParam modal_params[] = {
-    FMB_BEAM_SECTION_PARAMS(MODAL_MAX_ELEMENTS),
-    {.key = "model",
-     .kind = FMB_PARAM_CHOICE,
-     .fallback = "complete",
-     .choices = modal_all_models,
-     .doc = "coupling deformation kept in full, to first order, or left out"},
-    FMB_BEAM_FRAME_PARAMS,
-    {.key = "damping",
-     .kind = FMB_PARAM_NUMBER,
-     .flags = FMB_NONNEGATIVE,
-     .unit = "s",
-     .fallback = "0",
-     .doc = "stiffness-proportional damping time beta: modal forces omega_i^2 (eta_i + beta eta_i')"},
-    {.key = "quadrature_points",
-     .kind = FMB_PARAM_INT,
-     .unit = "1",
-     .fallback = "6",
-     .lo = 4,
-     .hi = FMB_GAUSS_MAX,
-     .doc = "read for the full mesh; the reduced beam's tensors are always integrated exactly"},
-    {.key = "integration",
-     .kind = FMB_PARAM_CHOICE,
-     .fallback = "reduced",
-     .choices = modal_integration_names,
-     .doc = "model: exact's; ignored here"},
-    {.key = "assembly",
-     .kind = FMB_PARAM_CHOICE,
-     .fallback = "auto",
-     .choices = modal_assembly_names,
-     .doc = "auto or dense (banded does not apply to the reduced beam)"},
-    FMB_BEAM_REDUCTION_PARAM,
-    {.key = NULL},
-};
+/* the keys are type beam's (beam.c): one declaration for `types`, `conform` and the unknown-key check */
+extern const fmbParam fmb_beam_params[];
 
 /* reached through beam.c's `variant` op when the item has `reduction:` */
 const fmbBodyType fmb_body_beam_modal = {
@@ -904,7 +871,7 @@ const fmbBodyType fmb_body_beam_modal = {
     .max_bdf_order = modal_max_bdf_order,
     .invalid_state = modal_invalid_state,
     .velocity_error_test = modal_velocity_error_test,
-    .params = modal_params,
+    .params = fmb_beam_params,
     .example = "length: 1\nelements: 4\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
                "angular_velocity: 3\nvelocity: [0.2, 0.5]\nreduction: {modes: 3, axial_modes: 1}\n",
     .example_damped = "damping: 0.05\n",
