@@ -24,7 +24,7 @@
 
 #include "beam_section.h"
 #include "flexmbd.h"
-#include "internal.h" /* fmbp_node, fmbp_check_unknown: the `reduction` mapping's own keys */
+#include "internal.h" /* fmbp_node: the `reduction` mapping's own keys */
 
 extern void dsygv_(const int* itype, const char* jobz, const char* uplo, const int* n, double* a, const int* lda,
                    double* b, const int* ldb, double* w, double* work, const int* lwork, int* info);
@@ -308,7 +308,14 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
                            "expected a mapping for 'reduction', e.g. {modes: 4} (or {modes: 4, axial_modes: 1})");
   err |= fmb_get_int(p, red, "modes", FMB_REQUIRED, 0, 2 * (long)m->ne, &m->nbend);
   err |= fmb_get_int(p, red, "axial_modes", FMB_OPTIONAL, 0, m->ne, &m->naxial);
-  if (err || fmbp_check_unknown(p, red, "'reduction'")) return -1;
+  if (err) return -1;
+  /* its own keys only (the unknown-key check of the item would list every key of the beam) */
+  for (yaml_node_pair_t* pr = rn->data.mapping.pairs.start; pr < rn->data.mapping.pairs.top; ++pr) {
+    const yaml_node_t* key = fmbp_node(p, pr->key);
+    const char* k = key && key->type == YAML_SCALAR_NODE ? (const char*)key->data.scalar.value : "";
+    if (strcmp(k, "modes") != 0 && strcmp(k, "axial_modes") != 0)
+      return fmb_parse_error(p, pr->key, "unknown key '%s' in 'reduction' (expected modes, axial_modes)", k);
+  }
   m->k = m->nbend + m->naxial;
   if (m->k < 1)
     return fmb_parse_error(p, fmb_find_key(p, red, "modes"),
