@@ -58,21 +58,10 @@ typedef struct Beam {
 /* ---------------------------------------------------------------------------------------------
  * Shape functions on one element, xi in [0, 1], element length le.
  * ------------------------------------------------------------------------------------------- */
-static void hermite(double xi, double le, double ns[4], double nd[4]) {
-  double x2 = xi * xi, x3 = x2 * xi;
-  if (ns) {
-    ns[0] = 1.0 - 3.0 * x2 + 2.0 * x3;
-    ns[1] = le * (xi - 2.0 * x2 + x3);
-    ns[2] = 3.0 * x2 - 2.0 * x3;
-    ns[3] = le * (-x2 + x3);
-  }
-  if (nd) {
-    nd[0] = (-6.0 * xi + 6.0 * x2) / le;
-    nd[1] = 1.0 - 4.0 * xi + 3.0 * x2;
-    nd[2] = (6.0 * xi - 6.0 * x2) / le;
-    nd[3] = -2.0 * xi + 3.0 * x2;
-  }
-}
+/* the element's shape functions, poly_mul and int_weights are beam_section.h's (shared with beam_modal.c) */
+#define hermite fmb_beam_hermite
+#define poly_mul fmb_beam_poly_mul
+#define int_weights fmb_beam_int_weights
 
 /* element dofs of a deformation vector p: axial ends a[2], transverse d[4] (root node = 0) */
 static void gather(const double* p, int e, double a[2], double d[4]) {
@@ -126,14 +115,6 @@ static void h_weights(const Beam* b, const double pw[5], double G[4][3]) {
       G[j][i] = b->nslope[j][0] * pw[i] + b->nslope[j][1] * pw[i + 1] + b->nslope[j][2] * pw[i + 2];
 }
 
-static void poly_mul(const double a[3], const double c[3], double out[5]) {
-  out[0] = a[0] * c[0];
-  out[1] = a[0] * c[1] + a[1] * c[0];
-  out[2] = a[0] * c[2] + a[1] * c[1] + a[2] * c[0];
-  out[3] = a[1] * c[2] + a[2] * c[1];
-  out[4] = a[2] * c[2];
-}
-
 /* an element's slope polynomials of p and pd (cp, cv) and the quartics w2'^2 (pp) and w2' w2d'
    (pv), whose integrals give w_c = -1/2 int w2'^2 and its rate -int w2' w2d' */
 static void slope_products(const Beam* b, const double d[4], const double dd[4], double cp[3], double cv[3],
@@ -142,14 +123,6 @@ static void slope_products(const Beam* b, const double d[4], const double dd[4],
   slope_poly(b, dd, cv);
   poly_mul(cp, cp, pp);
   poly_mul(cp, cv, pv);
-}
-
-static void int_weights(double le, double xi, double pw[5]) {
-  double xk = xi;
-  for (int k = 0; k < 5; ++k) {
-    pw[k] = le * xk / (k + 1);
-    xk *= xi;
-  }
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -170,10 +143,7 @@ static void beam_setup(Beam* b) {
   fmb_gauss_legendre01(b->ng, b->xg, b->wg);
   for (int g = 0; g < b->ng; ++g) hermite(b->xg[g], b->le, b->ns_out[g], b->nd_out[g]);
   double le = b->le;
-  /* coefficients of xi^0..2 in the slope functions d/dx [H1, le H2, H3, le H4] (hermite's nd) */
-  const double nslope[4][3] = {
-      {0.0, -6.0 / le, 6.0 / le}, {1.0, -4.0, 3.0}, {0.0, 6.0 / le, -6.0 / le}, {0.0, -2.0, 3.0}};
-  memcpy(b->nslope, nslope, sizeof nslope);
+  fmb_beam_slope_coefficients(le, b->nslope);
   for (int g = 0; g < b->ng; ++g) int_weights(le, b->xg[g], b->pw_out[g]);
   int_weights(le, 1.0, b->pw_full);
   h_weights(b, b->pw_full, b->G_full);
@@ -1608,7 +1578,8 @@ static int beam_velocity_error_test(const void* self) {
 /* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
 static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
 
-static const fmbParam beam_params[] = {
+/* the keys of type beam, whichever file reads them (beam_modal.c's table declares these too) */
+const fmbParam fmb_beam_params[] = {
     FMB_BEAM_SECTION_PARAMS(MAX_ELEMENTS),
     {.key = "model",
      .kind = FMB_PARAM_CHOICE,
@@ -1641,6 +1612,7 @@ static const fmbParam beam_params[] = {
      .fallback = "auto",
      .choices = assembly_names,
      .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
+    FMB_BEAM_REDUCTION_PARAM,
     {.key = NULL},
 };
 
@@ -1661,6 +1633,9 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   int model = BEAM_COMPLETE;
   if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model)) return NULL;
   if (model == 3) return &fmb_body_beam_exact;
+  /* `reduction: {modes: k}`: the same beam in k of its own clamped-free modes (bodies/beam_modal.c) */
+  extern const fmbBodyType fmb_body_beam_modal;
+  if (fmb_find_key(p, item, "reduction") >= 0) return &fmb_body_beam_modal;
   const char* fd = getenv("FMB_BEAM_FD_JACOBIAN");
   return fd && strcmp(fd, "1") == 0 ? &beam_fd : &fmb_body_beam;
 }
@@ -1672,7 +1647,7 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   .energy = beam_energy, .output_names = fmb_beam_output_names, .output_units = fmb_beam_output_units,               \
   .output_lookup = beam_output_lookup, .output = beam_output, .describe = beam_describe,                             \
   .indefinite_mass = beam_indefinite_mass, .max_bdf_order = beam_max_bdf_order, .invalid_state = beam_invalid_state, \
-  .velocity_error_test = beam_velocity_error_test, .params = beam_params,                                            \
+  .velocity_error_test = beam_velocity_error_test, .params = fmb_beam_params,                                        \
   .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"         \
              "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",                                                          \
   .example_damped = "damping: 0.05\n", .centreline = beam_centreline, .variant = beam_variant, .naux = beam_naux,    \

@@ -59,6 +59,14 @@
     .doc = "initial frame angular velocity"                                                                           \
   }
 
+/* `reduction: {modes: k, axial_modes: m}` (bodies/beam_modal.c): declared by both tables */
+#define FMB_BEAM_REDUCTION_PARAM                                                                                    \
+  {                                                                                                                 \
+    .key = "reduction", .kind = FMB_PARAM_MAP, .fallback = "none (the full mesh)",                                  \
+    .doc = "{modes: k, axial_modes: m}: the beam in its k lowest clamped-free bending modes (and m axial ones) of " \
+           "its own elements, the coupling kept exactly (docs/models.md, reduced beam)"                             \
+  }
+
 /* the parse error for a section whose element mass or stiffness is not a usable double (length
    1e-300: EI/le^3 overflows) */
 static inline void fmb_beam_refuse_degenerate(fmbParser* p, fmbNode item, double L, int ne, double rho, double A,
@@ -68,6 +76,46 @@ static inline void fmb_beam_refuse_degenerate(fmbParser* p, fmbNode item, double
                   "Young's modulus %g gives an element mass %g, bending stiffness %g and axial stiffness %g: "
                   "not all are usable (finite, non-zero) floating-point numbers",
                   L, ne, rho, A, Izz, E, me, k_bend, k_axial);
+}
+
+/* Shape functions on one element of the small-strain models, xi in [0, 1], element length le:
+   cubic Hermite values ns (transverse w2 from [v_l, v'_l, v_r, v'_r]) and slopes nd = dns/dx.
+   Shared by beam.c and beam_modal.c (its modes are nodal vectors of the same elements). */
+static inline void fmb_beam_hermite(double xi, double le, double ns[4], double nd[4]) {
+  double x2 = xi * xi, x3 = x2 * xi;
+  if (ns) {
+    ns[0] = 1.0 - 3.0 * x2 + 2.0 * x3;
+    ns[1] = le * (xi - 2.0 * x2 + x3);
+    ns[2] = 3.0 * x2 - 2.0 * x3;
+    ns[3] = le * (-x2 + x3);
+  }
+  if (nd) {
+    nd[0] = (-6.0 * xi + 6.0 * x2) / le;
+    nd[1] = 1.0 - 4.0 * xi + 3.0 * x2;
+    nd[2] = (6.0 * xi - 6.0 * x2) / le;
+    nd[3] = -2.0 * xi + 3.0 * x2;
+  }
+}
+/* coefficients of xi^0..2 in the slope functions d/dx [H1, le H2, H3, le H4] (the hermite nd) */
+static inline void fmb_beam_slope_coefficients(double le, double nslope[4][3]) {
+  const double c[4][3] = {{0.0, -6.0 / le, 6.0 / le}, {1.0, -4.0, 3.0}, {0.0, 6.0 / le, -6.0 / le}, {0.0, -2.0, 3.0}};
+  memcpy(nslope, c, sizeof c);
+}
+/* the product of two quadratics in xi (two slopes): a quartic's five coefficients */
+static inline void fmb_beam_poly_mul(const double a[3], const double c[3], double out[5]) {
+  out[0] = a[0] * c[0];
+  out[1] = a[0] * c[1] + a[1] * c[0];
+  out[2] = a[0] * c[2] + a[1] * c[1] + a[2] * c[0];
+  out[3] = a[1] * c[2] + a[2] * c[1];
+  out[4] = a[2] * c[2];
+}
+/* pw_k = le xi^(k+1) / (k+1): the integral over [0, xi] in x of a quartic is its coefficients . pw */
+static inline void fmb_beam_int_weights(double le, double xi, double pw[5]) {
+  double xk = xi;
+  for (int k = 0; k < 5; ++k) {
+    pw[k] = le * xk / (k + 1);
+    xk *= xi;
+  }
 }
 
 /* element e (0-based, clamped to the mesh) and local coordinate xi in [0, 1] of arc length x */

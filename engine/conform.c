@@ -224,6 +224,7 @@ static void check_params(Report* r, const char* path, const char* type, const fm
       case FMB_PARAM_BODY: bad_case(r, path, type, ex, s, reg, p->key, "no_such_body"), ncase++; break;
       case FMB_PARAM_JOINT: bad_case(r, path, type, ex, s, reg, p->key, "no_such_joint"), ncase++; break;
       case FMB_PARAM_TABLE: bad_case(r, path, type, ex, s, reg, p->key, "[[0, 1, 2]]"), ncase++; break;
+      case FMB_PARAM_MAP: bad_case(r, path, type, ex, s, reg, p->key, "[1, 2]"), ncase++; break;
     }
   }
   /* the keys parse reads are declared: an unknown key's message lists what was read */
@@ -688,7 +689,9 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   lines_parse(&ex, example);
   for (const char* e = extra; e && *e;) { /* the "key=value" list after ':' */
     ++e;
-    const size_t len = strcspn(e, ",");
+    size_t len = 0; /* up to the next comma outside {} and [] (reduction={modes: 3, axial_modes: 1}) */
+    for (int depth = 0; e[len] && (depth > 0 || e[len] != ','); ++len)
+      depth += (e[len] == '{' || e[len] == '[') - (e[len] == '}' || e[len] == ']');
     char kv[256];
     snprintf(kv, sizeof kv, "%.*s", (int)len, e);
     char* eq = strchr(kv, '=');

@@ -139,7 +139,8 @@ typedef enum {
   FMB_PARAM_CHOICE, /* fmb_get_choice; the words in `choices` */
   FMB_PARAM_BODY,   /* fmb_get_body */
   FMB_PARAM_JOINT,  /* fmb_get_joint */
-  FMB_PARAM_TABLE   /* fmb_get_table: [[t, value], ...] or a CSV file name */
+  FMB_PARAM_TABLE,  /* fmb_get_table: [[t, value], ...] or a CSV file name */
+  FMB_PARAM_MAP     /* a mapping of sub-keys, which `doc` names (beam's `reduction: {modes: k}`) */
 } fmbParamKind;
 
 typedef struct fmbParam {

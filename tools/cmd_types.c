@@ -17,6 +17,7 @@ static void print_range(const fmbParam* p) {
   if (p->kind == FMB_PARAM_BODY) printf(" a body name (or ground)");
   if (p->kind == FMB_PARAM_JOINT) printf(" a joint named earlier");
   if (p->kind == FMB_PARAM_TABLE) printf(" [[t, value], ...] or a CSV file");
+  if (p->kind == FMB_PARAM_MAP) printf(" {key: value, ...}");
 }
 
 static void print_params(const fmbParam* params) {

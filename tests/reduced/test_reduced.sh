@@ -1,0 +1,121 @@
+#!/bin/sh
+# test_reduced.sh FLEXMBD SOURCE_DIR OUT_DIR — the beam in modal coordinates (`reduction:`,
+# bodies/beam_modal.c, docs/models.md "The reduced beam"), each result against an independent value:
+#  A  clamped-free frequencies of the reduced beam (modes at rest) against the Euler-Bernoulli
+#     continuum (beta_n L = 1.8751, 4.6941, 7.8548, 10.9955), and `check` listing them with the
+#     first dropped one;
+#  B  every mode of the mesh kept (2 ne bending + ne axial): the reduced beam is the full mesh in
+#     other coordinates, so the w15 spin-up agrees with the full mesh to solver tolerance, for
+#     complete, FOAC and ZOAC;
+#  C  the reduced complete beam keeps the dynamic stiffening: at w0 = 15 with k = 4 it stays
+#     bounded and its deflection is within 1 % of the full complete mesh's;
+#  D  the reduced ZOAC beam diverges at w0 = 15 as the full ZOAC does (exit 3, about the same time);
+#  E  the reduced pendulum conserves T + U_e + U_g over 5 s;
+#  F  the rotating beam's stiffened first frequency (modes) against the continuum at 4 and 15 rad/s,
+#     and ZOAC's missing stiffening sqrt(w1^2 - W^2);
+#  G  bad `reduction:` input: exit 2 at file:line:column.
+. "$(dirname "$0")/../exact/cli_lib.sh" # F, SRC, OUT, check, near; in SRC
+# largest |a - b| of column COL over two CSVs with the same rows; largest |a| of a column
+maxdiff() {
+  awk -F, -v col="$3" 'FNR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i; next }
+    NR == FNR { a[FNR] = $c; next } { d = $c - a[FNR]; if (d < 0) d = -d; if (d > m) m = d } END { print m + 0 }' "$1" "$2"
+}
+peak() {
+  awk -F, -v col="$2" 'FNR == 1 { for (i = 1; i <= NF; i++) if ($i == col) c = i; next }
+    { d = $c; if (d < 0) d = -d; if (d > m) m = d } END { print m + 0 }' "$1"
+}
+le() { awk -v a="$1" -v b="$2" 'BEGIN { exit !(a <= b) }'; }
+stat() { tail -1 "$1" | tr ' ' '\n' | sed -n "s/^$2=//p"; }
+W15=scenes/paper/spinup_w15.yaml
+
+# A: clamped-free frequencies, 16 elements, k = 4, at rest (Euler-Bernoulli: formulation note §8)
+"$F" modes scenes/campbell_beam.yaml --count 4 --set joints.spin.speed=0 --set 'bodies.beam.reduction={modes: 4}' \
+  -o "$OUT/rest.csv" 2>"$OUT/rest.err"
+i=0
+for ref in 3.909343 24.499435 68.599127 134.426910; do
+  i=$((i + 1))
+  w=$(sed -n "$((i + 1))p" "$OUT/rest.csv" | cut -d, -f2)
+  echo "A: mode $i: $w rad/s (Euler-Bernoulli $ref)"
+  check "A: mode $i within 2e-4 relative of the continuum" "near '$w' $ref $(awk -v r=$ref 'BEGIN { print 2e-4 * r }')"
+done
+"$F" check $W15 --set 'bodies.beam.reduction={modes: 4}' >"$OUT/check.txt" 2>&1
+grep "body 'beam'" "$OUT/check.txt"
+check "A: check lists the retained frequencies and the first dropped one" \
+  "grep -q 'retained (rad/s): 3.90934 24.4995 68.6014 134.446; first dropped: bending 222.30' '$OUT/check.txt'"
+
+# B: every mode kept reproduces the full mesh (8 elements: 16 bending + 8 axial modes)
+for model in complete foac zoac; do
+  S="--set bodies.beam.elements=8 --set bodies.beam.model=$model --set solver.rtol=1e-9 --set solver.t_end=3"
+  "$F" run $W15 $S -o "$OUT/full_$model.csv" 2>"$OUT/full_$model.err"
+  "$F" run $W15 $S --set 'bodies.beam.reduction={modes: 16, axial_modes: 8}' -o "$OUT/all_$model.csv" \
+    2>"$OUT/all_$model.err"
+  d=$(maxdiff "$OUT/full_$model.csv" "$OUT/all_$model.csv" beam.tip_v)
+  du=$(maxdiff "$OUT/full_$model.csv" "$OUT/all_$model.csv" beam.tip_u)
+  de=$(maxdiff "$OUT/full_$model.csv" "$OUT/all_$model.csv" energy.total)
+  echo "B: $model, all modes vs full mesh (rtol 1e-9): tip_v $d m (peak $(peak "$OUT/full_$model.csv" beam.tip_v)), tip_u $du m, energy $de J"
+  check "B: $model all-modes tip_v within 3e-8 m of the full mesh" "le '$d' 3e-8"
+  check "B: $model all-modes tip_u within 3e-8 m and energy within 1e-7 J" "le '$du' 3e-8 && le '$de' 1e-7"
+done
+
+# C: w0 = 15, k = 4, complete: bounded and within 1 % of the full complete mesh (16 elements)
+"$F" run $W15 --set solver.rtol=1e-8 -o "$OUT/w15_full.csv" 2>"$OUT/w15_full.err"
+"$F" run $W15 --set solver.rtol=1e-8 --set 'bodies.beam.reduction={modes: 4}' -o "$OUT/w15_k4.csv" 2>"$OUT/w15_k4.err"
+rc=$?
+p=$(peak "$OUT/w15_full.csv" beam.tip_v)
+d=$(maxdiff "$OUT/w15_full.csv" "$OUT/w15_k4.csv" beam.tip_v)
+echo "C: w0 = 15, k = 4: exit $rc, t_reached $(stat "$OUT/w15_k4.err" t_reached); max |tip_v - full| = $d m of a peak $p m"
+check "C: the reduced complete beam runs the w0 = 15 spin-up to the end" "[ $rc -eq 0 ] && [ '$(stat "$OUT/w15_k4.err" t_reached)' = 20 ]"
+check "C: its deflection is within 1 % of the full complete mesh's peak" "le '$d' $(awk -v p=$p 'BEGIN { print 0.01 * p }')"
+
+# D: ZOAC reduced diverges at w0 = 15 as the full ZOAC does
+"$F" run $W15 --set bodies.beam.model=zoac -o "$OUT/zoac_full.csv" 2>"$OUT/zoac_full.err"
+rf=$?
+"$F" run $W15 --set bodies.beam.model=zoac --set 'bodies.beam.reduction={modes: 4}' -o "$OUT/zoac_k4.csv" \
+  2>"$OUT/zoac_k4.err"
+rr=$?
+tf=$(stat "$OUT/zoac_full.err" t_reached)
+tr=$(stat "$OUT/zoac_k4.err" t_reached)
+echo "D: ZOAC at w0 = 15: full mesh exit $rf at t = $tf s, reduced (k = 4) exit $rr at t = $tr s"
+check "D: the reduced ZOAC beam diverges (exit 3) like the full one" "[ $rr -eq 3 ] && [ $rf -eq 3 ]"
+check "D: it stops within 0.5 s of the full ZOAC" "near '$tr' '$tf' 0.5"
+
+# E: energy balance of the reduced pendulum over 5 s (the scene: rtol 1e-10)
+"$F" run scenes/paper/pendulum.yaml --set 'bodies.beam.reduction={modes: 4}' -o "$OUT/pend.csv" 2>"$OUT/pend.err"
+drift=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) { if ($i == "energy.total") e = i; if ($i == "energy.gravity") g = i } next }
+  NR == 2 { e0 = $e } { d = $e - e0; if (d < 0) d = -d; if (d > m) m = d; u = $g; if (u < 0) u = -u; if (u > G) G = u }
+  END { print m / G }' "$OUT/pend.csv")
+bend=$(peak "$OUT/pend.csv" beam.tip_v)
+echo "E: reduced pendulum (k = 4), 5 s: energy drift $drift of max |U_g|, peak tip_v $bend m"
+check "E: T + U_e + U_g constant to 1e-8 of max |U_g|" "le '$drift' 1e-8"
+check "E: the beam bends (peak tip_v > 1 cm)" "le 0.01 '$bend'"
+
+# F: the rotating beam's first frequency (formulation note §8: 4.26118 at 4 rad/s, 6.3351 at 15)
+for case in "4 4 4.26118" "8 15 6.3351"; do
+  set -- $case
+  w=$("$F" modes scenes/campbell_beam.yaml --count 1 --set joints.spin.speed=$2 \
+    --set "bodies.beam.reduction={modes: $1}" -o - 2>/dev/null | tail -1 | cut -d, -f2)
+  echo "F: k = $1 at $2 rad/s: $w rad/s (continuum $3)"
+  check "F: stiffened first frequency within 1e-3 relative (k = $1, $2 rad/s)" \
+    "near '$w' $3 $(awk -v r=$3 'BEGIN { print 1e-3 * r }')"
+done
+w=$("$F" modes scenes/campbell_beam.yaml --count 1 --set joints.spin.speed=2 --set bodies.beam.model=zoac \
+  --set 'bodies.beam.reduction={modes: 4}' -o - 2>/dev/null | tail -1 | cut -d, -f2)
+echo "F: ZOAC reduced at 2 rad/s: $w rad/s (sqrt(w1^2 - W^2) = 3.359011)"
+check "F: ZOAC reduced lacks the stiffening: sqrt(w1^2 - W^2) to 1e-5" "near '$w' 3.359011 3.4e-5"
+
+# G: bad input in the scene file (a copy of the w15 scene with lines after `model: complete`): exit 2
+# at file:line:column (line 19, the first line added)
+for bad in "reduction: 4|19:16:.*expected a mapping for .reduction." \
+  "reduction: {modes: 33}|19:24:.*.modes." \
+  "reduction: {modes: 2, mods: 1}|19:27:.*unknown key .mods." \
+  "reduction: {modes: 0}|19:24:.*at least one mode" \
+  "assembly: banded\n    reduction: {modes: 2}|19:15:.*does not apply with .reduction."; do
+  lines=${bad%%|*}
+  msg=${bad#*|}
+  sed "s/^    model: complete/    model: complete\n    $lines/" $W15 >"$OUT/bad.yaml"
+  "$F" check "$OUT/bad.yaml" >"$OUT/bad.txt" 2>&1
+  rc=$?
+  echo "G: $lines: exit $rc: $(grep -m1 'bad.yaml:' "$OUT/bad.txt")"
+  check "G: '$lines' refused with exit 2 at its line and column" "[ $rc -eq 2 ] && grep -q 'bad.yaml:$msg' '$OUT/bad.txt'"
+done
+exit $fail
