@@ -568,15 +568,18 @@ int fmb_cmd_sweep(int argc, char** argv) {
     if (!rc && dry) {
       long distinct = 0;
       for (long i = 0; i < sw->nrun; ++i) distinct += sw->first[i] == i;
-      printf("sweep plan: %ld runs (%ld distinct) of %s %s, %d swept paths:", sw->nrun, distinct, sw->verb, sw->scene,
-             sw->plan.npath);
+      printf("sweep plan: %ld runs (%ld distinct) of %s %s, %d swept paths:", sw->nrun, distinct, sw->verb,
+             sw->scene_given, sw->plan.npath);
       for (int k = 0; k < sw->plan.npath; ++k) printf(" %s", sw->plan.path[k]);
       printf("\n");
-      if (fmb_journal_write_plan(sw) == 0) printf("sweep plan: written to %s/plan.csv\n", sw->dir);
+      if (fmb_journal_write_plan(sw) == 0)
+        printf("sweep plan: written to %s/plan.csv\n", sw->dir);
+      else
+        rc = FMB_EXIT_BAD_INPUT;
       fflush(stdout);
       long pick[3] = {0, sw->nrun - 1, (long)(fmb_plan_uniform(sw->plan.seed, 0, 1u << 20) * (double)sw->nrun)};
       for (int k = 0; k < 3 && !rc; ++k)
-        if (k == 0 || pick[k] != pick[0]) rc = check_run(sw, pick[k], 1);
+        if (k == 0 || (pick[k] != pick[0] && pick[k] != pick[1])) rc = check_run(sw, pick[k], 1);
       if (!rc && size > YES_LIMIT && !yes) printf("sweep plan: more than 1e6 runs: run it with --yes\n");
       ext->mpi_finalize(0);
       return rc ? FMB_EXIT_BAD_INPUT : 0;
