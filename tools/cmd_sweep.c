@@ -197,11 +197,17 @@ static int check_run(fmbSweep* sw, long index, int verbose) {
   return rc;
 }
 
-/* DIR, DIR/series, DIR/logs, DIR/inputs: made, or folders already (never links: a link planted
+/* DIR (and its parents), DIR/series, DIR/logs, DIR/inputs: made, or folders already (never links: a link planted
    there would send the runs' files elsewhere) */
 static int make_dirs(const char* dir) {
   char p[4300];
   const char* sub[4] = {"", "/series", "/logs", "/inputs"};
+  snprintf(p, sizeof p, "%s", dir); /* its parents too (-o out/study in a fresh checkout) */
+  for (char* c = strchr(p + 1, '/'); c; c = strchr(c + 1, '/')) {
+    *c = '\0';
+    if (mkdir(p, 0755) != 0 && errno != EEXIST) break; /* said below, at DIR itself */
+    *c = '/';
+  }
   for (int k = 0; k < 4; ++k) {
     snprintf(p, sizeof p, "%s%s", dir, sub[k]);
     struct stat st;
