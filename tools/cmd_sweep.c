@@ -219,6 +219,19 @@ static int make_dirs(const char* dir) {
       fprintf(stderr, "flexmbd sweep: %s is not a folder of its own (a file or a link): give another -o DIR\n", p);
       return FMB_EXIT_BAD_INPUT;
     }
+    /* no link in series/ or logs/: a run's CSV or log written through one would land elsewhere */
+    DIR* d = k == 1 || k == 2 ? opendir(p) : NULL;
+    struct dirent* e;
+    while (d && (e = readdir(d))) {
+      char q[4600];
+      snprintf(q, sizeof q, "%s/%s", p, e->d_name);
+      if (lstat(q, &st) == 0 && S_ISLNK(st.st_mode)) {
+        fprintf(stderr, "flexmbd sweep: %s is a symbolic link: the sweep writes only files of its own there\n", q);
+        closedir(d);
+        return FMB_EXIT_BAD_INPUT;
+      }
+    }
+    if (d) closedir(d);
   }
   return 0;
 }

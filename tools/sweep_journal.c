@@ -301,6 +301,7 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
   }
   IdMap map;
   if (idmap_build(&map, sw->id, sw->nrun)) return FMB_EXIT_BAD_INPUT;
+  const int journal_existed = f != NULL; /* a journal (its header was checked above) */
   if (f) { /* resume: the latest row of each run; a partial last line (a crash mid-write) is cut */
     long at = ftell(f), good_end = at;
     size_t cap = 1 << 16;
@@ -354,6 +355,13 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
   }
   /* dispatches of runs without a row: the runs in flight when the sweep last stopped */
   dir_file(sw, "inflight.log", path, sizeof path);
+  struct stat ist;
+  if (!journal_existed && lstat(path, &ist) == 0 && !made_here(sw, "inflight.log", &ist)) {
+    /* an inflight.log beside no journal: not the sweep's (someone's file, or a planted one) */
+    fprintf(stderr, "flexmbd sweep: %s was not made by a sweep: refusing to append to it (move it away)\n", path);
+    idmap_free(&map);
+    return FMB_EXIT_BAD_INPUT;
+  }
   rfd = open_own(sw, "inflight.log", O_RDONLY);
   if (rfd == -2) return idmap_free(&map), FMB_EXIT_BAD_INPUT;
   f = rfd >= 0 ? fdopen(rfd, "r") : NULL;

@@ -103,6 +103,10 @@ static int add_path(fmbSweepPlan* p, const char* spec, const char** rest, char* 
     return -1;
   }
   const size_t n = (size_t)(eq - spec);
+  if (n > 200) { /* PATH=VALUE must fit FMB_SWEEP_SET_LEN whole: never cut */
+    say(err, len, "a PATH longer than 200 characters", spec);
+    return -1;
+  }
   for (size_t i = 0; i < n; ++i)
     if (spec[i] == ',' || spec[i] == ' ' || spec[i] == ':') {
       say(err, len, "a PATH has no ',', ':' or blanks", spec);

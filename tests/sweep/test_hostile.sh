@@ -111,14 +111,27 @@ rc=0
 # links planted in a shared folder: .plan.csv.tmp and logs/check.err redirect nothing, a linked
 # inflight.log or logs/ is refused; the victim stays as it was
 echo "victim" > "$D/victim"
-mkdir -p "$D/linked/logs"
+mkdir -p "$D/linked"
 ln -s "$D/victim" "$D/linked/.plan.csv.tmp"
-ln -s "$D/victim" "$D/linked/logs/check.err"
 ln -s "$D/victim" "$D/linked/.table.csv.tmp"
 "$F" sweep "$SCENE" -o "$D/linked" --quiet --set solver.t_end=0.2 --grid solver.rtol=1e-6,1e-7 2> "$D/linked.err" ||
   { cat "$D/linked.err"; fail "a sweep beside planted links"; }
 [ "$(cat "$D/victim")" = victim ] || fail "a planted link redirected a write of the sweep"
-[ -L "$D/linked/logs/check.err" ] || fail "the sweep removed a link it did not make"
+for planted in logs/check.err series/0123456789abcdef.csv; do
+  rm -rf "$D/linked_sub"
+  mkdir -p "$D/linked_sub/logs" "$D/linked_sub/series"
+  ln -s "$D/victim" "$D/linked_sub/$planted"
+  rc=0
+  "$F" sweep "$SCENE" -o "$D/linked_sub" --quiet --set solver.t_end=0.2 --grid solver.rtol=1e-6 2> "$D/linked.err" || rc=$?
+  [ "$rc" = 2 ] && grep -q "is a symbolic link" "$D/linked.err" || { cat "$D/linked.err"; fail "a link as $planted: exit $rc"; }
+  [ "$(cat "$D/victim")" = victim ] && [ -L "$D/linked_sub/$planted" ] || fail "a link as $planted: victim or link changed"
+done
+# someone's inflight.log (no journal beside it) is not appended to
+mkdir -p "$D/their_log"
+echo "their log" > "$D/their_log/inflight.log"
+rc=0
+"$F" sweep "$SCENE" -o "$D/their_log" --quiet --set solver.t_end=0.2 --grid solver.rtol=1e-6 2> "$D/their.err" || rc=$?
+[ "$rc" = 2 ] && [ "$(cat "$D/their_log/inflight.log")" = "their log" ] || { cat "$D/their.err"; fail "someone's inflight.log: exit $rc"; }
 mkdir -p "$D/linked2"
 ln -s "$D/victim" "$D/linked2/inflight.log"
 rc=0
@@ -177,7 +190,8 @@ for name in runs.csv inflight.log; do
   mkfifo "$D/fifodir/$name"
   rc=0
   within 10 "$F" sweep "$SCENE" -o "$D/fifodir" --quiet --set solver.t_end=0.2 --grid solver.rtol=1e-6 2> "$D/fifo.err" || rc=$?
-  [ "$rc" = 2 ] && grep -q "not a regular file" "$D/fifo.err" || { cat "$D/fifo.err"; fail "a FIFO as $name: exit $rc"; }
+  [ "$rc" = 2 ] && grep -q "not a regular file\|not made by a sweep" "$D/fifo.err" ||
+    { cat "$D/fifo.err"; fail "a FIFO as $name: exit $rc"; }
   rc=0
   within 10 "$F" sweep --status "$D/fifodir" > /dev/null 2>&1 || rc=$?
   [ "$rc" != 137 ] || fail "--status waits on a FIFO $name"
