@@ -567,6 +567,10 @@ int fmb_cmd_sweep(int argc, char** argv) {
     if (sw->reference) fmb_safe_note_input(sw->reference);
     rc = make_dirs(sw->dir);
     if (!rc) rc = fmb_sweep_lock(sw);
+    /* the files written at the end too, checked now: refused before the runs, not after them */
+    const char* const ends[3] = {"plan.csv", "table.csv", "sweep.h5"};
+    for (int k = 0; k < 3 && !rc; ++k)
+      if (fmb_sweep_may_write(sw, ends[k])) rc = FMB_EXIT_BAD_INPUT;
     char path[4300];
     if (!rc && snapshot_scene(sw, scene_text, scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
     if (!rc && strcmp(path, sw->scene) != 0) rc = bad("the scene's snapshot is not %s", sw->scene);

@@ -108,6 +108,15 @@ cp "$D/own_input/plan.csv" "$D/own_input.keep"
 rc=0
 "$F" sweep "$SCENE" -o "$D/own_input" --quiet --set solver.t_end=0.2 --samples "$D/own_input/plan.csv" 2> "$D/own.err" || rc=$?
 [ "$rc" = 2 ] && cmp -s "$D/own_input/plan.csv" "$D/own_input.keep" || { cat "$D/own.err"; fail "the samples file was replaced"; }
+# the reference is the folder's table.csv: refused at the start, not after the runs
+mkdir -p "$D/ref_in"
+"$F" run "$SCENE" -o "$D/ref_in/table.csv" --quiet --set solver.t_end=0.2 2> /dev/null || fail "the reference run"
+cp "$D/ref_in/table.csv" "$D/ref_in.keep"
+rc=0
+"$F" sweep "$SCENE" -o "$D/ref_in" --quiet --set solver.t_end=0.2 --grid solver.rtol=1e-6 --reference "$D/ref_in/table.csv" \
+  2> "$D/ref_in.err" || rc=$?
+[ "$rc" = 2 ] && cmp -s "$D/ref_in/table.csv" "$D/ref_in.keep" && [ ! -e "$D/ref_in/runs.csv" ] ||
+  { cat "$D/ref_in.err"; fail "the reference as the folder's table.csv: exit $rc"; }
 # links planted in a shared folder: .plan.csv.tmp and logs/check.err redirect nothing, a linked
 # inflight.log or logs/ is refused; the victim stays as it was
 echo "victim" > "$D/victim"
