@@ -258,14 +258,26 @@ static int snapshot_file(fmbSweep* sw, const char* sub, const char* name, const 
   return fmb_sweep_file_close(sw, rel, f, ok) == 0 && ok ? 0 : -1;
 }
 
+/* the snapshot's folder name: a hash of the scene's bytes and of its folder (the links beside the
+   copy lead into that folder: the same bytes elsewhere are another snapshot) */
+static void snapshot_name(const char* scene, const char* text, size_t n, char sub[17]) {
+  const char* slash = strrchr(scene, '/');
+  char from[4300];
+  snprintf(from, sizeof from, "%.*s", slash ? (int)(slash - scene) : 1, slash ? scene : ".");
+  char* real = realpath(from[0] ? from : "/", NULL);
+  uint64_t h = fmb_fnv1a(FMB_FNV_OFFSET, text, n);
+  if (real) h = fmb_fnv1a(h, real, strlen(real) + 1);
+  free(real);
+  snprintf(sub, 17, "%016llx", (unsigned long long)fmb_mix64(h));
+}
+
 /* The scene as the runs read it: its bytes, read once, hashed into the run ids and written to
    DIR/inputs/HASH/NAME, which every run loads. An edit of the scene during the sweep changes
    nothing (the ids and the runs are of the snapshot; the next start of the sweep sees a new
    plan). The files the scene names by relative paths (tables, plugins) are found beside it as
    before: DIR/inputs/HASH/ holds a link to every other entry of the scene's folder. */
-static int snapshot_scene(fmbSweep* sw, const char* text, size_t n, char* path, size_t len) {
-  char sub[40], dir[4300];
-  snprintf(sub, sizeof sub, "%016llx", (unsigned long long)fmb_mix64(fmb_fnv1a(FMB_FNV_OFFSET, text, n)));
+static int snapshot_scene(fmbSweep* sw, const char* sub, const char* text, size_t n, char* path, size_t len) {
+  char dir[4300];
   snprintf(dir, sizeof dir, "%s/inputs/%s", sw->dir, sub);
   struct stat st;
   if (mkdir(dir, 0755) != 0 && (errno != EEXIST || lstat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
@@ -530,13 +542,13 @@ int fmb_cmd_sweep(int argc, char** argv) {
   }
   /* every run loads the snapshot DIR/inputs/HASH/NAME (snapshot_scene, written by rank 0 below) */
   sw->scene_given = sw->scene;
+  char snap_sub[17];
+  snapshot_name(sw->scene, scene_text, scene_len, snap_sub);
   {
     char* snap = malloc(strlen(sw->dir) + strlen(sw->scene) + 64);
     const char* slash = strrchr(sw->scene, '/');
     if (!snap) return bad("out of memory%s", "");
-    sprintf(snap, "%s/inputs/%016llx/%s", sw->dir,
-            (unsigned long long)fmb_mix64(fmb_fnv1a(FMB_FNV_OFFSET, scene_text, scene_len)),
-            slash ? slash + 1 : sw->scene);
+    sprintf(snap, "%s/inputs/%s/%s", sw->dir, snap_sub, slash ? slash + 1 : sw->scene);
     sw->scene = snap;
   }
   if (make_ids(sw, scene_text, scene_len)) return bad("out of memory for %s runs", "the");
@@ -572,11 +584,9 @@ int fmb_cmd_sweep(int argc, char** argv) {
     for (int k = 0; k < 3 && !rc; ++k)
       if (fmb_sweep_may_write(sw, ends[k])) rc = FMB_EXIT_BAD_INPUT;
     char path[4300];
-    if (!rc && snapshot_scene(sw, scene_text, scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
+    if (!rc && snapshot_scene(sw, snap_sub, scene_text, scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
     if (!rc && strcmp(path, sw->scene) != 0) rc = bad("the scene's snapshot is not %s", sw->scene);
-    const char* sub = sw->scene + strlen(sw->dir) + 8; /* inputs/HASH/... */
-    char hash[17];
-    snprintf(hash, sizeof hash, "%.16s", sub);
+    const char* hash = snap_sub;
     if (!rc && samples_name && snapshot_file(sw, hash, "samples.csv", samples_text, samples_len, path, sizeof path))
       rc = FMB_EXIT_BAD_INPUT;
     if (!rc && sw->reference) {
