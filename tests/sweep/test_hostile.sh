@@ -166,6 +166,14 @@ for i in 2 3 4 5; do
     { cat "$D/edited/table.csv"; fail "run $i is of the scene edited during the sweep"; }
 done
 
+# the snapshot still finds what the scene names beside it (rotor.yaml's table rotor_torque.csv):
+# the rows equal those of the scene run in place
+"$F" sweep "$SRC/scenes/rotor.yaml" -o "$D/rotor" --quiet --keep series --set solver.t_end=0.2 --grid solver.rtol=1e-6 \
+  2> "$D/rotor.err" || { cat "$D/rotor.err"; fail "a scene with a relative table file"; }
+"$F" run "$SRC/scenes/rotor.yaml" -o "$D/rotor.csv" --quiet --set solver.t_end=0.2 --set solver.rtol=1e-06 2> /dev/null ||
+  fail "the rotor run"
+cmp -s "$D/rotor.csv" "$D/rotor/series/$(cell "$D/rotor/table.csv" run_id 0).csv" || fail "the snapshot's rotor run differs"
+
 # ---- 5. plans ----------------------------------------------------------------------------------------
 for n in 2.5 3abc 0 -4 1e3.5; do
   rc=0
