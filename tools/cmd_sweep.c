@@ -8,8 +8,10 @@
  * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
  * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
  * index) and, when built with HDF5, DIR/sweep.h5. Under mpirun/srun the ranks share the runs
- * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
- * 4 interrupted (SIGINT/SIGTERM: every child killed, the journal flushed; run again to resume). */
+ * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec (or
+ * the folder is another sweep's, or holds files the sweep did not make), 3 a write failed (a full
+ * disk) or no runner could be started, 4 interrupted (SIGINT/SIGTERM: every child killed, the
+ * journal flushed); 3 and 4 resume when run again. */
 #define _GNU_SOURCE /* sched_getaffinity */
 #include <dirent.h>
 #include <errno.h>
@@ -320,7 +322,8 @@ static void usage(FILE* f) {
       "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
       "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
       "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
-      "spec, 4 interrupted (resumable). docs/sweep.md\n");
+      "spec or a folder not the sweep's, 3 a write failed (disk full), 4 interrupted (3 and 4 resume). "
+      "docs/sweep.md\n");
 }
 
 int fmb_cmd_sweep(int argc, char** argv) {
@@ -592,8 +595,9 @@ int fmb_cmd_sweep(int argc, char** argv) {
     if (!rc && sw->reference) {
       char* ref = NULL;
       size_t nref = 0;
-      if (fmb_sweep_read_input(sw->reference, 1u << 30, &ref, &nref, err, sizeof err) ||
-          snapshot_file(sw, hash, "reference.csv", ref, nref, path, sizeof path))
+      if (fmb_sweep_read_input(sw->reference, 1u << 30, &ref, &nref, err, sizeof err))
+        rc = (fprintf(stderr, "flexmbd sweep: --reference %s\n", err), FMB_EXIT_BAD_INPUT);
+      else if (snapshot_file(sw, hash, "reference.csv", ref, nref, path, sizeof path))
         rc = FMB_EXIT_BAD_INPUT;
       free(ref);
     }
@@ -613,7 +617,6 @@ int fmb_cmd_sweep(int argc, char** argv) {
       long pick[3] = {0, sw->nrun - 1, (long)(fmb_plan_uniform(sw->plan.seed, 0, 1u << 20) * (double)sw->nrun)};
       for (int k = 0; k < 3 && !rc; ++k)
         if (k == 0 || (pick[k] != pick[0] && pick[k] != pick[1])) rc = check_run(sw, pick[k], 1);
-      if (!rc && size > YES_LIMIT && !yes) printf("sweep plan: more than 1e6 runs: run it with --yes\n");
       ext->mpi_finalize(0);
       return rc ? FMB_EXIT_BAD_INPUT : 0;
     }

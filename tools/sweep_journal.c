@@ -187,11 +187,9 @@ static int made_here(const fmbSweep* sw, const char* name, const struct stat* st
   return found;
 }
 
-static void note_made(const fmbSweep* sw, const char* name) {
-  char path[4200];
-  struct stat st;
-  dir_file(sw, name, path, sizeof path);
-  if (lstat(path, &st) != 0 || made_here(sw, name, &st)) return;
+static void note_made_as(const fmbSweep* sw, const char* name, const struct stat* made) {
+  const struct stat st = *made;
+  if (made_here(sw, name, &st)) return;
   const int fd = open_own(sw, ".sweep-files", O_WRONLY | O_CREAT | O_APPEND);
   if (fd < 0) return;
   char line[512];
@@ -199,6 +197,12 @@ static void note_made(const fmbSweep* sw, const char* name) {
       snprintf(line, sizeof line, "%llu %llu %s\n", (unsigned long long)st.st_dev, (unsigned long long)st.st_ino, name);
   if (write(fd, line, (size_t)n) != n) fmb_sweep_disk_full((fmbSweep*)sw, ".sweep-files", errno);
   close(fd);
+}
+static void note_made(const fmbSweep* sw, const char* name) {
+  char path[4200];
+  struct stat st;
+  dir_file(sw, name, path, sizeof path);
+  if (lstat(path, &st) == 0) note_made_as(sw, name, &st);
 }
 
 int fmb_sweep_may_write(const fmbSweep* sw, const char* name) {
@@ -227,6 +231,10 @@ fmbSafeFile* fmb_sweep_file_open(const fmbSweep* sw, const char* name) {
 
 int fmb_sweep_file_close(fmbSweep* sw, const char* name, fmbSafeFile* f, int keep) {
   if (!f) return -1;
+  /* listed before the rename (it keeps the temporary's inode): a sweep killed between the two
+     leaves a file it can replace again, not one it takes for someone else's */
+  struct stat st;
+  if (keep && fstat(fmb_safe_fd(f), &st) == 0) note_made_as(sw, name, &st);
   const int rc = fmb_safe_close(f, keep);
   if (keep && rc != 0) {
     char path[4200];
@@ -234,7 +242,6 @@ int fmb_sweep_file_close(fmbSweep* sw, const char* name, fmbSafeFile* f, int kee
     fmb_sweep_disk_full(sw, path, errno);
     fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
   }
-  if (keep && rc == 0) note_made(sw, name);
   return rc;
 }
 
@@ -265,6 +272,9 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
   for (long i = 0; i < sw->nrun; ++i) sw->row_at[i] = -1, sw->status[i] = -1;
   int rfd = open_own(sw, "runs.csv", O_RDONLY);
   if (rfd == -2) return FMB_EXIT_BAD_INPUT;
+  struct stat rst;
+  if (rfd >= 0 && fstat(rfd, &rst) == 0 && rst.st_size == 0) /* killed before its header: nothing in it */
+    close(rfd), rfd = -1;
   FILE* f = rfd >= 0 ? fdopen(rfd, "r") : NULL;
   if (f) {
     char first[256] = "", head[1 << 16] = "";
