@@ -101,13 +101,17 @@ static void child_setup(const fmbChildSpec* s, pid_t parent) {
     rl.rlim_cur = rl.rlim_max = (rlim_t)(s->mem_limit_mb * 1048576.0);
     setrlimit(RLIMIT_AS, &rl);
   }
-  int in = s->use_fds ? s->stdin_fd : open("/dev/null", O_RDONLY | O_CLOEXEC);
+  if (s->use_fds) { /* via copies above 10: a pipe may already sit at 3 or 4 */
+    const int req = fcntl(s->request_fd, F_DUPFD_CLOEXEC, 10), ans = fcntl(s->answer_fd, F_DUPFD_CLOEXEC, 10);
+    if (req < 0 || ans < 0 || dup2(req, 3) < 0 || dup2(ans, 4) < 0) _exit(127);
+  }
+  int in = open("/dev/null", O_RDONLY | O_CLOEXEC);
   if (in >= 0) dup2(in, 0);
   const char* paths[2] = {s->stdout_path, s->stderr_path};
   for (int k = 0; k < 2; ++k) {
-    int fd = k == 0 && s->use_fds
-                 ? s->stdout_fd
-                 : open(paths[k] ? paths[k] : "/dev/null", O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    /* O_NOFOLLOW: a link planted in a shared output folder does not redirect the write */
+    int fd = open(paths[k] ? paths[k] : "/dev/null",
+                  O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC | (paths[k] ? O_NOFOLLOW : 0), 0644);
     if (fd >= 0) dup2(fd, k + 1);
   }
   struct sigaction dfl;

@@ -31,11 +31,14 @@ typedef struct fmbChildSpec {
   char* const* argv;     /* a program to execute (argv[0] is its path) ... */
   void (*fn)(void* arg); /* ... or a function run in the forked child; it must _exit */
   void* arg;
-  const char *stdout_path, *stderr_path; /* NULL: /dev/null */
-  int use_fds, stdin_fd, stdout_fd;      /* use_fds: stdin and stdout are these (pipes) instead */
-  double timeout_s;                      /* wall time allowed; <= 0: none */
-  double mem_limit_mb;                   /* RLIMIT_AS of the child; <= 0: none */
-  long tag;                              /* the caller's name for the child, handed back */
+  const char *stdout_path, *stderr_path; /* NULL: /dev/null; opened without following a link */
+  /* use_fds: two more descriptors, request_fd as the child's fd 3 and answer_fd as its fd 4 (a
+     runner's pipes, tools/run_serve.c: a channel of their own, apart from stdin and stdout, so
+     nothing the child prints can be taken for an answer) */
+  int use_fds, request_fd, answer_fd;
+  double timeout_s;    /* wall time allowed; <= 0: none */
+  double mem_limit_mb; /* RLIMIT_AS of the child; <= 0: none */
+  long tag;            /* the caller's name for the child, handed back */
 } fmbChildSpec;
 
 typedef struct fmbChildResult {

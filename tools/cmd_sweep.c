@@ -8,9 +8,12 @@
  * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
  * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
  * index) and, when built with HDF5, DIR/sweep.h5. Under mpirun/srun the ranks share the runs
- * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec,
- * 4 interrupted (SIGINT/SIGTERM: every child killed, the journal flushed; run again to resume). */
+ * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec (or
+ * the folder is another sweep's, or holds files the sweep did not make), 3 a write failed (a full
+ * disk) or no runner could be started, 4 interrupted (SIGINT/SIGTERM: every child killed, the
+ * journal flushed); 3 and 4 resume when run again. */
 #define _GNU_SOURCE /* sched_getaffinity */
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <sched.h>
@@ -67,7 +70,7 @@ static int add_metrics(fmbSweep* sw, const char* spec) {
    and the run's overrides (fixed and swept), sorted, numbers printed %.17g; identical runs share
    one id and run once */
 static int by_text(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
-static uint64_t hash_file(uint64_t h, const char* path) {
+static uint64_t hash_file(uint64_t h, const char* path) { /* the plugins' files */
   FILE* f = fopen(path, "rb");
   if (!f) return h;
   char buf[1 << 15];
@@ -84,12 +87,12 @@ static int by_id(const void* a, const void* b) {
   const IdIndex *x = a, *y = b;
   return x->id < y->id ? -1 : x->id > y->id ? 1 : (x->i > y->i) - (x->i < y->i);
 }
-static int make_ids(fmbSweep* sw) {
+static int make_ids(fmbSweep* sw, const char* scene_text, size_t scene_len) {
   sw->id = malloc((size_t)sw->nrun * sizeof *sw->id);
   sw->first = malloc((size_t)sw->nrun * sizeof *sw->first);
   if (!sw->id || !sw->first) return -1;
   uint64_t base = fmb_fnv1a(FMB_FNV_OFFSET, "flexmbd sweep run 1", 20);
-  base = hash_file(base, sw->scene);
+  base = fmb_fnv1a(base, scene_text, scene_len); /* the bytes of the snapshot the runs read */
   const char* version = FLEXMBD_VERSION " " FLEXMBD_COMMIT;
   base = fmb_fnv1a(base, sw->verb, strlen(sw->verb) + 1);
   base = fmb_fnv1a(base, version, strlen(version) + 1);
@@ -124,16 +127,32 @@ static int make_ids(fmbSweep* sw) {
   return 0;
 }
 
-/* `flexmbd check` of run `index` in a child: its exit code (its messages on stderr when it fails) */
+/* a file of our own in DIR/logs (mkstemp: created new, never a link or someone's file), closed */
+static int own_temp(const fmbSweep* sw, const char* stem, char* path, size_t len) {
+  snprintf(path, len, "%s/logs/%s.XXXXXX", sw->dir, stem);
+  const int fd = mkstemp(path);
+  if (fd < 0) return -1;
+  close(fd);
+  return 0;
+}
+
+/* `flexmbd check` of run `index` in a child: its exit code (its messages on stderr when it fails);
+   with --verb run, every --metric column is checked against the outputs it lists (2 when one is
+   missing: refused before any run) */
 static int check_run(fmbSweep* sw, long index, int verbose) {
-  char err[4300];
-  snprintf(err, sizeof err, "%s/logs/check.err", sw->dir);
+  char err[4300], out[4300];
+  if (own_temp(sw, "check-err", err, sizeof err) || own_temp(sw, "check-out", out, sizeof out)) {
+    fprintf(stderr, "flexmbd sweep: cannot create a file in %s/logs: %s\n", sw->dir, strerror(errno));
+    unlink(err);
+    return 3;
+  }
   char* argv[FMB_SWEEP_MAX_ARGS];
   char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
   fmb_sweep_argv(sw, index, "check", NULL, argv, sets);
   fmbPool* pool = fmb_pool_new(1);
   /* a check that crashes or hangs is left to the runs to record; only refused input stops the sweep */
   fmbChildSpec spec = {.argv = argv,
+                       .stdout_path = out,
                        .stderr_path = err,
                        .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,
                        .mem_limit_mb = sw->mem_limit_mb};
@@ -142,7 +161,7 @@ static int check_run(fmbSweep* sw, long index, int verbose) {
     while (fmb_pool_wait(pool, 1.0, &r) == 0) {
     }
   fmb_pool_free(pool);
-  const int rc = r.status == FMB_CHILD_OK ? 0 : r.status == FMB_CHILD_BAD_INPUT ? 2 : 3;
+  int rc = r.status == FMB_CHILD_OK ? 0 : r.status == FMB_CHILD_BAD_INPUT ? 2 : 3;
   if (verbose || rc) {
     fprintf(stderr, "check of run %ld:", index);
     for (int k = 0; k < sw->plan.npath; ++k) fprintf(stderr, " %s", sets[k]);
@@ -153,20 +172,138 @@ static int check_run(fmbSweep* sw, long index, int verbose) {
       if (strncmp(line, "stats:", 6) != 0) fprintf(stderr, "  %s", line);
     if (f) fclose(f);
   }
+  if (rc == 0 && strcmp(sw->verb, "run") == 0 && sw->nmetric > 0) { /* "outputs: t a b ..." */
+    FILE* f = fopen(out, "r");
+    size_t cap = 0;
+    char* line = NULL;
+    while (f && getline(&line, &cap, f) > 0 && strncmp(line, "outputs: ", 9) != 0) {
+    }
+    for (int k = 0; f && line && strncmp(line, "outputs: ", 9) == 0 && k < sw->nmetric; ++k) {
+      const char* c = sw->metric[k].column;
+      const size_t n = strlen(c);
+      int found = 0;
+      for (const char* p = line + 8; p && !found; p = strchr(p + 1, ' '))
+        found = strncmp(p + 1, c, n) == 0 && (p[1 + n] == ' ' || p[1 + n] == '\n' || !p[1 + n]);
+      if (!found) {
+        line[strcspn(line, "\n")] = '\0';
+        fprintf(stderr, "flexmbd sweep: --metric %s: the runs have no column '%s' (%s)\n", c, c, line);
+        rc = 2;
+        break;
+      }
+    }
+    free(line);
+    if (f) fclose(f);
+  }
   unlink(err);
+  unlink(out);
   return rc;
 }
 
+/* DIR (and its parents), DIR/series, DIR/logs, DIR/inputs: made, or folders already (never links: a link planted
+   there would send the runs' files elsewhere) */
 static int make_dirs(const char* dir) {
   char p[4300];
-  const char* sub[3] = {"", "/series", "/logs"};
-  for (int k = 0; k < 3; ++k) {
+  const char* sub[4] = {"", "/series", "/logs", "/inputs"};
+  snprintf(p, sizeof p, "%s", dir); /* its parents too (-o out/study in a fresh checkout) */
+  for (char* c = strchr(p + 1, '/'); c; c = strchr(c + 1, '/')) {
+    *c = '\0';
+    if (mkdir(p, 0755) != 0 && errno != EEXIST) break; /* said below, at DIR itself */
+    *c = '/';
+  }
+  for (int k = 0; k < 4; ++k) {
     snprintf(p, sizeof p, "%s%s", dir, sub[k]);
+    struct stat st;
     if (mkdir(p, 0755) != 0 && errno != EEXIST) {
       fprintf(stderr, "flexmbd sweep: cannot create %s: %s\n", p, strerror(errno));
       return FMB_EXIT_BAD_INPUT;
     }
+    if ((k ? lstat(p, &st) : stat(p, &st)) != 0 || !S_ISDIR(st.st_mode)) {
+      fprintf(stderr, "flexmbd sweep: %s is not a folder of its own (a file or a link): give another -o DIR\n", p);
+      return FMB_EXIT_BAD_INPUT;
+    }
+    /* no link in series/ or logs/: a run's CSV or log written through one would land elsewhere */
+    DIR* d = k == 1 || k == 2 ? opendir(p) : NULL;
+    struct dirent* e;
+    while (d && (e = readdir(d))) {
+      char q[4600];
+      snprintf(q, sizeof q, "%s/%s", p, e->d_name);
+      if (lstat(q, &st) == 0 && S_ISLNK(st.st_mode)) {
+        fprintf(stderr, "flexmbd sweep: %s is a symbolic link: the sweep writes only files of its own there\n", q);
+        closedir(d);
+        return FMB_EXIT_BAD_INPUT;
+      }
+    }
+    if (d) closedir(d);
   }
+  return 0;
+}
+
+/* bytes into DIR/inputs/SUB/name through the safe path, unless a file with these bytes is there */
+static int snapshot_file(fmbSweep* sw, const char* sub, const char* name, const char* text, size_t n, char* path,
+                         size_t len) {
+  char rel[600];
+  snprintf(rel, sizeof rel, "inputs/%s/%s", sub, name);
+  snprintf(path, len, "%s/%s", sw->dir, rel);
+  char* old = NULL;
+  size_t oldn = 0;
+  char why[600];
+  struct stat st;
+  if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) &&
+      fmb_sweep_read_input(path, n, &old, &oldn, why, sizeof why) == 0 && oldn == n && memcmp(old, text, n) == 0) {
+    free(old);
+    return 0;
+  }
+  free(old);
+  fmbSafeFile* f = fmb_sweep_file_open(sw, rel);
+  const int ok = f && (n == 0 || write(fmb_safe_fd(f), text, n) == (ssize_t)n);
+  if (f && !ok) fmb_sweep_disk_full(sw, path, errno);
+  return fmb_sweep_file_close(sw, rel, f, ok) == 0 && ok ? 0 : -1;
+}
+
+/* the snapshot's folder name: a hash of the scene's bytes and of its folder (the links beside the
+   copy lead into that folder: the same bytes elsewhere are another snapshot) */
+static void snapshot_name(const char* scene, const char* text, size_t n, char sub[17]) {
+  const char* slash = strrchr(scene, '/');
+  char from[4300];
+  snprintf(from, sizeof from, "%.*s", slash ? (int)(slash - scene) : 1, slash ? scene : ".");
+  char* real = realpath(from[0] ? from : "/", NULL);
+  uint64_t h = fmb_fnv1a(FMB_FNV_OFFSET, text, n);
+  if (real) h = fmb_fnv1a(h, real, strlen(real) + 1);
+  free(real);
+  snprintf(sub, 17, "%016llx", (unsigned long long)fmb_mix64(h));
+}
+
+/* The scene as the runs read it: its bytes, read once, hashed into the run ids and written to
+   DIR/inputs/HASH/NAME, which every run loads. An edit of the scene during the sweep changes
+   nothing (the ids and the runs are of the snapshot; the next start of the sweep sees a new
+   plan). The files the scene names by relative paths (tables, plugins) are found beside it as
+   before: DIR/inputs/HASH/ holds a link to every other entry of the scene's folder. */
+static int snapshot_scene(fmbSweep* sw, const char* sub, const char* text, size_t n, char* path, size_t len) {
+  char dir[4300];
+  snprintf(dir, sizeof dir, "%s/inputs/%s", sw->dir, sub);
+  struct stat st;
+  if (mkdir(dir, 0755) != 0 && (errno != EEXIST || lstat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
+    fprintf(stderr, "flexmbd sweep: cannot create the folder %s of its own\n", dir);
+    return -1;
+  }
+  const char* slash = strrchr(sw->scene_given, '/');
+  const char* base = slash ? slash + 1 : sw->scene_given;
+  if (snapshot_file(sw, sub, base, text, n, path, len)) return -1;
+  char from[4300];
+  snprintf(from, sizeof from, "%.*s", slash ? (int)(slash - sw->scene_given) : 1, slash ? sw->scene_given : ".");
+  char* real = realpath(from[0] ? from : "/", NULL);
+  DIR* d = real ? opendir(real) : NULL;
+  struct dirent* e;
+  int count = 0;
+  while (d && (e = readdir(d)) && count < 100000) {
+    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0 || strcmp(e->d_name, base) == 0) continue;
+    char link[4600], target[8400];
+    snprintf(link, sizeof link, "%s/%s", dir, e->d_name);
+    snprintf(target, sizeof target, "%s/%s", strcmp(real, "/") ? real : "", e->d_name);
+    if (symlink(target, link) == 0) ++count;
+  }
+  if (d) closedir(d);
+  free(real);
   return 0;
 }
 
@@ -185,7 +322,8 @@ static void usage(FILE* f) {
       "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
       "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
       "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
-      "spec, 4 interrupted (resumable). docs/sweep.md\n");
+      "spec or a folder not the sweep's, 3 a write failed (disk full), 4 interrupted (3 and 4 resume). "
+      "docs/sweep.md\n");
 }
 
 int fmb_cmd_sweep(int argc, char** argv) {
@@ -203,6 +341,9 @@ int fmb_cmd_sweep(int argc, char** argv) {
   int dry = 0, resume = 0, fresh = 0, yes = 0, design_lhs = -1;
   long count = 0;
   int seed_given = 0;
+  char* samples_text = NULL; /* the --samples file as read once (its copy goes to DIR/inputs) */
+  size_t samples_len = 0;
+  const char* samples_name = NULL;
   char err[1200];
   for (int i = 2; i < argc; ++i) {
     const char* a = argv[i];
@@ -220,8 +361,12 @@ int fmb_cmd_sweep(int argc, char** argv) {
                             : fmb_plan_add_random(&sw->plan, v, err, sizeof err);
       if (r) return bad("%s", err);
     } else if (strcmp(a, "--samples") == 0) {
-      if (!(v = VALUE("a CSV file")) || fmb_plan_add_samples(&sw->plan, v, err, sizeof err))
-        return v ? bad("%s", err) : FMB_EXIT_BAD_INPUT;
+      if (!(v = VALUE("a CSV file"))) return FMB_EXIT_BAD_INPUT;
+      if (samples_text) return bad("one --samples file at a time%s", "");
+      if (fmb_sweep_read_input(v, 1u << 30, &samples_text, &samples_len, err, sizeof err) ||
+          fmb_plan_add_samples(&sw->plan, v, samples_text, samples_len, err, sizeof err))
+        return bad("--samples %s", err);
+      samples_name = v;
     } else if (strcmp(a, "--count") == 0) {
       char* end;
       if (!(v = VALUE("N"))) return FMB_EXIT_BAD_INPUT;
@@ -337,14 +482,18 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (!sw->scene) return usage(stderr), bad("no scene file given%s", "");
   if (!sw->dir) return bad("no output folder given (-o DIR)%s", "");
   if (resume && fresh) return bad("--resume and --fresh exclude each other%s", "");
-  if (fmb_cli_check_input(sw->scene, "scene")) return FMB_EXIT_BAD_INPUT;
+  char* scene_text = NULL; /* the scene's bytes, read once: hashed into the ids and snapshotted */
+  size_t scene_len = 0;
+  if (fmb_sweep_read_input(sw->scene, 1u << 28, &scene_text, &scene_len, err, sizeof err))
+    return fprintf(stderr, "%s (the scene)\n", err), FMB_EXIT_BAD_INPUT;
   if (sw->serve == 1 && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
   if (design_lhs >= 0 && !sw->plan.nrandom) return bad("--design goes with --random%s", "");
   if (seed_given && !sw->plan.nrandom) return bad("--seed goes with --random%s", "");
   sw->plan.count = count;
   sw->plan.lhs = design_lhs == 1;
+  /* the size from the factors' counts alone, before a value is laid out or a random sample drawn:
+     a refused plan costs nothing (a plan of 1e7 runs was built in full, 8.6 s and 395 MB, first) */
   const double size = fmb_plan_size(&sw->plan);
-  if (fmb_plan_finish(&sw->plan, err, sizeof err) && !(size > MAX_PLAN)) return bad("%s", err);
   if (size > MAX_PLAN)
     return fprintf(stderr, "flexmbd sweep: a plan of %.4g runs is beyond the limit of 1e9\n", size), FMB_EXIT_BAD_INPUT;
   if (size > YES_LIMIT && !yes && !dry)
@@ -352,6 +501,12 @@ int fmb_cmd_sweep(int argc, char** argv) {
                    "flexmbd sweep: the plan has %.4g runs (more than 1e6): check it with --dry-run, then add --yes\n",
                    size),
            FMB_EXIT_BAD_INPUT;
+  if (size > YES_LIMIT && !yes) { /* --dry-run of a huge plan: its size, nothing built or written */
+    printf("sweep plan: %.0f runs of %s %s (more than 1e6): add --yes to lay it out (plan.csv) and check it\n", size,
+           sw->verb, sw->scene);
+    return 0;
+  }
+  if (fmb_plan_finish(&sw->plan, err, sizeof err)) return bad("%s", err);
   sw->nrun = (long)size;
   for (int k = 0; k < sw->nfixed; ++k)
     for (int p = 0; p < sw->plan.npath; ++p)
@@ -388,7 +543,18 @@ int fmb_cmd_sweep(int argc, char** argv) {
 #endif
     sw->jobs = n > 0 ? (int)n : 1;
   }
-  if (make_ids(sw)) return bad("out of memory for %s runs", "the");
+  /* every run loads the snapshot DIR/inputs/HASH/NAME (snapshot_scene, written by rank 0 below) */
+  sw->scene_given = sw->scene;
+  char snap_sub[17];
+  snapshot_name(sw->scene, scene_text, scene_len, snap_sub);
+  {
+    char* snap = malloc(strlen(sw->dir) + strlen(sw->scene) + 64);
+    const char* slash = strrchr(sw->scene, '/');
+    if (!snap) return bad("out of memory%s", "");
+    sprintf(snap, "%s/inputs/%s/%s", sw->dir, snap_sub, slash ? slash + 1 : sw->scene);
+    sw->scene = snap;
+  }
+  if (make_ids(sw, scene_text, scene_len)) return bad("out of memory for %s runs", "the");
   /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
      libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
   fmbFarmTransport ranks;
@@ -409,20 +575,48 @@ int fmb_cmd_sweep(int argc, char** argv) {
     return 0;
   }
   if (sw->rank == 0) {
+    /* the folder is the sweep's own: made, locked, and the inputs noted (no file of the sweep may
+       replace one) and snapshotted, before anything is written there */
+    fmb_safe_note_input(sw->scene_given);
+    if (samples_name) fmb_safe_note_input(samples_name);
+    if (sw->reference) fmb_safe_note_input(sw->reference);
     rc = make_dirs(sw->dir);
+    if (!rc) rc = fmb_sweep_lock(sw);
+    /* the files written at the end too, checked now: refused before the runs, not after them */
+    const char* const ends[3] = {"plan.csv", "table.csv", "sweep.h5"};
+    for (int k = 0; k < 3 && !rc; ++k)
+      if (fmb_sweep_may_write(sw, ends[k])) rc = FMB_EXIT_BAD_INPUT;
+    char path[4300];
+    if (!rc && snapshot_scene(sw, snap_sub, scene_text, scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
+    if (!rc && strcmp(path, sw->scene) != 0) rc = bad("the scene's snapshot is not %s", sw->scene);
+    const char* hash = snap_sub;
+    if (!rc && samples_name && snapshot_file(sw, hash, "samples.csv", samples_text, samples_len, path, sizeof path))
+      rc = FMB_EXIT_BAD_INPUT;
+    if (!rc && sw->reference) {
+      char* ref = NULL;
+      size_t nref = 0;
+      if (fmb_sweep_read_input(sw->reference, 1u << 30, &ref, &nref, err, sizeof err))
+        rc = (fprintf(stderr, "flexmbd sweep: --reference %s\n", err), FMB_EXIT_BAD_INPUT);
+      else if (snapshot_file(sw, hash, "reference.csv", ref, nref, path, sizeof path))
+        rc = FMB_EXIT_BAD_INPUT;
+      free(ref);
+    }
+    if (!rc) fmb_safe_note_input(sw->scene);
     if (!rc && dry) {
       long distinct = 0;
       for (long i = 0; i < sw->nrun; ++i) distinct += sw->first[i] == i;
-      printf("sweep plan: %ld runs (%ld distinct) of %s %s, %d swept paths:", sw->nrun, distinct, sw->verb, sw->scene,
-             sw->plan.npath);
+      printf("sweep plan: %ld runs (%ld distinct) of %s %s, %d swept paths:", sw->nrun, distinct, sw->verb,
+             sw->scene_given, sw->plan.npath);
       for (int k = 0; k < sw->plan.npath; ++k) printf(" %s", sw->plan.path[k]);
       printf("\n");
-      if (fmb_journal_write_plan(sw) == 0) printf("sweep plan: written to %s/plan.csv\n", sw->dir);
+      if (fmb_journal_write_plan(sw) == 0)
+        printf("sweep plan: written to %s/plan.csv\n", sw->dir);
+      else
+        rc = FMB_EXIT_BAD_INPUT;
       fflush(stdout);
       long pick[3] = {0, sw->nrun - 1, (long)(fmb_plan_uniform(sw->plan.seed, 0, 1u << 20) * (double)sw->nrun)};
       for (int k = 0; k < 3 && !rc; ++k)
-        if (k == 0 || pick[k] != pick[0]) rc = check_run(sw, pick[k], 1);
-      if (!rc && size > YES_LIMIT && !yes) printf("sweep plan: more than 1e6 runs: run it with --yes\n");
+        if (k == 0 || (pick[k] != pick[0] && pick[k] != pick[1])) rc = check_run(sw, pick[k], 1);
       ext->mpi_finalize(0);
       return rc ? FMB_EXIT_BAD_INPUT : 0;
     }
@@ -444,14 +638,28 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (!rc) rc = sw->serve ? fmb_sweep_serve(sw, t) : fmb_sweep_farm(sw, t);
   if (sw->rank == 0 && sw->journal_fd >= 0) {
     fmb_sweep_progress(sw, 1);
-    if (fmb_journal_write_table(sw)) fprintf(stderr, "flexmbd sweep: cannot write %s/table.csv\n", sw->dir);
+    if (fmb_journal_write_table(sw) && !sw->disk_full) fmb_sweep_disk_full(sw, "table.csv", EIO);
     ext = fmb_sweep_extension_load(1);
-    if (rc == 0 && ext->write_h5(sw) < 0) fprintf(stderr, "flexmbd sweep: cannot write %s/sweep.h5\n", sw->dir);
+    if (rc == 0 && !sw->disk_full && ext->has_hdf5) { /* through the safe path: a temporary beside it */
+      fmbSafeFile* h5 = fmb_sweep_file_open(sw, "sweep.h5");
+      const int ok = h5 && ext->write_h5(sw, fmb_safe_write_path(h5)) == 0;
+      if (h5 && !ok) fprintf(stderr, "flexmbd sweep: cannot write %s/sweep.h5\n", sw->dir);
+      if (fmb_sweep_file_close(sw, "sweep.h5", h5, ok) != 0 || !ok) fmb_sweep_disk_full(sw, "sweep.h5", EIO);
+    }
+    fmb_journal_close(sw);
     if (rc == FMB_EXIT_INTERRUPTED)
       fprintf(stderr,
               "sweep: interrupted; every child stopped, %s/runs.csv is complete: run the same command to resume\n",
               sw->dir);
-    fmb_journal_close(sw);
+    if (sw->disk_full && (rc == 0 || rc == FMB_EXIT_INTERRUPTED)) {
+      long left = 0;
+      for (long i = 0; i < sw->nrun; ++i) left += sw->first[i] == i && sw->status[i] < 0;
+      fprintf(stderr,
+              "flexmbd sweep: stopped: a write failed (%s; the disk is full?): %ld runs have no row; free space and "
+              "run the same command to resume\n",
+              sw->disk_why, left);
+      rc = FMB_EXIT_SOLVER;
+    }
   }
   ext->mpi_finalize(rc);
   return rc;

@@ -14,12 +14,14 @@
 #include "child_pool.h"
 #include "csv_table.h"
 #include "farm.h"
+#include "flexmbd.h" /* fmbSafeFile */
 #include "sweep_plan.h"
 
 #define FMB_SWEEP_MAX_METRICS 64
 #define FMB_SWEEP_MAX_FIXED 256
-#define FMB_SWEEP_MAX_RETRIES 3 /* starts without a row before a run is marked lost */
-#define FMB_SWEEP_SYNC_S 1.0    /* the journal goes to the disk at most this often (sweep_journal.c) */
+#define FMB_SWEEP_MAX_RETRIES 3   /* starts without a row before a run is marked lost */
+#define FMB_SWEEP_CUT "disk_full" /* the status of a row never written: a run cut short by a full disk */
+#define FMB_SWEEP_SYNC_S 1.0      /* the journal goes to the disk at most this often (sweep_journal.c) */
 /* the stats fields every row carries, in the order of the stats line */
 #define FMB_SWEEP_NSTATS 9
 extern const char* const fmb_sweep_stat_names[FMB_SWEEP_NSTATS];
@@ -78,22 +80,44 @@ typedef struct fmbSweep {
   double median_wall;
   long median_at;
   volatile sig_atomic_t* stop;
+  /* the disk refused a write (the journal, or a run's own CSV): no more runs are handed out, the
+     runs cut short get no row (a resume does them again), and the sweep ends non-zero saying so */
+  int disk_full;
+  char disk_why[600];
+  int lock_fd;             /* DIR/sweep.lock, held (flock) while the sweep runs */
+  const char* scene_given; /* the scene as the user named it; sw->scene is the snapshot in DIR */
 } fmbSweep;
 
 /* sweep_journal.c */
+/* The folder is the sweep's own (docs/sweep.md, "Files"). DIR/sweep.lock: a second sweep on the
+   folder is refused, naming the pid and host of the first (flock: a lock whose holder died is free
+   again, whatever its pid); 0 or FMB_EXIT_BAD_INPUT after saying so. */
+int fmb_sweep_lock(fmbSweep* sw);
+/* DIR/name may be written by this sweep: it does not exist, or it is a regular file a sweep made
+   there (listed in DIR/.sweep-files with its inode), never a link, never a file of someone else;
+   0, or -1 after saying why */
+int fmb_sweep_may_write(const fmbSweep* sw, const char* name);
+/* DIR/name written through the one safe-file path (engine/safe_file.c: a temporary beside it,
+   renamed at fmb_sweep_file_close(keep), never over an input) after fmb_sweep_may_write; the
+   file made is recorded as the sweep's. NULL after saying why. */
+fmbSafeFile* fmb_sweep_file_open(const fmbSweep* sw, const char* name);
+int fmb_sweep_file_close(fmbSweep* sw, const char* name, fmbSafeFile* f, int keep);
+/* a full disk (or any refused write of the sweep's own files): noted once, the sweep stops */
+void fmb_sweep_disk_full(fmbSweep* sw, const char* what, int err);
 /* the header line of runs.csv / table.csv (no newline) into buf; its length or -1 */
 int fmb_sweep_header(const fmbSweep* sw, char* buf, size_t len);
 /* opens DIR/runs.csv and DIR/inflight.log: resumes (the same plan, or `resume` given), sets aside
    (`fresh`) or refuses another plan (2); fills row_at/status/starts. 0 or an exit code. */
 int fmb_journal_open(fmbSweep* sw, int resume, int fresh);
-/* appends one row (ending in '\n') to runs.csv with one write (to the disk once a second); 0 or -1 */
+/* appends one row (ending in '\n') to runs.csv with one write (to the disk once a second): 0; 1
+   when not recorded (a run cut short by a full disk, or the write refused: sw->disk_full) */
 int fmb_journal_append(fmbSweep* sw, long index, const char* row);
 /* records the dispatch of run `index` in inflight.log before it starts */
 void fmb_journal_started(fmbSweep* sw, long index);
 /* DIR/table.csv: the latest row of every planned run, sorted by index (indices of this plan) */
-int fmb_journal_write_table(const fmbSweep* sw);
+int fmb_journal_write_table(fmbSweep* sw);
 /* DIR/plan.csv: index, run_id and the swept values */
-int fmb_journal_write_plan(const fmbSweep* sw);
+int fmb_journal_write_plan(fmbSweep* sw);
 /* takes a start back: run `index` was killed because the sweep was interrupted, not lost */
 void fmb_journal_cancelled(fmbSweep* sw, long index);
 void fmb_journal_close(fmbSweep* sw);
@@ -157,8 +181,9 @@ typedef struct fmbSweepExtension {
   /* MPI_Init; *t: this rank, their number and the farm's messages (farm.h); 0 or -1 */
   int (*mpi_init)(fmbFarmTransport* t);
   void (*mpi_finalize)(int rc); /* MPI_Finalize, or MPI_Abort when interrupted */
-  /* DIR/sweep.h5 from DIR/plan.csv, DIR/table.csv and (--keep series) the series; 0 or -1 */
-  int (*write_h5)(const fmbSweep* sw);
+  /* the HDF5 file at `path` (the safe path's temporary for DIR/sweep.h5, cmd_sweep.c) from
+     DIR/plan.csv, DIR/table.csv and (--keep series) the series; 0 or -1 */
+  int (*write_h5)(const fmbSweep* sw, const char* path);
 } fmbSweepExtension;
 /* started by mpirun or srun (their environment variables: OMPI_COMM_WORLD_SIZE, PMIX_RANK, ...) */
 int fmb_sweep_launched_by_mpi(void);
@@ -172,5 +197,5 @@ const fmbSweepExtension* fmb_sweep_extension_load(int load);
 /* in the module (sweep_mpi.c, sweep_h5.c) */
 int fmb_sweep_mpi_init(fmbFarmTransport* t);
 void fmb_sweep_mpi_finalize(int rc);
-int fmb_sweep_write_h5(const fmbSweep* sw);
+int fmb_sweep_write_h5(const fmbSweep* sw, const char* path);
 #endif

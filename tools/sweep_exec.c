@@ -5,6 +5,7 @@
  * row keeps comes from the child's exit (child_pool.c), its stats line (the last stderr line,
  * docs/robustness.md) and, for --metric and --reference, its CSV, read back with the one CSV
  * reader (csv_table.c). */
+#include <errno.h>
 #include <inttypes.h>
 #include <math.h>
 #include <stdarg.h>
@@ -12,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/resource.h>
+#include <sys/statvfs.h>
 #include <unistd.h>
 
 #include "cli.h"
@@ -153,14 +155,15 @@ static void put_double(Buf* b, double v) {
   else
     put(b, ",%s", isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
 }
-/* a message as one CSV field: quoted, inner quotes doubled, at most 200 characters */
+/* a message as one CSV field: quoted, inner quotes doubled, control characters (a line break
+   would end the row) as blanks, at most 200 characters */
 static void put_message(Buf* b, const char* msg) {
   put(b, ",\"");
   for (int i = 0; msg[i] && i < 200; ++i) {
     if (msg[i] == '"')
       put(b, "\"\"");
     else
-      put(b, "%c", msg[i]);
+      put(b, "%c", (unsigned char)msg[i] < 32 ? ' ' : msg[i]);
   }
   put(b, "\"\n");
 }
@@ -172,6 +175,16 @@ static void put_lead(const fmbSweep* sw, Buf* b, long index, int attempt, const 
   for (int k = 0; k < sw->plan.npath; ++k) put(b, ",%s", fmb_plan_value(&sw->plan, index, k));
 }
 
+/* A run that did not end ok because the disk was full is no result of the run: its CSV (or its
+   messages) could not be written. Told by the engine's own message for a refused CSV write, or by
+   a folder left without free space (the run's stderr may then be cut too). */
+static int cut_by_disk(const fmbSweep* sw, const fmbChildResult* r, const char* msg) {
+  if (r->status == FMB_CHILD_OK || r->status == FMB_CHILD_BAD_INPUT || r->status == FMB_CHILD_INTERRUPTED) return 0;
+  if (strstr(msg, "writing the output failed")) return 1;
+  struct statvfs v;
+  return statvfs(sw->dir, &v) == 0 && (double)v.f_bavail * (double)v.f_frsize < 65536.0;
+}
+
 /* the row from what the run's end told: status, its stats fields, its message */
 static char* build_row(fmbSweep* sw, const fmbChildResult* r, int attempt, char stats[FMB_SWEEP_NSTATS][40],
                        char* msg) {
@@ -179,6 +192,13 @@ static char* build_row(fmbSweep* sw, const fmbChildResult* r, int attempt, char 
   const long index = r->tag;
   char series[4300];
   run_file(sw, index, "series", ".csv", series, sizeof series);
+  if (cut_by_disk(sw, r, msg)) { /* the journal takes no row for it (fmb_journal_append) */
+    Buf b = {0};
+    put_lead(sw, &b, index, attempt, FMB_SWEEP_CUT, r->exit_code, r->signal, r->wall_s);
+    put(&b, "\n");
+    unlink(series);
+    return b.s;
+  }
   if (r->status == FMB_CHILD_CRASHED && r->signal) {
     char m[msglen];
     snprintf(m, sizeof m, "killed by signal %d (%s)%s%.1800s", r->signal, strsignal(r->signal), msg[0] ? ": " : "",
@@ -329,10 +349,8 @@ long* fmb_sweep_todo(fmbSweep* sw, long* n, long* n_inflight) {
 /* records the row of a finished child */
 static void finish(fmbSweep* sw, const fmbChildResult* r) {
   char* row = fmb_sweep_row(sw, r, sw->starts[sw->first[r->tag]]);
-  if (!row || fmb_journal_append(sw, r->tag, row) != 0)
-    fprintf(stderr, "flexmbd sweep: cannot append to %s/runs.csv: the run will be done again on resume\n", sw->dir);
-  else
-    fmb_sweep_account(sw, (int)r->status, r->wall_s);
+  if (!row) fmb_sweep_disk_full(sw, "a row", ENOMEM);
+  if (row && fmb_journal_append(sw, r->tag, row) == 0) fmb_sweep_account(sw, (int)r->status, r->wall_s);
   free(row);
 }
 
@@ -347,7 +365,7 @@ int fmb_sweep_rerun_inflight(fmbSweep* sw, const long* todo, long n) {
   if (n == 0) return 0;
   fmbPool* pool = fmb_pool_new(1);
   if (!pool) return FMB_EXIT_BAD_INPUT;
-  for (long k = 0; k < n && !*sw->stop; ++k) {
+  for (long k = 0; k < n && !*sw->stop && !sw->disk_full; ++k) {
     fmb_journal_started(sw, todo[k]);
     if (fmb_sweep_start(sw, pool, todo[k], fmb_sweep_timeout(sw)) != 0) continue;
     sw->running = 1;
@@ -370,7 +388,7 @@ typedef struct {
 } Feed;
 static int feed_next(void* ctx, fmbFarmTask* task) {
   Feed* f = ctx;
-  if (f->next >= f->n) return 0;
+  if (f->next >= f->n || f->sw->disk_full) return 0; /* a full disk: nothing more is started */
   const long i = f->todo[f->next++];
   fmb_journal_started(f->sw, i);
   task->index = i;
@@ -408,8 +426,9 @@ static void feed_take(void* ctx, const fmbChildResult* local, char* row, int len
   }
   if (index >= 0 && index < sw->nrun && len > 0 && fmb_journal_append(sw, index, row) == 0)
     fmb_sweep_account(sw, status, wall_s);
-  else
-    fprintf(stderr, "flexmbd sweep: cannot append to %s/runs.csv: the run will be done again on resume\n", sw->dir);
+  else if (!sw->disk_full)
+    fprintf(stderr, "flexmbd sweep: a row that cannot be taken (run %ld): the run will be done again on resume\n",
+            index);
   free(row);
 }
 static void feed_tick(void* ctx, long running) {

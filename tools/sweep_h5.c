@@ -161,8 +161,8 @@ static int write_series(hid_t file, const fmbSweep* sw, const Text* table) {
   return rc;
 }
 
-int fmb_sweep_write_h5(const fmbSweep* sw) {
-  char path[4300], tmp[4300];
+int fmb_sweep_write_h5(const fmbSweep* sw, const char* out) {
+  char path[4300];
   Text plan, table;
   snprintf(path, sizeof path, "%s/plan.csv", sw->dir);
   if (text_load(path, &plan)) return -1;
@@ -171,13 +171,11 @@ int fmb_sweep_write_h5(const fmbSweep* sw) {
     text_free(&plan);
     return -1;
   }
-  snprintf(tmp, sizeof tmp, "%s/.sweep.h5.tmp", sw->dir);
-  snprintf(path, sizeof path, "%s/sweep.h5", sw->dir);
   H5Eset_auto2(H5E_DEFAULT, NULL, NULL); /* our message, not HDF5's stack dump */
-  hid_t f = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
+  hid_t f = H5Fcreate(out, H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
   int rc = f < 0 ? -1 : 0;
   if (!rc) {
-    string_attribute(f, "scene", sw->scene);
+    string_attribute(f, "scene", sw->scene_given ? sw->scene_given : sw->scene);
     string_attribute(f, "verb", sw->verb);
     string_attribute(f, "flexmbd", FLEXMBD_VERSION);
     char runs[32];
@@ -185,9 +183,8 @@ int fmb_sweep_write_h5(const fmbSweep* sw) {
     string_attribute(f, "runs", runs);
     rc = write_columns(f, "plan", &plan) || write_columns(f, "runs", &table) ||
          (sw->keep_series && write_series(f, sw, &table));
-    H5Fclose(f);
+    if (H5Fclose(f) < 0) rc = -1; /* a full disk may tell only here */
   }
-  if (!rc && rename(tmp, path) != 0) rc = -1;
   text_free(&plan), text_free(&table);
   return rc;
 }

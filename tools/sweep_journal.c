@@ -17,6 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/file.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -91,6 +92,159 @@ static const char* field(const char* line, int k) {
   return line;
 }
 
+/* ---- the folder is the sweep's own ---------------------------------------------------------- */
+
+void fmb_sweep_disk_full(fmbSweep* sw, const char* what, int err) {
+  if (sw->disk_full) return;
+  sw->disk_full = 1;
+  snprintf(sw->disk_why, sizeof sw->disk_why, "%.500s: %s", what, strerror(err));
+}
+
+/* opens path without following a link and without waiting (a FIFO never blocks), refusing
+   anything but a regular file: the fd, -1 with errno (ENOENT: it does not exist), or -2 after
+   saying why */
+static int open_regular(const char* path, int flags) {
+  const int fd = open(path, flags | O_NOFOLLOW | O_NONBLOCK | O_NOCTTY | O_CLOEXEC, 0644);
+  if (fd < 0 && errno == ELOOP) {
+    fprintf(stderr, "flexmbd sweep: %s is a symbolic link: the sweep uses only files of its own there\n", path);
+    return -2;
+  }
+  if (fd < 0) return -1;
+  struct stat st;
+  if (fstat(fd, &st) != 0 || !S_ISREG(st.st_mode)) {
+    close(fd);
+    fprintf(stderr, "flexmbd sweep: %s is not a regular file (a FIFO, device or folder): not a sweep's\n", path);
+    return -2;
+  }
+  fcntl(fd, F_SETFL, fcntl(fd, F_GETFL) & ~O_NONBLOCK);
+  return fd;
+}
+static int open_own(const fmbSweep* sw, const char* name, int flags) {
+  char path[4200];
+  dir_file(sw, name, path, sizeof path);
+  return open_regular(path, flags);
+}
+/* a FILE* to read path (open_regular), NULL when absent; *refused when it is not a plain file */
+static FILE* read_regular(const char* path, int* refused) {
+  const int fd = open_regular(path, O_RDONLY);
+  if (fd == -2) *refused = 1;
+  FILE* f = fd >= 0 ? fdopen(fd, "r") : NULL;
+  if (fd >= 0 && !f) close(fd);
+  return f;
+}
+
+int fmb_sweep_lock(fmbSweep* sw) {
+  char host[256] = "?", path[4200];
+  gethostname(host, sizeof host - 1);
+  dir_file(sw, "sweep.lock", path, sizeof path);
+  const int fd = open_own(sw, "sweep.lock", O_RDWR | O_CREAT);
+  if (fd == -2) return FMB_EXIT_BAD_INPUT;
+  if (fd < 0) {
+    fprintf(stderr, "flexmbd sweep: cannot create %s: %s\n", path, strerror(errno));
+    return FMB_EXIT_BAD_INPUT;
+  }
+  if (flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    char who[300] = "";
+    const ssize_t n = pread(fd, who, sizeof who - 1, 0);
+    who[n > 0 ? n : 0] = '\0';
+    who[strcspn(who, "\n")] = '\0';
+    long pid = 0;
+    char other[256] = "?";
+    sscanf(who, "pid %ld host %255s", &pid, other);
+    fprintf(stderr,
+            "flexmbd sweep: %s is in use by another sweep (pid %ld on host %s, %s): wait for it to end, or give "
+            "another -o DIR\n",
+            sw->dir, pid, other, path);
+    close(fd);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  /* free: no sweep holds it (a lock left by a sweep that died, whatever its pid, is free again) */
+  char line[400];
+  const int n = snprintf(line, sizeof line, "pid %ld host %s\n", (long)getpid(), host);
+  if (ftruncate(fd, 0) != 0 || pwrite(fd, line, (size_t)n, 0) != n) {
+    fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
+    close(fd);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  sw->lock_fd = fd;
+  return 0;
+}
+
+/* DIR/.sweep-files: "DEV INO NAME" per file a sweep made in DIR (appended) */
+static int made_here(const fmbSweep* sw, const char* name, const struct stat* st) {
+  const int fd = open_own(sw, ".sweep-files", O_RDONLY);
+  if (fd < 0) return 0;
+  FILE* f = fdopen(fd, "r");
+  if (!f) return close(fd), 0;
+  char line[512];
+  int found = 0;
+  unsigned long long dev, ino;
+  char n[400];
+  while (!found && fgets(line, sizeof line, f))
+    found = sscanf(line, "%llu %llu %399s", &dev, &ino, n) == 3 && dev == (unsigned long long)st->st_dev &&
+            ino == (unsigned long long)st->st_ino && strcmp(n, name) == 0;
+  fclose(f);
+  return found;
+}
+
+static void note_made_as(const fmbSweep* sw, const char* name, const struct stat* made) {
+  const struct stat st = *made;
+  if (made_here(sw, name, &st)) return;
+  const int fd = open_own(sw, ".sweep-files", O_WRONLY | O_CREAT | O_APPEND);
+  if (fd < 0) return;
+  char line[512];
+  const int n =
+      snprintf(line, sizeof line, "%llu %llu %s\n", (unsigned long long)st.st_dev, (unsigned long long)st.st_ino, name);
+  if (write(fd, line, (size_t)n) != n) fmb_sweep_disk_full((fmbSweep*)sw, ".sweep-files", errno);
+  close(fd);
+}
+static void note_made(const fmbSweep* sw, const char* name) {
+  char path[4200];
+  struct stat st;
+  dir_file(sw, name, path, sizeof path);
+  if (lstat(path, &st) == 0) note_made_as(sw, name, &st);
+}
+
+int fmb_sweep_may_write(const fmbSweep* sw, const char* name) {
+  char path[4200];
+  struct stat st;
+  dir_file(sw, name, path, sizeof path);
+  if (lstat(path, &st) != 0) return errno == ENOENT ? 0 : -1;
+  const char* why = S_ISLNK(st.st_mode)         ? "is a symbolic link"
+                    : !S_ISREG(st.st_mode)      ? "is not a regular file"
+                    : fmb_safe_input_at(path)   ? "is an input of this sweep"
+                    : !made_here(sw, name, &st) ? "was not made by a sweep"
+                                                : NULL;
+  if (!why) return 0;
+  fprintf(stderr, "flexmbd sweep: %s %s: refusing to replace it (move it away, or give another -o DIR)\n", path, why);
+  return -1;
+}
+
+fmbSafeFile* fmb_sweep_file_open(const fmbSweep* sw, const char* name) {
+  if (fmb_sweep_may_write(sw, name)) return NULL;
+  char path[4200], err[600];
+  dir_file(sw, name, path, sizeof path);
+  fmbSafeFile* f = fmb_safe_open(path, err, sizeof err);
+  if (!f) fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, err);
+  return f;
+}
+
+int fmb_sweep_file_close(fmbSweep* sw, const char* name, fmbSafeFile* f, int keep) {
+  if (!f) return -1;
+  /* listed before the rename (it keeps the temporary's inode): a sweep killed between the two
+     leaves a file it can replace again, not one it takes for someone else's */
+  struct stat st;
+  if (keep && fstat(fmb_safe_fd(f), &st) == 0) note_made_as(sw, name, &st);
+  const int rc = fmb_safe_close(f, keep);
+  if (keep && rc != 0) {
+    char path[4200];
+    dir_file(sw, name, path, sizeof path);
+    fmb_sweep_disk_full(sw, path, errno);
+    fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
+  }
+  return rc;
+}
+
 /* renames DIR/name to DIR/name.N (the first free N) */
 static void set_aside(const fmbSweep* sw, const char* name) {
   char from[4200], to[4300];
@@ -116,7 +270,12 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
   sw->starts = calloc((size_t)sw->nrun, sizeof *sw->starts);
   if (!sw->row_at || !sw->status || !sw->starts) return FMB_EXIT_BAD_INPUT;
   for (long i = 0; i < sw->nrun; ++i) sw->row_at[i] = -1, sw->status[i] = -1;
-  FILE* f = fopen(path, "r");
+  int rfd = open_own(sw, "runs.csv", O_RDONLY);
+  if (rfd == -2) return FMB_EXIT_BAD_INPUT;
+  struct stat rst;
+  if (rfd >= 0 && fstat(rfd, &rst) == 0 && rst.st_size == 0) /* killed before its header: nothing in it */
+    close(rfd), rfd = -1;
+  FILE* f = rfd >= 0 ? fdopen(rfd, "r") : NULL;
   if (f) {
     char first[256] = "", head[1 << 16] = "";
     if (!fgets(first, sizeof first, f) || !fgets(head, sizeof head, f)) first[0] = '\0';
@@ -152,6 +311,7 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
   }
   IdMap map;
   if (idmap_build(&map, sw->id, sw->nrun)) return FMB_EXIT_BAD_INPUT;
+  const int journal_existed = f != NULL; /* a journal (its header was checked above) */
   if (f) { /* resume: the latest row of each run; a partial last line (a crash mid-write) is cut */
     long at = ftell(f), good_end = at;
     size_t cap = 1 << 16;
@@ -173,28 +333,48 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
     }
     free(line);
     fclose(f);
-    if (truncate(path, good_end) != 0) {
+    const int wfd = open_own(sw, "runs.csv", O_WRONLY);
+    const int cut = wfd >= 0 ? ftruncate(wfd, good_end) : -1;
+    if (wfd >= 0) close(wfd);
+    if (cut != 0) {
       fprintf(stderr, "flexmbd sweep: cannot cut the partial last line of %s: %s\n", path, strerror(errno));
       idmap_free(&map);
       return FMB_EXIT_BAD_INPUT;
     }
   }
-  sw->journal_fd = open(path, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
+  sw->journal_fd = open_own(sw, "runs.csv", O_WRONLY | O_CREAT | O_APPEND);
   if (sw->journal_fd < 0) {
-    fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
+    if (sw->journal_fd == -1) fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
+    sw->journal_fd = -1;
     idmap_free(&map);
     return FMB_EXIT_BAD_INPUT;
   }
+  note_made(sw, "runs.csv");
   struct stat st;
   if (fstat(sw->journal_fd, &st) == 0 && st.st_size == 0) {
     char top[1 << 16];
-    int n = snprintf(top, sizeof top, "# flexmbd sweep journal: plan=%016" PRIx64 " runs=%ld scene=%s verb=%s\n%s\n",
-                     sw->digest, sw->nrun, sw->scene, sw->verb, header);
-    if (n <= 0 || write(sw->journal_fd, top, (size_t)n) != n) return FMB_EXIT_BAD_INPUT;
+    int n = snprintf(top, sizeof top, "# flexmbd sweep journal: plan=%016" PRIx64 " runs=%ld scene=%s verb=%s\n",
+                     sw->digest, sw->nrun, sw->scene_given ? sw->scene_given : sw->scene, sw->verb);
+    for (int k = 0; k < n - 1; ++k) /* a line break in the scene's name would end the line */
+      if ((unsigned char)top[k] < 32) top[k] = '?';
+    n += snprintf(top + n, sizeof top - (size_t)n, "%s\n", header);
+    if (n <= 0 || write(sw->journal_fd, top, (size_t)n) != n) {
+      fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
+      return FMB_EXIT_SOLVER;
+    }
   }
   /* dispatches of runs without a row: the runs in flight when the sweep last stopped */
   dir_file(sw, "inflight.log", path, sizeof path);
-  f = fopen(path, "r");
+  struct stat ist;
+  if (!journal_existed && lstat(path, &ist) == 0 && !made_here(sw, "inflight.log", &ist)) {
+    /* an inflight.log beside no journal: not the sweep's (someone's file, or a planted one) */
+    fprintf(stderr, "flexmbd sweep: %s was not made by a sweep: refusing to append to it (move it away)\n", path);
+    idmap_free(&map);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  rfd = open_own(sw, "inflight.log", O_RDONLY);
+  if (rfd == -2) return idmap_free(&map), FMB_EXIT_BAD_INPUT;
+  f = rfd >= 0 ? fdopen(rfd, "r") : NULL;
   if (f) {
     char line[64];
     while (fgets(line, sizeof line, f)) { /* "~ID": a start taken back (the sweep was interrupted) */
@@ -204,8 +384,14 @@ int fmb_journal_open(fmbSweep* sw, int resume, int fresh) {
     fclose(f);
   }
   idmap_free(&map);
-  sw->inflight_fd = open(path, O_WRONLY | O_CREAT | O_APPEND | O_CLOEXEC, 0644);
-  return sw->inflight_fd < 0 ? FMB_EXIT_BAD_INPUT : 0;
+  sw->inflight_fd = open_own(sw, "inflight.log", O_WRONLY | O_CREAT | O_APPEND);
+  if (sw->inflight_fd < 0) {
+    if (sw->inflight_fd == -1) fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, strerror(errno));
+    sw->inflight_fd = -1;
+    return FMB_EXIT_BAD_INPUT;
+  }
+  note_made(sw, "inflight.log");
+  return 0;
 }
 
 static int write_all(int fd, const char* s, size_t n) {
@@ -219,8 +405,23 @@ static int write_all(int fd, const char* s, size_t n) {
 }
 
 int fmb_journal_append(fmbSweep* sw, long index, const char* row) {
+  const char* stf = field(row, 3);
+  char st[32] = "";
+  if (stf) snprintf(st, sizeof st, "%.*s", (int)strcspn(stf, ","), stf);
+  if (strcmp(st, FMB_SWEEP_CUT) == 0) { /* cut short by a full disk: no row, a resume does it again */
+    fmb_sweep_disk_full(sw, "a run's own files", ENOSPC);
+    return 1;
+  }
+  if (sw->disk_full) return 1; /* the rows after a refused one would stand for runs it lost */
   const long at = (long)lseek(sw->journal_fd, 0, SEEK_END);
-  if (write_all(sw->journal_fd, row, strlen(row))) return -1;
+  if (write_all(sw->journal_fd, row, strlen(row))) {
+    char path[4200];
+    dir_file(sw, "runs.csv", path, sizeof path);
+    fmb_sweep_disk_full(sw, path, errno);
+    if (at >= 0 && ftruncate(sw->journal_fd, at) != 0) { /* a partial row: a resume cuts it */
+    }
+    return 1;
+  }
   const double now = fmb_pool_now();
   if (now - sw->last_sync >= FMB_SWEEP_SYNC_S) {
     fdatasync(sw->journal_fd);
@@ -229,9 +430,6 @@ int fmb_journal_append(fmbSweep* sw, long index, const char* row) {
   }
   const long first = sw->first[index];
   sw->row_at[first] = at;
-  const char* stf = field(row, 3);
-  char st[32] = "";
-  if (stf) snprintf(st, sizeof st, "%.*s", (int)strcspn(stf, ","), stf);
   sw->status[first] = fmb_child_status_of(st);
   return 0;
 }
@@ -239,7 +437,8 @@ int fmb_journal_append(fmbSweep* sw, long index, const char* row) {
 void fmb_journal_started(fmbSweep* sw, long index) {
   char line[32];
   int n = snprintf(line, sizeof line, "%016" PRIx64 "\n", sw->id[index]);
-  write_all(sw->inflight_fd, line, (size_t)n); /* synced with the journal (fmb_journal_append) */
+  if (write_all(sw->inflight_fd, line, (size_t)n)) /* synced with the journal (fmb_journal_append) */
+    fmb_sweep_disk_full(sw, "inflight.log", errno);
   ++sw->starts[sw->first[index]];
 }
 
@@ -251,32 +450,16 @@ void fmb_journal_cancelled(fmbSweep* sw, long index) {
 }
 
 void fmb_journal_close(fmbSweep* sw) {
-  if (sw->journal_fd > 0) fdatasync(sw->journal_fd), close(sw->journal_fd);
+  if (sw->journal_fd > 0 && (fdatasync(sw->journal_fd) != 0 || close(sw->journal_fd) != 0))
+    fmb_sweep_disk_full(sw, "runs.csv", errno);
   if (sw->inflight_fd > 0) fdatasync(sw->inflight_fd), close(sw->inflight_fd);
   sw->journal_fd = sw->inflight_fd = -1;
 }
 
-/* writes `tmp` then renames it over DIR/name: a reader sees the old file or the new one */
-static FILE* open_replacement(const fmbSweep* sw, const char* name, char* tmp, size_t len) {
-  snprintf(tmp, len, "%s/.%s.tmp", sw->dir, name);
-  return fopen(tmp, "w");
-}
-static int replace(const fmbSweep* sw, const char* name, const char* tmp, FILE* f) {
-  char path[4200];
-  dir_file(sw, name, path, sizeof path);
-  int bad = fflush(f) != 0 || ferror(f);
-  bad |= fclose(f) != 0;
-  if (bad || rename(tmp, path) != 0) {
-    fprintf(stderr, "flexmbd sweep: cannot write %s\n", path);
-    return -1;
-  }
-  return 0;
-}
-
-int fmb_journal_write_plan(const fmbSweep* sw) {
-  char tmp[4200];
-  FILE* f = open_replacement(sw, "plan.csv", tmp, sizeof tmp);
-  if (!f) return -1;
+int fmb_journal_write_plan(fmbSweep* sw) {
+  fmbSafeFile* sf = fmb_sweep_file_open(sw, "plan.csv");
+  FILE* f = sf ? fmb_safe_stream(sf) : NULL;
+  if (!f) return fmb_sweep_file_close(sw, "plan.csv", sf, 0), -1;
   fprintf(f, "index,run_id");
   for (int k = 0; k < sw->plan.npath; ++k) fprintf(f, ",%s", sw->plan.path[k]);
   fputc('\n', f);
@@ -285,18 +468,19 @@ int fmb_journal_write_plan(const fmbSweep* sw) {
     for (int k = 0; k < sw->plan.npath; ++k) fprintf(f, ",%s", fmb_plan_value(&sw->plan, i, k));
     fputc('\n', f);
   }
-  return replace(sw, "plan.csv", tmp, f);
+  return fmb_sweep_file_close(sw, "plan.csv", sf, 1);
 }
 
-int fmb_journal_write_table(const fmbSweep* sw) {
-  char path[4200], tmp[4200], header[1 << 16];
-  dir_file(sw, "runs.csv", path, sizeof path);
-  FILE* in = fopen(path, "r");
+int fmb_journal_write_table(fmbSweep* sw) {
+  char header[1 << 16];
+  const int rfd = open_own(sw, "runs.csv", O_RDONLY);
+  FILE* in = rfd >= 0 ? fdopen(rfd, "r") : NULL;
   if (!in) return -1;
-  FILE* f = open_replacement(sw, "table.csv", tmp, sizeof tmp);
+  fmbSafeFile* sf = fmb_sweep_file_open(sw, "table.csv");
+  FILE* f = sf ? fmb_safe_stream(sf) : NULL;
   if (!f || fmb_sweep_header(sw, header, sizeof header) < 0) {
     fclose(in);
-    if (f) fclose(f);
+    fmb_sweep_file_close(sw, "table.csv", sf, 0);
     return -1;
   }
   fprintf(f, "%s\n", header);
@@ -311,13 +495,15 @@ int fmb_journal_write_table(const fmbSweep* sw) {
   }
   free(line);
   fclose(in);
-  return replace(sw, "table.csv", tmp, f);
+  return fmb_sweep_file_close(sw, "table.csv", sf, 1);
 }
 
 int fmb_journal_status(const char* dir) {
   char path[4200];
+  int refused = 0;
   snprintf(path, sizeof path, "%s/plan.csv", dir);
-  FILE* f = fopen(path, "r");
+  FILE* f = read_regular(path, &refused);
+  if (refused) return FMB_EXIT_BAD_INPUT;
   if (!f) {
     fprintf(stderr, "flexmbd sweep --status: %s: no plan.csv (not a sweep folder?): %s\n", dir, strerror(errno));
     return FMB_EXIT_BAD_INPUT;
@@ -349,7 +535,7 @@ int fmb_journal_status(const char* dir) {
   for (long i = 0; i < n; ++i) st[i] = -1;
   snprintf(path, sizeof path, "%s/runs.csv", dir);
   long rows = 0;
-  if ((f = fopen(path, "r"))) {
+  if ((f = read_regular(path, &refused))) {
     while ((got = getline(&line, &cap, f)) > 0) {
       if (line[0] == '#' || line[got - 1] != '\n') continue;
       const char *idf = field(line, 1), *stf = field(line, 3);
@@ -363,12 +549,17 @@ int fmb_journal_status(const char* dir) {
     fclose(f);
   }
   snprintf(path, sizeof path, "%s/inflight.log", dir);
-  if ((f = fopen(path, "r"))) {
+  if ((f = read_regular(path, &refused))) {
     while (getline(&line, &cap, f) > 0) {
       long i = idmap_get(&map, strtoull(line + (line[0] == '~'), NULL, 16));
       if (i >= 0) started[i] += line[0] == '~' ? -1 : 1;
     }
     fclose(f);
+  }
+  if (refused) {
+    idmap_free(&map);
+    free(line), free(ids), free(st), free(started);
+    return FMB_EXIT_BAD_INPUT;
   }
   long count[FMB_CHILD_NSTATUS] = {0}, done = 0, unique = 0, inflight = 0;
   for (long i = 0; i < n; ++i) {

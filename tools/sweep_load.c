@@ -28,7 +28,8 @@ static int no_mpi_init(fmbFarmTransport* t) {
   return 0;
 }
 static void no_mpi_finalize(int rc) { (void)rc; }
-static int no_h5(const fmbSweep* sw) {
+static int no_h5(const fmbSweep* sw, const char* path) {
+  (void)path;
   (void)sw;
   return 1;
 }

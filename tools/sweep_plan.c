@@ -8,9 +8,13 @@
 #include "sweep_plan.h"
 
 #include <errno.h>
+#include <fcntl.h>
 #include <math.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "csv_table.h"
 
@@ -52,18 +56,43 @@ static void say(char* err, size_t len, const char* what, const char* spec) {
   snprintf(err, len, "%s: '%s'", what, spec);
 }
 
-/* a value as the runs get it: a finite number printed %.17g, anything else as written */
-static void normalized(const char* text, char* out, size_t len) {
-  while (*text == ' ') ++text;
+/* A value as the runs get it: a finite number printed %.17g, or a word (a model name, an
+   integrator) of letters, digits and _ . + - / kept as written. Nothing else: a value reaches a
+   run as `--set PATH=VALUE`, a runner's request and a CSV cell, and a tab, a line break, a quote,
+   a comma or YAML's [ ] { } in it would be read as more than one value there (a second override,
+   a second request, a second cell). A value longer than FMB_PLAN_VALUE_MAX is refused, not cut.
+   0, or -1 with what is wrong in why. */
+static int normalized(const char* text, size_t n, char* out, size_t len, char* why, size_t whylen) {
+  while (n > 0 && *text == ' ') ++text, --n;
+  while (n > 0 && text[n - 1] == ' ') --n;
+  if (n > FMB_PLAN_VALUE_MAX) {
+    snprintf(why, whylen, "a value of %zu characters (at most %d): '%.40s...'", n, FMB_PLAN_VALUE_MAX, text);
+    return -1;
+  }
+  char item[FMB_PLAN_VALUE_MAX + 1];
+  memcpy(item, text, n);
+  item[n] = '\0';
   char* end;
   errno = 0;
-  const double v = strtod(text, &end);
-  size_t n = strlen(text);
-  while (n > 0 && text[n - 1] == ' ') --n;
-  if (end != text && (size_t)(end - text) == n && isfinite(v) && errno != ERANGE)
+  const double v = strtod(item, &end);
+  if (n > 0 && end == item + n && isfinite(v) && errno != ERANGE) {
     snprintf(out, len, "%.17g", v);
-  else
-    snprintf(out, len, "%.*s", (int)n, text);
+    return 0;
+  }
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = (unsigned char)item[i];
+    if (!((c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || strchr("_.+-/", c))) {
+      char shown[16];
+      snprintf(shown, sizeof shown, c < 32 || c > 126 ? "byte 0x%02x" : "'%c'", c);
+      snprintf(why, whylen, "a value is a number or a word of letters, digits and _ . + - /, not %s (in '%.*s')", shown,
+               (int)(n < 60 ? n : 60), item);
+      for (char* q = why; *q; ++q)
+        if ((unsigned char)*q < 32) *q = '?';
+      return -1;
+    }
+  }
+  snprintf(out, len, "%s", item);
+  return 0;
 }
 
 /* registers PATH (the text before '='), refusing a repeat; its index or -1 */
@@ -74,6 +103,10 @@ static int add_path(fmbSweepPlan* p, const char* spec, const char** rest, char* 
     return -1;
   }
   const size_t n = (size_t)(eq - spec);
+  if (n > 200) { /* PATH=VALUE must fit FMB_SWEEP_SET_LEN whole: never cut */
+    say(err, len, "a PATH longer than 200 characters", spec);
+    return -1;
+  }
   for (size_t i = 0; i < n; ++i)
     if (spec[i] == ',' || spec[i] == ' ' || spec[i] == ':') {
       say(err, len, "a PATH has no ',', ':' or blanks", spec);
@@ -103,30 +136,40 @@ static fmbSweepFactor* new_factor(fmbSweepPlan* p) {
   return f;
 }
 
-/* splits "v1,v2,..." into normalized values; the count, or -1 (an empty item) */
-static long split_list(const char* text, char*** out) {
+/* splits "v1,v2,..." into normalized values; the count, or -1 with why (an empty item, a value
+   that is neither a number nor a word) */
+static long split_list(const char* text, char*** out, char* why, size_t whylen) {
   long n = 1;
   for (const char* c = text; *c; ++c) n += *c == ',';
   char** v = calloc((size_t)n, sizeof *v);
-  if (!v) return -1;
+  if (!v) return snprintf(why, whylen, "out of memory"), -1;
   const char* s = text;
   for (long i = 0; i < n; ++i) {
     const char* e = strchr(s, ',');
     size_t len = e ? (size_t)(e - s) : strlen(s);
-    char item[256];
-    snprintf(item, sizeof item, "%.*s", (int)(len < 255 ? len : 255), s);
-    char norm[256];
-    normalized(item, norm, sizeof norm);
-    if (!norm[0]) {
+    char norm[FMB_PLAN_VALUE_MAX + 40];
+    int bad = normalized(s, len, norm, sizeof norm, why, whylen);
+    if (!bad && !norm[0]) bad = 1, snprintf(why, whylen, "an empty value in the list");
+    if (bad || !(v[i] = strdup(norm))) {
       for (long k = 0; k < i; ++k) free(v[k]);
       free(v);
       return -1;
     }
-    v[i] = strdup(norm);
     s = e ? e + 1 : s + len;
   }
   *out = v;
   return n;
+}
+
+/* N of a grid A:B:N: a whole number from 1 to 1e8, written as digits or as a number with an
+   exponent whose value is whole (1e3); 2.5, 3abc, 0 or -4 are refused, never rounded or cut */
+static int grid_count(const char* text, long* n) {
+  char* end;
+  errno = 0;
+  const double c = strtod(text, &end);
+  if (end == text || *end || errno == ERANGE || !(c >= 1) || c > 1e8 || c != floor(c)) return -1;
+  *n = (long)c;
+  return 0;
 }
 
 int fmb_plan_add_grid(fmbSweepPlan* p, const char* spec, char* err, size_t len) {
@@ -138,48 +181,77 @@ int fmb_plan_add_grid(fmbSweepPlan* p, const char* spec, char* err, size_t len) 
   f->npath = 1;
   f->path[0] = k;
   if (strchr(rest, ':')) { /* A:B:N[:log] */
-    double a, b;
-    long n;
-    char scale[8] = "", tail;
-    int got = sscanf(rest, "%lf:%lf:%ld:%7[a-z]%c", &a, &b, &n, scale, &tail);
-    if (!(got == 3 || (got == 4 && strcmp(scale, "log") == 0))) {
+    char part[4][64];
+    int np = 0;
+    for (const char* s = rest;; ++np) { /* A, B, N and maybe "log": at most four parts */
+      const size_t l = strcspn(s, ":");
+      if (np == 4 || l >= sizeof part[0]) {
+        np = 5;
+        break;
+      }
+      memcpy(part[np], s, l);
+      part[np][l] = '\0';
+      if (!s[l]) {
+        ++np;
+        break;
+      }
+      s += l + 1;
+    }
+    char *ea, *eb;
+    const double a = np >= 3 && np <= 4 ? strtod(part[0], &ea) : 0, b = np >= 3 && np <= 4 ? strtod(part[1], &eb) : 0;
+    long n = 0;
+    if (np < 3 || np > 4 || (np == 4 && strcmp(part[3], "log") != 0) || ea == part[0] || *ea || eb == part[1] || *eb) {
       say(err, len, "--grid expects PATH=A:B:N or PATH=A:B:N:log (N values from A to B)", spec);
       return -1;
     }
-    if (n < 1 || n > 100000000L || !isfinite(a) || !isfinite(b)) {
-      say(err, len, "--grid: N must be from 1 to 1e8 and A, B finite", spec);
+    if (grid_count(part[2], &n) != 0) {
+      snprintf(err, len, "--grid: N (the number of values) must be a whole number from 1 to 1e8, got '%s' in '%s'",
+               part[2], spec);
       return -1;
     }
-    const int logscale = got == 4;
+    if (!isfinite(a) || !isfinite(b)) {
+      say(err, len, "--grid: A and B must be finite numbers", spec);
+      return -1;
+    }
+    const int logscale = np == 4;
     if (logscale && (a <= 0 || b <= 0)) {
       say(err, len, "--grid ...:log needs A > 0 and B > 0", spec);
       return -1;
     }
     f->nrow = n;
-    f->value = calloc((size_t)n, sizeof *f->value);
-    if (!f->value) return -1;
-    for (long i = 0; i < n; ++i) {
-      double v;
-      if (i == 0)
-        v = a;
-      else if (i == n - 1)
-        v = b;
-      else if (logscale)
-        v = exp(log(a) + (log(b) - log(a)) * (double)i / (double)(n - 1));
-      else
-        v = a + (b - a) * (double)i / (double)(n - 1);
-      char t[40];
-      snprintf(t, sizeof t, "%.17g", v);
-      if (!(f->value[i] = strdup(t))) return -1;
-    }
+    f->is_range = 1, f->logscale = logscale, f->a = a, f->b = b; /* laid out by fmb_plan_finish */
     return 0;
   }
-  f->nrow = split_list(rest, &f->value);
+  char why[300];
+  f->nrow = split_list(rest, &f->value, why, sizeof why);
   if (f->nrow < 1) {
     f->nrow = 0;
-    say(err, len, "--grid: an empty value in the list (expected PATH=v1,v2,...)", spec);
+    snprintf(err, len, "--grid: %s (expected PATH=v1,v2,...): '%s'", why, spec);
     return -1;
   }
+  return 0;
+}
+
+/* a grid A:B:N's values, once the plan's size was accepted */
+static int lay_out_range(fmbSweepFactor* f) {
+  const long n = f->nrow;
+  f->value = calloc((size_t)n, sizeof *f->value);
+  if (!f->value) return -1;
+  for (long i = 0; i < n; ++i) {
+    double v;
+    if (i == 0)
+      v = f->a;
+    else if (i == n - 1)
+      v = f->b;
+    else if (f->logscale)
+      v = exp(log(f->a) + (log(f->b) - log(f->a)) * (double)i / (double)(n - 1));
+    else
+      v = f->a + (f->b - f->a) * (double)i / (double)(n - 1);
+    char t[40];
+    snprintf(t, sizeof t, "%.17g", v);
+    if (!(f->value[i] = strdup(t))) return -1;
+  }
+  f->is_range = 0;
   return 0;
 }
 
@@ -189,9 +261,10 @@ int fmb_plan_add_zip(fmbSweepPlan* p, const char* spec, char* err, size_t len) {
   const int k = add_path(p, spec, &rest, err, len);
   if (k < 0) return -1;
   char** v;
-  long n = split_list(rest, &v);
+  char why[300];
+  long n = split_list(rest, &v, why, sizeof why);
   if (n < 1) {
-    say(err, len, "--zip: an empty value in the list (expected PATH=v1,v2,...)", spec);
+    snprintf(err, len, "--zip: %s (expected PATH=v1,v2,...): '%s'", why, spec);
     return -1;
   }
   /* the zip factor is the one marked zip (value laid out row-major over its paths) */
@@ -228,10 +301,45 @@ int fmb_plan_add_zip(fmbSweepPlan* p, const char* spec, char* err, size_t len) {
   return 0;
 }
 
-int fmb_plan_add_samples(fmbSweepPlan* p, const char* file, char* err, size_t len) {
-  FILE* f = fopen(file, "r");
+int fmb_sweep_read_input(const char* path, size_t max, char** text, size_t* n, char* err, size_t errlen) {
+  *text = NULL, *n = 0;
+  const int fd = open(path, O_RDONLY | O_NONBLOCK | O_NOCTTY | O_CLOEXEC);
+  struct stat st;
+  if (fd < 0 || fstat(fd, &st) != 0) {
+    snprintf(err, errlen, "%s: cannot open it: %s", path, strerror(errno));
+    if (fd >= 0) close(fd);
+    return -1;
+  }
+  const char* why = S_ISDIR(st.st_mode)        ? "it is a folder, expected a file"
+                    : !S_ISREG(st.st_mode)     ? "it is not a regular file (a FIFO, device or socket would be read "
+                                                 "without end)"
+                    : (size_t)st.st_size > max ? "it is too large"
+                                               : NULL;
+  char* buf = why ? NULL : malloc((size_t)st.st_size + 1);
+  size_t got = 0;
+  if (!why && !buf) why = "out of memory";
+  while (!why && got < (size_t)st.st_size) { /* a regular file never blocks: O_NONBLOCK is harmless */
+    const ssize_t r = read(fd, buf + got, (size_t)st.st_size - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r < 0) why = strerror(errno);
+    if (r <= 0) break;
+    got += (size_t)r;
+  }
+  close(fd);
+  if (why) {
+    free(buf);
+    snprintf(err, errlen, "%s: %s", path, why);
+    return -1;
+  }
+  buf[got] = '\0';
+  *text = buf, *n = got;
+  return 0;
+}
+
+int fmb_plan_add_samples(fmbSweepPlan* p, const char* file, const char* text, size_t textlen, char* err, size_t len) {
+  FILE* f = fmemopen((void*)text, textlen, "r");
   if (!f) {
-    snprintf(err, len, "%s: cannot open the samples file: %s", file, strerror(errno));
+    snprintf(err, len, "%s: cannot read the samples: %s", file, strerror(errno));
     return -1;
   }
   char* line = malloc(FMB_CSV_MAX_LINE);
@@ -281,12 +389,15 @@ int fmb_plan_add_samples(fmbSweepPlan* p, const char* file, char* err, size_t le
     for (;;) {
       const char* e = strchr(s, ',');
       size_t l = e ? (size_t)(e - s) : strlen(s);
-      char item[256], norm[256];
-      snprintf(item, sizeof item, "%.*s", (int)(l < 255 ? l : 255), s);
-      normalized(item, norm, sizeof norm);
-      if (c == fa->npath || !norm[0]) {
-        snprintf(err, len, "%s:%ld: expected %d values (one per header column), got %s", file, lineno, fa->npath,
-                 c == fa->npath ? "more" : "an empty one");
+      char norm[FMB_PLAN_VALUE_MAX + 40], why[300];
+      const int bad = normalized(s, l, norm, sizeof norm, why, sizeof why);
+      if (bad || c == fa->npath || !norm[0]) {
+        if (bad)
+          snprintf(err, len, "%s:%ld:%ld: %s", file, lineno, (long)(s - line) + 1, why);
+        else
+          snprintf(err, len, "%s:%ld: expected %d values (one per header column), got %s", file, lineno, fa->npath,
+                   c == fa->npath ? "more" : "an empty one");
+        for (int k = 0; k < c; ++k) free(fa->value[fa->nrow * fa->npath + k]);
         goto done;
       }
       fa->value[fa->nrow * fa->npath + c++] = strdup(norm);
@@ -360,6 +471,9 @@ int fmb_plan_finish(fmbSweepPlan* p, char* err, size_t len) {
   if (!p->nrandom && p->count) return snprintf(err, len, "--count goes with --random"), -1;
   if (p->nfactor == 0 && !p->nrandom)
     return snprintf(err, len, "nothing to sweep: give --grid, --zip, --samples or --random"), -1;
+  for (int i = 0; i < p->nfactor; ++i)
+    if (p->factor[i].is_range && lay_out_range(&p->factor[i]) != 0)
+      return snprintf(err, len, "out of memory for %ld grid values", p->factor[i].nrow), -1;
   if (!p->nrandom) return 0;
   if (p->nfactor == FMB_SWEEP_MAX_PATHS) return snprintf(err, len, "too many factors"), -1;
   const long n = p->count;

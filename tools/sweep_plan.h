@@ -13,7 +13,10 @@ typedef struct fmbSweepFactor {
   int npath;
   int path[FMB_SWEEP_MAX_PATHS]; /* indices into fmbSweepPlan.path */
   long nrow;
-  char** value; /* nrow x npath */
+  char** value;           /* nrow x npath; a grid A:B:N gets its values only in fmb_plan_finish, once the
+                   plan's size has been accepted (a refused plan of 1e9 runs allocates nothing) */
+  int is_range, logscale; /* a grid A:B:N[:log] not yet laid out */
+  double a, b;
 } fmbSweepFactor;
 
 typedef struct fmbSweepPlan {
@@ -32,17 +35,26 @@ typedef struct fmbSweepPlan {
 } fmbSweepPlan;
 
 /* Each adds a factor (or a random path); 0, or -1 with "what was expected" in err. */
-int fmb_plan_add_grid(fmbSweepPlan* p, const char* spec, char* err, size_t len);    /* PATH=A:B:N[:log] | PATH=v1,v2 */
-int fmb_plan_add_zip(fmbSweepPlan* p, const char* spec, char* err, size_t len);     /* PATH=v1,v2,... (paired) */
-int fmb_plan_add_samples(fmbSweepPlan* p, const char* file, char* err, size_t len); /* CSV, header = paths */
-int fmb_plan_add_random(fmbSweepPlan* p, const char* spec, char* err, size_t len);  /* PATH=uniform(a,b)|... */
-/* after all options: the random factor (needs --count); 0 or -1 */
+int fmb_plan_add_grid(fmbSweepPlan* p, const char* spec, char* err, size_t len); /* PATH=A:B:N[:log] | PATH=v1,v2 */
+int fmb_plan_add_zip(fmbSweepPlan* p, const char* spec, char* err, size_t len);  /* PATH=v1,v2,... (paired) */
+/* CSV, header = paths: `text` (len bytes) is the file's content, read once (fmb_sweep_read_input), `file` its name */
+int fmb_plan_add_samples(fmbSweepPlan* p, const char* file, const char* text, size_t textlen, char* err, size_t len);
+int fmb_plan_add_random(fmbSweepPlan* p, const char* spec, char* err, size_t len); /* PATH=uniform(a,b)|... */
+/* after all options and after the size was accepted: grids laid out, the random factor (needs
+   --count); 0 or -1 */
 int fmb_plan_finish(fmbSweepPlan* p, char* err, size_t len);
 /* the number of runs, as a double (a product that may not fit a long: checked before use) */
 double fmb_plan_size(const fmbSweepPlan* p);
 /* the value of path k in run i */
 const char* fmb_plan_value(const fmbSweepPlan* p, long i, int k);
 void fmb_plan_free(fmbSweepPlan* p);
+/* the longest value a plan holds (a longer one is refused, never cut) */
+#define FMB_PLAN_VALUE_MAX 255
+/* A whole input file into memory (malloc'd, NUL-terminated, *n bytes): opened without waiting
+   (O_NONBLOCK: a FIFO never blocks) and refused unless a regular file of at most max bytes, so a
+   FIFO, /dev/zero or a terminal given as an input is an error, not a hang. 0, or -1 with
+   "PATH: why" in err. */
+int fmb_sweep_read_input(const char* path, size_t max, char** text, size_t* n, char* err, size_t errlen);
 
 /* the counter-based generator: a uniform number in (0, 1) for (seed, sample, stream), the same
    whatever the order samples are drawn in (splitmix64's finalizer over a combined counter) */

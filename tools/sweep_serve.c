@@ -17,20 +17,25 @@
 #include <unistd.h>
 
 #include "cli.h"
+#include "serve_protocol.h"
 #include "sweep.h"
 
 typedef struct {
   int alive;
-  int in, out; /* the runner's stdin (we write) and stdout (we read) */
-  long index;  /* the run in flight, -1 none */
+  int in, out;  /* the runner's requests (its fd 3, we write) and answers (its fd 4, we read) */
+  long index;   /* the run in flight, -1 none */
+  uint64_t seq; /* the number of its request, repeated by the answer */
   int attempt;
   double start, deadline;
   int timed_out;
   int reaped; /* its process ended and was collected (res) */
   fmbChildResult res;
-  char buf[8192]; /* its answer so far */
+  char buf[FMB_SERVE_MAX_ANSWER + 128]; /* its answer so far */
   size_t n;
+  const char* broken; /* why its answers are not taken any more (it is being killed) */
 } Runner;
+
+static uint64_t next_seq; /* numbers the requests of this sweep */
 
 static int start_runner(fmbSweep* sw, fmbPool* pool, Runner* r, int slot) {
   int to[2], from[2];
@@ -52,8 +57,8 @@ static int start_runner(fmbSweep* sw, fmbPool* pool, Runner* r, int slot) {
   fmbChildSpec spec = {.argv = argv,
                        .stderr_path = err,
                        .use_fds = 1,
-                       .stdin_fd = to[0],
-                       .stdout_fd = from[1],
+                       .request_fd = to[0],
+                       .answer_fd = from[1],
                        .mem_limit_mb = sw->mem_limit_mb,
                        .tag = slot};
   const int rc = fmb_pool_start(pool, &spec);
@@ -69,25 +74,37 @@ static int start_runner(fmbSweep* sw, fmbPool* pool, Runner* r, int slot) {
 
 /* hands run `index` to an idle runner: 0, or -1 (its pipe is gone: it died) */
 static int dispatch(fmbSweep* sw, Runner* r, long index, int attempt, double timeout) {
-  char line[FMB_SWEEP_MAX_PATHS * FMB_SWEEP_SET_LEN + 4400];
-  int n = snprintf(line, sizeof line, "%s/series/%016llx.csv", sw->dir, (unsigned long long)sw->id[index]);
-  for (int k = 0; k < sw->plan.npath && n < (int)sizeof line; ++k)
-    n += snprintf(line + n, sizeof line - (size_t)n, "\t%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
-  if (n >= (int)sizeof line - 1) return -1;
-  line[n++] = '\n';
+  char out[4300];
+  char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
+  const char* fields[1 + FMB_SWEEP_MAX_PATHS];
+  snprintf(out, sizeof out, "%s/series/%016llx.csv", sw->dir, (unsigned long long)sw->id[index]);
+  fields[0] = out;
+  for (int k = 0; k < sw->plan.npath; ++k) {
+    snprintf(sets[k], sizeof sets[k], "%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, index, k));
+    fields[1 + k] = sets[k];
+  }
+  size_t n;
+  char* line = fmb_serve_request(++next_seq, fields, 1 + sw->plan.npath, &n);
+  if (!line) return -1;
   r->index = index;
+  r->seq = next_seq;
   r->attempt = attempt;
   r->start = fmb_pool_now();
   r->deadline = timeout > 0 ? r->start + timeout : 0.0;
   r->timed_out = 0;
   r->n = 0;
+  int rc = 0;
   for (const char* p = line; n > 0;) {
-    ssize_t w = write(r->in, p, (size_t)n);
+    ssize_t w = write(r->in, p, n);
     if (w < 0 && errno == EINTR) continue;
-    if (w <= 0) return -1;
-    p += w, n -= (int)w;
+    if (w <= 0) {
+      rc = -1;
+      break;
+    }
+    p += w, n -= (size_t)w;
   }
-  return 0;
+  free(line);
+  return rc;
 }
 
 static void record(fmbSweep* sw, const fmbRunFeed* feed, const Runner* r, const fmbChildResult* res, const char* stats,
@@ -95,19 +112,14 @@ static void record(fmbSweep* sw, const fmbRunFeed* feed, const Runner* r, const 
   feed->done(feed->ctx, res, fmb_sweep_row_served(sw, res, r->attempt, stats, msg));
 }
 
-/* a runner's answer "EXIT<TAB>stats: ...<TAB>message" for its run */
-static void answered(fmbSweep* sw, const fmbRunFeed* feed, Runner* r, char* line) {
-  char* save = NULL;
-  const char* code = strtok_r(line, "\t", &save);
-  const char* stats = strtok_r(NULL, "\t", &save);
-  const char* msg = strtok_r(NULL, "", &save);
-  const int rc = code ? atoi(code) : -1;
+/* a runner's answer for its run in flight (serve_protocol.h) */
+static void answered(fmbSweep* sw, const fmbRunFeed* feed, Runner* r, int rc, const char* stats, const char* msg) {
   fmbChildResult res = {.tag = r->index, .exit_code = rc, .wall_s = fmb_pool_now() - r->start};
   res.status = rc == 0   ? FMB_CHILD_OK
                : rc == 2 ? FMB_CHILD_BAD_INPUT
                : rc == 3 ? FMB_CHILD_SOLVER_STOPPED
                          : FMB_CHILD_CRASHED;
-  record(sw, feed, r, &res, stats ? stats : "", msg ? msg : "");
+  record(sw, feed, r, &res, stats, msg);
   r->index = -1;
 }
 
@@ -136,7 +148,9 @@ static void ended(fmbSweep* sw, const fmbRunFeed* feed, fmbPool* pool, Runner* r
                         .wall_s = fmb_pool_now() - r->start};
   run.status = r->timed_out ? FMB_CHILD_TIMEOUT : FMB_CHILD_CRASHED;
   /* the row's message says what happened (fmb_sweep_row_served); the runner's last words follow */
-  record(sw, feed, r, &run, "", r->timed_out ? "" : tail);
+  char why[800];
+  snprintf(why, sizeof why, "%s%s%s", r->broken ? r->broken : "", r->broken && tail[0] ? ": " : "", tail);
+  record(sw, feed, r, &run, "", r->timed_out ? "" : why);
   r->index = -1;
 }
 
@@ -203,16 +217,20 @@ int fmb_sweep_serve_feed(fmbSweep* sw, const fmbRunFeed* feed) {
         ended(sw, feed, pool, runners, k);
         continue;
       }
-      if (got > 0 && !r->timed_out) { /* a killed runner's last words are not its run's result */
+      if (got > 0 && !r->timed_out && !r->broken) { /* a killed runner's last words are not its run's result */
         r->n += (size_t)got;
-        r->buf[r->n] = '\0';
-        char* nl = memchr(r->buf, '\n', r->n);
-        if (nl && r->index >= 0) {
-          *nl = '\0';
-          answered(sw, feed, r, r->buf);
+        uint64_t seq;
+        int rc;
+        char stats[2100], msg[FMB_SERVE_MAX_ANSWER];
+        const long used = fmb_serve_parse_answer(r->buf, r->n, &seq, &rc, stats, sizeof stats, msg, sizeof msg);
+        if (used != 0 && (used < 0 || r->index < 0 || seq != r->seq || (size_t)used != r->n)) {
+          /* not the answer to the request in flight (or more than it): this runner is out of step
+             with us, whatever the cause; none of its words are taken, it is replaced */
+          r->broken = used < 0 ? "the runner's answer was malformed" : "the runner answered out of turn";
+          fmb_pool_kill(pool, k); /* its pipe closes: ended() on a later pass */
+        } else if (used > 0) {
+          answered(sw, feed, r, rc, stats, msg);
           r->n = 0;
-        } else if (r->n == sizeof r->buf - 1) {
-          r->n = 0; /* an answer too long to be ours: dropped, the runner is killed at its deadline */
         }
       }
       if (r->index >= 0 && r->deadline > 0 && now >= r->deadline && !r->timed_out) {
@@ -242,7 +260,7 @@ typedef struct {
 } Local;
 static int local_next(void* ctx, long* index, int* attempt, double* timeout) {
   Local* l = ctx;
-  if (l->next >= l->n) return -1;
+  if (l->next >= l->n || l->sw->disk_full) return -1; /* a full disk: nothing more is started */
   *index = l->todo[l->next++];
   fmb_journal_started(l->sw, *index);
   *attempt = l->sw->starts[l->sw->first[*index]];

@@ -5,10 +5,13 @@
  *   5 exit 7 (an exit code flexmbd never returns)
  *   6 its output `level` is NaN from a finite state (tests/failures' nan_output: the message names the
  *     column and blames the output op, not the run's tolerances)
+ *   7 nothing wrong, but it prints on stdout when loaded, lines shaped like a runner's answers
+ *     (test_hostile.sh: the serve runner's answers must not be read from stdout)
  * The fault happens at the first evaluation of the equations (so `flexmbd check`, which only
  * loads the scene, passes), in the child, as a broken plugin's would. */
 #include <math.h>
 #include <signal.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -36,7 +39,13 @@ static int faulty_parse(fmbParser* p, fmbNode item, void** self) {
   int* fault = calloc(1, sizeof *fault);
   if (!fault) return fmb_parse_error(p, item, "out of memory");
   *self = fault;
-  return fmb_get_int(p, item, "fault", 0, 0, 6, fault) ? -1 : 0;
+  if (fmb_get_int(p, item, "fault", 0, 0, 7, fault)) return -1;
+  if (*fault == 7) { /* the old one-line answer and the framed one (serve_protocol.h) */
+    printf("0\tstats: status=ok t_reached=9 steps=1\tprinted by a plugin\nA 1 0 0 0\n");
+    fflush(stdout);
+    *fault = 0;
+  }
+  return 0;
 }
 static void faulty_destroy(void* self) { free(self); }
 static int faulty_ncoord(const void* self) {

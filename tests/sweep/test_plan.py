@@ -138,7 +138,7 @@ check(len(c) == 2 and c[0]["run_id"] != a[0]["run_id"], "run ids: another value 
 bad = [
     (["--grid", "bodies.nope.mass=1,2"], "no item named 'nope'"),
     (["--grid", "solver.rtol="], "empty value"),
-    (["--grid", "solver.rtol=1e-3:1e-6:0"], "N must be from 1"),
+    (["--grid", "solver.rtol=1e-3:1e-6:0"], "N (the number of values) must be a whole number"),
     (["--grid", "solver.t_end=1:2:10000", "--grid", "solver.rtol=1e-6:1e-8:1000"], "add --yes"),
     (["--random", "solver.rtol=uniform(1,2)"], "--count"),
     (["--zip", "solver.rtol=1,2", "--zip", "solver.t_end=1,2,3"], "same length"),

@@ -98,11 +98,14 @@ expect() { # fault status signal
   [ "$(echo "$line" | cut -d, -f4)" = "$2" ] || fail "fault $1: status $(echo "$line" | cut -d, -f4), expected $2: $line"
   [ -z "$3" ] || [ "$(echo "$line" | cut -d, -f6)" = "$3" ] || fail "fault $1: signal $(echo "$line" | cut -d, -f6), expected $3"
 }
+# --timeout 8: the endless allocation (fault 4) reaches --mem-limit in ~1.5 s on a quiet machine,
+# and took 2.2 s and 4.2 s in full-suite runs on the shared 2-core one (load average 14; 13344e9's
+# binary took the same 2.8-3.3 s there), where --timeout 2 made it `timeout`
 for runner in serve spawn; do
   FAULTS=faults_$runner
   [ $runner = spawn ] && FAULTS=faults
   rc=0
-  "$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/$FAULTS" -j 2 --quiet --timeout 2 \
+  "$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/$FAULTS" -j 2 --quiet --timeout 8 \
     ${FAULTS_ALLOC:+--mem-limit 256} --runner $runner --grid "bodies.f.fault=0,1,2,3,${FAULTS_ALLOC:+4,}5" 2> "$D/faults.err" || rc=$?
   [ "$rc" = 0 ] || { cat "$D/faults.err"; fail "the sweep with faults ($runner) ended with $rc"; }
   expect 0 ok 0
@@ -120,7 +123,7 @@ c=$((3 + ${#FAULTS_ALLOC}))
 grep -q "$n planned ($n distinct), $n with a row, 0 to do" "$D/status.txt" && grep -q "crashed  *$c" "$D/status.txt" ||
   { cat "$D/status.txt"; fail "--status counts"; }
 # --retry crashed: the crashed runs again (attempt 2), the others kept
-"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 2 \
+"$F" sweep "$SRC/tests/sweep/faulty.yaml" --plugin "$PLUGIN" -o "$D/faults" -j 2 --quiet --timeout 8 \
   ${FAULTS_ALLOC:+--mem-limit 256} --grid "bodies.f.fault=0,1,2,3,${FAULTS_ALLOC:+4,}5" --retry crashed 2> "$D/retry.err" ||
   fail "--retry crashed"
 grep -q "sweep: $c runs" "$D/retry.err" || { cat "$D/retry.err"; fail "--retry crashed should rerun $c runs"; }
