@@ -577,9 +577,9 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (sw->rank == 0) {
     /* the folder is the sweep's own: made, locked, and the inputs noted (no file of the sweep may
        replace one) and snapshotted, before anything is written there */
-    fmb_safe_note_input(sw->scene_given);
-    if (samples_name) fmb_safe_note_input(samples_name);
-    if (sw->reference) fmb_safe_note_input(sw->reference);
+    fmb_cli_note_input(sw->scene_given);
+    if (samples_name) fmb_cli_note_input(samples_name);
+    if (sw->reference) fmb_cli_note_input(sw->reference);
     rc = make_dirs(sw->dir);
     if (!rc) rc = fmb_sweep_lock(sw);
     /* the files written at the end too, checked now: refused before the runs, not after them */
@@ -601,7 +601,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
         rc = FMB_EXIT_BAD_INPUT;
       free(ref);
     }
-    if (!rc) fmb_safe_note_input(sw->scene);
+    if (!rc) fmb_cli_note_input(sw->scene);
     if (!rc && dry) {
       long distinct = 0;
       for (long i = 0; i < sw->nrun; ++i) distinct += sw->first[i] == i;

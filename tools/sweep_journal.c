@@ -210,11 +210,11 @@ int fmb_sweep_may_write(const fmbSweep* sw, const char* name) {
   struct stat st;
   dir_file(sw, name, path, sizeof path);
   if (lstat(path, &st) != 0) return errno == ENOENT ? 0 : -1;
-  const char* why = S_ISLNK(st.st_mode)         ? "is a symbolic link"
-                    : !S_ISREG(st.st_mode)      ? "is not a regular file"
-                    : fmb_safe_input_at(path)   ? "is an input of this sweep"
-                    : !made_here(sw, name, &st) ? "was not made by a sweep"
-                                                : NULL;
+  const char* why = S_ISLNK(st.st_mode)                              ? "is a symbolic link"
+                    : !S_ISREG(st.st_mode)                           ? "is not a regular file"
+                    : fmb_inputs_at(fmb_cli_inputs(), path, NULL, 0) ? "is an input of this sweep"
+                    : !made_here(sw, name, &st)                      ? "was not made by a sweep"
+                                                                     : NULL;
   if (!why) return 0;
   fprintf(stderr, "flexmbd sweep: %s %s: refusing to replace it (move it away, or give another -o DIR)\n", path, why);
   return -1;
@@ -224,7 +224,7 @@ fmbSafeFile* fmb_sweep_file_open(const fmbSweep* sw, const char* name) {
   if (fmb_sweep_may_write(sw, name)) return NULL;
   char path[4200], err[600];
   dir_file(sw, name, path, sizeof path);
-  fmbSafeFile* f = fmb_safe_open(path, err, sizeof err);
+  fmbSafeFile* f = fmb_cli_safe_open(path, err, sizeof err);
   if (!f) fprintf(stderr, "flexmbd sweep: cannot write %s: %s\n", path, err);
   return f;
 }
