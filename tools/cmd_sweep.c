@@ -341,8 +341,8 @@ int fmb_cmd_sweep(int argc, char** argv) {
   int dry = 0, resume = 0, fresh = 0, yes = 0, design_lhs = -1;
   long count = 0;
   int seed_given = 0;
-  char* samples_text = NULL; /* the --samples file as read once (its copy goes to DIR/inputs) */
-  size_t samples_len = 0;
+  char** samples_text = &sw->samples_text; /* the --samples file as read once (its copy goes to DIR/inputs) */
+  size_t* samples_len = &sw->samples_len;
   const char* samples_name = NULL;
   char err[1200];
   for (int i = 2; i < argc; ++i) {
@@ -362,9 +362,9 @@ int fmb_cmd_sweep(int argc, char** argv) {
       if (r) return bad("%s", err);
     } else if (strcmp(a, "--samples") == 0) {
       if (!(v = VALUE("a CSV file"))) return FMB_EXIT_BAD_INPUT;
-      if (samples_text) return bad("one --samples file at a time%s", "");
-      if (fmb_sweep_read_input(v, 1u << 30, &samples_text, &samples_len, err, sizeof err) ||
-          fmb_plan_add_samples(&sw->plan, v, samples_text, samples_len, err, sizeof err))
+      if (*samples_text) return bad("one --samples file at a time%s", "");
+      if (fmb_sweep_read_input(v, 1u << 30, samples_text, samples_len, err, sizeof err) ||
+          fmb_plan_add_samples(&sw->plan, v, *samples_text, *samples_len, err, sizeof err))
         return bad("--samples %s", err);
       samples_name = v;
     } else if (strcmp(a, "--count") == 0) {
@@ -482,9 +482,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   if (!sw->scene) return usage(stderr), bad("no scene file given%s", "");
   if (!sw->dir) return bad("no output folder given (-o DIR)%s", "");
   if (resume && fresh) return bad("--resume and --fresh exclude each other%s", "");
-  char* scene_text = NULL; /* the scene's bytes, read once: hashed into the ids and snapshotted */
-  size_t scene_len = 0;
-  if (fmb_sweep_read_input(sw->scene, 1u << 28, &scene_text, &scene_len, err, sizeof err))
+  if (fmb_sweep_read_input(sw->scene, 1u << 28, &sw->scene_text, &sw->scene_len, err, sizeof err))
     return fprintf(stderr, "%s (the scene)\n", err), FMB_EXIT_BAD_INPUT;
   if (sw->serve == 1 && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
   if (design_lhs >= 0 && !sw->plan.nrandom) return bad("--design goes with --random%s", "");
@@ -546,7 +544,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
   /* every run loads the snapshot DIR/inputs/HASH/NAME (snapshot_scene, written by rank 0 below) */
   sw->scene_given = sw->scene;
   char snap_sub[17];
-  snapshot_name(sw->scene, scene_text, scene_len, snap_sub);
+  snapshot_name(sw->scene, sw->scene_text, sw->scene_len, snap_sub);
   {
     char* snap = malloc(strlen(sw->dir) + strlen(sw->scene) + 64);
     const char* slash = strrchr(sw->scene, '/');
@@ -554,7 +552,7 @@ int fmb_cmd_sweep(int argc, char** argv) {
     sprintf(snap, "%s/inputs/%s/%s", sw->dir, snap_sub, slash ? slash + 1 : sw->scene);
     sw->scene = snap;
   }
-  if (make_ids(sw, scene_text, scene_len)) return bad("out of memory for %s runs", "the");
+  if (make_ids(sw, sw->scene_text, sw->scene_len)) return bad("out of memory for %s runs", "the");
   /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
      libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
   fmbFarmTransport ranks;
@@ -587,10 +585,10 @@ int fmb_cmd_sweep(int argc, char** argv) {
     for (int k = 0; k < 3 && !rc; ++k)
       if (fmb_sweep_may_write(sw, ends[k])) rc = FMB_EXIT_BAD_INPUT;
     char path[4300];
-    if (!rc && snapshot_scene(sw, snap_sub, scene_text, scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
+    if (!rc && snapshot_scene(sw, snap_sub, sw->scene_text, sw->scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
     if (!rc && strcmp(path, sw->scene) != 0) rc = bad("the scene's snapshot is not %s", sw->scene);
     const char* hash = snap_sub;
-    if (!rc && samples_name && snapshot_file(sw, hash, "samples.csv", samples_text, samples_len, path, sizeof path))
+    if (!rc && samples_name && snapshot_file(sw, hash, "samples.csv", *samples_text, *samples_len, path, sizeof path))
       rc = FMB_EXIT_BAD_INPUT;
     if (!rc && sw->reference) {
       char* ref = NULL;

@@ -86,6 +86,12 @@ typedef struct fmbSweep {
   char disk_why[600];
   int lock_fd;             /* DIR/sweep.lock, held (flock) while the sweep runs */
   const char* scene_given; /* the scene as the user named it; sw->scene is the snapshot in DIR */
+  /* the scene's and the --samples file's bytes, each read once (hashed into the ids, snapshotted
+     into DIR/inputs): held for the command's life by the sweep, as its plan is */
+  char* scene_text;
+  size_t scene_len;
+  char* samples_text;
+  size_t samples_len;
 } fmbSweep;
 
 /* sweep_journal.c */
