@@ -199,6 +199,7 @@ _PROTOTYPES = {
     "fmb_ninput": (ctypes.c_int, [_P]),
     "fmb_input_name": (ctypes.c_char_p, [_P, ctypes.c_int]),
     "fmb_set_input": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.c_double]),
+    "fmb_set_input_motion": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.c_double, ctypes.c_double, ctypes.c_double]),
     "fmb_get_input": (ctypes.c_int, [_P, _P, ctypes.c_char_p, ctypes.POINTER(ctypes.c_double)]),
     "fmb_campbell": (ctypes.c_int, [ctypes.POINTER(SceneSource), ctypes.POINTER(CampbellOptions),
                                     ctypes.POINTER(ctypes.c_double), ctypes.c_int,

@@ -431,6 +431,7 @@ class Simulation(_Owned):
             raise model._error(diag)
         self._own(ptr)
         # this run's messages go to `warn` or Python's warnings whichever thread advances it
+        self._warn_handler = warn
         self._warn = _lib.WarnFn(lambda user, msg: _lib.deliver(msg, warn)) if warn is not None else _lib.WARN_TO_PYTHON
         lib.fmb_data_set_warn(self._ptr, ctypes.cast(self._warn, ctypes.c_void_p), None)
         self.output_names: List[str] = model.output_names
@@ -538,24 +539,40 @@ class Simulation(_Owned):
             f"{call}: no input named {name!r}; this scene's inputs: {have} (an input is a joint with "
             "`profile: input` (a drive, a prismatic joint) or `law: input` (a force), named by the joint)")
 
-    def set_load(self, name: str, value: float) -> None:
-        """Set input `name` (a load with `law: input`, a drive with `profile: input`) from now on
-        (fmb_set_input): piecewise constant, the next advance starts from it. A bad name or value
-        (not finite, or one a scene's `value:` would be refused for) raises ValueError naming it."""
-        call = f"Simulation.set_load({name!r}, {value!r})"
+    def set_load(self, name: str, value: float, rate: Optional[float] = None, accel: float = 0.0) -> None:
+        """Set input `name` (a load with `law: input`, a drive with `profile: input`) from now on.
+
+        Without `rate` (fmb_set_input) the value holds, piecewise constant: a drive set so is at rest
+        between settings, and the library warns once when such a drive jumps. With `rate` (and
+        optionally `accel`, fmb_set_input_motion) the input is value + rate*tau + accel*tau**2/2 from
+        now on (tau = t - now), so a drive fed a smooth motion moves with it: its velocities and the
+        kinetic energy follow the rate (docs/api.md, "Inputs"). A bad name or value (not finite, or
+        one a scene's `value:` would be refused for) raises ValueError naming it."""
+        call = f"Simulation.set_load({name!r}, {value!r}" + ("" if rate is None else f", rate={rate!r}") + ")"
         if not isinstance(name, str):
             raise _lib.ArgumentError(f"{call}: the input's name must be a str")
         if name not in self.inputs:
             raise self._no_input(call, name)
         try:
             value = float(value)
+            motion = rate is not None or accel != 0.0
+            rate = 0.0 if rate is None else float(rate)
+            accel = float(accel)
         except (TypeError, ValueError):
-            raise _lib.ArgumentError(f"{call}: the value must be a number") from None
+            raise _lib.ArgumentError(f"{call}: the value, rate and accel must be numbers") from None
+        fn = "fmb_set_input_motion" if motion else "fmb_set_input"
         with _lib.captured_messages() as said, self._use() as d:
-            rc = _lib.library().fmb_set_input(self._mptr, d, name.encode(), value)
+            if motion:
+                rc = _lib.library().fmb_set_input_motion(self._mptr, d, name.encode(), value, rate, accel)
+            else:
+                rc = _lib.library().fmb_set_input(self._mptr, d, name.encode(), value)
         if rc:
-            why = "; ".join(m.replace("fmb_set_input: ", "") for m in said) or "refused"
+            why = "; ".join(m.replace(fn + ": ", "") for m in said) or "refused"
             raise _lib.ArgumentError(f"{call}: {why}")
+        for m in said:  # a jump of a drive held by value: the library's warning, in Python's terms
+            text = m.replace(fn + ": ", call + ": ").replace("fmb_set_input_motion (docs/api.md)",
+                                                            "set_load(name, value, rate=...) (docs/python.md)")
+            _lib.deliver(text.encode(), self._warn_handler)
 
     def get_load(self, name: str) -> float:
         """The current value of input `name`."""
