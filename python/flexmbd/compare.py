@@ -33,12 +33,13 @@ MAX_LINE = 1 << 20
 _NUMBER = re.compile(
     r"[ \t\n\v\f\r]*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
     r"|0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][+-]?\d+)?"
-    r"|(?i:inf(?:inity)?|nan(?:\([0-9A-Za-z_]*\))?))")
+    r"|(?i:inf(?:inity)?|nan(?:\([0-9A-Za-z_]*\))?))[ \t]*")  # blanks after it too (csv_table.c)
 _SIMPLE = re.compile(r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?")
 
 
 def _strtod(text: str) -> float:
-    """a field _NUMBER accepted, as strtod reads it"""
+    """a field _NUMBER accepted, as strtod reads it (the blanks after it skipped, as csv_table.c does)"""
+    text = text.rstrip(" \t")
     if _SIMPLE.fullmatch(text):
         return float(text)
     s = text.lstrip(" \t\n\v\f\r")
@@ -105,6 +106,8 @@ def read_csv(path: Union[str, "os.PathLike[str]"]) -> _Table:
             data = f.read()
     except OSError as e:
         raise ValueError(f"{label}: cannot open: {os.strerror(e.errno or 0)}") from None
+    if data.startswith(b"\xef\xbb\xbf"):  # a byte-order mark is no part of the first line (csv_table.c)
+        data = data[3:]
     lines = data.split(b"\n")
     if data.endswith(b"\n") or not data:
         lines.pop()  # what follows the last newline is no line

@@ -10,6 +10,7 @@ centreline. What the run lacks for the drawing is said in the page's notes."""
 from __future__ import annotations
 
 import ctypes
+import math
 import html
 import os
 from typing import List, Optional, Sequence, Union
@@ -203,9 +204,11 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
                                  f"{' '.join(names[1:40])}{' ...' if len(names) > 40 else ''})")
             plot.append(c - 1)
         plot = plot[:64]
-    else:  # the first column that is not a drawing's
-        plot = [next((c - 1 for c in range(1, len(names))
-                      if not _is_shape_column(names[c]) and c not in geometric), 0)][: 1 if len(names) > 1 else 0]
+    elif len(names) > 1:  # the column that moves most (cmd_view.c default_column)
+        plot = [_default_column(names, np.asarray(result.values, dtype=np.float64), geometric,
+                                tuple(getattr(model, "plugins", ()) or ())) - 1]
+    else:
+        plot = []
     if scale != 1.0:
         notes.append("deformation scale %g" % scale)
     if title is None:
@@ -282,6 +285,41 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
     out.append('],"notes":[' + ",".join(_json_string(n) for n in notes) + "]}")
     out.append(template[at + len(PLACEHOLDER):])
     return "".join(out)
+
+
+def _default_column(names, values, geometric, plugins) -> int:
+    """cmd_view.c default_column: the column that moves most, its range against the largest |value|
+    of any column in its unit (a column of unknown unit is its own scale), so that round-off about
+    zero is no motion; the plot's own columns before the drawing's; ties to the first."""
+    from .plot import unit
+
+    n = len(names)
+    rng, scale, group, units = [0.0] * n, [0.0] * n, list(range(n)), {}
+    for c in range(1, n):
+        col = values[:, c]
+        seen = col[~np.isnan(col)]  # fmin/fmax pass NaN by, as the C scan does
+        lo, hi = (float(seen.min()), float(seen.max())) if len(seen) else (math.inf, -math.inf)
+        rng[c] = hi - lo if len(col) else 0.0
+        am = float(np.abs(seen).max()) if len(seen) else 0.0
+        u = unit(names[c], plugins)
+        if u is not None and u in units:
+            group[c] = units[u]
+        elif u is not None and len(units) < 64:
+            units[u] = c
+        if math.isfinite(am):
+            scale[group[c]] = max(scale[group[c]], am)
+    best, best_motion = 1, 0.0
+    for drawing_pass in (False, True):
+        if best_motion != 0.0:
+            break
+        for c in range(1, n):
+            if (_is_shape_column(names[c]) or c in geometric) != drawing_pass:
+                continue
+            sc = scale[group[c]]
+            motion = rng[c] / sc if math.isfinite(rng[c]) and sc > 0.0 and rng[c] > 1e-9 * sc else 0.0
+            if motion > best_motion:
+                best_motion, best = motion, c
+    return best
 
 
 def _is_shape_column(name: str) -> bool:
