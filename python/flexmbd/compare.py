@@ -106,22 +106,28 @@ def read_csv(path: Union[str, "os.PathLike[str]"]) -> _Table:
             data = f.read()
     except OSError as e:
         raise ValueError(f"{label}: cannot open: {os.strerror(e.errno or 0)}") from None
-    if data.startswith(b"\xef\xbb\xbf"):  # a byte-order mark is no part of the first line (csv_table.c)
-        data = data[3:]
     lines = data.split(b"\n")
     if data.endswith(b"\n") or not data:
         lines.pop()  # what follows the last newline is no line
-    lineno = 0
+    # a byte-order mark (a spreadsheet's "CSV UTF-8") is no part of the first name or comment: the
+    # first line loses it once read, so it still counts towards that line's length (csv_table.c)
+    mark = 3 if lines and lines[0].startswith(b"\xef\xbb\xbf") else 0
+    if mark:
+        lines[0] = lines[0][mark:]
+
+    def too_long(k: int) -> bool:
+        return len(lines[k]) + (mark if k == 0 else 0) > MAX_LINE
+
     k = 0
     while k < len(lines) and lines[k][:1] == b"#":  # metadata lines before the header
-        if len(lines[k]) > MAX_LINE:
+        if too_long(k):
             raise ValueError(f"{label}:{k + 1}: line longer than {MAX_LINE} bytes (not a flexmbd CSV?)")
         k += 1
     if k == len(lines):
         raise ValueError(f"{label}: empty (no header row)")
     lineno = k + 1
     raw = lines[k]
-    if len(raw) > MAX_LINE:
+    if too_long(k):
         raise ValueError(f"{label}:{lineno}: line longer than {MAX_LINE} bytes (not a flexmbd CSV?)")
     header = raw[:-1] if raw.endswith(b"\r") else raw
     names = []
@@ -164,8 +170,7 @@ def _from_result(r: Result, label: str) -> _Table:
     if not names or len(r) == 0:
         raise ValueError(f"{label}: no data rows")
     _check_names(label, 1, names)
-    vals = np.ascontiguousarray(r.values, dtype=np.float64)
-    values = np.char.mod("%.12g", vals).astype(np.float64)
+    values = r._as_written()
     _check_times(label, values, list(range(2, len(values) + 2)))
     return _Table(label, names, values)
 

@@ -763,6 +763,12 @@ class Result:
         if rc:
             raise _lib.error_from(diag, None, rc)
 
+    def _as_written(self) -> np.ndarray:
+        """the values as the CSV to_csv writes holds them (%.12g, fmb_write_table's digits): what a
+        command given that CSV computes on (flexmbd.compare, flexmbd.view's default column)"""
+        values = np.asarray(self.values, dtype=np.float64)
+        return np.char.mod("%.12g", values).astype(np.float64).reshape(values.shape)  # (0, n) stays 2-D
+
     def to_pandas(self):
         """A pandas DataFrame indexed by t (needs pandas)."""
         try:

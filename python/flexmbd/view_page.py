@@ -205,7 +205,9 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
             plot.append(c - 1)
         plot = plot[:64]
     elif len(names) > 1:  # the column that moves most (cmd_view.c default_column)
-        plot = [_default_column(names, np.asarray(result.values, dtype=np.float64), geometric,
+        # on the CSV's digits, which the command reads and this page draws: motions that differ
+        # only beyond them tie, and the tie goes to the first column there too
+        plot = [_default_column(names, result._as_written(), geometric,
                                 tuple(getattr(model, "plugins", ()) or ())) - 1]
     else:
         plot = []

@@ -101,7 +101,7 @@ def test_column_sets(out):
     same_as_cli(later, ref)  # refused: no common time
 
 
-@pytest.mark.parametrize("name,text", [
+BAD_AND_ODD = [
     ("empty", ""),
     ("only_meta", "#x\n"),
     ("no_name", "t,,a\n0,1,2\n"),
@@ -114,12 +114,27 @@ def test_column_sets(out):
     ("time_back", "t,a\n0,1\n1,2\n0.5,3\nbad\n"),
     ("time_nan", "t,a\nnan,1\n"),
     ("crlf_hex_inf", "t,a\r\n0,0x1p-2\r\n\r\n1, -inf\r\n2,+1.5e0\r\n"),
-])
+    # a spreadsheet's CSV: padded cells, a byte-order mark on the first line (only there)
+    ("padded", "t,a\n0 ,\t1\t\n1 , 0x1p1 \r\n2,inf \n"),
+    ("blank_then_text", "t,a\n0,1 x\n"),
+    ("blank_cell", "t,a\n0, \n"),
+    ("bom", "\ufefft,a\r\n0,1\r\n"),
+    ("bom_meta", "\ufeff# rtol=1e-3\nt,a\n0,1\n"),
+    ("bom_only", "\ufeff"),
+    ("bom_blank_line", "\ufeff\r\nt,a\n0,1\n"),
+    ("bom_second_line", "t,a\n\ufeff0,1\n"),
+    ("bom_twice", "\ufeff\ufefft,a\n0,1\n"),
+    # the mark counts towards the first line's length limit (1 << 20 bytes): this one is 2 over
+    ("bom_long_line", "\ufeff#" + "x" * ((1 << 20) - 2) + "\nt,a\n0,1\n"),
+]
+
+
+@pytest.mark.parametrize("name,text", BAD_AND_ODD, ids=[name for name, _ in BAD_AND_ODD])
 def test_bad_and_odd_files(out, name, text):
     """the reader's messages (file:line: what was expected) and the forms strtod accepts"""
     path = os.path.join(out, name + ".csv")
-    with open(path, "w", newline="") as f:
-        f.write(text)
+    with open(path, "wb") as f:
+        f.write(text.encode("utf-8"))
     ok = write(os.path.join(out, "ok.csv"), "t,a", [["0", "1"], ["2", "1"]])
     same_as_cli(path, ok)
     same_as_cli(ok, path)

@@ -71,3 +71,30 @@ def test_repr_html_says_why_not(out):
     assert "does not know its scene" in shown
     with pytest.raises(ValueError, match="no column 'nope' to plot"):
         flexmbd.view(flexmbd.load(SPIN, set=BEAM_OUTPUTS).run(), columns=["nope"])
+
+
+def test_default_column_on_the_csv_digits(out):
+    """the column the plot opens on is chosen on the digits the page and the CSV carry (%.12g), as
+    the command reads them: two columns whose motions differ only beyond the 12th digit tie, and a
+    tie goes to the first (a page of the run in memory once chose the second)"""
+    scene = os.path.join(SRC, "scenes", "pendulum.yaml")
+    model = flexmbd.load(scene, set={"solver.t_end": 0.02})
+    run = model.run()
+    values = run.values[:2].copy()
+    names = list(run.columns)
+    for c in range(1, len(names)):
+        if names[c] not in ("bob.x", "bob.y", "bob.theta"):
+            values[:, c] = 0.25  # held: no motion
+    values[:, names.index("bob.vx")] = [-0.5, 0.5]
+    values[:, names.index("bob.vy")] = [-0.5, 0.5 + 1e-14]  # the same range and scale to 12 digits
+    memory = flexmbd.Result(names, values, dict(run.stats))
+    csv, page = os.path.join(out, "tie.csv"), os.path.join(out, "tie.html")
+    memory.to_csv(csv)
+    rc, _, err = cli("view", csv, scene, "--set", "solver.t_end=0.02", "-o", page)
+    assert rc == 0, err
+    with open(page, encoding="utf-8") as f:
+        expected = f.read()
+    title = f"{scene}, {csv}"
+    assert f'"plot":[{names.index("bob.vx") - 1}]' in expected  # the first of the tie
+    assert view_page.page(memory, model, title=title) == expected
+    assert view_page.page(flexmbd.Result.from_csv(csv), model, title=title) == expected
