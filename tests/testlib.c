@@ -151,3 +151,23 @@ double fmbt_energy_balance(const fmbtCsv* c, const char* body) {
   }
   return worst / emax;
 }
+
+char* fmbt_slurp(const char* path, size_t* len) {
+  FILE* f = fopen(path, "rb");
+  *len = 0;
+  if (!f) return NULL;
+  size_t cap = 1 << 16, n = 0, got;
+  char* buf = malloc(cap);
+  while (buf && (got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
+    n += got;
+    if (cap - n < 2) {
+      char* grown = realloc(buf, cap *= 2);
+      if (!grown) free(buf);
+      buf = grown;
+    }
+  }
+  fclose(f);
+  if (buf) buf[n] = '\0';
+  *len = buf ? n : 0;
+  return buf;
+}

@@ -39,5 +39,7 @@ double fmbt_crossing_frequency(const fmbtCsv* c, const char* col, double t0, int
    energy.total, BODY.omega and BODY.ang_momentum */
 double fmbt_energy_balance(const fmbtCsv* c, const char* body);
 const char* fmbt_out_path(const char* name, char* buf, size_t len);
+/* a whole file into memory (NUL-terminated, *len bytes; free() it); NULL when unreadable */
+char* fmbt_slurp(const char* path, size_t* len);
 
 #endif

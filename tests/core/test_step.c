@@ -21,22 +21,6 @@
 
 #include "testlib.h"
 
-/* a whole file into memory (NUL-terminated); NULL when unreadable */
-static char* slurp(const char* path, size_t* len) {
-  FILE* f = fopen(path, "rb");
-  if (!f) return NULL;
-  size_t cap = 1 << 16, n = 0, got;
-  char* buf = malloc(cap);
-  while (buf && (got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-    n += got;
-    if (cap - n < 2) buf = realloc(buf, cap *= 2);
-  }
-  fclose(f);
-  if (buf) buf[n] = '\0';
-  *len = n;
-  return buf;
-}
-
 typedef struct {
   int ncol, nrow, cap;
   double* values; /* row-major, t first */
@@ -116,8 +100,8 @@ static void compare(const char* scene, const char* const* sets, int nsets, const
   step_run(m, &tab);
   ENSURE(write_table(m, &tab, step_csv) == 0);
   size_t na = 0, nb = 0;
-  char* a = slurp(run_csv, &na);
-  char* b = slurp(step_csv, &nb);
+  char* a = fmbt_slurp(run_csv, &na);
+  char* b = fmbt_slurp(step_csv, &nb);
   const int same = a && b && na == nb && memcmp(a, b, na) == 0;
   ENSURE(same);
   ENSURE(rrc == tab.rc);

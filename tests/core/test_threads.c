@@ -61,22 +61,6 @@ static int copy_file(const char* from, const char* to) {
   return rc;
 }
 
-static char* slurp(const char* path, size_t* len) {
-  FILE* f = fopen(path, "rb");
-  *len = 0;
-  if (!f) return NULL;
-  size_t cap = 1 << 16, n = 0, got;
-  char* buf = malloc(cap);
-  while (buf && (got = fread(buf + n, 1, cap - n - 1, f)) > 0) {
-    n += got;
-    if (cap - n < 2) buf = realloc(buf, cap *= 2);
-  }
-  fclose(f);
-  if (buf) buf[n] = '\0';
-  *len = n;
-  return buf;
-}
-
 /* fmb_run's rows again with the stepping calls, written through fmb_write_table */
 static int step_to_csv(const fmbModel* m, const char* out, char* why, size_t whylen) {
   fmbDiag diag;
@@ -194,8 +178,8 @@ int main(void) {
       snprintf(pa, sizeof pa, "%s/%s", a->dir, files[f]);
       snprintf(pb, sizeof pb, "%s/%s", b->dir, files[f]);
       size_t na, nb;
-      char* xa = slurp(pa, &na);
-      char* xb = slurp(pb, &nb);
+      char* xa = fmbt_slurp(pa, &na);
+      char* xb = fmbt_slurp(pb, &nb);
       ENSURE(xa && xb && na > 0);
       if (!xa || !xb || na != nb || memcmp(xa, xb, na) != 0) same = 0;
       /* the stepped rows are fmb_run's rows */
