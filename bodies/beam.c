@@ -1203,7 +1203,7 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   double Ipp = 0.0, Ipv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
   for (int e = 0; e < ne; ++e) {
-    double ua[2], d[4], uda[2], dd[4], pp[5], pv5[5];
+    double ua[2], d[4], uda[2], dd[4], pp[5] = {0}, pv5[5] = {0}; /* set and read only when coupled */
     gather(p, e, ua, d);
     gather(pd, e, uda, dd);
     if (coupled) {
