@@ -11,7 +11,15 @@ CF=${CLANG_FORMAT:-clang-format-14}
 command -v "$CF" >/dev/null || { echo "format.sh: $CF not found (apt-get install clang-format-14)" >&2; exit 2; }
 check=0
 if [ "${1:-}" = "--check" ]; then check=1; shift; fi
-if [ $# -gt 0 ]; then files=("$@"); else mapfile -t files < <(git ls-files '*.c' '*.h'); fi
+files=()
+for f in "$@"; do # C sources only: clang-format would mangle a shell script given by mistake
+  case "$f" in
+    *.c | *.h) files+=("$f") ;;
+    *) echo "format.sh: $f left alone (not a .c or .h file)" >&2 ;;
+  esac
+done
+if [ $# -eq 0 ]; then mapfile -t files < <(git ls-files '*.c' '*.h'); fi
+[ ${#files[@]} -gt 0 ] || exit 0
 if [ $check -eq 0 ]; then
   "$CF" -i --style=file "${files[@]}"
   exit 0
