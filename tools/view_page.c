@@ -145,6 +145,100 @@ static int parse_columns(const char* list, const fmbTable* tb, int* cols, int ca
 }
 
 /* the page: the template with the data where its placeholder stands */
+/* "bodies": each body's frame columns, its centreline's columns and stations */
+static void write_bodies(FILE* f, const ViewBody* vb, int nb) {
+  for (int b = 0; b < nb; ++b) {
+    const ViewBody* v = &vb[b];
+    fputs(b ? ",\n{\"name\":" : "\n{\"name\":", f);
+    json_string(f, v->name);
+    if (v->frame[0])
+      fprintf(f, ",\"frame\":[%d,%d,%d]", v->frame[0] - 1, v->frame[1] - 1, v->frame[2] - 1);
+    else
+      fputs(",\"frame\":null", f);
+    if (v->centreline && v->nshape >= 2) {
+      fputs(",\"shape\":[", f);
+      for (int k = 0; k < v->nshape; ++k)
+        fprintf(f, "%s[%d,%d]", k ? "," : "", v->shape[2 * k] - 1, v->shape[2 * k + 1] - 1);
+      fputs("],\"stations\":[", f);
+      for (int k = 0; k < v->nshape; ++k) {
+        fputs(k ? ",[" : "[", f);
+        json_number(f, v->station[2 * k]);
+        fputc(',', f);
+        json_number(f, v->station[2 * k + 1]);
+        fputc(']', f);
+      }
+      fputc(']', f);
+    } else {
+      fputs(",\"shape\":null", f);
+    }
+    fputc('}', f);
+  }
+}
+
+/* "points": the drawing's points (a centreline's as the CSV's stations, from first_station[b]);
+   index: drawing point -> page point, -1 dropped */
+static void write_points(FILE* f, const ViewBody* vb, const fmbDrawing* d, const fmbModel* m, int* index,
+                         int* first_station) {
+  int npoint = 0;
+  for (int i = 0; i < d->npoint; ++i) {
+    const fmbDrawPoint* p = &d->point[i];
+    index[i] = -1;
+    const ViewBody* v = p->body > 0 ? &vb[p->body - 1] : NULL;
+    if (v && v->centreline && v->nshape >= 2 && p->station >= 0) {
+      if (p->station > 0) continue; /* the CSV's stations stand for them, written once */
+      first_station[p->body - 1] = npoint;
+      for (int k = 0; k < v->nshape; ++k, ++npoint) {
+        fprintf(f, "%s{\"body\":%d,\"local\":[", npoint ? ",\n" : "\n", p->body - 1);
+        json_number(f, v->station[2 * k]);
+        fputc(',', f);
+        json_number(f, v->station[2 * k + 1]);
+        fprintf(f, "],\"station\":%d,\"joint\":null}", k);
+      }
+      index[i] = first_station[p->body - 1];
+      continue;
+    }
+    const char* joint = NULL;
+    for (int c = 0; c < d->ncell && !joint; ++c)
+      if ((d->cell[c].part == FMB_DRAW_JOINT || d->cell[c].part == FMB_DRAW_FORCE_ELEMENT))
+        for (int k = 0; k < d->cell[c].count; ++k)
+          if (d->conn[d->cell[c].first + k] == i) fmb_model_joint(m, d->cell[c].owner, &joint, NULL);
+    fprintf(f, "%s{\"body\":%d,\"local\":[", npoint ? ",\n" : "\n", p->body - 1);
+    json_number(f, p->local[0]);
+    fputc(',', f);
+    json_number(f, p->local[1]);
+    fprintf(f, "],\"station\":%d,\"joint\":", v && v->centreline && v->nshape >= 2 ? p->station : -1);
+    if (joint)
+      json_string(f, joint);
+    else
+      fputs("null", f);
+    fputc('}', f);
+    index[i] = npoint++;
+  }
+}
+
+/* "cells" and the traces' points (a centreline's tip, a joint's point on a body) */
+static int write_cells(FILE* f, const ViewBody* vb, const fmbDrawing* d, const int* index, const int* first_station,
+                       int* trace) {
+  int ncell = 0, ntrace = 0;
+  for (int c = 0; c < d->ncell; ++c) {
+    const fmbDrawCell* cell = &d->cell[c];
+    fprintf(f, "%s{\"part\":%d,\"points\":[", ncell++ ? ",\n" : "\n", cell->part);
+    if (cell->part == FMB_DRAW_CENTRELINE && cell->owner > 0 && vb[cell->owner - 1].centreline &&
+        vb[cell->owner - 1].nshape >= 2) {
+      const ViewBody* v = &vb[cell->owner - 1];
+      for (int k = 0; k < v->nshape; ++k) fprintf(f, "%s%d", k ? "," : "", first_station[cell->owner - 1] + k);
+      if (ntrace < VIEW_MAX_TRACES) trace[ntrace++] = first_station[cell->owner - 1] + v->nshape - 1; /* the tip */
+    } else {
+      for (int k = 0; k < cell->count; ++k) fprintf(f, "%s%d", k ? "," : "", index[d->conn[cell->first + k]]);
+      const int p0 = d->conn[cell->first];
+      if (cell->part == FMB_DRAW_JOINT && d->point[p0].body > 0 && ntrace < VIEW_MAX_TRACES)
+        trace[ntrace++] = index[p0];
+    }
+    fputs("]}", f);
+  }
+  return ntrace;
+}
+
 static int write_page(FILE* f, const char* title, const fmbTable* tb, const ViewBody* vb, int nb, const fmbDrawing* d,
                       const fmbModel* m, const int* plot, int nplot, double scale, const char* const* notes,
                       int nnotes) {
@@ -183,36 +277,10 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
     fputc(']', f);
   }
   fputs("],\n\"bodies\":[", f);
-  for (int b = 0; b < nb; ++b) {
-    const ViewBody* v = &vb[b];
-    fputs(b ? ",\n{\"name\":" : "\n{\"name\":", f);
-    json_string(f, v->name);
-    if (v->frame[0])
-      fprintf(f, ",\"frame\":[%d,%d,%d]", v->frame[0] - 1, v->frame[1] - 1, v->frame[2] - 1);
-    else
-      fputs(",\"frame\":null", f);
-    if (v->centreline && v->nshape >= 2) {
-      fputs(",\"shape\":[", f);
-      for (int k = 0; k < v->nshape; ++k)
-        fprintf(f, "%s[%d,%d]", k ? "," : "", v->shape[2 * k] - 1, v->shape[2 * k + 1] - 1);
-      fputs("],\"stations\":[", f);
-      for (int k = 0; k < v->nshape; ++k) {
-        fputs(k ? ",[" : "[", f);
-        json_number(f, v->station[2 * k]);
-        fputc(',', f);
-        json_number(f, v->station[2 * k + 1]);
-        fputc(']', f);
-      }
-      fputc(']', f);
-    } else {
-      fputs(",\"shape\":null", f);
-    }
-    fputc('}', f);
-  }
+  write_bodies(f, vb, nb);
   /* the drawing's points; a centreline's stations are resampled to the CSV's when they differ,
      so its cell is rebuilt from the CSV's stations */
   fputs("],\n\"points\":[", f);
-  int npoint = 0;
   int* index = malloc(((size_t)d->npoint + 1) * sizeof *index); /* drawing point -> page point, -1 dropped */
   int* first_station = calloc((size_t)nb + 1, sizeof *first_station);
   if (!index || !first_station) {
@@ -220,58 +288,10 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
     free(first_station);
     return -1;
   }
-  for (int i = 0; i < d->npoint; ++i) {
-    const fmbDrawPoint* p = &d->point[i];
-    index[i] = -1;
-    const ViewBody* v = p->body > 0 ? &vb[p->body - 1] : NULL;
-    if (v && v->centreline && v->nshape >= 2 && p->station >= 0) {
-      if (p->station > 0) continue; /* the CSV's stations stand for them, written once */
-      first_station[p->body - 1] = npoint;
-      for (int k = 0; k < v->nshape; ++k, ++npoint) {
-        fprintf(f, "%s{\"body\":%d,\"local\":[", npoint ? ",\n" : "\n", p->body - 1);
-        json_number(f, v->station[2 * k]);
-        fputc(',', f);
-        json_number(f, v->station[2 * k + 1]);
-        fprintf(f, "],\"station\":%d,\"joint\":null}", k);
-      }
-      index[i] = first_station[p->body - 1];
-      continue;
-    }
-    const char* joint = NULL;
-    for (int c = 0; c < d->ncell && !joint; ++c)
-      if ((d->cell[c].part == FMB_DRAW_JOINT || d->cell[c].part == FMB_DRAW_FORCE_ELEMENT))
-        for (int k = 0; k < d->cell[c].count; ++k)
-          if (d->conn[d->cell[c].first + k] == i) fmb_model_joint(m, d->cell[c].owner, &joint, NULL);
-    fprintf(f, "%s{\"body\":%d,\"local\":[", npoint ? ",\n" : "\n", p->body - 1);
-    json_number(f, p->local[0]);
-    fputc(',', f);
-    json_number(f, p->local[1]);
-    fprintf(f, "],\"station\":%d,\"joint\":", v && v->centreline && v->nshape >= 2 ? p->station : -1);
-    if (joint)
-      json_string(f, joint);
-    else
-      fputs("null", f);
-    fputc('}', f);
-    index[i] = npoint++;
-  }
+  write_points(f, vb, d, m, index, first_station);
   fputs("],\n\"cells\":[", f);
-  int ncell = 0, ntrace = 0, trace[VIEW_MAX_TRACES];
-  for (int c = 0; c < d->ncell; ++c) {
-    const fmbDrawCell* cell = &d->cell[c];
-    fprintf(f, "%s{\"part\":%d,\"points\":[", ncell++ ? ",\n" : "\n", cell->part);
-    if (cell->part == FMB_DRAW_CENTRELINE && cell->owner > 0 && vb[cell->owner - 1].centreline &&
-        vb[cell->owner - 1].nshape >= 2) {
-      const ViewBody* v = &vb[cell->owner - 1];
-      for (int k = 0; k < v->nshape; ++k) fprintf(f, "%s%d", k ? "," : "", first_station[cell->owner - 1] + k);
-      if (ntrace < VIEW_MAX_TRACES) trace[ntrace++] = first_station[cell->owner - 1] + v->nshape - 1; /* the tip */
-    } else {
-      for (int k = 0; k < cell->count; ++k) fprintf(f, "%s%d", k ? "," : "", index[d->conn[cell->first + k]]);
-      const int p0 = d->conn[cell->first];
-      if (cell->part == FMB_DRAW_JOINT && d->point[p0].body > 0 && ntrace < VIEW_MAX_TRACES)
-        trace[ntrace++] = index[p0];
-    }
-    fputs("]}", f);
-  }
+  int trace[VIEW_MAX_TRACES];
+  const int ntrace = write_cells(f, vb, d, index, first_station, trace);
   fputs("],\n\"traces\":[", f);
   for (int k = 0; k < ntrace; ++k) fprintf(f, "%s%d", k ? "," : "", trace[k]);
   fputs("],\"plot\":[", f);
