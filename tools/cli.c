@@ -75,14 +75,6 @@ void fmb_cli_print_diag(const fmbDiag* d) {
   fprintf(stderr, "%s\n", text);
 }
 
-const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what) {
-  if (*i + 1 >= argc) {
-    fprintf(stderr, "flexmbd %s: %s needs %s\n", cmd, argv[*i], what);
-    return NULL;
-  }
-  return argv[++*i];
-}
-
 int fmb_cli_check_set(const char* cmd, const char* ov, const char* next) {
   (void)cmd; /* the message has the library's form for a --set (engine/yaml_get.c): the option, then why */
   const char* eq = strchr(ov, '=');
@@ -96,43 +88,41 @@ int fmb_cli_check_set(const char* cmd, const char* ov, const char* next) {
   return FMB_EXIT_BAD_INPUT;
 }
 
-int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s) {
-  const char* a = argv[*i];
-  const char* ov = NULL;
-  if (strcmp(a, "--plugin") == 0 || strncmp(a, "--plugin=", 9) == 0) {
-    const char* so = a[8] == '=' ? a + 9 : fmb_cli_value(cmd, argc, argv, i, "a plugin file (x.so)");
-    fmbDiag d;
-    fmbRegistry* reg = fmb_cli_registry();
-    if (!so || !reg) return FMB_EXIT_BAD_INPUT;
-    if (fmb_registry_load(reg, so, &d)) {
-      fmb_cli_print_diag(&d);
-      return FMB_EXIT_BAD_INPUT;
-    }
-    fmb_cli_note_input(so); /* its code runs in this process: no output may replace the file */
-    if (s->nplugins < (int)(sizeof s->plugins / sizeof s->plugins[0])) s->plugins[s->nplugins++] = so;
-    return 1;
-  }
-  if (strcmp(a, "--set") == 0) {
-    if (!(ov = fmb_cli_value(cmd, argc, argv, i, "PATH=VALUE"))) return FMB_EXIT_BAD_INPUT;
-  } else if (strncmp(a, "--set=", 6) == 0) {
-    ov = a + 6;
-  } else if (a[0] == '-' && a[1] != '\0') {
-    return 0; /* an option of the command's own */
-  } else if (!s->scene) {
-    s->scene = a;
-    fmb_cli_note_input(a); /* no output of this command may replace it (fmb_cli_inputs) */
-    return 1;
-  } else {
-    fprintf(stderr, "flexmbd %s: one scene file at a time (got '%s' and '%s')\n", cmd, s->scene, a);
-    return FMB_EXIT_BAD_INPUT;
-  }
-  if (fmb_cli_check_set(cmd, ov, *i + 1 < argc ? argv[*i + 1] : NULL)) return FMB_EXIT_BAD_INPUT;
+int fmb_opt_read_set(const fmbOptContext* ctx, void* at, const char* value) {
+  fmbCliScene* s = at;
+  if (fmb_cli_check_set(ctx->cmd, value, ctx->next)) return FMB_EXIT_BAD_INPUT;
   if (s->nover == FMB_CLI_MAX_OVERRIDES) {
-    fprintf(stderr, "flexmbd %s: more than %d --set overrides\n", cmd, FMB_CLI_MAX_OVERRIDES);
+    fprintf(stderr, "flexmbd %s: more than %d --set overrides\n", ctx->cmd, FMB_CLI_MAX_OVERRIDES);
     return FMB_EXIT_BAD_INPUT;
   }
-  s->overrides[s->nover++] = ov;
-  return 1;
+  s->overrides[s->nover++] = value;
+  return 0;
+}
+
+int fmb_opt_read_plugin(const fmbOptContext* ctx, void* at, const char* so) {
+  (void)ctx;
+  fmbCliScene* s = at;
+  fmbDiag d;
+  fmbRegistry* reg = fmb_cli_registry();
+  if (!reg) return FMB_EXIT_BAD_INPUT;
+  if (fmb_registry_load(reg, so, &d)) {
+    fmb_cli_print_diag(&d);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmb_cli_note_input(so); /* its code runs in this process: no output may replace the file */
+  if (s->nplugins < (int)(sizeof s->plugins / sizeof s->plugins[0])) s->plugins[s->nplugins++] = so;
+  return 0;
+}
+
+int fmb_opt_scene_positional(const fmbOptContext* ctx, const char* arg) {
+  fmbCliScene* s = ctx->self; /* the command's options begin with their fmbCliScene */
+  if (s->scene) {
+    fprintf(stderr, "flexmbd %s: one scene file at a time (got '%s' and '%s')\n", ctx->cmd, s->scene, arg);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  s->scene = arg;
+  fmb_cli_note_input(arg); /* no output of this command may replace it (fmb_cli_inputs) */
+  return 0;
 }
 
 int fmb_cli_check_input(const char* path, const char* what) {

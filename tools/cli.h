@@ -7,6 +7,7 @@
 #include <stdio.h>
 
 #include "flexmbd.h"
+#include "options.h"
 
 #define FMB_CLI_MAX_OVERRIDES 256
 
@@ -27,15 +28,9 @@ typedef struct fmbCliScene {
   int nplugins;
 } fmbCliScene;
 
-/* Takes argv[*i] if it is `--set PATH=VALUE`, `--set=PATH=VALUE`, `--plugin x.so` (loaded into
-   fmb_cli_registry() at once) or (when no scene was given yet) the scene file; returns 1 when
-   taken (advancing *i past an argument), 0 when not ours, or FMB_EXIT_BAD_INPUT after printing why (prefixed by `cmd`). */
-int fmb_cli_take_scene_arg(const char* cmd, int argc, char** argv, int* i, fmbCliScene* s);
 /* a --set value `ov` has the form PATH=VALUE: 0, else FMB_EXIT_BAD_INPUT after saying so in the
    option's terms (`next`, the argument after it or NULL, shows `--set PATH VALUE`, a space for =) */
 int fmb_cli_check_set(const char* cmd, const char* ov, const char* next);
-/* the argument after argv[*i] (advancing *i), or NULL after printing that `what` is missing */
-const char* fmb_cli_value(const char* cmd, int argc, char** argv, int* i, const char* what);
 /* file:line:col: error: msg (or the shorter forms when no location is known), on stderr or in buf */
 void fmb_cli_print_diag(const fmbDiag* d);
 void fmb_cli_format_diag(const fmbDiag* d, char* buf, size_t len);
@@ -89,7 +84,10 @@ typedef struct fmbCliCompare {
 } fmbCliCompare;
 int fmb_cli_compare(const fmbCliCompare* c);
 
-/* the commands */
+/* the commands: each one's options and usage (its fmbCommandSpec, tools/options.h) and its main */
+extern const fmbCommandSpec fmb_run_command, fmb_check_command, fmb_types_command, fmb_compare_command,
+    fmb_regress_command, fmb_conform_command, fmb_plot_command, fmb_new_command, fmb_static_command, fmb_modes_command,
+    fmb_campbell_command, fmb_view_command, fmb_sweep_command;
 int fmb_cmd_run(int argc, char** argv);
 int fmb_cmd_check(int argc, char** argv);
 int fmb_cmd_types(int argc, char** argv);
@@ -107,12 +105,57 @@ int fmb_cmd_sweep(int argc, char** argv);
 typedef struct fmbCliAnalysis {
   fmbStaticOptions opt; /* --at T, --quiet */
   int method;           /* --eigen dense|sparse|auto */
-  int count, count_max; /* --count K (1..count_max) */
+  int count;            /* --count K */
   int at_given, quiet;
 } fmbCliAnalysis;
-/* Takes --at T, --quiet/-q and, when count_max > 0, --eigen and --count K; same returns as
-   fmb_cli_take_scene_arg */
-int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fmbCliAnalysis* a);
+/* --at T (also sets opt.has_t and at_given) */
+int fmb_cli_read_at(const fmbOptContext* ctx, void* at, const char* value);
+/* --at T and --quiet/-q of a command whose options hold an fmbCliAnalysis `field` */
+#define FMB_CLI_ANALYSIS_ENTRIES(Type, field)                                                                         \
+  {"--at",                                                                                                            \
+   NULL,                                                                                                              \
+   FMB_OPT_CALL,                                                                                                      \
+   "T",                                                                                                               \
+   offsetof(Type, field),                                                                                             \
+   "hold the drives at time T (default: the scene's t0)",                                                             \
+   "a finite time in seconds",                                                                                        \
+   0,                                                                                                                 \
+   0,                                                                                                                 \
+   NULL,                                                                                                              \
+   fmb_cli_read_at,                                                                                                   \
+   0},                                                                                                                \
+  {                                                                                                                   \
+    "--quiet", "-q", FMB_OPT_FLAG, NULL, offsetof(Type, field.quiet), "no progress messages", NULL, 0, 0, NULL, NULL, \
+        0                                                                                                             \
+  }
+/* --eigen and --count K (1..count_max) of the commands that compute modes */
+#define FMB_CLI_EIGEN_ENTRIES(Type, field, count_max, count_needs)                                                    \
+  {"--eigen",                                                                                                         \
+   NULL,                                                                                                              \
+   FMB_OPT_CHOICE,                                                                                                    \
+   "dense|sparse|auto",                                                                                               \
+   offsetof(Type, field.method),                                                                                      \
+   "the eigensolver (auto: sparse for large models)",                                                                 \
+   "dense, sparse or auto",                                                                                           \
+   0,                                                                                                                 \
+   0,                                                                                                                 \
+   "auto|dense|sparse",                                                                                               \
+   NULL,                                                                                                              \
+   0}, /* FMB_EIGEN_* order */                                                                                        \
+  {                                                                                                                   \
+    "--count", NULL, FMB_OPT_INT, "K", offsetof(Type, field.count), "the number of modes", count_needs, 1, count_max, \
+        NULL, NULL, 0                                                                                                 \
+  }
+/* `campbell`'s options (tools/cmd_campbell.c) and its work on them (tools/campbell_table.c): argv is
+   the command line, which -j children and ranks run again with one speed each */
+typedef struct fmbCliCampbell {
+  fmbCliScene s; /* first: fmb_opt_scene_positional */
+  fmbCliAnalysis an;
+  const char *out, *png, *path, *speeds_text;
+  const char* modes_out; /* internal: a child of -j or of a rank (its -j is not used) */
+  int jobs;
+} fmbCliCampbell;
+int fmb_cli_campbell(const fmbCliCampbell* a, int argc, char** argv);
 /* load the scene (with overrides[0..nover)) and solve its static or steady state: *m, *y, *yp
    are the caller's to free (fmb_free, free) also on failure; returns 0 or an exit code */
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,

@@ -5,16 +5,27 @@
 
 #include "cli.h"
 
-int fmb_cmd_check(int argc, char** argv) {
+typedef struct {
   fmbCliScene s;
-  memset(&s, 0, sizeof s);
-  for (int i = 2; i < argc; ++i) {
-    int r = fmb_cli_take_scene_arg("check", argc, argv, &i, &s);
-    if (r == 1) continue;
-    if (r) return r;
-    fprintf(stderr, "flexmbd check: unknown option '%s'\n", argv[i]);
-    return FMB_EXIT_BAD_INPUT;
-  }
+} CheckArgs;
+
+static const fmbOpt check_options[] = {FMB_OPT_SCENE_ENTRIES(CheckArgs, s)};
+
+const fmbCommandSpec fmb_check_command = {"check",
+                                          "SCENE.yaml",
+                                          "load, validate and describe the scene and its constraints at t0; no run",
+                                          check_options,
+                                          FMB_OPT_COUNT(check_options),
+                                          fmb_opt_scene_positional,
+                                          NULL};
+
+int fmb_cmd_check(int argc, char** argv) {
+  CheckArgs o;
+  memset(&o, 0, sizeof o);
+  fmbCliScene s;
+  int rc;
+  if (fmb_opt_parse(&fmb_check_command, argc, argv, &o, &rc)) return rc;
+  s = o.s;
   if (!s.scene) {
     fprintf(stderr, "flexmbd check: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
@@ -26,7 +37,7 @@ int fmb_cmd_check(int argc, char** argv) {
     return diag.code ? diag.code : FMB_EXIT_BAD_INPUT;
   }
   fmb_describe(m, stdout);
-  int rc = fmb_check_constraints(m, stdout, &diag);
+  rc = fmb_check_constraints(m, stdout, &diag);
   if (!rc) fmb_describe_solver(m, stdout);
   if (rc) fmb_cli_print_diag(&diag);
   fmb_free(m);

@@ -16,6 +16,7 @@
  * extra column, or OUT shorter than REF; 2 bad input (unreadable or malformed CSV, unknown option,
  * an unknown --columns name, no common time). */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -23,24 +24,52 @@
 #include "cli.h"
 #include "csv_table.h"
 
-static void usage(FILE* f) {
-  fprintf(f, "usage: flexmbd compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A] [--common]\n"
-             "  --rtol R, --atol A  fail (exit 1) when a column's max error exceeds A + R * (its range in REF)\n"
-             "  --columns a,b       compare only these columns\n"
-             "  --common            compare the columns both files have (a missing or extra one is no failure)\n");
-}
-
-/* a non-negative finite number from an option's argument, or -1 after saying why */
-static int tolerance_arg(const char* opt, const char* s, double* out) {
+/* --rtol R, --atol A: a non-negative finite number; either asks for the check */
+static int tolerance_arg(const fmbOptContext* ctx, void* at, const char* v) {
   char* end;
-  double x = s ? strtod(s, &end) : NAN;
-  if (!s || end == s || *end || !isfinite(x) || x < 0.0) {
-    fprintf(stderr, "flexmbd compare: %s needs a number >= 0, got '%s'\n", opt, s ? s : "");
-    return -1;
+  const double x = strtod(v, &end);
+  if (end == v || *end || !isfinite(x) || x < 0.0) {
+    fprintf(stderr, "flexmbd compare: %s needs a number >= 0, got '%s'\n", ctx->option, v);
+    return FMB_EXIT_BAD_INPUT;
   }
-  *out = x;
+  *(double*)at = x;
+  ((fmbCliCompare*)ctx->self)->check = 1;
   return 0;
 }
+
+static int compare_file(const fmbOptContext* ctx, const char* arg) {
+  fmbCliCompare* c = ctx->self;
+  if (c->out && c->ref) {
+    fprintf(stderr, "flexmbd compare: two CSV files, OUT and REF (got a third, '%s')\n", arg);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  *(c->out ? &c->ref : &c->out) = arg;
+  return 0;
+}
+
+static const fmbOpt compare_options[] = {
+    {"--columns", "-c", FMB_OPT_STRING, "a,b,...", offsetof(fmbCliCompare, columns), "compare only these columns",
+     "a comma-separated list", 0, 0, NULL, NULL, 0},
+    {"--rtol", NULL, FMB_OPT_CALL, "R", offsetof(fmbCliCompare, rtol),
+     "fail (exit 1) when a column's max error exceeds A + R * (its range in REF)", "a number >= 0", 0, 0, NULL,
+     tolerance_arg, 0},
+    {"--atol", NULL, FMB_OPT_CALL, "A", offsetof(fmbCliCompare, atol), "the absolute part A of that tolerance",
+     "a number >= 0", 0, 0, NULL, tolerance_arg, 0},
+    {"--common", NULL, FMB_OPT_FLAG, NULL, offsetof(fmbCliCompare, common),
+     "compare the columns both files have (a missing or extra one is no failure)", NULL, 0, 0, NULL, NULL, 0},
+    {"--tag", NULL, FMB_OPT_STRING, "TEXT", offsetof(fmbCliCompare, tag), "append TEXT to every line", "a text", 0, 0,
+     NULL, NULL, 0},
+};
+
+const fmbCommandSpec fmb_compare_command = {
+    "compare",
+    "OUT.csv REF.csv",
+    "the error of OUT against REF per column, one line each; exit 1 beyond tolerance",
+    compare_options,
+    FMB_OPT_COUNT(compare_options),
+    compare_file,
+    "exit: 0 within tolerance (or none asked), 1 a column beyond it, a missing or extra column, or OUT shorter "
+    "than REF, 2 bad input\n"};
 
 /* are the column sets the same? prints each difference; returns the number of differences */
 static int column_set_differences(const fmbTable* out, const fmbTable* ref, const char* fo, const char* fr) {
@@ -61,37 +90,10 @@ static int column_set_differences(const fmbTable* out, const fmbTable* ref, cons
 int fmb_cmd_compare(int argc, char** argv) {
   fmbCliCompare c;
   memset(&c, 0, sizeof c);
-  int nf = 0;
-  for (int i = 2; i < argc; ++i) {
-    const char* a = argv[i];
-    if (strcmp(a, "--tag") == 0 && i + 1 < argc) {
-      c.tag = argv[++i];
-    } else if (strcmp(a, "--columns") == 0 || strcmp(a, "-c") == 0) {
-      if (!(c.columns = fmb_cli_value("compare", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strncmp(a, "--columns=", 10) == 0) {
-      c.columns = a + 10;
-    } else if (strcmp(a, "--rtol") == 0 || strcmp(a, "--atol") == 0) {
-      const char* v = fmb_cli_value("compare", argc, argv, &i, "a number");
-      if (!v || tolerance_arg(a, v, a[2] == 'r' ? &c.rtol : &c.atol)) return FMB_EXIT_BAD_INPUT;
-      c.check = 1;
-    } else if (strcmp(a, "--common") == 0) {
-      c.common = 1;
-    } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-      usage(stdout);
-      return 0;
-    } else if (a[0] == '-' && a[1] != '\0') {
-      fprintf(stderr, "flexmbd compare: unknown option '%s'\n", a);
-      usage(stderr);
-      return FMB_EXIT_BAD_INPUT;
-    } else if (nf < 2) {
-      *(nf++ ? &c.ref : &c.out) = a;
-    } else {
-      fprintf(stderr, "flexmbd compare: two CSV files, OUT and REF (got a third, '%s')\n", a);
-      return FMB_EXIT_BAD_INPUT;
-    }
-  }
-  if (nf != 2) {
-    usage(stderr);
+  int rc;
+  if (fmb_opt_parse(&fmb_compare_command, argc, argv, &c, &rc)) return rc;
+  if (!c.out || !c.ref) {
+    fmb_opt_usage(&fmb_compare_command, stderr, 0);
     return FMB_EXIT_BAD_INPUT;
   }
   return fmb_cli_compare(&c);

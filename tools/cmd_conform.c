@@ -3,6 +3,7 @@
  * a check fails, 2 for bad arguments or a plugin that does not load. */
 #include <dirent.h>
 #include <errno.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,35 +27,49 @@ static void remove_work(const char* dir) {
 
 static int conform_types(fmbRegistry* reg, const char* const* names, int nnames, const char* work);
 
+typedef struct {
+  fmbCliScene s; /* the --plugin files */
+  const char* work;
+  const char** names; /* the named types: at most one per argument */
+  int nnames;
+} ConformArgs;
+
+static int conform_type_name(const fmbOptContext* ctx, const char* arg) {
+  ConformArgs* o = ctx->self;
+  o->names[o->nnames++] = arg;
+  return 0;
+}
+
+static const fmbOpt conform_options[] = {
+    FMB_OPT_PLUGIN(ConformArgs, s),
+    {"--work", NULL, FMB_OPT_STRING, "DIR", offsetof(ConformArgs, work),
+     "keep the checks' scenes and runs in DIR (default: a temporary folder, removed)", "a folder", 0, 0, NULL, NULL, 0},
+};
+
+const fmbCommandSpec fmb_conform_command = {
+    "conform",
+    "[TYPE]...",
+    "conformance checks of every (or the named) body and joint type; exit 1 on a failure",
+    conform_options,
+    FMB_OPT_COUNT(conform_options),
+    conform_type_name,
+    NULL};
+
 int fmb_cmd_conform(int argc, char** argv) {
-  fmbCliScene s;
-  memset(&s, 0, sizeof s);
-  /* the named types: at most one per argument */
-  const char** names = calloc((size_t)argc, sizeof *names);
-  int nnames = 0;
-  if (!names) return FMB_EXIT_BAD_INPUT;
-  const char* work = NULL;
-  for (int i = 2; i < argc; ++i) {
-    if (strcmp(argv[i], "--work") == 0) {
-      if (!(work = fmb_cli_value("conform", argc, argv, &i, "a folder"))) {
-        free(names);
-        return FMB_EXIT_BAD_INPUT;
-      }
-      continue;
-    }
-    if (argv[i][0] != '-') {
-      names[nnames++] = argv[i];
-      continue;
-    }
-    int r = fmb_cli_take_scene_arg("conform", argc, argv, &i, &s);
-    if (r != 1 || s.nover) {
-      if (r <= 1) fprintf(stderr, "flexmbd conform: unknown option '%s'\n", argv[i]);
-      free(names);
-      return r > 1 ? r : FMB_EXIT_BAD_INPUT;
-    }
+  ConformArgs o;
+  memset(&o, 0, sizeof o);
+  o.names = calloc((size_t)argc, sizeof *o.names);
+  if (!o.names) return FMB_EXIT_BAD_INPUT;
+  int rc;
+  if (fmb_opt_parse(&fmb_conform_command, argc, argv, &o, &rc)) {
+    free(o.names);
+    return rc;
   }
+  const char** names = o.names;
+  const int nnames = o.nnames;
+  const char* work = o.work;
   fmbRegistry* reg = fmb_cli_registry();
-  int rc = reg ? 0 : FMB_EXIT_BAD_INPUT;
+  rc = reg ? 0 : FMB_EXIT_BAD_INPUT;
   /* the scenes and runs go to a folder of our own (mkdtemp: new, 0700, no link followed into it),
      removed afterwards; --work DIR keeps them in DIR for a look */
   char own[1100] = "";

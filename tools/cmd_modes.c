@@ -8,6 +8,7 @@
  * the static solution's stats line. */
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -31,45 +32,53 @@ static int modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
   return rc;
 }
 
-int fmb_cmd_modes(int argc, char** argv) {
-  fmbCliScene s;
-  memset(&s, 0, sizeof s);
+typedef struct {
+  fmbCliScene s; /* first: fmb_opt_scene_positional */
   fmbCliAnalysis an;
-  memset(&an, 0, sizeof an);
-  an.count = 10;
-  an.count_max = 1000000;
-  an.opt.quiet = 1;
-  const char *out = NULL, *shapes = NULL, *animate = NULL;
-  double amplitude = 0.1;
-  int static_given = 0;
-  for (int i = 2; i < argc; ++i) {
-    const char* a = argv[i];
-    int r = fmb_cli_take_scene_arg("modes", argc, argv, &i, &s);
-    if (!r) r = fmb_cli_take_analysis_arg("modes", argc, argv, &i, &an);
-    if (r == 1) continue;
-    if (r) return r;
-    if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-      if (!(out = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--shapes") == 0) {
-      if (!(shapes = fmb_cli_value("modes", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--animate") == 0) {
-      if (!(animate = fmb_cli_value("modes", argc, argv, &i, "a directory"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--amplitude") == 0) {
-      const char* v = fmb_cli_value("modes", argc, argv, &i, "a number");
-      char* end;
-      if (!v) return FMB_EXIT_BAD_INPUT;
-      amplitude = strtod(v, &end);
-      if (*end || end == v || !(amplitude > 0.0)) {
-        fprintf(stderr, "flexmbd modes: --amplitude needs a positive number (m or rad), got '%s'\n", v);
-        return FMB_EXIT_BAD_INPUT;
-      }
-    } else if (strcmp(a, "--static") == 0) {
-      static_given = 1;
-    } else {
-      fprintf(stderr, "flexmbd modes: unknown option '%s'\n", a);
-      return FMB_EXIT_BAD_INPUT;
-    }
-  }
+  const char *out, *shapes, *animate;
+  double amplitude;
+  int static_given;
+} ModesArgs;
+
+static const fmbOpt modes_options[] = {
+    {"--output", "-o", FMB_OPT_STRING, "modes.csv", offsetof(ModesArgs, out),
+     "one row per mode: frequency (rad/s, Hz), damping ratio (default: stdout)", "a file name", 0, 0, NULL, NULL, 0},
+    FMB_CLI_EIGEN_ENTRIES(ModesArgs, an, 1000000, "an integer from 1 to 1000000"),
+    FMB_CLI_ANALYSIS_ENTRIES(ModesArgs, an),
+    {"--static", NULL, FMB_OPT_FLAG, NULL, offsetof(ModesArgs, static_given), "about the state at the scene's t0", NULL,
+     0, 0, NULL, NULL, 0},
+    {"--shapes", NULL, FMB_OPT_STRING, "shapes.csv", offsetof(ModesArgs, shapes), "the mode shapes as a CSV",
+     "a file name", 0, 0, NULL, NULL, 0},
+    {"--animate", NULL, FMB_OPT_STRING, "DIR", offsetof(ModesArgs, animate),
+     "each mode as a ParaView animation DIR/modeK/", "a directory", 0, 0, NULL, NULL, 0},
+    {"--amplitude", NULL, FMB_OPT_DOUBLE, "A", offsetof(ModesArgs, amplitude),
+     "the largest coordinate of an animated mode (default 0.1)", "a positive number (m or rad)", 0, HUGE_VAL, NULL,
+     NULL, FMB_OPT_ABOVE_MIN},
+    FMB_OPT_SCENE_ENTRIES(ModesArgs, s),
+};
+
+const fmbCommandSpec fmb_modes_command = {
+    "modes",
+    "SCENE.yaml",
+    "frequencies, damping ratios and shapes of small motions about the static or steady state",
+    modes_options,
+    FMB_OPT_COUNT(modes_options),
+    fmb_opt_scene_positional,
+    NULL};
+
+int fmb_cmd_modes(int argc, char** argv) {
+  ModesArgs o;
+  memset(&o, 0, sizeof o);
+  o.an.count = 10;
+  o.an.opt.quiet = 1;
+  o.amplitude = 0.1;
+  int rc;
+  if (fmb_opt_parse(&fmb_modes_command, argc, argv, &o, &rc)) return rc;
+  const fmbCliScene s = o.s;
+  const fmbCliAnalysis an = o.an;
+  const char *out = o.out, *shapes = o.shapes, *animate = o.animate;
+  const double amplitude = o.amplitude;
+  const int static_given = o.static_given;
   if (!s.scene) {
     fprintf(stderr, "flexmbd modes: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
@@ -87,7 +96,7 @@ int fmb_cmd_modes(int argc, char** argv) {
   double *y, *yp;
   fmbModes* md = NULL;
   const clock_t c0 = clock();
-  int rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
+  rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
   if (!rc) rc = fmb_modes(m, res.t, y, yp, an.count, an.method, &md, &diag);
   if (!rc) rc = modes_csv(md, out, &diag);
   if (!rc && shapes) rc = fmb_write_mode_shapes(m, res.t, y, yp, md, shapes, &diag);

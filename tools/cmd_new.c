@@ -142,18 +142,43 @@ static void list_starters(FILE* f) {
   for (int i = 0; i < NSTARTERS; ++i) fprintf(f, "  %-13s %s\n", starters[i].name, starters[i].what);
 }
 
+typedef struct {
+  const char* name;
+} NewArgs;
+
+static int starter_name(const fmbOptContext* ctx, const char* arg) {
+  NewArgs* o = ctx->self;
+  if (o->name) {
+    fprintf(stderr, "flexmbd new: one starter at a time (got '%s' and '%s')\n", o->name, arg);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  o->name = arg;
+  return 0;
+}
+
+const fmbCommandSpec fmb_new_command = {"new",
+                                        "pendulum|beam|rotor|slider-crank > scene.yaml",
+                                        "a commented starter scene on stdout",
+                                        NULL,
+                                        0,
+                                        starter_name,
+                                        NULL};
+
 int fmb_cmd_new(int argc, char** argv) {
-  if (argc != 3) {
+  NewArgs o = {NULL};
+  int rc;
+  if (fmb_opt_parse(&fmb_new_command, argc, argv, &o, &rc)) return rc;
+  if (!o.name) {
     fprintf(stderr, "usage: flexmbd new NAME > scene.yaml, with NAME one of:\n");
     list_starters(stderr);
     return FMB_EXIT_BAD_INPUT;
   }
   for (int i = 0; i < NSTARTERS; ++i)
-    if (strcmp(argv[2], starters[i].name) == 0) {
+    if (strcmp(o.name, starters[i].name) == 0) {
       fputs(starters[i].text, stdout);
       return fflush(stdout) == 0 ? 0 : FMB_EXIT_BAD_INPUT;
     }
-  fprintf(stderr, "flexmbd new: no starter named '%s'; there are:\n", argv[2]);
+  fprintf(stderr, "flexmbd new: no starter named '%s'; there are:\n", o.name);
   list_starters(stderr);
   return FMB_EXIT_BAD_INPUT;
 }

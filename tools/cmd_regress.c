@@ -26,29 +26,55 @@
 
 #define DEFAULT_TIMEOUT_S 600.0
 
-static void usage(FILE* f) {
-  fprintf(
-      f,
-      "usage: flexmbd regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]... [--slow F] [--rows N]\n"
-      "  PATH        a scene, or a folder searched for scenes with a reference SCENE.ref.csv (default: .)\n"
-      "  --bless     write or update the references (a folder: every *.yaml in it); with --set, the\n"
-      "              references record those overrides, otherwise the ones they had\n"
-      "  --junit F   also write the results as JUnit XML\n"
-      "  -j N        run N scenes at once\n"
-      "  --slow F    warn when a scene takes more than F times its reference's CPU time (default 3)\n"
-      "  --rows N    rows kept in a reference (default %d)\n"
-      "  --timeout S wall time allowed per scene, in seconds (default %g)\n"
-      "exit: 0 all pass, 1 a scene fails, 2 bad input, 4 interrupted\n",
-      REGRESS_DEFAULT_ROWS, DEFAULT_TIMEOUT_S);
-}
+typedef struct {
+  RegressOptions o;
+  RegressList paths;
+} RegressArgs;
 
-static int positive_int(const char* s, int lo, int hi, int* out) {
-  char* end;
-  long v = s ? strtol(s, &end, 10) : 0;
-  if (!s || end == s || *end || v < lo || v > hi) return -1;
-  *out = (int)v;
+static int regress_read_set(const fmbOptContext* ctx, void* at, const char* value) {
+  RegressOptions* o = at;
+  if (fmb_cli_check_set(ctx->cmd, value, ctx->next)) return FMB_EXIT_BAD_INPUT;
+  o->sets[o->nsets++] = value; /* o->sets has room for every argument */
   return 0;
 }
+
+static int regress_path(const fmbOptContext* ctx, const char* arg) {
+  RegressArgs* a = ctx->self;
+  return regress_list_push(&a->paths, (char*)arg) ? FMB_EXIT_BAD_INPUT : 0;
+}
+
+#define STR_(x) #x
+#define STR(x) STR_(x)
+static const fmbOpt regress_options[] = {
+    {"--bless", NULL, FMB_OPT_FLAG, NULL, offsetof(RegressArgs, o.bless),
+     "write or update the references (a folder: every *.yaml in it)", NULL, 0, 0, NULL, NULL, 0},
+    {"--junit", NULL, FMB_OPT_STRING, "FILE", offsetof(RegressArgs, o.junit), "also write the results as JUnit XML",
+     "a file name", 0, 0, NULL, NULL, 0},
+    {"--jobs", "-j", FMB_OPT_INT, "N", offsetof(RegressArgs, o.jobs), "run N scenes at once",
+     "a whole number from 1 to 256", 1, 256, NULL, NULL, 0},
+    {"--set", NULL, FMB_OPT_CALL, "PATH=VALUE", offsetof(RegressArgs, o),
+     "override a value of every scene; with --bless the references record it", "PATH=VALUE", 0, 0, NULL,
+     regress_read_set, FMB_OPT_REPEAT},
+    {"--slow", NULL, FMB_OPT_DOUBLE, "F", offsetof(RegressArgs, o.slow),
+     "warn when a scene takes more than F times its reference's CPU time (default 3)", "a factor >= 1", 1, HUGE_VAL,
+     NULL, NULL, 0},
+    {"--rows", NULL, FMB_OPT_INT, "N", offsetof(RegressArgs, o.rows),
+     "rows kept in a reference (default " STR(REGRESS_DEFAULT_ROWS) ")", "a whole number from 2 to 100000", 2, 100000,
+     NULL, NULL, 0},
+    {"--timeout", NULL, FMB_OPT_DOUBLE, "SEC", offsetof(RegressArgs, o.timeout_s),
+     "wall time allowed per scene (default 600)", "a number of seconds > 0", 0, HUGE_VAL, NULL, NULL,
+     FMB_OPT_ABOVE_MIN},
+};
+
+const fmbCommandSpec fmb_regress_command = {
+    "regress",
+    "[PATH...]",
+    "scenes against their stored references (PATH: a scene, or a folder searched for scenes with a reference "
+    "SCENE.ref.csv; default .)",
+    regress_options,
+    FMB_OPT_COUNT(regress_options),
+    regress_path,
+    "exit: 0 all pass, 1 a scene fails, 2 bad input, 4 interrupted (docs/regression.md)\n"};
 
 static void remove_tmpdir(const char* dir) {
   DIR* d = opendir(dir);
@@ -71,74 +97,21 @@ static int regress(const RegressOptions* op, const RegressList* sc, RegressList*
    hangs off o, paths and scenes, which the caller frees) */
 static int parse_arguments(int argc, char** argv, RegressOptions* op, RegressList* pathsp, RegressList* scenesp,
                            RegressList* notes) {
-  RegressOptions o = *op;
-  RegressList paths = {0}, scenes = {0};
+  RegressArgs args = {*op, {0}};
+  RegressList scenes = {0};
   int rc = -1;
 #define return_code(c) \
   do {                 \
     rc = (c);          \
     goto out;          \
   } while (0)
-  for (int i = 2; i < argc; ++i) {
-    const char* a = argv[i];
-    const char* v;
-    if (strcmp(a, "--bless") == 0) {
-      o.bless = 1;
-    } else if (strcmp(a, "--junit") == 0) {
-      if (!(o.junit = fmb_cli_value("regress", argc, argv, &i, "a file name"))) return_code(FMB_EXIT_BAD_INPUT);
-    } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "a number")) || positive_int(v, 1, 256, &o.jobs)) {
-        fprintf(stderr, "flexmbd regress: -j needs a whole number from 1 to 256\n");
-        return_code(FMB_EXIT_BAD_INPUT);
-      }
-    } else if (strncmp(a, "-j", 2) == 0 && a[2]) {
-      if (positive_int(a + 2, 1, 256, &o.jobs)) {
-        fprintf(stderr, "flexmbd regress: -j needs a whole number from 1 to 256\n");
-        return_code(FMB_EXIT_BAD_INPUT);
-      }
-    } else if (strcmp(a, "--rows") == 0) {
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "a number")) || positive_int(v, 2, 100000, &o.rows)) {
-        fprintf(stderr, "flexmbd regress: --rows needs a whole number from 2 to 100000\n");
-        return_code(FMB_EXIT_BAD_INPUT);
-      }
-    } else if (strcmp(a, "--timeout") == 0) {
-      char* end;
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "seconds")) || (o.timeout_s = strtod(v, &end), *end) ||
-          !(o.timeout_s > 0.0) || !isfinite(o.timeout_s)) {
-        fprintf(stderr, "flexmbd regress: --timeout needs a number of seconds > 0\n");
-        return_code(FMB_EXIT_BAD_INPUT);
-      }
-    } else if (strcmp(a, "--slow") == 0) {
-      char* end;
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "a factor")) || (o.slow = strtod(v, &end), *end) ||
-          !(o.slow >= 1.0) || !isfinite(o.slow)) {
-        fprintf(stderr, "flexmbd regress: --slow needs a factor >= 1\n");
-        return_code(FMB_EXIT_BAD_INPUT);
-      }
-    } else if (strcmp(a, "--set") == 0) {
-      if (!(v = fmb_cli_value("regress", argc, argv, &i, "PATH=VALUE")) ||
-          fmb_cli_check_set("regress", v, i + 1 < argc ? argv[i + 1] : NULL))
-        return_code(FMB_EXIT_BAD_INPUT);
-      op->sets[o.nsets++] = v;
-    } else if (strncmp(a, "--set=", 6) == 0) {
-      if (fmb_cli_check_set("regress", a + 6, i + 1 < argc ? argv[i + 1] : NULL)) return_code(FMB_EXIT_BAD_INPUT);
-      op->sets[o.nsets++] = a + 6;
-    } else if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-      usage(stdout);
-      return_code(0);
-    } else if (a[0] == '-' && a[1]) {
-      fprintf(stderr, "flexmbd regress: unknown option '%s'\n", a);
-      usage(stderr);
-      return_code(FMB_EXIT_BAD_INPUT);
-    } else {
-      if (regress_list_push(&paths, (char*)a)) return_code(FMB_EXIT_BAD_INPUT);
-    }
-  }
-  if (paths.n == 0 && regress_list_push(&paths, ".")) return_code(FMB_EXIT_BAD_INPUT);
+  if (fmb_opt_parse(&fmb_regress_command, argc, argv, &args, &rc)) goto out;
+  rc = -1;
+  if (args.paths.n == 0 && regress_list_push(&args.paths, ".")) return_code(FMB_EXIT_BAD_INPUT);
   /* the scenes */
-  for (int i = 0; i < paths.n; ++i) {
+  for (int i = 0; i < args.paths.n; ++i) {
     struct stat st;
-    const char* p = paths.v[i];
+    const char* p = args.paths.v[i];
     if (stat(p, &st) != 0) {
       fprintf(stderr, "flexmbd regress: %s: %s\n", p, strerror(errno));
       return_code(FMB_EXIT_BAD_INPUT);
@@ -146,13 +119,13 @@ static int parse_arguments(int argc, char** argv, RegressOptions* op, RegressLis
     if (S_ISDIR(st.st_mode)) {
       int before = scenes.n;
       char why[1400];
-      if (regress_walk(p, o.bless, &scenes, notes, why, sizeof why)) {
+      if (regress_walk(p, args.o.bless, &scenes, notes, why, sizeof why)) {
         fprintf(stderr, "flexmbd regress: %s\n", why);
         return_code(FMB_EXIT_BAD_INPUT);
       }
       if (scenes.n == before) {
-        fprintf(stderr, "flexmbd regress: no scene %sunder %s%s\n", o.bless ? "" : "with a reference ", p,
-                o.bless ? "" : " (make references with: flexmbd regress --bless PATH)");
+        fprintf(stderr, "flexmbd regress: no scene %sunder %s%s\n", args.o.bless ? "" : "with a reference ", p,
+                args.o.bless ? "" : " (make references with: flexmbd regress --bless PATH)");
         return_code(FMB_EXIT_BAD_INPUT);
       }
     } else if (S_ISREG(st.st_mode)) {
@@ -169,9 +142,8 @@ static int parse_arguments(int argc, char** argv, RegressOptions* op, RegressLis
   }
 out:
 #undef return_code
-  o.sets = op->sets;
-  *op = o;
-  *pathsp = paths;
+  *op = args.o;
+  *pathsp = args.paths;
   *scenesp = scenes;
   return rc;
 }

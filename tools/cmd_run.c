@@ -2,6 +2,7 @@
  *                [--vtk DIR] [--reference REF.csv [--columns a,b]]
  *                [--models zoac,foac,complete,exact]`
  * Integrates the scene, writing the CSV as it goes; the last stderr line is the stats line. */
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,53 +10,57 @@
 
 #include "cli.h"
 
+typedef struct {
+  fmbCliScene s; /* first: fmb_opt_scene_positional */
+  const char* out;
+  const char* reference; /* --reference REF.csv: error against REF and the run's cost */
+  const char* columns;
+  int quiet, progress;
+  const char* vtk;    /* --vtk DIR: a ParaView animation there */
+  int vtk_every;      /* --vtk-every N: of every Nth row */
+  const char* models; /* --models zoac,foac,complete,exact: tools/run_models.c */
+  int serve;          /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
+} RunArgs;
+
+#define RUN_STRING(name, alias, meta, field, help, needs) \
+  { name, alias, FMB_OPT_STRING, meta, offsetof(RunArgs, field), help, needs, 0, 0, NULL, NULL, 0 }
+#define RUN_FLAG(name, alias, field, help) \
+  { name, alias, FMB_OPT_FLAG, NULL, offsetof(RunArgs, field), help, NULL, 0, 0, NULL, NULL, 0 }
+static const fmbOpt run_options[] = {
+    RUN_STRING("--output", "-o", "OUT.csv", out, "the CSV, written as the run goes (default: stdout)", "a file name"),
+    FMB_OPT_SCENE_ENTRIES(RunArgs, s),
+    RUN_FLAG("--quiet", "-q", quiet, "no progress line, no warnings but errors"),
+    RUN_FLAG("--progress", NULL, progress, "the progress line from the start, also off a terminal"),
+    RUN_STRING("--vtk", NULL, "DIR", vtk, "the run as a ParaView animation in DIR", "a directory"),
+    {"--vtk-every", NULL, FMB_OPT_INT, "N", offsetof(RunArgs, vtk_every), "animate every Nth row (default 1)",
+     "a whole number N >= 1 (every Nth row)", 1, 1000000000, NULL, NULL, 0},
+    RUN_STRING("--reference", NULL, "REF.csv", reference, "also print the error against REF and the run's cost",
+               "a CSV file"),
+    RUN_STRING("--columns", NULL, "a,b,...", columns, "the columns compared with --reference",
+               "a comma-separated list"),
+    RUN_STRING("--models", NULL, "zoac,foac,complete,exact", models,
+               "once per beam model, columns NAME@MODEL, a stats line each", "a comma-separated list of beam models"),
+    RUN_FLAG("--serve", NULL, serve, "internal: runs on demand for `sweep --runner serve`"),
+};
+
+const fmbCommandSpec fmb_run_command = {"run",
+                                        "SCENE.yaml",
+                                        "integrate the scene, writing the CSV as it goes; the last stderr line is "
+                                        "the stats line",
+                                        run_options,
+                                        FMB_OPT_COUNT(run_options),
+                                        fmb_opt_scene_positional,
+                                        NULL};
+
 int fmb_cmd_run(int argc, char** argv) {
-  fmbCliScene s;
-  memset(&s, 0, sizeof s);
-  const char* out = NULL;
-  const char* reference = NULL; /* --reference REF.csv: error against REF and the run's cost */
-  const char* columns = NULL;
-  int quiet = 0, progress = 0;
-  const char* vtk = NULL;    /* --vtk DIR: a ParaView animation there */
-  int vtk_every = 1;         /* --vtk-every N: of every Nth row */
-  const char* models = NULL; /* --models zoac,foac,complete,exact: tools/run_models.c */
-  int serve = 0;             /* --serve: runs on demand for `sweep --runner serve` (tools/run_serve.c) */
-  for (int i = 2; i < argc; ++i) {
-    const char* a = argv[i];
-    int r = fmb_cli_take_scene_arg("run", argc, argv, &i, &s);
-    if (r == 1) continue;
-    if (r) return r;
-    if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-      if (!(out = fmb_cli_value("run", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--reference") == 0) {
-      if (!(reference = fmb_cli_value("run", argc, argv, &i, "a CSV file"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--columns") == 0) {
-      if (!(columns = fmb_cli_value("run", argc, argv, &i, "a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--models") == 0) {
-      if (!(models = fmb_cli_value("run", argc, argv, &i, "a comma-separated list of beam models")))
-        return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-      quiet = 1;
-    } else if (strcmp(a, "--serve") == 0) {
-      serve = 1;
-    } else if (strcmp(a, "--progress") == 0) {
-      progress = 1;
-    } else if (strcmp(a, "--vtk") == 0) {
-      if (!(vtk = fmb_cli_value("run", argc, argv, &i, "a directory"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--vtk-every") == 0) {
-      const char* v = fmb_cli_value("run", argc, argv, &i, "a whole number N >= 1");
-      char* end = NULL;
-      const long n = v ? strtol(v, &end, 10) : 0;
-      if (!v || end == v || *end || n < 1 || n > 1000000000L) {
-        if (v) fprintf(stderr, "flexmbd run: --vtk-every expects a whole number N >= 1 (every Nth row), got '%s'\n", v);
-        return FMB_EXIT_BAD_INPUT;
-      }
-      vtk_every = (int)n;
-    } else {
-      fprintf(stderr, "flexmbd run: unknown option '%s'\n", a);
-      return FMB_EXIT_BAD_INPUT;
-    }
-  }
+  RunArgs o;
+  memset(&o, 0, sizeof o);
+  o.vtk_every = 1;
+  int rc;
+  if (fmb_opt_parse(&fmb_run_command, argc, argv, &o, &rc)) return rc;
+  const fmbCliScene s = o.s;
+  const char *out = o.out, *reference = o.reference, *columns = o.columns, *vtk = o.vtk, *models = o.models;
+  const int quiet = o.quiet, progress = o.progress, vtk_every = o.vtk_every, serve = o.serve;
   if (reference && (!out || strcmp(out, "-") == 0)) {
     fprintf(stderr, "flexmbd: --reference needs the run's CSV in a file (-o OUT.csv)\n");
     return FMB_EXIT_BAD_INPUT;
@@ -98,7 +103,7 @@ int fmb_cmd_run(int argc, char** argv) {
                        .vtk_dir = vtk,
                        .vtk_every = vtk_every,
                        .stop = stop};
-  int rc = fmb_run(m, &opt, &stats, &diag);
+  rc = fmb_run(m, &opt, &stats, &diag);
   fmb_cli_warn_end();
   if (rc) fmb_cli_print_diag(&diag);
   if (reference) {

@@ -3,6 +3,7 @@
  * with its drives held at t0 or T: the scene's outputs as one CSV row; the last stderr line is
  * `stats: status=... t=... speed=... iterations=... load_steps=... residual=... cpu_s=...`. */
 #include <math.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -10,50 +11,17 @@
 
 #include "cli.h"
 
-static int parse_time(const char* cmd, const char* text, double* t) {
+int fmb_cli_read_at(const fmbOptContext* ctx, void* at, const char* text) {
+  fmbCliAnalysis* a = at;
   char* end;
-  *t = strtod(text, &end);
+  a->opt.t = strtod(text, &end);
   /* nan and inf parse as numbers; they are bad input, not a solver failure at t = nan */
-  if (end == text || *end != '\0' || !isfinite(*t)) {
-    fprintf(stderr, "flexmbd %s: --at needs a finite time in seconds, got '%s'\n", cmd, text);
+  if (end == text || *end != '\0' || !isfinite(a->opt.t)) {
+    fprintf(stderr, "flexmbd %s: --at needs a finite time in seconds, got '%s'\n", ctx->cmd, text);
     return FMB_EXIT_BAD_INPUT;
   }
+  a->opt.has_t = a->at_given = 1;
   return 0;
-}
-
-int fmb_cli_take_analysis_arg(const char* cmd, int argc, char** argv, int* i, fmbCliAnalysis* a) {
-  const char* arg = argv[*i];
-  if (strcmp(arg, "--at") == 0) {
-    const char* v = fmb_cli_value(cmd, argc, argv, i, "a time");
-    if (!v || parse_time(cmd, v, &a->opt.t)) return FMB_EXIT_BAD_INPUT;
-    a->opt.has_t = a->at_given = 1;
-  } else if (strcmp(arg, "--quiet") == 0 || strcmp(arg, "-q") == 0) {
-    a->quiet = 1;
-  } else if (a->count_max > 0 && strcmp(arg, "--eigen") == 0) {
-    static const char* const names[] = {"auto", "dense", "sparse"}; /* FMB_EIGEN_* order */
-    const char* v = fmb_cli_value(cmd, argc, argv, i, "dense, sparse or auto");
-    if (!v) return FMB_EXIT_BAD_INPUT;
-    a->method = -1;
-    for (int k = 0; k < 3; ++k)
-      if (strcmp(v, names[k]) == 0) a->method = k;
-    if (a->method < 0) {
-      fprintf(stderr, "flexmbd %s: --eigen expects dense, sparse or auto, got '%s'\n", cmd, v);
-      return FMB_EXIT_BAD_INPUT;
-    }
-  } else if (a->count_max > 0 && strcmp(arg, "--count") == 0) {
-    const char* v = fmb_cli_value(cmd, argc, argv, i, "a number of modes");
-    char* end;
-    if (!v) return FMB_EXIT_BAD_INPUT;
-    const long k = strtol(v, &end, 10);
-    if (*end || end == v || k < 1 || k > a->count_max) {
-      fprintf(stderr, "flexmbd %s: --count needs an integer from 1 to %d, got '%s'\n", cmd, a->count_max, v);
-      return FMB_EXIT_BAD_INPUT;
-    }
-    a->count = (int)k;
-  } else {
-    return 0;
-  }
-  return 1;
 }
 
 int fmb_cli_steady_state(const fmbCliScene* s, int nover, const fmbStaticOptions* opt, fmbModel** m, double** y,
@@ -72,25 +40,35 @@ void fmb_cli_print_static(const fmbStaticResult* r, int ok, double cpu_s, FILE* 
           r->residual_start, cpu_s);
 }
 
-int fmb_cmd_static(int argc, char** argv) {
-  fmbCliScene s;
-  memset(&s, 0, sizeof s);
+typedef struct {
+  fmbCliScene s; /* first: fmb_opt_scene_positional */
   fmbCliAnalysis an;
-  memset(&an, 0, sizeof an);
-  const char* out = NULL;
-  for (int i = 2; i < argc; ++i) {
-    const char* a = argv[i];
-    int r = fmb_cli_take_scene_arg("static", argc, argv, &i, &s);
-    if (!r) r = fmb_cli_take_analysis_arg("static", argc, argv, &i, &an);
-    if (r == 1) continue;
-    if (r) return r;
-    if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-      if (!(out = fmb_cli_value("static", argc, argv, &i, "a file name"))) return FMB_EXIT_BAD_INPUT;
-    } else {
-      fprintf(stderr, "flexmbd static: unknown option '%s'\n", a);
-      return FMB_EXIT_BAD_INPUT;
-    }
-  }
+  const char* out;
+} StaticArgs;
+
+static const fmbOpt static_options[] = {
+    {"--output", "-o", FMB_OPT_STRING, "OUT.csv", offsetof(StaticArgs, out),
+     "the state as one CSV row (default: stdout)", "a file name", 0, 0, NULL, NULL, 0},
+    FMB_CLI_ANALYSIS_ENTRIES(StaticArgs, an),
+    FMB_OPT_SCENE_ENTRIES(StaticArgs, s),
+};
+
+const fmbCommandSpec fmb_static_command = {"static",
+                                           "SCENE.yaml",
+                                           "equilibrium, or steady rotation under a constant-speed drive",
+                                           static_options,
+                                           FMB_OPT_COUNT(static_options),
+                                           fmb_opt_scene_positional,
+                                           NULL};
+
+int fmb_cmd_static(int argc, char** argv) {
+  StaticArgs o;
+  memset(&o, 0, sizeof o);
+  int rc;
+  if (fmb_opt_parse(&fmb_static_command, argc, argv, &o, &rc)) return rc;
+  const fmbCliScene s = o.s;
+  fmbCliAnalysis an = o.an;
+  const char* out = o.out;
   if (!s.scene) {
     fprintf(stderr, "flexmbd static: no scene file given\n");
     return FMB_EXIT_BAD_INPUT;
@@ -102,7 +80,7 @@ int fmb_cmd_static(int argc, char** argv) {
   fmbModel* m;
   double *y, *yp;
   const clock_t c0 = clock();
-  int rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
+  rc = fmb_cli_steady_state(&s, s.nover, &an.opt, &m, &y, &yp, &res, &diag);
   if (!rc) rc = fmb_write_state_row(m, out, res.t, y, yp, &diag);
   if (rc) fmb_cli_print_diag(&diag);
   /* bad input ran nothing: the error line is the last word, as for `run` */

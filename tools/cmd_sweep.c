@@ -5,44 +5,24 @@
  *                 [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...] [--keep summary|series]
  *                 [--runner auto|spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] [--yes] [--quiet] [--plugin x.so]...`
  *               `flexmbd sweep --status DIR`
- * Options -> plan -> engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
+ * This file reads the options (one table, tools/options.h); tools/sweep_main.c goes from them to
+ * the plan and the engine (docs/sweep.md). Every run is a child process (child_pool.c), its row
  * appended to DIR/runs.csv as it ends (sweep_journal.c); at the end DIR/table.csv (sorted by
  * index) and, when built with HDF5, DIR/sweep.h5. Under mpirun/srun the ranks share the runs
  * (farm.c, sweep_mpi.c). Exit: 0 every planned run has a row (whatever its status), 2 bad spec (or
  * the folder is another sweep's, or holds files the sweep did not make), 3 a write failed (a full
  * disk) or no runner could be started, 4 interrupted (SIGINT/SIGTERM: every child killed, the
  * journal flushed); 3 and 4 resume when run again. */
-#define _GNU_SOURCE /* sched_getaffinity */
-#include <dirent.h>
-#include <errno.h>
 #include <math.h>
-#include <sched.h>
-#include <signal.h>
+#include <stddef.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include "cli.h"
-#include "flexmbd_commit.h" /* generated at build time: FLEXMBD_COMMIT */
 #include "sweep.h"
 
-#define YES_LIMIT 1e6 /* a larger plan needs --yes */
-#define MAX_PLAN 1e9  /* a larger plan is refused */
-
-static volatile sig_atomic_t stop_requested;
-static void on_stop(int sig) {
-  (void)sig;
-  stop_requested = 1;
-}
-
-static int bad(const char* fmt, const char* what) {
-  fprintf(stderr, "flexmbd sweep: ");
-  fprintf(stderr, fmt, what);
-  fputc('\n', stderr);
-  return FMB_EXIT_BAD_INPUT;
-}
+#define bad fmb_sweep_bad
 
 /* COL:max,min,end,rms -> one metric per statistic */
 static int add_metrics(fmbSweep* sw, const char* spec) {
@@ -66,599 +46,189 @@ static int add_metrics(fmbSweep* sw, const char* spec) {
   return 0;
 }
 
-/* the id of every run: FNV-1a 64 over the scene's bytes, the verb, the engine version, the plugins
-   and the run's overrides (fixed and swept), sorted, numbers printed %.17g; identical runs share
-   one id and run once */
-static int by_text(const void* a, const void* b) { return strcmp(*(char* const*)a, *(char* const*)b); }
-static uint64_t hash_file(uint64_t h, const char* path) { /* the plugins' files */
-  FILE* f = fopen(path, "rb");
-  if (!f) return h;
-  char buf[1 << 15];
-  size_t n;
-  while ((n = fread(buf, 1, sizeof buf, f)) > 0) h = fmb_fnv1a(h, buf, n);
-  fclose(f);
-  return h;
+static int read_metric(const fmbOptContext* ctx, void* at, const char* v) {
+  (void)ctx;
+  return add_metrics(at, v) ? FMB_EXIT_BAD_INPUT : 0;
 }
-typedef struct {
-  uint64_t id;
-  long i;
-} IdIndex;
-static int by_id(const void* a, const void* b) {
-  const IdIndex *x = a, *y = b;
-  return x->id < y->id ? -1 : x->id > y->id ? 1 : (x->i > y->i) - (x->i < y->i);
+
+/* --grid, --zip, --random: a factor of the plan */
+static int read_factor(const fmbOptContext* ctx, void* at, const char* v) {
+  fmbSweepPlan* plan = at;
+  char err[1200];
+  const int r = ctx->option[2] == 'g'   ? fmb_plan_add_grid(plan, v, err, sizeof err)
+                : ctx->option[2] == 'z' ? fmb_plan_add_zip(plan, v, err, sizeof err)
+                                        : fmb_plan_add_random(plan, v, err, sizeof err);
+  return r ? bad("%s", err) : 0;
 }
-static int make_ids(fmbSweep* sw, const char* scene_text, size_t scene_len) {
-  sw->id = malloc((size_t)sw->nrun * sizeof *sw->id);
-  sw->first = malloc((size_t)sw->nrun * sizeof *sw->first);
-  if (!sw->id || !sw->first) return -1;
-  uint64_t base = fmb_fnv1a(FMB_FNV_OFFSET, "flexmbd sweep run 1", 20);
-  base = fmb_fnv1a(base, scene_text, scene_len); /* the bytes of the snapshot the runs read */
-  const char* version = FLEXMBD_VERSION " " FLEXMBD_COMMIT;
-  base = fmb_fnv1a(base, sw->verb, strlen(sw->verb) + 1);
-  base = fmb_fnv1a(base, version, strlen(version) + 1);
-  for (int k = 0; k < sw->nplugins; ++k) base = hash_file(base, sw->plugins[k]);
-  const int nset = sw->nfixed + sw->plan.npath;
-  char** sets = malloc((size_t)nset * sizeof *sets);
-  char* text = malloc((size_t)sw->plan.npath * 600);
-  if (!sets || !text) return free(sets), free(text), -1;
-  sw->digest = FMB_FNV_OFFSET;
-  for (long i = 0; i < sw->nrun; ++i) {
-    int n = 0;
-    for (int k = 0; k < sw->nfixed; ++k) sets[n++] = (char*)sw->fixed[k];
-    for (int k = 0; k < sw->plan.npath; ++k) {
-      snprintf(text + 600 * k, 600, "%s=%s", sw->plan.path[k], fmb_plan_value(&sw->plan, i, k));
-      sets[n++] = text + 600 * k;
-    }
-    qsort(sets, (size_t)n, sizeof *sets, by_text);
-    uint64_t h = base;
-    for (int k = 0; k < n; ++k) h = fmb_fnv1a(h, sets[k], strlen(sets[k]) + 1);
-    sw->id[i] = fmb_mix64(h); /* FNV-1a alone leaves ids of runs that differ in a last digit alike */
-    sw->digest = fmb_fnv1a(sw->digest, &h, sizeof h);
-  }
-  free(sets), free(text);
-  /* identical runs: the first index of each id (a sorted copy keeps this O(n log n)) */
-  IdIndex* p = malloc((size_t)sw->nrun * sizeof *p);
-  if (!p) return -1;
-  for (long i = 0; i < sw->nrun; ++i) p[i] = (IdIndex){sw->id[i], i};
-  qsort(p, (size_t)sw->nrun, sizeof *p, by_id);
-  for (long k = 0; k < sw->nrun; ++k)
-    sw->first[p[k].i] = k > 0 && p[k].id == p[k - 1].id ? sw->first[p[k - 1].i] : p[k].i;
-  free(p);
+
+/* --samples F.csv, read once (its copy goes to DIR/inputs) */
+static int read_samples(const fmbOptContext* ctx, void* at, const char* v) {
+  fmbSweepArgs* a = ctx->self;
+  fmbSweep* sw = at;
+  char err[1200];
+  if (sw->samples_text) return bad("one --samples file at a time%s", "");
+  if (fmb_sweep_read_input(v, 1u << 30, &sw->samples_text, &sw->samples_len, err, sizeof err) ||
+      fmb_plan_add_samples(&sw->plan, v, sw->samples_text, sw->samples_len, err, sizeof err))
+    return bad("--samples %s", err);
+  a->samples_name = v;
   return 0;
 }
 
-/* a file of our own in DIR/logs (mkstemp: created new, never a link or someone's file), closed */
-static int own_temp(const fmbSweep* sw, const char* stem, char* path, size_t len) {
-  snprintf(path, len, "%s/logs/%s.XXXXXX", sw->dir, stem);
-  const int fd = mkstemp(path);
-  if (fd < 0) return -1;
-  close(fd);
+static int read_seed(const fmbOptContext* ctx, void* at, const char* v) {
+  char* end;
+  *(uint64_t*)at = strtoull(v, &end, 10);
+  if (*end || !*v || v[0] == '-') return bad("--seed needs a whole number >= 0, got '%s'", v);
+  ((fmbSweepArgs*)ctx->self)->seed_given = 1;
   return 0;
 }
 
-/* `flexmbd check` of run `index` in a child: its exit code (its messages on stderr when it fails);
-   with --verb run, every --metric column is checked against the outputs it lists (2 when one is
-   missing: refused before any run) */
-static int check_run(fmbSweep* sw, long index, int verbose) {
-  char err[4300], out[4300];
-  if (own_temp(sw, "check-err", err, sizeof err) || own_temp(sw, "check-out", out, sizeof out)) {
-    fprintf(stderr, "flexmbd sweep: cannot create a file in %s/logs: %s\n", sw->dir, strerror(errno));
-    unlink(err);
-    return 3;
-  }
-  char* argv[FMB_SWEEP_MAX_ARGS];
-  char sets[FMB_SWEEP_MAX_PATHS][FMB_SWEEP_SET_LEN];
-  fmb_sweep_argv(sw, index, "check", NULL, argv, sets);
-  fmbPool* pool = fmb_pool_new(1);
-  /* a check that crashes or hangs is left to the runs to record; only refused input stops the sweep */
-  fmbChildSpec spec = {.argv = argv,
-                       .stdout_path = out,
-                       .stderr_path = err,
-                       .timeout_s = sw->timeout_s < 10 ? sw->timeout_s : 10.0,
-                       .mem_limit_mb = sw->mem_limit_mb};
-  fmbChildResult r = {.status = FMB_CHILD_CRASHED};
-  if (pool && fmb_pool_start(pool, &spec) == 0)
-    while (fmb_pool_wait(pool, 1.0, &r) == 0) {
-    }
-  fmb_pool_free(pool);
-  int rc = r.status == FMB_CHILD_OK ? 0 : r.status == FMB_CHILD_BAD_INPUT ? 2 : 3;
-  if (verbose || rc) {
-    fprintf(stderr, "check of run %ld:", index);
-    for (int k = 0; k < sw->plan.npath; ++k) fprintf(stderr, " %s", sets[k]);
-    fprintf(stderr, ": %s\n", rc == 0 ? "loads" : fmb_child_status_name(r.status));
-    FILE* f = rc ? fopen(err, "r") : NULL;
-    char line[2048];
-    while (f && fgets(line, sizeof line, f))
-      if (strncmp(line, "stats:", 6) != 0) fprintf(stderr, "  %s", line);
-    if (f) fclose(f);
-  }
-  if (rc == 0 && strcmp(sw->verb, "run") == 0 && sw->nmetric > 0) { /* "outputs: t a b ..." */
-    FILE* f = fopen(out, "r");
-    size_t cap = 0;
-    char* line = NULL;
-    while (f && getline(&line, &cap, f) > 0 && strncmp(line, "outputs: ", 9) != 0) {
-    }
-    for (int k = 0; f && line && strncmp(line, "outputs: ", 9) == 0 && k < sw->nmetric; ++k) {
-      const char* c = sw->metric[k].column;
-      const size_t n = strlen(c);
-      int found = 0;
-      for (const char* p = line + 8; p && !found; p = strchr(p + 1, ' '))
-        found = strncmp(p + 1, c, n) == 0 && (p[1 + n] == ' ' || p[1 + n] == '\n' || !p[1 + n]);
-      if (!found) {
-        line[strcspn(line, "\n")] = '\0';
-        fprintf(stderr, "flexmbd sweep: --metric %s: the runs have no column '%s' (%s)\n", c, c, line);
-        rc = 2;
-        break;
-      }
-    }
-    free(line);
-    if (f) fclose(f);
-  }
-  unlink(err);
-  unlink(out);
-  return rc;
+/* --set PATH=VALUE: numbers as every run gets them, %.17g (so the run id does not depend on how
+   they were typed) */
+static int read_set(const fmbOptContext* ctx, void* at, const char* v) {
+  (void)ctx;
+  fmbSweep* sw = at;
+  if (!strchr(v, '=') || sw->nfixed == FMB_SWEEP_MAX_FIXED) return bad("--set needs PATH=VALUE, got '%s'", v);
+  char* end;
+  const char* val = strchr(v, '=') + 1;
+  double x = strtod(val, &end);
+  char* t = malloc(strlen(v) + 40);
+  if (!t) return FMB_EXIT_BAD_INPUT;
+  if (end != val && !*end && isfinite(x))
+    sprintf(t, "%.*s=%.17g", (int)(val - 1 - v), v, x);
+  else
+    strcpy(t, v);
+  sw->fixed[sw->nfixed++] = t;
+  return 0;
 }
 
-/* DIR (and its parents), DIR/series, DIR/logs, DIR/inputs: made, or folders already (never links: a link planted
-   there would send the runs' files elsewhere) */
-static int make_dirs(const char* dir) {
-  char p[4300];
-  const char* sub[4] = {"", "/series", "/logs", "/inputs"};
-  snprintf(p, sizeof p, "%s", dir); /* its parents too (-o out/study in a fresh checkout) */
-  for (char* c = strchr(p + 1, '/'); c; c = strchr(c + 1, '/')) {
-    *c = '\0';
-    if (mkdir(p, 0755) != 0 && errno != EEXIST) break; /* said below, at DIR itself */
-    *c = '/';
-  }
-  for (int k = 0; k < 4; ++k) {
-    snprintf(p, sizeof p, "%s%s", dir, sub[k]);
-    struct stat st;
-    if (mkdir(p, 0755) != 0 && errno != EEXIST) {
-      fprintf(stderr, "flexmbd sweep: cannot create %s: %s\n", p, strerror(errno));
-      return FMB_EXIT_BAD_INPUT;
-    }
-    if ((k ? lstat(p, &st) : stat(p, &st)) != 0 || !S_ISDIR(st.st_mode)) {
-      fprintf(stderr, "flexmbd sweep: %s is not a folder of its own (a file or a link): give another -o DIR\n", p);
-      return FMB_EXIT_BAD_INPUT;
-    }
-    /* no link in series/ or logs/: a run's CSV or log written through one would land elsewhere */
-    DIR* d = k == 1 || k == 2 ? opendir(p) : NULL;
-    struct dirent* e;
-    while (d && (e = readdir(d))) {
-      char q[4600];
-      snprintf(q, sizeof q, "%s/%s", p, e->d_name);
-      if (lstat(q, &st) == 0 && S_ISLNK(st.st_mode)) {
-        fprintf(stderr, "flexmbd sweep: %s is a symbolic link: the sweep writes only files of its own there\n", q);
-        closedir(d);
-        return FMB_EXIT_BAD_INPUT;
-      }
-    }
-    if (d) closedir(d);
+/* --plugin x.so: its real path, hashed into the run ids and handed to every run */
+static int read_plugin(const fmbOptContext* ctx, void* at, const char* v) {
+  (void)ctx;
+  fmbSweep* sw = at;
+  if (sw->nplugins == 16) return bad("at most 16 --plugin files%s", "");
+  char* real = realpath(v, NULL);
+  if (!real) return bad("--plugin: cannot find '%s'", v);
+  sw->plugins[sw->nplugins++] = real;
+  return 0;
+}
+
+static int read_timeout(const fmbOptContext* ctx, void* at, const char* v) {
+  (void)ctx;
+  fmbSweep* sw = at;
+  char* end;
+  double t = strtod(v, &end);
+  const int rel = *end == 'x' && !end[1];
+  if (end == v || (*end && !rel) || !(t > 0) || !isfinite(t))
+    return bad("--timeout needs SEC (> 0) or Nx (N times the median of ok runs), got '%s'", v);
+  if (rel)
+    sw->timeout_factor = t;
+  else
+    sw->timeout_s = t;
+  return 0;
+}
+
+static int read_retry(const fmbOptContext* ctx, void* at, const char* v) {
+  (void)ctx;
+  for (const char* s = v; *s;) {
+    char name[32];
+    size_t n = strcspn(s, ",");
+    snprintf(name, sizeof name, "%.*s", (int)(n < 31 ? n : 31), s);
+    int st = fmb_child_status_of(name);
+    if (st < 0 || st == FMB_CHILD_OK)
+      return bad("--retry needs statuses among solver_stopped,bad_input,timeout,crashed,lost, got '%s'", v);
+    *(unsigned*)at |= 1u << st;
+    s += n + (s[n] == ',');
   }
   return 0;
 }
 
-/* bytes into DIR/inputs/SUB/name through the safe path, unless a file with these bytes is there */
-static int snapshot_file(fmbSweep* sw, const char* sub, const char* name, const char* text, size_t n, char* path,
-                         size_t len) {
-  char rel[600];
-  snprintf(rel, sizeof rel, "inputs/%s/%s", sub, name);
-  snprintf(path, len, "%s/%s", sw->dir, rel);
-  char* old = NULL;
-  size_t oldn = 0;
-  char why[600];
-  struct stat st;
-  if (lstat(path, &st) == 0 && S_ISREG(st.st_mode) &&
-      fmb_sweep_read_input(path, n, &old, &oldn, why, sizeof why) == 0 && oldn == n && memcmp(old, text, n) == 0) {
-    free(old);
-    return 0;
-  }
-  free(old);
-  fmbSafeFile* f = fmb_sweep_file_open(sw, rel);
-  const int ok = f && (n == 0 || write(fmb_safe_fd(f), text, n) == (ssize_t)n);
-  if (f && !ok) fmb_sweep_disk_full(sw, path, errno);
-  return fmb_sweep_file_close(sw, rel, f, ok) == 0 && ok ? 0 : -1;
-}
-
-/* the snapshot's folder name: a hash of the scene's bytes and of its folder (the links beside the
-   copy lead into that folder: the same bytes elsewhere are another snapshot) */
-static void snapshot_name(const char* scene, const char* text, size_t n, char sub[17]) {
-  const char* slash = strrchr(scene, '/');
-  char from[4300];
-  snprintf(from, sizeof from, "%.*s", slash ? (int)(slash - scene) : 1, slash ? scene : ".");
-  char* real = realpath(from[0] ? from : "/", NULL);
-  uint64_t h = fmb_fnv1a(FMB_FNV_OFFSET, text, n);
-  if (real) h = fmb_fnv1a(h, real, strlen(real) + 1);
-  free(real);
-  snprintf(sub, 17, "%016llx", (unsigned long long)fmb_mix64(h));
-}
-
-/* The scene as the runs read it: its bytes, read once, hashed into the run ids and written to
-   DIR/inputs/HASH/NAME, which every run loads. An edit of the scene during the sweep changes
-   nothing (the ids and the runs are of the snapshot; the next start of the sweep sees a new
-   plan). The files the scene names by relative paths (tables, plugins) are found beside it as
-   before: DIR/inputs/HASH/ holds a link to every other entry of the scene's folder. */
-static int snapshot_scene(fmbSweep* sw, const char* sub, const char* text, size_t n, char* path, size_t len) {
-  char dir[4300];
-  snprintf(dir, sizeof dir, "%s/inputs/%s", sw->dir, sub);
-  struct stat st;
-  if (mkdir(dir, 0755) != 0 && (errno != EEXIST || lstat(dir, &st) != 0 || !S_ISDIR(st.st_mode))) {
-    fprintf(stderr, "flexmbd sweep: cannot create the folder %s of its own\n", dir);
-    return -1;
-  }
-  const char* slash = strrchr(sw->scene_given, '/');
-  const char* base = slash ? slash + 1 : sw->scene_given;
-  if (snapshot_file(sw, sub, base, text, n, path, len)) return -1;
-  char from[4300];
-  snprintf(from, sizeof from, "%.*s", slash ? (int)(slash - sw->scene_given) : 1, slash ? sw->scene_given : ".");
-  char* real = realpath(from[0] ? from : "/", NULL);
-  DIR* d = real ? opendir(real) : NULL;
-  struct dirent* e;
-  int count = 0;
-  while (d && (e = readdir(d)) && count < 100000) {
-    if (strcmp(e->d_name, ".") == 0 || strcmp(e->d_name, "..") == 0 || strcmp(e->d_name, base) == 0) continue;
-    char link[4600], target[8400];
-    snprintf(link, sizeof link, "%s/%s", dir, e->d_name);
-    snprintf(target, sizeof target, "%s/%s", strcmp(real, "/") ? real : "", e->d_name);
-    if (symlink(target, link) == 0) ++count;
-  }
-  if (d) closedir(d);
-  free(real);
+static int sweep_scene(const fmbOptContext* ctx, const char* arg) {
+  fmbSweepArgs* a = ctx->self;
+  if (a->sw.scene) return bad("unknown option or extra argument '%s'", arg);
+  a->sw.scene = arg;
   return 0;
 }
 
-static void usage(FILE* f) {
-  fprintf(
-      f,
-      "usage: flexmbd sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log] | --grid PATH=v1,v2,...]... [--zip "
-      "PATH=v1,v2,...]...\n"
-      "         [--samples FILE.csv] [--random PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)]... --count N [--seed S]\n"
-      "         [--design mc|lhs] [--set PATH=VALUE]... [--verb run|static|modes] [--metric COL:max,min,end,rms]...\n"
-      "         [--reference REF.csv [--columns a,b]] [-j K] [--timeout SEC|Nx] [--retry STATUS,...]\n"
-      "         [--keep summary|series] [--runner auto|spawn|serve] [--mem-limit MB] [--dry-run] [--resume|--fresh] "
-      "[--yes]\n"
-      "         [--quiet] [--plugin x.so]...\n"
-      "       flexmbd sweep --status DIR\n"
-      "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
-      "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
-      "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
-      "spec or a folder not the sweep's, 3 a write failed (disk full), 4 interrupted (3 and 4 resume). "
-      "docs/sweep.md\n");
-}
+#define AT(field) offsetof(fmbSweepArgs, field)
+#define SWEEP_CALL(name, meta, at, help, needs, call, flags) \
+  { name, NULL, FMB_OPT_CALL, meta, at, help, needs, 0, 0, NULL, call, flags }
+#define SWEEP_FLAG(name, alias, field, help) \
+  { name, alias, FMB_OPT_FLAG, NULL, AT(field), help, NULL, 0, 0, NULL, NULL, 0 }
+static const fmbOpt sweep_options[] = {
+    {"--output", "-o", FMB_OPT_STRING, "DIR", AT(sw.dir), "the sweep's folder (runs.csv, table.csv, series/, logs/)",
+     "a folder", 0, 0, NULL, NULL, 0},
+    SWEEP_CALL("--grid", "PATH=A:B:N[:log]|PATH=v1,v2,...", AT(sw.plan),
+               "a factor: every value, crossed with the others", "PATH=VALUES", read_factor, FMB_OPT_REPEAT),
+    SWEEP_CALL("--zip", "PATH=v1,v2,...", AT(sw.plan), "factors that vary together (the same count of values)",
+               "PATH=VALUES", read_factor, FMB_OPT_REPEAT),
+    SWEEP_CALL("--samples", "F.csv", AT(sw), "one run per row of F.csv (a column per PATH)", "a CSV file", read_samples,
+               0),
+    SWEEP_CALL("--random", "PATH=uniform(a,b)|normal(m,s)|lognormal(m,s)", AT(sw.plan),
+               "a random factor (with --count)", "PATH=VALUES", read_factor, FMB_OPT_REPEAT),
+    {"--count", NULL, FMB_OPT_INT, "N", AT(count), "the number of random samples", "a whole number from 1 to 1e9", 1,
+     1e9, NULL, NULL, 0},
+    SWEEP_CALL("--seed", "S", AT(sw.plan.seed), "the random samples' seed", "a whole number >= 0", read_seed, 0),
+    {"--design", NULL, FMB_OPT_CHOICE, "mc|lhs", AT(design_lhs), "random sampling or a Latin hypercube", "mc or lhs", 0,
+     0, "mc|lhs", NULL, 0},
+    SWEEP_CALL("--set", "PATH=VALUE", AT(sw), "a value every run gets", "PATH=VALUE", read_set, FMB_OPT_REPEAT),
+    {"--verb", NULL, FMB_OPT_CHOICE, "run|static|modes", AT(verb), "what each run computes (default run)",
+     "run, static or modes", 0, 0, "run|static|modes", NULL, 0},
+    SWEEP_CALL("--metric", "COL:max,min,end,rms", AT(sw), "a summary of a column per run, in its row",
+               "COLUMN:max|min|end|rms", read_metric, FMB_OPT_REPEAT),
+    {"--reference", NULL, FMB_OPT_STRING, "REF.csv", AT(sw.reference), "the error of every run against REF",
+     "a CSV file", 0, 0, NULL, NULL, 0},
+    {"--columns", NULL, FMB_OPT_STRING, "a,b,...", AT(columns), "the columns compared with --reference",
+     "a comma-separated list", 0, 0, NULL, NULL, 0},
+    {"--jobs", "-j", FMB_OPT_INT, "K", AT(sw.jobs), "K runs at once (default: the CPUs this process may use)",
+     "1 to 1024 children", 1, 1024, NULL, NULL, 0},
+    SWEEP_CALL("--timeout", "SEC|Nx", AT(sw), "a run's wall time limit (Nx: N times the median of ok runs)",
+               "SEC or Nx", read_timeout, 0),
+    SWEEP_CALL("--retry", "STATUS,...", AT(sw.retry_mask), "run again the runs that ended so, on resume",
+               "a list of statuses", read_retry, 0),
+    {"--keep", NULL, FMB_OPT_CHOICE, "summary|series", AT(sw.keep_series), "keep each run's CSV (series) or not",
+     "summary or series", 0, 0, "summary|series", NULL, 0},
+    {"--runner", NULL, FMB_OPT_CHOICE, "auto|spawn|serve", AT(runner), "a process per run, or persistent runners",
+     "auto, spawn or serve", 0, 0, "auto|spawn|serve", NULL, 0},
+    {"--mem-limit", NULL, FMB_OPT_DOUBLE, "MB", AT(sw.mem_limit_mb), "a run's memory limit",
+     "megabytes (>= 16) per run", 16, HUGE_VAL, NULL, NULL, 0},
+    SWEEP_FLAG("--dry-run", NULL, dry, "lay out and check the plan (plan.csv), run nothing"),
+    SWEEP_FLAG("--resume", NULL, resume, "go on with the folder's sweep (the default when it is this one)"),
+    SWEEP_FLAG("--fresh", NULL, fresh, "start the folder's sweep again"),
+    SWEEP_FLAG("--yes", NULL, yes, "run a plan of more than 1e6 runs"),
+    SWEEP_FLAG("--quiet", "-q", sw.quiet, "no progress line"),
+    SWEEP_CALL("--plugin", "x.so", AT(sw), "a plugin every run loads", "a plugin file", read_plugin, FMB_OPT_REPEAT),
+    {"--status", NULL, FMB_OPT_STRING, "DIR", AT(status_dir), "what the sweep in DIR has done", "a sweep folder", 0, 0,
+     NULL, NULL, 0},
+};
+
+const fmbCommandSpec fmb_sweep_command = {
+    "sweep",
+    "SCENE.yaml -o DIR",
+    "many runs, each a child process; resumable (docs/sweep.md)",
+    sweep_options,
+    FMB_OPT_COUNT(sweep_options),
+    sweep_scene,
+    "also: flexmbd sweep --status DIR   what the sweep in DIR has done\n"
+    "Runs the scene once per planned point, each run a child process; DIR/runs.csv gets one row per finished run\n"
+    "(statuses ok, solver_stopped, bad_input, timeout, crashed, lost), DIR/table.csv the rows sorted by index.\n"
+    "Run it again to resume. Under mpirun or srun the ranks share the runs. Exit: 0 every run has a row, 2 bad\n"
+    "spec or a folder not the sweep's, 3 a write failed (disk full), 4 interrupted (3 and 4 resume). "
+    "docs/sweep.md\n"};
 
 int fmb_cmd_sweep(int argc, char** argv) {
-  static fmbSweep sw0;
-  fmbSweep* sw = &sw0;
-  memset(sw, 0, sizeof *sw);
+  static fmbSweepArgs a0;
+  fmbSweepArgs* a = &a0;
+  memset(a, 0, sizeof *a);
+  fmbSweep* sw = &a->sw;
   sw->verb = "run";
   sw->jobs = 0;
   sw->timeout_s = 600.0;
-  sw->serve = -1; /* --runner auto, resolved once the verb is known */
   sw->journal_fd = sw->inflight_fd = -1;
-  sw->stop = &stop_requested;
-  const char* columns = NULL;
-  const char* status_dir = NULL;
-  int dry = 0, resume = 0, fresh = 0, yes = 0, design_lhs = -1;
-  long count = 0;
-  int seed_given = 0;
-  char** samples_text = &sw->samples_text; /* the --samples file as read once (its copy goes to DIR/inputs) */
-  size_t* samples_len = &sw->samples_len;
-  const char* samples_name = NULL;
-  char err[1200];
-  for (int i = 2; i < argc; ++i) {
-    const char* a = argv[i];
-#define VALUE(what) (fmb_cli_value("sweep", argc, argv, &i, what))
-    const char* v = NULL;
-    if (strcmp(a, "--help") == 0 || strcmp(a, "-h") == 0) {
-      usage(stdout);
-      return 0;
-    } else if (strcmp(a, "-o") == 0 || strcmp(a, "--output") == 0) {
-      if (!(sw->dir = VALUE("a folder"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--grid") == 0 || strcmp(a, "--zip") == 0 || strcmp(a, "--random") == 0) {
-      if (!(v = VALUE("PATH=VALUES"))) return FMB_EXIT_BAD_INPUT;
-      int r = a[2] == 'g'   ? fmb_plan_add_grid(&sw->plan, v, err, sizeof err)
-              : a[2] == 'z' ? fmb_plan_add_zip(&sw->plan, v, err, sizeof err)
-                            : fmb_plan_add_random(&sw->plan, v, err, sizeof err);
-      if (r) return bad("%s", err);
-    } else if (strcmp(a, "--samples") == 0) {
-      if (!(v = VALUE("a CSV file"))) return FMB_EXIT_BAD_INPUT;
-      if (*samples_text) return bad("one --samples file at a time%s", "");
-      if (fmb_sweep_read_input(v, 1u << 30, samples_text, samples_len, err, sizeof err) ||
-          fmb_plan_add_samples(&sw->plan, v, *samples_text, *samples_len, err, sizeof err))
-        return bad("--samples %s", err);
-      samples_name = v;
-    } else if (strcmp(a, "--count") == 0) {
-      char* end;
-      if (!(v = VALUE("N"))) return FMB_EXIT_BAD_INPUT;
-      double c = strtod(v, &end);
-      if (*end || !(c >= 1) || c > MAX_PLAN || c != floor(c))
-        return bad("--count expects a whole number from 1 to 1e9, got '%s'", v);
-      count = (long)c;
-    } else if (strcmp(a, "--seed") == 0) {
-      char* end;
-      if (!(v = VALUE("a whole number"))) return FMB_EXIT_BAD_INPUT;
-      sw->plan.seed = strtoull(v, &end, 10);
-      if (*end || !*v || v[0] == '-') return bad("--seed expects a whole number >= 0, got '%s'", v);
-      seed_given = 1;
-    } else if (strcmp(a, "--design") == 0) {
-      if (!(v = VALUE("mc or lhs"))) return FMB_EXIT_BAD_INPUT;
-      if (strcmp(v, "mc") && strcmp(v, "lhs")) return bad("--design expects mc or lhs, got '%s'", v);
-      design_lhs = strcmp(v, "lhs") == 0;
-    } else if (strcmp(a, "--set") == 0 || strncmp(a, "--set=", 6) == 0) {
-      if (!(v = a[5] == '=' ? a + 6 : VALUE("PATH=VALUE"))) return FMB_EXIT_BAD_INPUT;
-      if (!strchr(v, '=') || sw->nfixed == FMB_SWEEP_MAX_FIXED) return bad("--set expects PATH=VALUE, got '%s'", v);
-      /* numbers as every run gets them: %.17g (so the run id does not depend on how they were typed) */
-      char* end;
-      const char* val = strchr(v, '=') + 1;
-      double x = strtod(val, &end);
-      char* t = malloc(strlen(v) + 40);
-      if (!t) return FMB_EXIT_BAD_INPUT;
-      if (end != val && !*end && isfinite(x))
-        sprintf(t, "%.*s=%.17g", (int)(val - 1 - v), v, x);
-      else
-        strcpy(t, v);
-      sw->fixed[sw->nfixed++] = t;
-    } else if (strcmp(a, "--plugin") == 0) {
-      if (!(v = VALUE("a plugin file"))) return FMB_EXIT_BAD_INPUT;
-      if (sw->nplugins == 16) return bad("at most 16 --plugin files%s", "");
-      char* real = realpath(v, NULL);
-      if (!real) return bad("--plugin: cannot find '%s'", v);
-      sw->plugins[sw->nplugins++] = real;
-    } else if (strcmp(a, "--verb") == 0) {
-      if (!(v = VALUE("run, static or modes"))) return FMB_EXIT_BAD_INPUT;
-      if (strcmp(v, "run") && strcmp(v, "static") && strcmp(v, "modes"))
-        return bad("--verb expects run, static or modes, got '%s'", v);
-      sw->verb = v;
-    } else if (strcmp(a, "--metric") == 0) {
-      if (!(v = VALUE("COLUMN:max|min|end|rms")) || add_metrics(sw, v)) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--reference") == 0) {
-      if (!(sw->reference = VALUE("a CSV file"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--columns") == 0) {
-      if (!(columns = VALUE("a comma-separated list"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "-j") == 0 || strcmp(a, "--jobs") == 0) {
-      char* end;
-      if (!(v = VALUE("a number of children"))) return FMB_EXIT_BAD_INPUT;
-      long j = strtol(v, &end, 10);
-      if (*end || j < 1 || j > 1024) return bad("-j expects 1 to 1024 children, got '%s'", v);
-      sw->jobs = (int)j;
-    } else if (strcmp(a, "--timeout") == 0) {
-      char* end;
-      if (!(v = VALUE("SEC or Nx"))) return FMB_EXIT_BAD_INPUT;
-      double t = strtod(v, &end);
-      const int rel = *end == 'x' && !end[1];
-      if (end == v || (*end && !rel) || !(t > 0) || !isfinite(t))
-        return bad("--timeout expects SEC (> 0) or Nx (N times the median of ok runs), got '%s'", v);
-      if (rel)
-        sw->timeout_factor = t;
-      else
-        sw->timeout_s = t;
-    } else if (strcmp(a, "--retry") == 0) {
-      if (!(v = VALUE("a list of statuses"))) return FMB_EXIT_BAD_INPUT;
-      for (const char* s = v; *s;) {
-        char name[32];
-        size_t n = strcspn(s, ",");
-        snprintf(name, sizeof name, "%.*s", (int)(n < 31 ? n : 31), s);
-        int st = fmb_child_status_of(name);
-        if (st < 0 || st == FMB_CHILD_OK)
-          return bad("--retry expects statuses among solver_stopped,bad_input,timeout,crashed,lost, got '%s'", v);
-        sw->retry_mask |= 1u << st;
-        s += n + (s[n] == ',');
-      }
-    } else if (strcmp(a, "--keep") == 0) {
-      if (!(v = VALUE("summary or series"))) return FMB_EXIT_BAD_INPUT;
-      if (strcmp(v, "summary") && strcmp(v, "series")) return bad("--keep expects summary or series, got '%s'", v);
-      sw->keep_series = strcmp(v, "series") == 0;
-    } else if (strcmp(a, "--runner") == 0) {
-      if (!(v = VALUE("auto, spawn or serve"))) return FMB_EXIT_BAD_INPUT;
-      if (strcmp(v, "auto") && strcmp(v, "spawn") && strcmp(v, "serve"))
-        return bad("--runner expects auto, spawn or serve, got '%s'", v);
-      sw->serve = strcmp(v, "auto") == 0 ? -1 : strcmp(v, "serve") == 0;
-    } else if (strcmp(a, "--mem-limit") == 0) {
-      char* end;
-      if (!(v = VALUE("megabytes"))) return FMB_EXIT_BAD_INPUT;
-      sw->mem_limit_mb = strtod(v, &end);
-      if (*end || !(sw->mem_limit_mb >= 16)) return bad("--mem-limit expects megabytes (>= 16) per run, got '%s'", v);
-    } else if (strcmp(a, "--status") == 0) {
-      if (!(status_dir = VALUE("a sweep folder"))) return FMB_EXIT_BAD_INPUT;
-    } else if (strcmp(a, "--dry-run") == 0) {
-      dry = 1;
-    } else if (strcmp(a, "--resume") == 0) {
-      resume = 1;
-    } else if (strcmp(a, "--fresh") == 0) {
-      fresh = 1;
-    } else if (strcmp(a, "--yes") == 0) {
-      yes = 1;
-    } else if (strcmp(a, "--quiet") == 0 || strcmp(a, "-q") == 0) {
-      sw->quiet = 1;
-    } else if (a[0] != '-' && !sw->scene) {
-      sw->scene = a;
-    } else {
-      usage(stderr);
-      return bad("unknown option or extra argument '%s'", a);
-    }
-#undef VALUE
-  }
-  if (status_dir) return fmb_journal_status(status_dir);
-  if (!sw->scene) return usage(stderr), bad("no scene file given%s", "");
-  if (!sw->dir) return bad("no output folder given (-o DIR)%s", "");
-  if (resume && fresh) return bad("--resume and --fresh exclude each other%s", "");
-  if (fmb_sweep_read_input(sw->scene, 1u << 28, &sw->scene_text, &sw->scene_len, err, sizeof err))
-    return fprintf(stderr, "%s (the scene)\n", err), FMB_EXIT_BAD_INPUT;
-  if (sw->serve == 1 && strcmp(sw->verb, "run") != 0) return bad("--runner serve goes with --verb run%s", "");
-  if (design_lhs >= 0 && !sw->plan.nrandom) return bad("--design goes with --random%s", "");
-  if (seed_given && !sw->plan.nrandom) return bad("--seed goes with --random%s", "");
-  sw->plan.count = count;
-  sw->plan.lhs = design_lhs == 1;
-  /* the size from the factors' counts alone, before a value is laid out or a random sample drawn:
-     a refused plan costs nothing (a plan of 1e7 runs was built in full, 8.6 s and 395 MB, first) */
-  const double size = fmb_plan_size(&sw->plan);
-  if (size > MAX_PLAN)
-    return fprintf(stderr, "flexmbd sweep: a plan of %.4g runs is beyond the limit of 1e9\n", size), FMB_EXIT_BAD_INPUT;
-  if (size > YES_LIMIT && !yes && !dry)
-    return fprintf(stderr,
-                   "flexmbd sweep: the plan has %.4g runs (more than 1e6): check it with --dry-run, then add --yes\n",
-                   size),
-           FMB_EXIT_BAD_INPUT;
-  if (size > YES_LIMIT && !yes) { /* --dry-run of a huge plan: its size, nothing built or written */
-    printf("sweep plan: %.0f runs of %s %s (more than 1e6): add --yes to lay it out (plan.csv) and check it\n", size,
-           sw->verb, sw->scene);
-    return 0;
-  }
-  if (fmb_plan_finish(&sw->plan, err, sizeof err)) return bad("%s", err);
-  sw->nrun = (long)size;
-  for (int k = 0; k < sw->nfixed; ++k)
-    for (int p = 0; p < sw->plan.npath; ++p)
-      if (strncmp(sw->fixed[k], sw->plan.path[p], strlen(sw->plan.path[p])) == 0 &&
-          sw->fixed[k][strlen(sw->plan.path[p])] == '=')
-        return bad("'%s' is both swept and fixed by --set", sw->plan.path[p]);
-  if (sw->reference) { /* the error per run against a reference, per column */
-    if (fmb_cli_check_input(sw->reference, "reference")) return FMB_EXIT_BAD_INPUT;
-    if (fmb_table_load(sw->reference, &sw->ref, err, sizeof err)) return bad("%s", err);
-    for (int c = 1; c < sw->ref.ncol && !columns && sw->nrefcol < FMB_SWEEP_MAX_METRICS; ++c)
-      sw->refcol[sw->nrefcol++] = c;
-    for (const char* s = columns; s && *s && sw->nrefcol < FMB_SWEEP_MAX_METRICS;) {
-      char name[200];
-      size_t n = strcspn(s, ",");
-      snprintf(name, sizeof name, "%.*s", (int)(n < 199 ? n : 199), s);
-      int c = fmb_table_col(&sw->ref, name);
-      if (c < 0)
-        return fprintf(stderr, "flexmbd sweep: --columns: no column '%s' in %s\n", name, sw->reference),
-               FMB_EXIT_BAD_INPUT;
-      sw->refcol[sw->nrefcol++] = c;
-      s += n + (s[n] == ',');
-    }
-  } else if (columns) {
-    return bad("--columns goes with --reference%s", "");
-  }
-  ssize_t el = readlink("/proc/self/exe", sw->exe, sizeof sw->exe - 1);
-  if (el <= 0) return bad("cannot find this program (/proc/self/exe)%s", "");
-  sw->exe[el] = '\0';
-  if (sw->jobs == 0) { /* the CPUs this process may use (a rank bound to cores gets its share) */
-    long n = sysconf(_SC_NPROCESSORS_ONLN);
-#ifdef __linux__
-    cpu_set_t set;
-    if (sched_getaffinity(0, sizeof set, &set) == 0) n = CPU_COUNT(&set);
-#endif
-    sw->jobs = n > 0 ? (int)n : 1;
-  }
-  /* every run loads the snapshot DIR/inputs/HASH/NAME (snapshot_scene, written by rank 0 below) */
-  sw->scene_given = sw->scene;
-  char snap_sub[17];
-  snapshot_name(sw->scene, sw->scene_text, sw->scene_len, snap_sub);
-  {
-    char* snap = malloc(strlen(sw->dir) + strlen(sw->scene) + 64);
-    const char* slash = strrchr(sw->scene, '/');
-    if (!snap) return bad("out of memory%s", "");
-    sprintf(snap, "%s/inputs/%s/%s", sw->dir, snap_sub, slash ? slash + 1 : sw->scene);
-    sw->scene = snap;
-  }
-  if (make_ids(sw, sw->scene_text, sw->scene_len)) return bad("out of memory for %s runs", "the");
-  /* the module (MPI, HDF5) is loaded now only under mpirun/srun: mapped into this process, its
-     libraries make every fork of a child slower; otherwise only at the end, for sweep.h5 */
-  fmbFarmTransport ranks;
-  const int mpi = fmb_farm_mpi_start("sweep", &ranks);
-  if (mpi < 0) return 0; /* built without MPI: rank 0 runs the sweep alone */
-  sw->rank = ranks.rank, sw->nranks = ranks.nranks;
-  const fmbSweepExtension* ext = fmb_sweep_extension_load(0);
-  /* --runner auto (the default): alone, persistent runners for `--verb run`; a process per run otherwise. A runner
-   * still runs each run in a child (a crash or a hang costs that run's row and a fresh runner takes the slot, tested)
-   * and saves the ~3 ms exec and linking of every run: 1.28x -> 1.70x the serial loop on 400 four-bar runs on 2 cores
-   * (bench/sweep.sh, docs/performance.md "Sweeps"). Across ranks it stays a process per run: with runners on the
-   * workers, SIGTERM to Open MPI 4.1's mpirun left mpirun spinning after the ranks' MPI_Abort (seen in sweep_mpi). */
-  if (sw->serve < 0) sw->serve = sw->nranks == 1 && strcmp(sw->verb, "run") == 0;
-
-  int rc = 0;
-  if (sw->rank != 0 && dry) { /* rank 0 alone checks the plan */
-    ext->mpi_finalize(0);
-    return 0;
-  }
-  if (sw->rank == 0) {
-    /* the folder is the sweep's own: made, locked, and the inputs noted (no file of the sweep may
-       replace one) and snapshotted, before anything is written there */
-    fmb_cli_note_input(sw->scene_given);
-    if (samples_name) fmb_cli_note_input(samples_name);
-    if (sw->reference) fmb_cli_note_input(sw->reference);
-    rc = make_dirs(sw->dir);
-    if (!rc) rc = fmb_sweep_lock(sw);
-    /* the files written at the end too, checked now: refused before the runs, not after them */
-    const char* const ends[3] = {"plan.csv", "table.csv", "sweep.h5"};
-    for (int k = 0; k < 3 && !rc; ++k)
-      if (fmb_sweep_may_write(sw, ends[k])) rc = FMB_EXIT_BAD_INPUT;
-    char path[4300];
-    if (!rc && snapshot_scene(sw, snap_sub, sw->scene_text, sw->scene_len, path, sizeof path)) rc = FMB_EXIT_BAD_INPUT;
-    if (!rc && strcmp(path, sw->scene) != 0) rc = bad("the scene's snapshot is not %s", sw->scene);
-    const char* hash = snap_sub;
-    if (!rc && samples_name && snapshot_file(sw, hash, "samples.csv", *samples_text, *samples_len, path, sizeof path))
-      rc = FMB_EXIT_BAD_INPUT;
-    if (!rc && sw->reference) {
-      char* ref = NULL;
-      size_t nref = 0;
-      if (fmb_sweep_read_input(sw->reference, 1u << 30, &ref, &nref, err, sizeof err))
-        rc = (fprintf(stderr, "flexmbd sweep: --reference %s\n", err), FMB_EXIT_BAD_INPUT);
-      else if (snapshot_file(sw, hash, "reference.csv", ref, nref, path, sizeof path))
-        rc = FMB_EXIT_BAD_INPUT;
-      free(ref);
-    }
-    if (!rc) fmb_cli_note_input(sw->scene);
-    if (!rc && dry) {
-      long distinct = 0;
-      for (long i = 0; i < sw->nrun; ++i) distinct += sw->first[i] == i;
-      printf("sweep plan: %ld runs (%ld distinct) of %s %s, %d swept paths:", sw->nrun, distinct, sw->verb,
-             sw->scene_given, sw->plan.npath);
-      for (int k = 0; k < sw->plan.npath; ++k) printf(" %s", sw->plan.path[k]);
-      printf("\n");
-      if (fmb_journal_write_plan(sw) == 0)
-        printf("sweep plan: written to %s/plan.csv\n", sw->dir);
-      else
-        rc = FMB_EXIT_BAD_INPUT;
-      fflush(stdout);
-      long pick[3] = {0, sw->nrun - 1, (long)(fmb_plan_uniform(sw->plan.seed, 0, 1u << 20) * (double)sw->nrun)};
-      for (int k = 0; k < 3 && !rc; ++k)
-        if (k == 0 || (pick[k] != pick[0] && pick[k] != pick[1])) rc = check_run(sw, pick[k], 1);
-      ext->mpi_finalize(0);
-      return rc ? FMB_EXIT_BAD_INPUT : 0;
-    }
-    if (!rc) rc = check_run(sw, 0, 0) == 2 ? FMB_EXIT_BAD_INPUT : 0; /* an unknown path: refused before anything runs */
-    if (!rc) rc = fmb_journal_open(sw, resume, fresh);
-    if (!rc) rc = fmb_journal_write_plan(sw) ? FMB_EXIT_BAD_INPUT : 0;
-  }
-  struct sigaction sa;
-  memset(&sa, 0, sizeof sa);
-  sa.sa_handler = on_stop; /* no SA_RESTART: the pool's wait returns at once */
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, NULL);
-  sigaction(SIGTERM, &sa, NULL);
-  sw->progress = !sw->quiet && isatty(STDERR_FILENO);
-  sw->t_start = fmb_pool_now();
-  if (sw->nranks > 1) /* rank 0's verdict on the spec and the journal: every rank stops on it */
-    rc = ranks.bcast_int(rc);
-  const fmbFarmTransport* t = sw->nranks > 1 ? &ranks : NULL;
-  if (!rc) rc = sw->serve ? fmb_sweep_serve(sw, t) : fmb_sweep_farm(sw, t);
-  if (sw->rank == 0 && sw->journal_fd >= 0) {
-    fmb_sweep_progress(sw, 1);
-    if (fmb_journal_write_table(sw) && !sw->disk_full) fmb_sweep_disk_full(sw, "table.csv", EIO);
-    ext = fmb_sweep_extension_load(1);
-    if (rc == 0 && !sw->disk_full && ext->has_hdf5) { /* through the safe path: a temporary beside it */
-      fmbSafeFile* h5 = fmb_sweep_file_open(sw, "sweep.h5");
-      const int ok = h5 && ext->write_h5(sw, fmb_safe_write_path(h5)) == 0;
-      if (h5 && !ok) fprintf(stderr, "flexmbd sweep: cannot write %s/sweep.h5\n", sw->dir);
-      if (fmb_sweep_file_close(sw, "sweep.h5", h5, ok) != 0 || !ok) fmb_sweep_disk_full(sw, "sweep.h5", EIO);
-    }
-    fmb_journal_close(sw);
-    if (rc == FMB_EXIT_INTERRUPTED)
-      fprintf(stderr,
-              "sweep: interrupted; every child stopped, %s/runs.csv is complete: run the same command to resume\n",
-              sw->dir);
-    if (sw->disk_full && (rc == 0 || rc == FMB_EXIT_INTERRUPTED)) {
-      long left = 0;
-      for (long i = 0; i < sw->nrun; ++i) left += sw->first[i] == i && sw->status[i] < 0;
-      fprintf(stderr,
-              "flexmbd sweep: stopped: a write failed (%s; the disk is full?): %ld runs have no row; free space and "
-              "run the same command to resume\n",
-              sw->disk_why, left);
-      rc = FMB_EXIT_SOLVER;
-    }
-  }
-  ext->mpi_finalize(rc);
-  return rc;
+  a->design_lhs = -1;
+  int rc;
+  if (fmb_opt_parse(&fmb_sweep_command, argc, argv, a, &rc)) return rc;
+  static const char* const verbs[] = {"run", "static", "modes"};
+  sw->verb = verbs[a->verb];
+  sw->serve = a->runner - 1; /* auto -1 (resolved once the verb is known), spawn 0, serve 1 */
+  return fmb_sweep_main(a);
 }

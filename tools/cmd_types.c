@@ -1,6 +1,7 @@
 /* cmd_types.c — `flexmbd types [--plugin x.so]...`: every registered body and joint type, where
  * it came from, its keys (unit, default, range) as the type declares them (fmbParam), and its
  * outputs. */
+#include <stddef.h>
 #include <stdio.h>
 #include <string.h>
 
@@ -50,16 +51,25 @@ static void print_outputs(const char* const* const* groups, int ngroups, const c
   printf("\n");
 }
 
+typedef struct {
+  fmbCliScene s; /* the --plugin files */
+} TypesArgs;
+
+static const fmbOpt types_options[] = {FMB_OPT_PLUGIN(TypesArgs, s)};
+
+const fmbCommandSpec fmb_types_command = {"types",
+                                          "",
+                                          "the registered body and joint types: keys, units, ranges, outputs",
+                                          types_options,
+                                          FMB_OPT_COUNT(types_options),
+                                          NULL,
+                                          NULL};
+
 int fmb_cmd_types(int argc, char** argv) {
-  fmbCliScene s;
-  memset(&s, 0, sizeof s);
-  for (int i = 2; i < argc; ++i) {
-    int r = fmb_cli_take_scene_arg("types", argc, argv, &i, &s);
-    if (r != 1 || s.scene || s.nover) {
-      fprintf(stderr, "flexmbd types: unexpected argument '%s' (only --plugin x.so)\n", argv[i]);
-      return FMB_EXIT_BAD_INPUT;
-    }
-  }
+  TypesArgs o;
+  memset(&o, 0, sizeof o);
+  int rc;
+  if (fmb_opt_parse(&fmb_types_command, argc, argv, &o, &rc)) return rc;
   const fmbRegistry* reg = fmb_cli_registry();
   if (!reg) return FMB_EXIT_BAD_INPUT;
   const char* const* frame[] = {fmb_engine_outputs("frame")};

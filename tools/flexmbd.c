@@ -8,73 +8,31 @@
 #include "flexmbd_commit.h" /* generated at build time: FLEXMBD_COMMIT */
 
 typedef struct {
-  const char* name;
+  const fmbCommandSpec* spec; /* its name, arguments, options (tools/options.h) */
   int (*main)(int argc, char** argv);
-  const char* usage; /* one or more lines, each starting with the command's name */
-  int own_help;      /* the command prints a longer --help itself */
 } Command;
 
 static const Command commands[] = {
-    {"run", fmb_cmd_run,
-     "run SCENE.yaml [-o OUT.csv] [--set PATH=VALUE]... [--plugin x.so]... [--quiet] [--progress] [--vtk DIR "
-     "[--vtk-every N]]\n"
-     "      [--reference REF.csv [--columns a,b,...]]   also print the error against REF and the cost\n"
-     "      [--models zoac,foac,complete,exact]   once per beam model, columns NAME@MODEL, a stats line each",
-     0},
-    {"check", fmb_cmd_check, "check SCENE.yaml [--set PATH=VALUE]...   load, validate and describe; no run", 0},
-    {"compare", fmb_cmd_compare,
-     "compare OUT.csv REF.csv [--columns a,b,...] [--rtol R] [--atol A]   error per column; exit 1 beyond tolerance",
-     1},
-    {"regress", fmb_cmd_regress,
-     "regress [PATH...] [--bless] [--junit FILE] [-j N] [--set PATH=VALUE]...   scenes against their stored references",
-     1},
-    {"types", fmb_cmd_types,
-     "types [--plugin x.so]...   the registered body and joint types: keys, units, ranges, outputs", 0},
-    {"conform", fmb_cmd_conform,
-     "conform [--plugin x.so]... [--work DIR] [TYPE]...   conformance checks of every (or the named) type; exit 1 on a "
-     "failure",
-     0},
-    {"plot", fmb_cmd_plot,
-     "plot OUT.csv [MORE.csv]... [COLUMN]... [-o FIG.png|.svg|.pdf] [--x COLUMN] [--logx] [--logy] [--abs]\n"
-     "      [--title T] [--xlabel L] [--ylabel L] [--xrange LO:HI] [--yrange LO:HI] [--legend a,b,...]\n"
-     "      [--diff REF.csv]   each column minus REF's (with --abs --logy: an error plot)\n"
-     "      [--shape BEAM --at t1,t2,...]   the beam's centreline at those times (BEAM.shape columns)\n"
-     "      columns against t through gnuplot; several CSVs overlaid (default: every column, OUT.png)",
-     0},
-    {"view", fmb_cmd_view,
-     "view RUN.csv SCENE.yaml [-o run.html] [--columns a,b,...] [--scale S] [--model M] [--set PATH=VALUE]... "
-     "[--plugin x.so]...\n"
-     "      one self-contained HTML page animating the run (mechanism, beam shapes, traces, a plot)",
-     0},
-    {"new", fmb_cmd_new, "new pendulum|beam|rotor|slider-crank > scene.yaml   a commented starter scene", 0},
-    {"static", fmb_cmd_static,
-     "static SCENE.yaml [-o OUT.csv] [--at T] [--set PATH=VALUE]...   equilibrium, or steady rotation under a "
-     "constant-speed drive",
-     0},
-    {"modes", fmb_cmd_modes,
-     "modes SCENE.yaml [--at T | --static] [--count K] [-o modes.csv] [--shapes shapes.csv] [--animate DIR]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes about the static or steady state",
-     0},
-    {"campbell", fmb_cmd_campbell,
-     "campbell SCENE.yaml --speed PATH --speeds A:B:N|S1,S2,... [--count K] [-j K] [-o campbell.csv] [--plot "
-     "campbell.png]\n"
-     "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC);\n"
-     "      under mpirun/srun the ranks share the speeds",
-     0},
-    {"sweep", fmb_cmd_sweep,
-     "sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log]|PATH=v1,v2,...]... [--zip ...] [--samples F.csv] [--random "
-     "...]\n"
-     "      [-j K] [--metric COL:max] [--timeout SEC|Nx] ...   many runs, each a child process; resumable "
-     "(docs/sweep.md)\n"
-     "sweep --status DIR   what a sweep has done",
-     1},
+    {&fmb_run_command, fmb_cmd_run},         {&fmb_check_command, fmb_cmd_check},
+    {&fmb_compare_command, fmb_cmd_compare}, {&fmb_regress_command, fmb_cmd_regress},
+    {&fmb_types_command, fmb_cmd_types},     {&fmb_conform_command, fmb_cmd_conform},
+    {&fmb_plot_command, fmb_cmd_plot},       {&fmb_view_command, fmb_cmd_view},
+    {&fmb_new_command, fmb_cmd_new},         {&fmb_static_command, fmb_cmd_static},
+    {&fmb_modes_command, fmb_cmd_modes},     {&fmb_campbell_command, fmb_cmd_campbell},
+    {&fmb_sweep_command, fmb_cmd_sweep},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 
+/* one line per command, from its table: flexmbd NAME ARGS [options]   what it does */
 static void usage(FILE* f) {
-  for (int i = 0; i < NCOMMANDS; ++i) fprintf(f, "%s flexmbd %s\n", i ? "      " : "usage:", commands[i].usage);
+  for (int i = 0; i < NCOMMANDS; ++i) {
+    const fmbCommandSpec* c = commands[i].spec;
+    fprintf(f, "%s flexmbd %s%s%s%s\n        %s\n", i ? "      " : "usage:", c->name, c->args[0] ? " " : "", c->args,
+            c->nopts ? " [options]" : "", c->summary);
+  }
   fprintf(f, "       flexmbd --version\n");
-  fprintf(f, "PATH addresses any scene value, bodies and joints by name: solver.rtol=1e-8, bodies.beam.elements=32\n"
+  fprintf(f, "flexmbd CMD --help lists the options of CMD\n"
+             "PATH addresses any scene value, bodies and joints by name: solver.rtol=1e-8, bodies.beam.elements=32\n"
              "exit codes: 0 ok, 1 beyond tolerance (compare, regress), 2 bad input, 3 solver failure, 4 interrupted\n");
 }
 
@@ -91,25 +49,18 @@ int main(int argc, char** argv) {
   }
   if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {
     for (int i = 0; argc == 3 && i < NCOMMANDS; ++i)
-      if (strcmp(argv[2], commands[i].name) == 0) {
-        printf("usage: flexmbd %s\n", commands[i].usage);
+      if (strcmp(argv[2], commands[i].spec->name) == 0) { /* `flexmbd help CMD`: CMD --help */
+        fmb_opt_usage(commands[i].spec, stdout, 1);
         return 0;
       }
     usage(stdout);
     return 0;
   }
-  /* `flexmbd CMD --help` and `flexmbd help CMD`: that command's lines of the usage */
-  const int help = argc == 3 && (strcmp(argv[2], "--help") == 0 || strcmp(argv[2], "-h") == 0);
+  /* `flexmbd CMD --help`: the command's parser writes the help from its table */
   for (int i = 0; i < NCOMMANDS; ++i)
-    if (strcmp(cmd, commands[i].name) == 0) {
-      if (help && !commands[i].own_help) {
-        printf("usage: flexmbd %s\n", commands[i].usage);
-        return 0;
-      }
-      return commands[i].main(argc, argv);
-    }
+    if (strcmp(cmd, commands[i].spec->name) == 0) return commands[i].main(argc, argv);
   const char* names[NCOMMANDS];
-  for (int i = 0; i < NCOMMANDS; ++i) names[i] = commands[i].name;
+  for (int i = 0; i < NCOMMANDS; ++i) names[i] = commands[i].spec->name;
   const char* nearest = fmb_nearest_word(cmd, names, NCOMMANDS);
   if (nearest) { /* a typo: the one command meant, not the whole usage */
     fprintf(stderr, "flexmbd: unknown command '%s'; did you mean '%s'? (flexmbd --help lists the commands)\n", cmd,

@@ -1,5 +1,6 @@
 /* sweep.h — what the parts of `flexmbd sweep` share (docs/sweep.md):
- *   cmd_sweep.c      options -> plan -> the engine; --status, --dry-run
+ *   cmd_sweep.c      the options (one table, tools/options.h)
+ *   sweep_main.c    options -> plan -> the engine; --status, --dry-run
  *   sweep_plan.c     grids, zip, samples, random designs
  *   sweep_journal.c  DIR/runs.csv (append-only, one row per finished run), resume, DIR/table.csv
  *   sweep_exec.c     one run as a child (child_pool.c) and its row; the local loop
@@ -197,6 +198,20 @@ int fmb_sweep_launched_by_mpi(void);
    *t when there is more than one rank; 0 otherwise (this process alone); -1 when this rank has
    nothing to do (built without MPI: rank 0 works alone, the others should leave at once) */
 int fmb_farm_mpi_start(const char* who, fmbFarmTransport* t);
+/* `sweep`'s options besides those stored in fmbSweep (tools/cmd_sweep.c) */
+typedef struct fmbSweepArgs {
+  fmbSweep sw;
+  const char *columns, *status_dir, *samples_name;
+  int dry, resume, fresh, yes, seed_given;
+  int design_lhs; /* -1 not given, 0 mc, 1 lhs */
+  int verb;       /* run, static, modes */
+  int runner;     /* auto, spawn, serve */
+  int count;      /* --count N */
+} fmbSweepArgs;
+/* the sweep of the parsed options (tools/sweep_main.c): the command's exit code */
+int fmb_sweep_main(fmbSweepArgs* a);
+/* "flexmbd sweep: " and fmt with what, on stderr; FMB_EXIT_BAD_INPUT */
+int fmb_sweep_bad(const char* fmt, const char* what);
 /* with `load`, the module's table (loaded once), or fallbacks (local pool, no HDF5) when it cannot
    be loaded; without, the fallbacks until it is */
 const fmbSweepExtension* fmb_sweep_extension_load(int load);

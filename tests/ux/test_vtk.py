@@ -158,7 +158,7 @@ check(all(abs(float(ds.get("timestep")) - float(row["t"])) <= 1e-12 * max(1.0, a
           for ds, row in zip(sets, rows[::3])), "--vtk-every 3: the steps are rows 0, 3, 6, ...")
 r = subprocess.run([flexmbd, "run", scene, "-o", os.path.join(out, "x.csv"), "--vtk", every, "--vtk-every", "0"],
                    capture_output=True, text=True)
-check(r.returncode == 2 and "--vtk-every expects" in r.stderr, f"--vtk-every 0: exit {r.returncode}")
+check(r.returncode == 2 and "--vtk-every needs" in r.stderr, f"--vtk-every 0: exit {r.returncode}")
 
 # the scene key `vtk` does the same as the option (added here by an override)
 keyed = os.path.join(out, "keyed")
