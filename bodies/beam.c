@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "beam_section.h"
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
 enum { MAX_ELEMENTS = 4096 };

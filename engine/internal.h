@@ -5,7 +5,8 @@
 
 #include <yaml.h>
 
-#include "flexmbd.h"
+#include "flexmbd_cli.h"
+#include "flexmbd_plugin.h"
 
 #define FMB_NAME_MAX 64
 #define FMB_WORLD 0 /* body index of the fixed world frame, named "ground" */
