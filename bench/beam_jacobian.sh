@@ -4,8 +4,8 @@
 # IDA's residual and Jacobian counts and the peak resident memory of
 #   - scenes/paper/spinup_w15.yaml as shipped (16 elements, complete, dense assembly, 20 s),
 #   - the omega0 = 4 spin-up's first 0.05 s at 64, 256, 1024 elements (banded assembly),
-# each with the analytic Jacobian and with FMB_BEAM_FD_JACOBIAN=1 (the beam's Jacobian ops
-# switched off at setup: the engine differences the residual, as before this work).
+# each with the analytic Jacobian and with `jacobian: differences` (the beam's Jacobian ops
+# switched off at load: the engine differences the residual, as before this work).
 # `residuals` counts IDA's calls only; the finite-difference Jacobian's own residual
 # evaluations (engine/fd.c) are not in it.
 #   bash bench/beam_jacobian.sh [flexmbd binary] > bench/results/beam_jacobian.csv
@@ -16,8 +16,9 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 one() { # fd(0/1) scene args... -> "cpu_s,residuals,jacobians,steps,maxrss_kb,status"
   local fd=$1; shift
-  if [ "$fd" = 1 ]; then export FMB_BEAM_FD_JACOBIAN=1; else unset FMB_BEAM_FD_JACOBIAN; fi
-  /usr/bin/time -f "%M" -o "$T/time" "$F" run "$@" -o "$T/out.csv" --quiet 2> "$T/err" || true
+  local jac=analytic
+  if [ "$fd" = 1 ]; then jac=differences; fi
+  /usr/bin/time -f "%M" -o "$T/time" "$F" run "$@" --set bodies.beam.jacobian=$jac -o "$T/out.csv" --quiet 2> "$T/err" || true
   awk -v rss="$(tail -1 "$T/time")" '/^stats:/ { for (i = 2; i <= NF; ++i) { split($i, kv, "="); f[kv[1]] = kv[2] }
     printf "%s,%s,%s,%s,%s,%s\n", f["cpu_s"], f["residuals"], f["jacobians"], f["steps"], rss, f["status"] }' "$T/err" | tail -1
 }

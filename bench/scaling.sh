@@ -2,7 +2,7 @@
 # bench/scaling.sh — cost and memory of the beam against the element count (docs/performance.md,
 # "Scaling"), the banded assembly beside the dense one and beside the landed 0a88803.
 #   1. per call, through the library (bench/scaling.c): beam residual, DAE residual, Jacobian (the
-#      beam's analytic one, and with FMB_BEAM_FD_JACOBIAN=1 the engine's differences: scaling_fd.csv),
+#      beam's analytic one, and with `jacobian: differences` the engine's differences: scaling_fd.csv),
 #      Newton-matrix factorization and solve — banded 64..4096 elements, dense 8..256; the
 #      exponents of cost against n fitted by least squares (banded: n >= 64);
 #   2. short runs (the omega0 = 4 spin-up's first 0.05 s, 19 steps) through the command line:
@@ -46,7 +46,7 @@ ND="8 16 32 64 128 256"; [ $QUICK = 1 ] && ND="8 16 32 64"
 "$EXE" scenes/paper/spinup_w15.yaml -s bodies.beam.assembly=banded $NB | tee "$RES/scaling.csv"
 "$EXE" scenes/paper/spinup_w15.yaml -s bodies.beam.assembly=dense $ND | tee "$RES/scaling_dense.csv"
 # the same banded calls with the engine's finite differences instead of the beam's analytic Jacobian
-FMB_BEAM_FD_JACOBIAN=1 "$EXE" scenes/paper/spinup_w15.yaml -s bodies.beam.assembly=banded $NB | tee "$RES/scaling_fd.csv"
+"$EXE" scenes/paper/spinup_w15.yaml -s bodies.beam.assembly=banded -s bodies.beam.jacobian=differences $NB | tee "$RES/scaling_fd.csv"
 # least-squares slope of log(column) against log(n) over n >= nmin
 fit() { # file nmin label column...
   local file=$1 nmin=$2 label=$3; shift 3

@@ -26,7 +26,7 @@
 #include <string.h>
 
 #include "beam_section.h"
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
 enum { MAX_ELEMENTS = 4096 };
@@ -1577,6 +1577,8 @@ static int beam_velocity_error_test(const void* self) {
 
 /* the `model:` words of type beam: this file's three, and `exact` (bodies/beam_exact.c) */
 static const char* const all_models[] = {"zoac", "foac", "complete", "exact", NULL};
+/* `jacobian:` the analytic K, C, M (default) or the engine's differences of the residual */
+static const char* const jacobian_names[] = {"analytic", "differences", NULL};
 
 /* the keys of type beam, whichever file reads them (beam_modal.c's table declares these too) */
 const fmbParam fmb_beam_params[] = {
@@ -1613,6 +1615,12 @@ const fmbParam fmb_beam_params[] = {
      .choices = assembly_names,
      .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
     FMB_BEAM_REDUCTION_PARAM,
+    {.key = "jacobian",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "analytic",
+     .choices = jacobian_names,
+     .doc = "analytic K, C, M, or differences: the engine differences the residual (to compare the two; "
+            "models complete, foac, zoac without reduction)"},
     {.key = NULL},
 };
 
@@ -1623,21 +1631,28 @@ static int beam_centreline(const void* self, int n, double* local) {
 
 /* `model: exact` (the geometrically exact beam) is its own implementation behind the same type
    name: bodies/beam_exact.c. The other three models are this file's.
-   FMB_BEAM_FD_JACOBIAN=1 in the environment (read when a scene's beam is parsed) hands the item
-   the table without the analytic Jacobians (beam_fd), so the engine differences the residual as
-   before them: for comparing the two (test_beam_jacobian_run, bench/beam_jacobian.sh). */
+   `jacobian: differences` hands the item the table without the analytic Jacobians (beam_fd), so
+   the engine differences the residual as before them: for comparing the two
+   (test_beam_jacobian_run, bench/beam_jacobian.sh). */
 extern const fmbBodyType fmb_body_beam_exact;
 static const fmbBodyType beam_fd;
 static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   extern const fmbBodyType fmb_body_beam;
-  int model = BEAM_COMPLETE;
-  if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model)) return NULL;
-  if (model == 3) return &fmb_body_beam_exact;
+  int model = BEAM_COMPLETE, differences = 0;
+  if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model) ||
+      fmb_get_choice(p, item, "jacobian", FMB_OPTIONAL, jacobian_names, &differences))
+    return NULL;
   /* `reduction: {modes: k}`: the same beam in k of its own clamped-free modes (bodies/beam_modal.c) */
   extern const fmbBodyType fmb_body_beam_modal;
-  if (fmb_find_key(p, item, "reduction") >= 0) return &fmb_body_beam_modal;
-  const char* fd = getenv("FMB_BEAM_FD_JACOBIAN");
-  return fd && strcmp(fd, "1") == 0 ? &beam_fd : &fmb_body_beam;
+  const int reduced = fmb_find_key(p, item, "reduction") >= 0;
+  if (differences && (model == 3 || reduced)) {
+    fmb_parse_error(p, fmb_find_key(p, item, "jacobian"),
+                    "jacobian: differences is for the complete, foac and zoac models without reduction");
+    return NULL;
+  }
+  if (model == 3) return &fmb_body_beam_exact;
+  if (reduced) return &fmb_body_beam_modal;
+  return differences ? &beam_fd : &fmb_body_beam;
 }
 
 /* the ops of both tables below (fmb_body_beam and beam_fd) */

@@ -31,7 +31,7 @@
 #include <string.h>
 
 #include "beam_section.h"
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 enum { EXACT_MAX_ELEMENTS = 4096 };
 enum { INTEGRATION_REDUCED = 0, INTEGRATION_FULL = 1 };

@@ -23,7 +23,7 @@
 #include <string.h>
 
 #include "beam_section.h"
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 #include "internal.h" /* fmbp_node: the `reduction` mapping's own keys */
 
 extern void dsygv_(const int* itype, const char* jobz, const char* uplo, const int* n, double* a, const int* lda,

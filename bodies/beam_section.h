@@ -7,7 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 /* the keys every beam model reads the same way, then the frame's initial state */
 #define FMB_BEAM_SECTION_PARAMS(max_elements)                                                              \

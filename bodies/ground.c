@@ -5,7 +5,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 typedef struct {
   double pos[2], angle;

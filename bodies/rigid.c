@@ -5,7 +5,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 typedef struct {
   double mass, inertia;

@@ -1,10 +1,10 @@
 /*
- * flexmbd.h — the one public header of the flexmbd engine.
+ * flexmbd.h — the public header for programs: load a scene, run it or step it, analyse it
+ * (statics, modes, Campbell diagrams, several models), and write its outputs.
  *
- * Two audiences:
- *   - programs that load a scene and run it (fmb_load, fmb_run, fmb_free);
- *   - plugin authors who add a body or joint/force type (fmbBodyType, fmbJointType and the
- *     fmb_get_* accessors used inside a plugin's parse function).
+ * Body and joint authors include flexmbd_plugin.h instead (it includes this one): the type tables,
+ * the YAML accessors of a parse, the evaluation helpers and the plugin descriptor. A program
+ * sees those tables only as opaque types (fmbBodyType, fmbJointType, fmbPlugin) that it hands on.
  *
  * Conventions: SI units; functions are fmb_verbNoun, outputs after inputs unless noted;
  * evaluation callbacks return 0 on success, >0 for a recoverable failure (IDA cuts the step,
@@ -21,15 +21,12 @@
 extern "C" {
 #endif
 
-/* The plugin ABI: the layout of fmbPlugin, fmbBodyType, fmbJointType, fmbParam and the signatures
-   of every function below. A plugin built for another number is refused when it is loaded
-   (engine/plugin.c). 2: the type tables gained params, example, example_damped, flags, and bodies
-   the optional centreline op and the optional naux, residual_aux, aux_initial, pattern,
-   pattern_jacobian, length_scale and model_range ops (added to 2 before any release of it). 3: the
-   stepping API (fmbData, fmb_init, fmb_advance, ...), the warn callback, and inputs: joints gained
-   the optional `input` op and read an input's value with fmb_eval_input; bodies and joints the
-   optional output_units (what plots and `view` put on their axes). */
-#define FMB_ABI_VERSION 3
+/* The program ABI: the shared library's SOVERSION (libflexmbd.so.FMB_SOVERSION). It changes when
+   a function of this header is removed or changes its signature, or a struct a program allocates
+   (fmbDiag, fmbStats, fmbRunOptions, ...) changes its layout. The plugin ABI is a number of its own
+   (FMB_PLUGIN_ABI_MAJOR/MINOR, flexmbd_plugin.h): a new analysis or run option does not break
+   plugins. */
+#define FMB_SOVERSION 3
 
 /* what the shared library exports (it is built with hidden visibility, docs/plugins.md) */
 #if defined(__GNUC__)
@@ -37,12 +34,12 @@ extern "C" {
 #else
 #define FMB_API
 #endif
-/* what a plugin exports: its one entry point, fmb_plugin_descriptor */
-#ifdef __cplusplus
-#define FMB_PLUGIN_EXPORT extern "C" FMB_API
-#else
-#define FMB_PLUGIN_EXPORT FMB_API
-#endif
+
+/* the library's release, "MAJOR.MINOR.PATCH" (what `flexmbd --version` prints first), at run time */
+FMB_API const char* fmb_version(void);
+/* the plugin ABI the library implements, as FMB_PLUGIN_ABI encodes it (flexmbd_plugin.h):
+   major * 1000 + minor */
+FMB_API int fmb_plugin_abi(void);
 
 /* ---------------------------------------------------------------------------------------------
  * Diagnostics: the first error wins; file/line/col are 1-based, 0 when not applicable.
@@ -60,342 +57,20 @@ typedef struct fmbDiag {
 } fmbDiag;
 
 /* ---------------------------------------------------------------------------------------------
- * Scene parsing API for plugins (the one YAML accessor layer, engine/yaml_get.c). A NULL parser,
- * key or output pointer makes an accessor return -1 without touching anything.
- * A node is an index into the loaded document. Every accessor records the key as "known" for
- * the unknown-key check, applies the default already in *out when the key is absent and not
- * required, and on error records file:line:column plus what was expected, returning non-zero.
+ * The registry: the body and joint types a load knows. A plugin is a set of types behind one
+ * descriptor (flexmbd_plugin.h); the built-in types are one too (fmb_builtin_plugin), and every
+ * type enters a registry through fmb_registry_add, which checks the plugin ABI and the required
+ * ops. The engine names no type; the program hands fmb_load a registry.
  * ------------------------------------------------------------------------------------------- */
-typedef struct fmbParser fmbParser;
-typedef int fmbNode;
-
-enum {
-  FMB_OPTIONAL = 0,
-  FMB_REQUIRED = 1 << 0,
-  FMB_POSITIVE = 1 << 1,    /* > 0 */
-  FMB_NONNEGATIVE = 1 << 2, /* >= 0 */
-  FMB_POSE = 1 << 3         /* fmb_get_angle: an orientation, where |angle| > 2 pi is suspicious */
-};
-
-FMB_API int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
-FMB_API int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out);
-FMB_API int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]);
-/* an angle in radians: a bare number is radians, `120 deg` / `2.1 rad` say their unit. With
-   FMB_POSE a bare number beyond 2*pi in magnitude draws a warning (degrees written as radians?) */
-FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
-/* a piecewise-linear table: an inline list of [t, value] pairs or the name of a CSV file of
-   "t,value" rows (one header line allowed; relative to the scene's folder). t strictly
-   increasing, at least two rows. *x and *y are malloc'ed (the caller frees them, also on error). */
-FMB_API int fmb_get_table(fmbParser* p, fmbNode map, const char* key, unsigned flags, double** x, double** y, int* n);
-/* one of a NULL-terminated list of words; *out is the index */
-FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned flags, const char* const* choices,
-                           int* out);
-/* a point of body `body` in the body's reference frame, [x, y] (default: *out as given); a point
-   the body cannot place (its `marker` fails in the pose the scene gives, e.g. beyond a beam's
-   length) is refused here, at the point, instead of failing the run later with a false cause */
-FMB_API int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]);
-/* a body by name ("ground" is always defined); *out is the body index */
-FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
-/* a joint defined earlier in the file, by name; *out is the joint index */
-FMB_API int fmb_get_joint(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
-/* body index and local point of attachment k (0 or 1) of an already parsed joint with
-   constraint rows (a pivot, a weld; not a spring's ends) */
-FMB_API int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local[2]);
-/* position and angle of material point `local` of body `body` in the pose the scene gives it
-   (before any assembly), e.g. for a joint whose default is the configuration as assembled.
-   Returns 0, or -1 (bad arguments, or the body cannot place the point). */
-FMB_API int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle);
-/* a plugin-level check failed at `node` (a value node or the item's mapping) */
-FMB_API int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 3, 4)))
-#endif
-    ;
-/* the value node of `key` in `map`, or -1 if absent (marks the key known) */
-FMB_API fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key);
-
-/* ---------------------------------------------------------------------------------------------
- * Evaluation environment shared by all plugins.
- * ------------------------------------------------------------------------------------------- */
-typedef struct fmbEnv {
-  double gravity[2]; /* m/s^2, global frame */
-  int has_gravity;   /* 0 when the scene has g = 0: plugins skip gravity terms entirely */
-} fmbEnv;
-
-typedef struct fmbEnergy {
-  double kinetic, strain, gravity, spring;
-} fmbEnergy;
-
-/* ---------------------------------------------------------------------------------------------
- * Parameter declarations. A type lists the keys its parse reads, with units, defaults and ranges:
- * `flexmbd types` prints them and `flexmbd conform` generates a bad scene from every range
- * (a value outside it must be refused at its file:line:column naming the key), so a new type
- * never edits the engine's test lists. The list ends with an entry whose key is NULL.
- * ------------------------------------------------------------------------------------------- */
-typedef enum {
-  FMB_PARAM_NUMBER, /* fmb_get_double; range from flags FMB_POSITIVE / FMB_NONNEGATIVE */
-  FMB_PARAM_INT,    /* fmb_get_int; range [lo, hi] */
-  FMB_PARAM_VEC2,   /* fmb_get_vec2 */
-  FMB_PARAM_CHOICE, /* fmb_get_choice; the words in `choices` */
-  FMB_PARAM_BODY,   /* fmb_get_body */
-  FMB_PARAM_JOINT,  /* fmb_get_joint */
-  FMB_PARAM_TABLE,  /* fmb_get_table: [[t, value], ...] or a CSV file name */
-  FMB_PARAM_MAP     /* a mapping of sub-keys, which `doc` names (beam's `reduction: {modes: k}`) */
-} fmbParamKind;
-
-typedef struct fmbParam {
-  const char* key;
-  fmbParamKind kind;
-  unsigned flags;             /* FMB_REQUIRED, FMB_POSITIVE, FMB_NONNEGATIVE as the parse passes them */
-  const char* unit;           /* SI unit, "1" for a pure number or count, NULL for words and names */
-  const char* fallback;       /* the default as a scene would write it; NULL when required or none */
-  long lo, hi;                /* FMB_PARAM_INT: the accepted range */
-  const char* const* choices; /* FMB_PARAM_CHOICE: NULL-terminated */
-  const char* doc;            /* one line */
-} fmbParam;
-
-/* type flags (fmbBodyType.flags, fmbJointType.flags) */
-enum {
-  FMB_TYPE_DOES_WORK = 1 << 0, /* feeds energy in (a prescribed motion, an applied load): conform
-                                  skips the energy-conservation run */
-  /* conform's fixture (fmb_conform) is made of the first registered body type and joint type
-     with this flag, so that the engine names no type: the body must take mass, inertia,
-     position, velocity and angular_velocity (a rigid body with a frame), the joint body1, body2
-     and point2 (a pin joining two bodies' points) */
-  FMB_TYPE_CONFORM_FIXTURE = 1 << 1
-};
-
-/* ---------------------------------------------------------------------------------------------
- * Body plugins. A body owns `ncoord` generalized coordinates q (frame x, y, theta first when the
- * body has a frame) and the same number of velocities v; its equations of motion are the rows
- *     R(q, v, a) = M(q) a - Q(q, v) = 0     (a = dv/dt, Q includes elastic, velocity and gravity)
- * The engine adds constraint forces and force elements. All arrays are the body's own slice.
- * ------------------------------------------------------------------------------------------- */
-typedef struct fmbBodyType {
-  const char* name; /* YAML `type:` */
-  int abi;          /* FMB_ABI_VERSION */
-  /* required */
-  int (*parse)(fmbParser* p, fmbNode item, void** self);
-  void (*destroy)(void* self);
-  int (*ncoord)(const void* self);
-  void (*initial)(const void* self, double* q0, double* v0);
-  int (*residual)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a, double* R,
-                  double* work);
-  /* position and angle of a material point given in the body's reference configuration
-     (`local`, body frame), with their derivatives wrt q (dpos_dq: 2 x ncoord row-major, may be
-     NULL; dangle_dq: ncoord, may be NULL). Joints and force elements see bodies only this way. */
-  int (*marker)(const void* self, const double* q, const double local[2], double pos[2], double* angle, double* dpos_dq,
-                double* dangle_dq, double* work);
-  /* optional */
-  size_t (*nwork)(const void* self); /* scratch doubles the engine allocates once; NULL = 0 */
-  /* dense ncoord x ncoord column-major blocks K = dR/dq, C = dR/dv, M = dR/da; NULL = the engine
-     differentiates `residual` numerically (engine/fd.c) */
-  int (*jacobian)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a, double* K,
-                  double* C, double* M, double* work);
-  void (*energy)(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* e, double* work);
-  /* named outputs beyond the frame's x, y, theta, omega, vx, vy (which the engine provides for
-     every body with a frame: ncoord >= 3, or a marker that places the origin [0, 0]): lookup returns an id >= 0 or -1 (NULL: the id is the name's
-     index in output_names); output evaluates one id. */
-  const char* const* output_names; /* NULL-terminated, for listings */
-  int (*output_lookup)(const void* self, const char* quantity);
-  int (*output)(const void* self, int id, const double* q, const double* v, double* value, double* work);
-  void (*describe)(
-      const void* self,
-      FILE*
-          f); /* rest of one line after "body 'NAME' (TYPE, N coordinates): ": active terms, variant; ends with a newline */
-  /* a body whose model can lose mass definiteness (FOAC) returns a hint saying why and what to
-     do; the engine then checks the mass matrix reduced to the constraint manifold at every
-     output time and stops the run with that hint when it is no longer positive definite.
-     NULL op or NULL return = always definite, no check. */
-  const char* (*indefinite_mass)(const void* self);
-  /* the highest BDF order this body's dynamics tolerate. A body with many undamped stiff
-     oscillatory modes (a finite-element beam) returns 2: BDF2 is A-stable, orders 3-5 amplify
-     modes inside their instability wedge and the error test then forces tiny steps. NULL = 5.
-     The engine uses the minimum over bodies unless the scene sets solver.max_order. */
-  int (*max_bdf_order)(const void* self);
-  /* 0 when this body's velocities should stay out of the error test unless the scene says
-     otherwise (solver.error_control): after any sudden load a finite-element body carries every
-     undamped mode, whose velocity amplitude falls only like 1/omega (its displacement like
-     1/omega^2), so a velocity error test makes the steps resolve modes at 1e5 rad/s that the
-     positions do not notice. NULL = 1 (positions and velocities tested). */
-  int (*velocity_error_test)(const void* self);
-  /* NULL when the state is within the model's validity; otherwise why not and what to do (a
-     beam whose deformation exceeds its length is diverging). Checked at every output time:
-     the run stops there with exit 3 instead of integrating a runaway solution. */
-  const char* (*invalid_state)(const void* self, const double* q, const double* v);
-  /* declarations (ABI 2): the keys parse reads; a valid instance as YAML lines `key: value`
-     (without name and type) that conform runs free under gravity; extra lines that make it
-     dissipate energy (NULL when it cannot); FMB_TYPE_* flags */
-  const fmbParam* params;
-  const char* example;
-  const char* example_damped;
-  unsigned flags;
-  /* A body with a deformable centreline (a beam) names points along it for drawing and for the
-     `BODY.shape` output: the reference points (body frame, as `marker` takes them) of n stations
-     from root to tip into local[2n]. With local == NULL it only returns the station count it
-     draws with by default (a beam: its nodes). The engine asks `marker` where they are now.
-     NULL = a body without a centreline (drawn from its frame and joint points). */
-  int (*centreline)(const void* self, int n, double* local);
-  /* a type whose items choose between implementations behind one `type:` name (beam: `model:
-     exact` is bodies/beam_exact.c) returns the ops table for this item, or NULL after recording
-     a parse error; the engine then parses and runs the item with that table. NULL op = this one. */
-  const struct fmbBodyType* (*variant)(fmbParser* p, fmbNode item);
-  /* 0 when this body's K, C, M must be evaluated afresh whenever IDA asks for a new iteration
-     matrix. The engine otherwise reassembles them from their last evaluation when only cj has
-     changed (engine/integrator_ida.c), which suits bodies whose tangent changes slowly; a
-     geometrically exact beam's axial stiffness EA t t^T turns with its tangent, and stale blocks
-     cost Newton failures (spin-up at 15 rad/s, 20 elements: 454 against 123, 1.7x the CPU).
-     NULL = 1 (reuse allowed). */
-  int (*reuse_blocks)(const void* self);
-  /* Auxiliary algebraic unknowns, for a body whose equations couple far-apart coordinates
-     through sums (the beam's coupling deformation accumulates every inboard slope): carrying
-     the sums as `naux` unknowns z with one equation each keeps every equation local, so the
-     Jacobian is sparse. With naux > 0 the engine integrates R(q, v, a, z) = 0 (ncoord rows, R
-     as `residual` returns it once Rz = 0) and Rz(q, v, a, z) = 0 (naux rows) from residual_aux;
-     aux_initial gives the z that satisfies Rz = 0. `residual` (z eliminated) stays required:
-     initial conditions and checks use it. NULL naux or 0 = none. */
-  int (*naux)(const void* self);
-  int (*residual_aux)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                      const double* z, double* R, double* Rz, double* work);
-  int (*aux_initial)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a, double* z,
-                     double* work);
-  /* The nonzeros of d[R; Rz]/d[x; z], x = q, v or a (their union), as (row, column) pairs over
-     the ncoord + naux rows and columns (duplicates allowed): with rows/cols NULL it returns the
-     count, else fills them. -1 (or a NULL op) = one dense block. The engine then differentiates
-     the body over that pattern, grouping columns that share no row (engine/fd.c). */
-  long (*pattern)(const void* self, int* rows, int* cols);
-  /* The analytic K = d[R; Rz]/d[q; z], C = dR/dv, M = dR/da over the declared pattern: one value
-     per (row, column) pair, in the order `pattern` lists the pairs (the engine sums duplicates,
-     so a body may list each element's block and add into it as it assembles); C and M are 0 in
-     the z columns. z is NULL when naux = 0. Nonzero = not evaluable (IDA cuts the step). The
-     engine uses it instead of differencing over the pattern; NULL = differences (engine/fd.c). */
-  int (*pattern_jacobian)(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                          const double* z, double* K, double* C, double* M, double* work);
-  /* Each coordinate's length scale into metres_per_unit[ncoord]: the metres a point of the body
-     moves per unit of the coordinate (1 for a displacement; the length L for a slope, a stretch
-     or an angle that swings the body). The engine divides the scene's atol by it for that
-     coordinate and its velocity (engine/tolerance.c), so one atol in metres controls slopes and
-     displacements alike at any size of the body. NULL = atol as given for every coordinate. */
-  void (*length_scale)(const void* self, double* metres_per_unit);
-  /* The range where the body's model is accurate (ABI 2, added before any release of it): NULL
-     while the state (q, v) is inside it; otherwise the body writes into msg[len] what left the
-     range, by how much, and what to use instead, and returns msg. The run warns once per body,
-     at the first output time it happens, with the time (beam: the tip deflection beyond the
-     model's measured limit, "use model: exact"). NULL op = no range stated. */
-  const char* (*model_range)(const void* self, const double* q, const double* v, char* msg, size_t len);
-  /* ABI 3, optional: the SI unit of each name in output_names (same order; "1" for a pure number),
-     for the axes of plots and of `view` (fmb_output_unit_in). NULL = not declared. */
-  const char* const* output_units;
-} fmbBodyType;
-
-/* ---------------------------------------------------------------------------------------------
- * Joint and force plugins. A joint touches at most two bodies; it contributes `nrows`
- * constraint rows Phi(q, t) = 0 and/or generalized forces. Its view of the bodies is an
- * fmbJointEval: the two bodies' coordinates and velocities, and fmb_marker() to ask a body where
- * a point is. Columns of phi_q (row-major, nrows x ncol) and entries of Q run over body 0's coordinates then
- * body 1's.
- * Rheonomic constraints must be of the form Phi(q) - f(t) (Phi_qt = 0).
- * ------------------------------------------------------------------------------------------- */
-typedef struct fmbJointEval fmbJointEval;
-
-typedef struct fmbJointType {
-  const char* name;
-  int abi;
-  /* required */
-  int (*parse)(fmbParser* p, fmbNode item, void** self);
-  void (*destroy)(void* self);
-  void (*bodies)(const void* self, int body[2]); /* body indices; body[1] may equal -1 */
-  /* optional */
-  int (*nrows)(const void* self); /* NULL = 0 (a pure force element) */
-  int (*attachment)(const void* self, int k, int* body, double local[2]);
-  int (*constraint)(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
-                    double* phi_tt);
-  int (*force)(const void* self, const fmbJointEval* ev, double* Q); /* adds to Q */
-  double (*energy)(const void* self, const fmbJointEval* ev);        /* spring potential */
-  const char* const* output_names; /* as for bodies: NULL output_lookup = the index in this list */
-  int (*output_lookup)(const void* self, const char* quantity);
-  int (*output)(const void* self, int id, const fmbJointEval* ev, double* value);
-  void (*describe)(const void* self, FILE* f);
-  /* declarations (ABI 2), as for bodies. conform's fixture has two rigid bodies `a` (centre at
-     [0.5, 0], pinned to ground at its end [-0.5, 0]) and `b` (centre at [1.5, 0]), 1 m long each,
-     and a revolute joint `pin` (ground to a): the example refers to them by these names. */
-  const fmbParam* params;
-  const char* example;
-  const char* example_damped;
-  unsigned flags;
-  /* ABI 3, optional: 1 when this instance takes its value from an input that a program sets
-     between steps (fmb_set_input; a drive or load with `profile: input` / `law: input`), with the
-     scene's initial `value:` in *initial; 0 otherwise. The input's name is the joint's. */
-  int (*input)(const void* self, double* initial);
-  /* ABI 3, optional: output_names' units, as for bodies */
-  const char* const* output_units;
-} fmbJointType;
-
-/* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
-   0, NULL or -1: a plugin bug, reported instead of crashing) */
-FMB_API double fmb_eval_time(const fmbJointEval* ev);
-FMB_API int fmb_eval_ncoord(const fmbJointEval* ev, int k); /* coordinates of body k (0 for ground) */
-FMB_API const double* fmb_eval_q(const fmbJointEval* ev, int k);
-FMB_API const double* fmb_eval_v(const fmbJointEval* ev, int k);
-/* position and angle of body k's material point `local`; derivatives wrt body k's coordinates
-   go to dpos_dq (row 0 at dpos_dq[0..nk), row 1 at dpos_dq[ld..ld+nk)) and dangle_dq[0..nk);
-   either may be NULL. Use ld = the joint's column count to write straight into phi_q rows. */
-FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle,
-                       double* dpos_dq, int ld, double* dangle_dq);
-/* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
-FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
-/* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
-   context or another k (0 would be body 0's column: a wrong place, silently) */
-FMB_API int fmb_eval_col0(const fmbJointEval* ev, int k);
-/* the current value of this joint's input (its `input` op said 1): the scene's `value:` until a
-   program sets it with fmb_set_input; NaN for a joint without an input */
-FMB_API double fmb_eval_input(const fmbJointEval* ev);
-/* its rate d/dt at the evaluation's time and (accel not NULL) its second rate: what the program
-   gave with fmb_set_input_motion, 0 for a value held (fmb_set_input); NaN without an input. A
-   prescribed motion reads them for its f' and f'' (a drive whose rate is 0 throws the motion
-   between settings away) */
-FMB_API double fmb_eval_input_rate(const fmbJointEval* ev, double* accel);
-
-/* ---------------------------------------------------------------------------------------------
- * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
- * ------------------------------------------------------------------------------------------- */
-#define FMB_GAUSS_MAX 10
-/* n-point Gauss-Legendre rule on [0, 1] (1 <= n <= FMB_GAUSS_MAX); exact to degree 2n-1.
-   Returns 0, or -1 for an unsupported n. */
-FMB_API int fmb_gauss_legendre01(int n, double* x, double* w);
-/* n-point Gauss-Lobatto rule on [0, 1] (2 <= n <= FMB_GAUSS_MAX): both ends and n - 2 interior
-   points, exact to degree 2n-3. Returns 0, or -1 for an unsupported n. */
-FMB_API int fmb_gauss_lobatto01(int n, double* x, double* w);
-
-/* Rigid-frame kinematics (engine/frame.c): the global position and angle of the point `local` of
-   a planar frame at frame = [x, y, theta] (p = r + A(theta) local, angle = theta), dp/dframe
-   (2 x 3 row-major) and dangle/dframe (3); angle and the derivatives may be NULL. A rigid body
-   (q = its frame) answers `marker` with exactly this call. */
-FMB_API void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* angle,
-                             double* dpos_dframe, double* dangle_dframe);
-
-/* ---------------------------------------------------------------------------------------------
- * Plugins and the registry. A plugin is a set of types behind one descriptor; the built-in types
- * are one too (fmb_builtin_plugin), and every type enters a registry through fmb_registry_add,
- * which checks the ABI and the required ops. A shared object exports the descriptor as
- *     FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void);
- * The engine names no type; the program hands fmb_load a registry.
- * ------------------------------------------------------------------------------------------- */
-typedef struct fmbPlugin {
-  int abi;          /* FMB_ABI_VERSION: first, never moves */
-  const char* name; /* for messages and `flexmbd types` */
-  const char* version;
-  const fmbBodyType* const* bodies; /* NULL-terminated; NULL = none */
-  const fmbJointType* const* joints;
-} fmbPlugin;
-#define FMB_PLUGIN_ENTRY "fmb_plugin_descriptor"
-typedef const fmbPlugin* (*fmbPluginEntry)(void);
+typedef struct fmbBodyType fmbBodyType;   /* a body type's table (flexmbd_plugin.h) */
+typedef struct fmbJointType fmbJointType; /* a joint or force type's table */
+typedef struct fmbPlugin fmbPlugin;       /* a plugin's descriptor */
 
 typedef struct fmbRegistry fmbRegistry;           /* growable, any number of types */
 FMB_API fmbRegistry* fmb_registry_new(void);      /* empty; NULL when out of memory */
 FMB_API void fmb_registry_free(fmbRegistry* reg); /* types and loaded code stay valid */
 /* register every type of `plugin` (origin: "built-in" or the file, for messages). Refuses, with
-   *diag filled (exit code 2), another ABI, a type without a name or a required op, and a name
+   *diag filled (exit code 2), another plugin ABI (flexmbd_plugin.h's rule), a type without a name or a required op, and a name
    already registered by another table; the same table twice is a no-op. */
 FMB_API int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* origin, fmbDiag* diag);
 /* dlopen a shared object (a path without '/' is taken in the current folder, never searched for),
@@ -522,9 +197,6 @@ FMB_API const char* fmb_output_unit(const char* column);
    declare for that quantity (output_units; a numbered name such as node12_v matches nodeK_v), when
    every type that declares the quantity agrees on it; NULL otherwise. reg may be NULL. */
 FMB_API const char* fmb_output_unit_in(const fmbRegistry* reg, const char* column);
-/* s as XML text or attribute value (& < > " ' escaped, control characters other than \n \t
-   dropped): the VTK collection, JUnit reports */
-FMB_API void fmb_write_xml_text(FILE* f, const char* s);
 /* NULL when m is NULL or out of memory; free with fmb_drawing_free (NULL allowed) */
 FMB_API fmbDrawing* fmb_drawing_new(const fmbModel* m);
 FMB_API void fmb_drawing_free(fmbDrawing* d);
@@ -803,52 +475,6 @@ typedef struct fmbModelsResult {
    models or the merged file with *diag saying why; *res (may be NULL) says what each run did. */
 FMB_API int fmb_run_models(const fmbSceneSource* scene, const char* const* bodies, int nbody, const char* const* models,
                            int nmodel, const fmbRunOptions* opt, fmbModelsResult* res, fmbDiag* diag);
-
-/* ---------------------------------------------------------------------------------------------
- * Writing a file without losing one (engine/safe_file.c): the content goes to a temporary file
- * beside `path` that replaces it only on fmb_safe_close(f, 1); fmb_safe_close(f, 0) removes the
- * temporary file and leaves `path` as it was. "-" and non-regular paths (a FIFO, /dev/null) are
- * written straight through and never removed. The caller owns the handle until fmb_safe_close.
- * ------------------------------------------------------------------------------------------- */
-typedef struct fmbSafeFile fmbSafeFile;
-/* A set of input files that a writer must not replace (fmbInputs): whatever name or link leads to
-   one (same device and inode), until the noted name no longer leads to that file (deleted or
-   replaced since: its inode may be reused). There is no process-wide list: each model keeps the
-   set of the files fmb_load read for it (the scene, its table files, the scene's plugins;
-   fmb_model_inputs) and the writers of its runs check against it; a program that reads more
-   (samples, references, plugins it loads itself) keeps a set of its own and opens its files with
-   fmb_safe_open_guarded. A set has its own lock: it may be shared by threads.
-   note: 0, or -1 (not a regular file, or out of memory); notes are counted, each undone by one
-   forget. add: every file of `from` noted in `to` (0, or -1). at: 1 when `path` is one of the set's
-   files, with the name it was noted under in name[namelen] (may be NULL), else 0. */
-typedef struct fmbInputs fmbInputs;
-FMB_API fmbInputs* fmb_inputs_new(void); /* NULL when out of memory */
-FMB_API void fmb_inputs_free(fmbInputs* in);
-FMB_API int fmb_inputs_note(fmbInputs* in, const char* path);
-FMB_API void fmb_inputs_forget(fmbInputs* in, const char* path);
-FMB_API int fmb_inputs_add(fmbInputs* to, const fmbInputs* from);
-FMB_API int fmb_inputs_at(const fmbInputs* in, const char* path, char* name, size_t namelen);
-FMB_API int fmb_inputs_count(const fmbInputs* in);
-/* the files fmb_load read for m (valid while m is); NULL for a NULL model */
-FMB_API const fmbInputs* fmb_model_inputs(const fmbModel* m);
-/* NULL with the reason in err on failure, among them a target that is one of `inputs` (may be NULL:
-   nothing refused on that ground; fmb_safe_open is fmb_safe_open_guarded with NULL) */
-FMB_API fmbSafeFile* fmb_safe_open_guarded(const char* path, const fmbInputs* inputs, char* err, size_t errlen);
-FMB_API fmbSafeFile* fmb_safe_open(const char* path, char* err, size_t errlen);
-FMB_API FILE* fmb_safe_stream(fmbSafeFile* f); /* a stdio stream over it (closed by fmb_safe_close) */
-FMB_API int fmb_safe_fd(const fmbSafeFile* f);
-FMB_API int fmb_safe_is_temporary(const fmbSafeFile* f);
-/* the file to write when another program writes it (gnuplot): the temporary file, or the target
-   written through; NULL for stdout */
-FMB_API const char* fmb_safe_write_path(const fmbSafeFile* f);
-/* keep != 0: put the content in place (rename); 0: discard it. 0, or -1 with errno on failure */
-FMB_API int fmb_safe_close(fmbSafeFile* f, int keep);
-
-/* "did you mean": of words[0..n) (NULL entries skipped), the nearest to `typed` when `typed` is
-   a typo of it (an edit distance, with adjacent transpositions, of 1 in a word of up to 4
-   letters, 2 from 5 on), else NULL. The scene loader's unknown keys and the program's unknown
-   commands are matched by this one rule. */
-FMB_API const char* fmb_nearest_word(const char* typed, const char* const* words, int n);
 
 #ifdef __cplusplus
 }

@@ -4,7 +4,7 @@
  * the point's angle is theta, d angle/dframe = [0, 0, 1]. */
 #include <math.h>
 
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* angle, double* dpos_dframe,
                      double* dangle_dframe) {

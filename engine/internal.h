@@ -5,7 +5,8 @@
 
 #include <yaml.h>
 
-#include "flexmbd.h"
+#include "flexmbd_cli.h"
+#include "flexmbd_plugin.h"
 
 #define FMB_NAME_MAX 64
 #define FMB_WORLD 0 /* body index of the fixed world frame, named "ground" */
@@ -91,6 +92,17 @@ typedef struct fmbSolverSettings {
      one of them per model by the rule of fmb_integrator_for (integrator_select.c) */
   const struct fmbIntegratorOps* integrator; /* one of fmb_integrators[] (integrator.h), never projected */
   long max_steps_per_output;
+  /* the reduced Newton system's LU (schur.c): auto = schur_use_dense's rule; klu or dense to
+     compare the two (solver.schur_lu; was the FMB_SCHUR_LU environment variable) */
+  enum { FMB_SCHUR_LU_AUTO = 0, FMB_SCHUR_LU_KLU = 1, FMB_SCHUR_LU_DENSE = 2 } schur_lu;
+  /* 0: formulation auto skips its scan of rigid closed loops for singular configurations
+     (singular.c), so a run reaches the switch at the GGL backend's failure (solver.singular_scan:
+     off; was FMB_TEST_NO_SINGULAR_WALK) */
+  int singular_scan;
+  /* > 0: the reduced Newton setup fails from its Nth factorization on, to exercise the fallback
+     to klu_full (solver.fault_reduced_setup, a test's fault injection; was
+     FMB_TEST_FAIL_REDUCED_SETUP). 0 = never */
+  long fault_reduced_setup;
 } fmbSolverSettings;
 
 /* A step this small relative to the whole run means IDA is closing in on a singularity it

@@ -6,7 +6,7 @@
 #include <math.h>
 #include <pthread.h>
 
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 static double rule_x[FMB_GAUSS_MAX + 1][FMB_GAUSS_MAX];
 static double rule_w[FMB_GAUSS_MAX + 1][FMB_GAUSS_MAX];

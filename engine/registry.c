@@ -3,6 +3,7 @@
  * included (builtin/builtin.c hands in a descriptor like any plugin): one door, one set of checks.
  * The registry holds pointers only; the tables live in the library or in a loaded plugin, which
  * is never unloaded (engine/plugin.c). */
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -155,14 +156,65 @@ static int valid_name(const char* name) {
   return 1;
 }
 
+/* The plugin ABI rule (flexmbd_plugin.h): `abi` is major * 1000 + minor, or a bare major below
+   1000 (what a 3.0 plugin wrote). Same major and a minor up to ours loads; anything else is refused
+   with both numbers. A table's fields are not read before this passes: another layout may not have
+   them where this one does. */
+static void split_abi(int abi, int* major, int* minor) {
+  *major = abi >= 1000 ? abi / 1000 : abi;
+  *minor = abi >= 1000 ? abi % 1000 : 0;
+}
+
 static int check_abi(const char* origin, const char* what, const char* name, int abi, fmbDiag* diag) {
-  if (abi == FMB_ABI_VERSION) return 0;
-  /* the name is not read from a table of another layout: it may not be where this ABI has it */
+  int major, minor;
+  split_abi(abi, &major, &minor);
+  if (major == FMB_PLUGIN_ABI_MAJOR && minor >= 0 && minor <= FMB_PLUGIN_ABI_MINOR) return 0;
+  const char* why = major != FMB_PLUGIN_ABI_MAJOR
+                        ? "rebuild it against this version's headers"
+                        : "it needs a newer flexmbd (or rebuild it against this version's headers)";
   fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0,
-               "%s%s%s%s was built for flexmbd plugin ABI %d; this flexmbd has ABI %d: rebuild it against this "
-               "version's headers",
-               what, name ? " '" : "", name ? name : "", name ? "'" : "", abi, FMB_ABI_VERSION);
+               "%s%s%s%s was built for flexmbd plugin ABI %d.%d; this flexmbd %s has plugin ABI %d.%d: %s", what,
+               name ? " '" : "", name ? name : "", name ? "'" : "", major, minor, fmb_version(), FMB_PLUGIN_ABI_MAJOR,
+               FMB_PLUGIN_ABI_MINOR, why);
   return -1;
+}
+
+/* the descriptor as this library lays it out: the plugin's `size` bytes of it (a 3.0 descriptor,
+   size 0, has every field up to `joints`), the fields a plugin's minor does not have left 0 (NULL:
+   absent). 0, or -1 with *diag for a size that cannot be a descriptor of the plugin's minor. */
+static int read_descriptor(const fmbPlugin* plugin, const char* origin, fmbPlugin* out, fmbDiag* diag) {
+  /* what ABI 3.0 had: int abi, then name at the next pointer boundary (padding where 3.1 has size) */
+  struct plugin30 {
+    int abi;
+    const char* name;
+    const char* version;
+    const void* bodies;
+    const void* joints;
+  };
+  const size_t size30 = sizeof(struct plugin30);
+  size_t size = plugin->size;
+  if (size == 0) {
+    /* 3.1 put `size` in 3.0's padding; where there was none (ILP32) a 3.0 descriptor has a
+       different layout and cannot be read as this one */
+    if (offsetof(fmbPlugin, name) != offsetof(struct plugin30, name)) {
+      fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0,
+                   "plugin was built for flexmbd plugin ABI 3.0, whose descriptor this platform cannot read: "
+                   "rebuild it against this version's headers");
+      return -1;
+    }
+    size = size30;
+  }
+  if (size < size30 || size > sizeof(fmbPlugin)) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, origin, 0, 0,
+                 "plugin descriptor says it is %zu bytes; plugin ABI %d.%d's is %zu to %zu: a corrupt descriptor, or "
+                 "one built with other headers",
+                 size, FMB_PLUGIN_ABI_MAJOR, FMB_PLUGIN_ABI_MINOR, size30, sizeof(fmbPlugin));
+    return -1;
+  }
+  memset(out, 0, sizeof *out);
+  memcpy(out, plugin, size);
+  out->size = (unsigned)size;
+  return 0;
 }
 
 int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* origin, fmbDiag* diag) {
@@ -175,8 +227,12 @@ int fmb_registry_add(fmbRegistry* reg, const fmbPlugin* plugin, const char* orig
     return -1;
   }
   if (!origin) origin = "?";
-  /* the descriptor's abi is read before anything else of it (the field never moves) */
+  /* the descriptor's abi is read before anything else of it (the field never moves), then its
+     size, then the rest as far as the plugin has it */
   if (check_abi(origin, "plugin", NULL, plugin->abi, diag)) return -1;
+  fmbPlugin desc;
+  if (read_descriptor(plugin, origin, &desc, diag)) return -1;
+  plugin = &desc;
   /* validate every table before registering any, so a refused plugin leaves the registry as it was */
   for (int k = 0; k < 2; ++k) {
     for (int i = 0; k ? (plugin->joints && plugin->joints[i]) : (plugin->bodies && plugin->bodies[i]); ++i) {

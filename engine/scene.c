@@ -45,8 +45,10 @@ static int get_atol(fmbParser* p, fmbNode node, double* atol, int* is_auto) {
 
 /* the keys of `solver:`, in the order parse_solver reads them: the one list for its messages */
 static const char* const solver_keys[] = {
-    "t_end",         "rtol",      "atol",      "output_step", "max_step",   "min_step", "linear_solver",
-    "error_control", "max_steps", "max_order", "formulation", "integrator", NULL};
+    "t_end",       "rtol",          "atol",          "output_step",   "max_step",
+    "min_step",    "linear_solver", "error_control", "max_steps",     "max_order",
+    "formulation", "integrator",    "schur_lu",      "singular_scan", "fault_reduced_setup",
+    NULL};
 
 static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   fmbSolverSettings* s = &m->solver;
@@ -72,6 +74,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   static const char* const solvers[] = {"klu", "dense", "klu_full", NULL}; /* order of FMB_LS_* */
   static const char* const controls[] = {"full", "positions", NULL};
   static const char* const formulations[] = {"ggl", "projected", "auto", NULL}; /* order of FMB_FORM_* */
+  static const char* const schur_lus[] = {"auto", "klu", "dense", NULL};        /* order of FMB_SCHUR_LU_* */
+  static const char* const scans[] = {"off", "auto", NULL};
   /* the GGL backends' names, from the one table of integrators (integrator_select.c), and auto */
   const char* integrators[9];
   const fmbIntegratorOps* integrator_ops[8];
@@ -82,7 +86,8 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
   s->positions_only = -1;                                     /* unset: chosen from the bodies */
   int max_steps = 100000, linear_solver = FMB_LS_KLU;
   s->max_order = 0; /* 0 = chosen from the bodies after they are parsed */
-  int atol_is_auto = 0;
+  int atol_is_auto = 0, schur_lu = FMB_SCHUR_LU_AUTO, fault_reduced_setup = 0;
+  s->singular_scan = 1;
   if (fmb_get_double(p, node, "t_end", FMB_REQUIRED | FMB_POSITIVE, &s->t_end) ||
       fmb_get_double(p, node, "rtol", FMB_POSITIVE, &s->rtol) || get_atol(p, node, &s->atol, &atol_is_auto) ||
       fmb_get_double(p, node, "output_step", FMB_POSITIVE, &s->output_step) ||
@@ -93,8 +98,13 @@ static int parse_solver(fmbParser* p, fmbModel* m, fmbNode node) {
       fmb_get_int(p, node, "max_steps", 0, 10, 100000000, &max_steps) ||
       fmb_get_int(p, node, "max_order", 0, 1, 5, &s->max_order) ||
       fmb_get_choice(p, node, "formulation", 0, formulations, &formulation) ||
-      fmb_get_choice(p, node, "integrator", 0, integrators, &integrator))
+      fmb_get_choice(p, node, "integrator", 0, integrators, &integrator) ||
+      fmb_get_choice(p, node, "schur_lu", 0, schur_lus, &schur_lu) ||
+      fmb_get_choice(p, node, "singular_scan", 0, scans, &s->singular_scan) ||
+      fmb_get_int(p, node, "fault_reduced_setup", 0, 0, 1000000000, &fault_reduced_setup))
     return -1;
+  s->schur_lu = schur_lu;
+  s->fault_reduced_setup = fault_reduced_setup;
   s->formulation = formulation;
   s->integrator = integrator < nintegrators ? integrator_ops[integrator] : NULL; /* NULL: auto */
   if (fmbp_check_unknown(p, node, "solver")) return -1;

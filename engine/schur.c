@@ -242,12 +242,11 @@ static int schur_blocks(fmbSchur* s) {
    and at least 90 % full. Large or sparse S (banded beams, long chains, big mechanisms) keep
    KLU, and so do the rigid mechanisms (the slider-crank's S is 51 x 51, 71 % full): at 30 % the
    dense LU's fresh pivots changed where IDA gives up at singular passages (test_parallelogram,
-   failure_singular_fourbar), whose tests pin KLU's behaviour. FMB_SCHUR_LU=klu or =dense
-   overrides the rule (to compare the two). */
+   failure_singular_fourbar), whose tests pin KLU's behaviour. The scene's solver.schur_lu: klu or
+   dense overrides the rule (to compare the two). */
 static int schur_use_dense(const fmbSchur* s) {
-  const char* force = getenv("FMB_SCHUR_LU");
-  if (force && strcmp(force, "klu") == 0) return 0;
-  if (force && strcmp(force, "dense") == 0) return 1;
+  if (s->m->solver.schur_lu == FMB_SCHUR_LU_KLU) return 0;
+  if (s->m->solver.schur_lu == FMB_SCHUR_LU_DENSE) return 1;
   const double nr = s->nr;
   return s->nr > 0 && s->nr <= 200 && (double)s->colptr[s->nr] >= 0.9 * nr * nr;
 }
@@ -266,8 +265,7 @@ fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
   s->acc = calloc(nc * ((size_t)s->nr + 1), sizeof(double));
   s->dq = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
   if (!s->first_kept || !s->diag_pos || !s->dinv || !s->acc || !s->dq) goto fail;
-  const char* fault = getenv("FMB_TEST_FAIL_REDUCED_SETUP");
-  s->fail_from = fault ? strtol(fault, NULL, 10) : 0;
+  s->fail_from = m->solver.fault_reduced_setup;
   for (int c = 0; c < m->nq; ++c) s->diag_pos[c] = -1;
   for (int c = 0; c < m->ny; ++c) {
     long k = m->colptr[c];

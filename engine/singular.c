@@ -115,10 +115,10 @@ static int rigid_bodies_only(const fmbModel* m) {
 }
 
 int fmb_needs_singular_method(const fmbModel* m) {
-  /* FMB_TEST_NO_SINGULAR_WALK: no walk, so that test_parallelogram still reaches the switch at
+  /* solver.singular_scan: off: no walk, so that test_parallelogram still reaches the switch at
      the GGL backend's failure (the fallback for what the walk does not find) */
-  if (getenv("FMB_TEST_NO_SINGULAR_WALK")) return 0;
-  if (!m || m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS || !rigid_bodies_only(m) || !has_closed_loop(m))
+  if (!m || !m->solver.singular_scan) return 0;
+  if (m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS || !rigid_bodies_only(m) || !has_closed_loop(m))
     return 0;
   const int nq = m->nq, nc = m->nc;
   fmbWorkspace* w = fmb_workspace_new(m);

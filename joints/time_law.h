@@ -15,7 +15,7 @@
  * times s itself (harmonic, table: laws of the position). */
 #ifndef FLEXMBD_TIME_LAW_H
 #define FLEXMBD_TIME_LAW_H
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 typedef enum {
   FMB_LAW_CONSTANT,

@@ -1,7 +1,7 @@
 /* two_point.h — what revolute, fixed and spring joints share: two bodies, a point on each. */
 #ifndef FLEXMBD_TWO_POINT_H
 #define FLEXMBD_TWO_POINT_H
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 typedef struct {
   int body[2];

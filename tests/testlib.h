@@ -6,7 +6,8 @@
 #include <stdio.h>
 
 #include "builtin.h"
-#include "flexmbd.h"
+#include "flexmbd_cli.h"
+#include "flexmbd_plugin.h"
 
 #include "check.h"
 

@@ -6,7 +6,8 @@
 #include <signal.h>
 #include <stdio.h>
 
-#include "flexmbd.h"
+#include "flexmbd_cli.h"
+#include "flexmbd_plugin.h"
 #include "options.h"
 
 #define FMB_CLI_MAX_OVERRIDES 256

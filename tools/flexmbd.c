@@ -44,7 +44,8 @@ int main(int argc, char** argv) {
   }
   const char* cmd = argv[1];
   if (strcmp(cmd, "--version") == 0 || strcmp(cmd, "version") == 0) {
-    printf("flexmbd %s (commit %s, plugin ABI %d)\n", FLEXMBD_VERSION, FLEXMBD_COMMIT, FMB_ABI_VERSION);
+    printf("flexmbd %s (commit %s, plugin ABI %d.%d)\n", FLEXMBD_VERSION, FLEXMBD_COMMIT, FMB_PLUGIN_ABI_MAJOR,
+           FMB_PLUGIN_ABI_MINOR);
     return 0;
   }
   if (strcmp(cmd, "--help") == 0 || strcmp(cmd, "-h") == 0 || strcmp(cmd, "help") == 0) {

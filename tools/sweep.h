@@ -15,7 +15,7 @@
 #include "child_pool.h"
 #include "csv_table.h"
 #include "farm.h"
-#include "flexmbd.h" /* fmbSafeFile */
+#include "flexmbd_cli.h" /* fmbSafeFile */
 #include "sweep_plan.h"
 
 #define FMB_SWEEP_MAX_METRICS 64

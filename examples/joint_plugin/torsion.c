@@ -17,7 +17,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 
-#include <flexmbd.h>
+#include <flexmbd_plugin.h>
 
 typedef struct {
   int body[2];         /* body indices (0 = the ground), as fmb_get_body gives them */

@@ -12,12 +12,12 @@
  * Analytic solutions (examples/plugin/check_foundation.c): heave is linear, omega_y^2 = k L / m,
  * about the sag y0 = m g_y / (k L); rocking is a pendulum in 2 theta, omega_t^2 = k L^3 / (12 J).
  *
- * Built against the installed flexmbd only (docs/plugins.md): flexmbd.h and libflexmbd. */
+ * Built against the installed flexmbd only (docs/plugins.md): flexmbd_plugin.h and libflexmbd. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <flexmbd.h>
+#include <flexmbd_plugin.h>
 
 typedef struct {
   double mass, inertia, length, stiffness, damping;

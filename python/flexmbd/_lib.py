@@ -24,8 +24,8 @@ import os
 import threading
 from typing import Optional
 
-#: the plugin/library ABI this package's struct layouts are written for (engine/flexmbd.h
-#: FMB_ABI_VERSION, also the shared library's SOVERSION)
+#: the program ABI this package's struct layouts are written for: engine/flexmbd.h FMB_SOVERSION,
+#: the shared library's SOVERSION (the plugin ABI is a number of its own, flexmbd_plugin.h)
 ABI = 3
 
 EXIT_OK = 0

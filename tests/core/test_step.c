@@ -1,5 +1,5 @@
 /* test_step.c — the stepping API (flexmbd.h "Stepping", issue 24) against fmb_run.
- * (FMB_TEST_NO_SINGULAR_WALK: formulation auto without its scan for singular configurations,
+ * (solver.singular_scan: off: formulation auto without its scan for singular configurations,
  * engine/singular.c, so that IDA meets the flat parallelogram and the advance switches there.)
  *
  * 1. For every shipped scene (scenes/ and its folders, found on disk so a new scene is covered
@@ -171,9 +171,9 @@ static void messages(void) {
   fmb_free(m);
 
   char scene[1024];
-  const char* sets[] = {"solver.formulation=auto", "solver.t_end=1"};
-  setenv("FMB_TEST_NO_SINGULAR_WALK", "1", 1); /* IDA fails at the flat and the run says so */
-  m = fmb_load(fmbt_path("scenes/parallelogram.yaml", scene, sizeof scene), sets, 2, fmb_builtin_registry(), &diag);
+  /* no scan: IDA fails at the flat and the run says so */
+  const char* sets[] = {"solver.formulation=auto", "solver.t_end=1", "solver.singular_scan=off"};
+  m = fmb_load(fmbt_path("scenes/parallelogram.yaml", scene, sizeof scene), sets, 3, fmb_builtin_registry(), &diag);
   ENSURE(m != NULL);
   if (m) {
     fmbData* d = fmb_data_new(m, &diag);
@@ -194,7 +194,6 @@ static void messages(void) {
     fmb_data_free(d);
     fmb_free(m);
   }
-  unsetenv("FMB_TEST_NO_SINGULAR_WALK");
 }
 
 int main(void) {
@@ -224,9 +223,8 @@ int main(void) {
   fmbt_path("scenes/parallelogram.yaml", scene, sizeof scene);
   const char* auto_set[] = {"solver.formulation=auto"};
   compare(scene, auto_set, 1, "parallelogram-auto", 0); /* the scan finds the flat: projected from t0 */
-  setenv("FMB_TEST_NO_SINGULAR_WALK", "1", 1);          /* no scan: IDA's failure at the flat, the switch */
-  compare(scene, auto_set, 1, "parallelogram-auto-switch", 0);
-  unsetenv("FMB_TEST_NO_SINGULAR_WALK");
+  const char* switch_set[] = {"solver.formulation=auto", "solver.singular_scan=off"}; /* no scan: IDA's failure */
+  compare(scene, switch_set, 2, "parallelogram-auto-switch", 0);                      /* at the flat, the switch */
   const char* ggl_set[] = {"solver.formulation=ggl"};
   compare(scene, ggl_set, 1, "parallelogram-ggl-fails", FMB_EXIT_SOLVER);
   fmbt_path("scenes/paper/spinup_w4.yaml", scene, sizeof scene);

@@ -9,7 +9,7 @@
 #include <stdio.h>
 
 #include "check.h"
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 extern const fmbBodyType fmb_body_beam_exact, fmb_body_ground, fmb_body_rigid;
 extern const fmbJointType fmb_joint_revolute, fmb_joint_fixed, fmb_joint_drive, fmb_joint_spring, fmb_joint_force;

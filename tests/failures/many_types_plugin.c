@@ -4,7 +4,7 @@
  * plugin file, which no output may replace (tests/failures/inputs_overwritten.sh). */
 #include <stdio.h>
 
-#include "flexmbd.h"
+#include "flexmbd_plugin.h"
 
 enum { MANY = 300 };
 static fmbBodyType types[MANY];

@@ -1,12 +1,21 @@
 /* broken.c — a plugin that breaks one rule, chosen at compile time (-DBREAK_...), to prove the
  * loader and `flexmbd conform` catch each (tests/install/run.sh). Without a BREAK_ macro it is a
- * correct 3-dof oscillator: a rigid body tied to its rest pose by springs,
+ * correct 3-dof oscillator: a rigid body tied to its rest pose by springs (-DABI_3_0: the same,
+ * with the descriptor and table a plugin built for plugin ABI 3.0 has, tests/core/test_plugin_abi.c),
  *     R = diag(m, m, J) a + k q - m g,     U = k |q|^2 / 2. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include <flexmbd.h>
+#include <flexmbd_plugin.h>
+
+#ifdef BREAK_ABI
+#define ABI ((FMB_PLUGIN_ABI_MAJOR + 1) * 1000) /* built, say, for the next major of the plugin ABI */
+#elif defined BREAK_ABI_MINOR
+#define ABI (FMB_PLUGIN_ABI + 1) /* a minor newer than this flexmbd's: fields it would not read */
+#else
+#define ABI FMB_PLUGIN_ABI
+#endif
 
 typedef struct {
   double mass, inertia, stiffness;
@@ -126,7 +135,11 @@ static const fmbBodyType oscillator = {
 #else
     .name = "oscillator",
 #endif
-    .abi = FMB_ABI_VERSION,
+#ifdef ABI_3_0
+    .abi = 3,
+#else
+    .abi = ABI,
+#endif
     .parse = osc_parse,
     .destroy = osc_destroy,
     .ncoord = osc_ncoord,
@@ -146,15 +159,27 @@ static const fmbBodyType oscillator = {
 };
 
 static const fmbBodyType* const bodies[] = {&oscillator, NULL};
-#ifdef BREAK_ABI
-#define ABI (FMB_ABI_VERSION + 1) /* built, say, for the next flexmbd */
+#ifdef ABI_3_0
+/* a plugin built against flexmbd 0.1's header (plugin ABI 3.0, then called ABI 3): its descriptor
+   had no `size` (the 4 bytes after `abi` were padding, zero in a static object) and its tables
+   said abi 3. The layout is spelled out here as that header had it. */
+struct plugin30 {
+  int abi;
+  const char* name;
+  const char* version;
+  const fmbBodyType* const* bodies;
+  const fmbJointType* const* joints;
+};
+static const struct plugin30 plugin30 = {.abi = 3, .name = "broken", .version = "0", .bodies = bodies};
+#define PLUGIN ((const fmbPlugin*)(const void*)&plugin30)
 #else
-#define ABI FMB_ABI_VERSION
+static const fmbPlugin plugin = {
+    .abi = ABI, .size = sizeof(fmbPlugin), .name = "broken", .version = "0", .bodies = bodies};
+#define PLUGIN (&plugin)
 #endif
-static const fmbPlugin plugin = {.abi = ABI, .name = "broken", .version = "0", .bodies = bodies};
 
 #ifndef BREAK_ENTRY
-FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void) { return &plugin; }
+FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void) { return PLUGIN; }
 #else
-FMB_PLUGIN_EXPORT const fmbPlugin* plugin_descriptor(void) { return &plugin; } /* the wrong name */
+FMB_PLUGIN_EXPORT const fmbPlugin* plugin_descriptor(void) { return PLUGIN; } /* the wrong name */
 #endif

@@ -1,9 +1,9 @@
 #!/bin/sh
 # run.sh SOURCE_DIR BUILD_DIR WORK_DIR — the installed package, as a user outside the tree has it:
-#  1. `cmake --install` into a temporary prefix: the library (shared, soname = plugin ABI, and
-#     static), the one public header and no private one, the program, the CMake package, flexmbd.pc;
+#  1. `cmake --install` into a temporary prefix: the library (shared, soname = FMB_SOVERSION, and
+#     static), the two public headers (flexmbd.h, flexmbd_plugin.h) and no private one, the program, the CMake package, flexmbd.pc;
 #     the shared library exports only fmb_* API symbols;
-#  2. the public header compiles alone, strictly, as C11 (and as C++ when g++ is there);
+#  2. each public header compiles alone, strictly, as C11 (and as C++ when g++ is there);
 #  3. examples/plugin/ copied out of the tree and built with find_package(flexmbd) (plugin and the
 #     embedding check program) and again with pkg-config;
 #  4. the plugin loaded by `--plugin` and by the scene's `plugins:` list; `flexmbd types` lists it;
@@ -11,7 +11,7 @@
 #     solution (check_foundation);
 #     docs/plugins.md's tutorial, extracted from the page, builds and passes conform the same way;
 #  5. deliberately broken plugins (tests/install/broken.c) are each caught, with a clear message:
-#     wrong ABI, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
+#     another plugin ABI major or a newer minor, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
 #     matrix that is not symmetric, energy that leaks (conform, exit 1);
 #  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc).
 . "$(dirname "$0")/prefix.sh"
@@ -31,39 +31,49 @@ expect() {
   echo "ok: $* -> exit $rc, '$(grep -E -m1 -- "$pattern" "$work/out")'"
 }
 
-abi=$(sed -n 's/^#define FMB_ABI_VERSION \([0-9]*\).*/\1/p' "$src/engine/flexmbd.h")
+abi=$(sed -n 's/^#define FMB_SOVERSION \([0-9]*\).*/\1/p' "$src/engine/flexmbd.h")
+pmajor=$(sed -n 's/^#define FMB_PLUGIN_ABI_MAJOR \([0-9]*\).*/\1/p' "$src/engine/flexmbd_plugin.h")
+pminor=$(sed -n 's/^#define FMB_PLUGIN_ABI_MINOR \([0-9]*\).*/\1/p' "$src/engine/flexmbd_plugin.h")
 
 # 1. the installed tree
-for f in include/flexmbd.h bin/flexmbd; do [ -e "$T/$f" ] || fail "$f not installed"; done
-[ -e "$libdir/libflexmbd.so.$abi" ] || fail "libflexmbd.so.$abi (soname = plugin ABI $abi) not installed"
+for f in include/flexmbd.h include/flexmbd_plugin.h bin/flexmbd; do [ -e "$T/$f" ] || fail "$f not installed"; done
+[ -e "$libdir/libflexmbd.so.$abi" ] || fail "libflexmbd.so.$abi (soname = FMB_SOVERSION $abi) not installed"
 [ -e "$libdir/libflexmbd.a" ] || fail "static libflexmbd.a not installed"
 [ -e "$libdir/pkgconfig/flexmbd.pc" ] || fail "flexmbd.pc not installed"
 [ -e "$libdir/cmake/flexmbd/flexmbdConfig.cmake" ] || fail "CMake package not installed"
-[ "$(ls "$T/include")" = flexmbd.h ] || fail "headers other than flexmbd.h installed: $(ls "$T/include")"
+[ "$(ls "$T/include" | tr '\n' ' ')" = "flexmbd.h flexmbd_plugin.h " ] ||
+  fail "headers other than flexmbd.h, flexmbd_plugin.h installed: $(ls "$T/include")"
 exported=$(nm -D --defined-only "$libdir/libflexmbd.so" | awk '$2 == "T" {print $3}')
 n_exported=$(echo "$exported" | wc -l)
 # xerbla_: LAPACK's error handler, replaced so that LAPACK never ends the calling program (engine/modes.c)
 bad=$(echo "$exported" | grep -v '^fmb_' | grep -v '^xerbla_$' | tr '\n' ' ')
 [ -z "$bad" ] || fail "the shared library exports non-API symbols: $bad"
 echo "$exported" | grep -q '^fmb_system_residual$' && fail "the shared library exports engine internals (fmb_system_residual)"
-echo "ok: installed into $T: $n_exported exported functions, all fmb_*; soname ABI $abi"
+echo "ok: installed into $T: $n_exported exported functions, all fmb_*; soname $abi"
 # the docs, scenes and examples under share/flexmbd; the installed program runs an installed scene
 share=$T/share/flexmbd
 for f in README.md docs/tutorial.md docs/plugins.md scenes/paper/spinup_w4.yaml scenes/rotor_torque.csv \
          scenes/pendulum.ref.csv examples/plugin/CMakeLists.txt; do
   [ -f "$share/$f" ] || fail "share/flexmbd/$f not installed"
 done
-expect 0 "^flexmbd [0-9]+\.[0-9]+\.[0-9]+ \(commit ([0-9a-f]+|unknown)" "$T/bin/flexmbd" --version
+expect 0 "^flexmbd [0-9]+\.[0-9]+\.[0-9]+ \(commit [^,]+, plugin ABI $pmajor\.$pminor\)" "$T/bin/flexmbd" --version
 expect 0 "stats: status=ok" "$T/bin/flexmbd" run "$share/scenes/rotor.yaml" -o "$work/rotor.csv" --set solver.t_end=0.05
 
-# 2. the header alone
+# 2. each header alone (a program's needs no plugin table; a plugin's carries the program's too)
+for h in flexmbd:FMB_SOVERSION flexmbd_plugin:FMB_PLUGIN_ABI; do
+  echo "#include <${h%%:*}.h>
+int main(void) { return ${h#*:} == 0; }" >"$work/hdr.c"
+  cc -std=c11 -Wall -Wextra -Werror -pedantic -I"$T/include" -c "$work/hdr.c" -o "$work/hdr.o" ||
+    fail "${h%%:*}.h does not compile alone as strict C11"
+  if command -v g++ >/dev/null; then
+    cp "$work/hdr.c" "$work/hdr.cpp"
+    g++ -Wall -Wextra -Werror -I"$T/include" -c "$work/hdr.cpp" -o "$work/hdrpp.o" || fail "${h%%:*}.h does not compile as C++"
+  fi
+done
 echo '#include <flexmbd.h>
-int main(void) { return FMB_ABI_VERSION == 0; }' >"$work/hdr.c"
-cc -std=c11 -Wall -Wextra -Werror -pedantic -I"$T/include" -c "$work/hdr.c" -o "$work/hdr.o" || fail "flexmbd.h does not compile alone as strict C11"
-if command -v g++ >/dev/null; then
-  cp "$work/hdr.c" "$work/hdr.cpp"
-  g++ -Wall -Wextra -Werror -I"$T/include" -c "$work/hdr.cpp" -o "$work/hdrpp.o" || fail "flexmbd.h does not compile as C++"
-fi
+int main(void) { fmbBodyType* t = 0; return t->abi; }' >"$work/opaque.c"
+cc -std=c11 -I"$T/include" -c "$work/opaque.c" -o "$work/opaque.o" 2>/dev/null &&
+  fail "flexmbd.h shows a type table's fields to programs (flexmbd_plugin.h's)"
 
 # 3. the example out of the tree: CMake package, then pkg-config
 ex=$work/example
@@ -134,14 +144,16 @@ cc -std=c11 -O2 -shared -fPIC "$tut/point_mass.c" $(pkg-config --cflags --libs f
   fail "the tutorial's pkg-config line"
 
 # 5. broken plugins
-for b in ABI OPS ENTRY NAME JACOBIAN MASS ENERGY PATTERN; do
+for b in ABI ABI_MINOR OPS ENTRY NAME JACOBIAN MASS ENERGY PATTERN; do
   cc -std=c11 -shared -fPIC -DBREAK_$b "$src/tests/install/broken.c" $(pkg-config --cflags --libs flexmbd) -lm \
     -o "$work/broken_$b.so" 2>/dev/null || fail "broken.c does not build with BREAK_$b"
 done
 cc -std=c11 -shared -fPIC "$src/tests/install/broken.c" $(pkg-config --cflags --libs flexmbd) -lm -o "$work/unbroken.so"
 expect 0 'ok   oscillator: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$work/unbroken.so" oscillator
-expect 2 "broken_ABI.so: error: plugin was built for flexmbd plugin ABI $((abi + 1)); this flexmbd has ABI $abi: rebuild it" \
+expect 2 "broken_ABI.so: error: plugin was built for flexmbd plugin ABI $((pmajor + 1))\.0; this flexmbd [0-9.]+ has plugin ABI $pmajor\.$pminor: rebuild it" \
   "$F" conform --plugin "$work/broken_ABI.so"
+expect 2 "broken_ABI_MINOR.so: error: plugin was built for flexmbd plugin ABI $pmajor\.$((pminor + 1)); this flexmbd [0-9.]+ has plugin ABI $pmajor\.$pminor: it needs a newer flexmbd" \
+  "$F" conform --plugin "$work/broken_ABI_MINOR.so"
 expect 2 "broken_OPS.so: error: body type 'oscillator' has no residual op \\(required\\)" \
   "$F" run "$ex/foundation.yaml" --plugin "$work/broken_OPS.so"
 expect 2 "broken_ENTRY.so: error: not a flexmbd plugin: it has no symbol fmb_plugin_descriptor" \

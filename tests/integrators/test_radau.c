@@ -169,15 +169,14 @@ static void spinup(const char* integ) {
   ENSURE(st_red.integrator && strcmp(st_red.integrator, integ) == 0); /* the stats line's integrator= */
 
   /* the fallback to klu_full: the reduced factorizations made to fail from the 5th on (schur.c's
-     test hook; the 5 s run factorizes 12 times). The run must go on with the whole matrices from
+     solver.fault_reduced_setup; the 5 s run factorizes 12 times). The run must go on with the whole matrices from
      the last accepted step and still meet the tolerance against IDA's reference; that it took
      another path shows in a difference from the reduced run (measured 2.1e-7 m, switch at t =
      0.006 s), while without the fallback the run would stop there (exit 3). */
   fmbtCsv fb;
   fmbStats st_fb;
-  setenv("FMB_TEST_FAIL_REDUCED_SETUP", "5", 1);
-  rc = run("scenes/paper/spinup_w15.yaml", integ, rtols[0], t_end, out_fb, &fb, &st_fb, NULL, NULL);
-  unsetenv("FMB_TEST_FAIL_REDUCED_SETUP");
+  rc = run("scenes/paper/spinup_w15.yaml", integ, rtols[0], t_end, out_fb, &fb, &st_fb, "solver.fault_reduced_setup=5",
+           NULL);
   ENSURE(rc == 0);
   const double efb = max_diff(&fb, &ref, "beam.tip_v"), dfb = max_diff(&fb, &c[0], "beam.tip_v");
   printf("spin-up 5 s, %s rtol 1e-6, reduced solve failing from the 5th factorization: tip_v error %.3e m, %.3e m "

@@ -100,9 +100,10 @@ static Linkage run(const char* scene, int cranks, int couplers, const char* cons
 
 /* one run, reported and checked: passes at least 10 flat positions, stays a parallelogram, and
    the crank angle is within `bound` of the 1-DOF pendulum */
+static const char* singular_scan = "auto"; /* solver.singular_scan of the runs checked() makes */
 static Linkage checked(const char* scene, int cranks, int couplers, double rtol, const char* formulation,
                        const char* integrator, double bound) {
-  char out[128], o[4][64];
+  char out[128], o[5][64];
   snprintf(out, sizeof out, "parallelogram_%d_%g_%s_%s.csv", cranks, rtol, formulation, integrator);
   /* "default": only rtol, as a user who writes no solver keys but rtol runs the scene */
   const int defaults = !strcmp(formulation, "default");
@@ -110,8 +111,9 @@ static Linkage checked(const char* scene, int cranks, int couplers, double rtol,
   snprintf(o[1], sizeof o[1], "solver.atol=%g", rtol / 100);
   snprintf(o[2], sizeof o[2], "solver.formulation=%s", formulation);
   snprintf(o[3], sizeof o[3], "solver.integrator=%s", integrator);
-  const char* ov[4] = {o[0], o[1], o[2], o[3]};
-  Linkage r = run(scene, cranks, couplers, ov, defaults ? 1 : 4, out);
+  snprintf(o[4], sizeof o[4], "solver.singular_scan=%s", singular_scan);
+  const char* ov[5] = {o[0], o[1], o[2], o[3], o[4]};
+  Linkage r = run(scene, cranks, couplers, ov, defaults ? 1 : 5, out);
   printf("%d crank(s), rtol %g, %s/%s: %d flat passages, crank angle error %.2e rad, cranks differ by %.1e, coupler "
          "turns %.1e rad, energy drift %.2e of %.4g J\n",
          cranks, rtol, formulation, integrator, r.flats, r.err, r.spread, r.coupler_turn, r.energy_drift, r.energy);
@@ -141,11 +143,11 @@ int main(void) {
   checked("scenes/parallelogram.yaml", 2, 1, 1e-8, "auto", "ida", 1e-5 / 3);
   checked("scenes/parallelogram.yaml", 2, 1, 1e-8, "auto", "radau5", 1e-5 / 3);
   /* the fallback for what the walk does not find: GGL until the integrator fails at a flat
-     position, then projected from the last row (FMB_TEST_NO_SINGULAR_WALK, engine/singular.c) */
-  setenv("FMB_TEST_NO_SINGULAR_WALK", "1", 1);
+     position, then projected from the last row (solver.singular_scan: off, engine/singular.c) */
+  singular_scan = "off";
   checked("scenes/parallelogram.yaml", 2, 1, 1e-8, "auto", "ida", 1e-5);
   checked("scenes/parallelogram.yaml", 2, 1, 1e-8, "auto", "radau5", 1e-5);
-  unsetenv("FMB_TEST_NO_SINGULAR_WALK");
+  singular_scan = "auto";
   /* issue 23 item 4: rows of 1, 2, 5, 20 linkages with the default settings (no solver key but
      rtol) within 1e-5 rad with a 3x margin at rtol 1e-8, 1e-9 and 1e-10, none stopping */
   static const int rows[] = {1, 2, 5, 20};

@@ -3,9 +3,10 @@
  *  - the driven four-bar: rocker angle vs the circle-intersection solution;
  *  - a stiff slider: the 2 kg block on a 1e6 N/m spring along the slider axis (707 rad/s), vs
  *    s(t) = s_eq + (s0 - s_eq) cos(w t);
- *  - the fallback: with the reduced solve made to fail (FMB_TEST_FAIL_REDUCED_SETUP, schur.c) the
+ *  - the fallback: with the reduced solve made to fail (solver.fault_reduced_setup, schur.c) the
  *    four-bar at 1e-12 continues with klu_full from the last good step and still matches the
- *    closed form (integrator_ida.c). */
+ *    closed form (integrator_ida.c);
+ *  - the reduced system factorized by KLU and by the dense LU (solver.schur_lu): both match it. */
 #define _POSIX_C_SOURCE 200809L
 #include <stdlib.h>
 
@@ -19,13 +20,14 @@ static double rocker_closed_form(double th2) {
   return atan2(Ay + aa * uy + h * ux, Ax + aa * ux - h * uy - d);
 }
 
-static double fourbar(const char* solver) {
+/* extra: one more override (a solver option), or NULL */
+static double fourbar(const char* solver, const char* extra) {
   char ls[64];
   snprintf(ls, sizeof ls, "solver.linear_solver=%s", solver);
-  const char* ov[] = {"solver.rtol=1e-12", "solver.atol=1e-12", ls};
+  const char* ov[] = {"solver.rtol=1e-12", "solver.atol=1e-12", ls, extra};
   fmbtCsv c;
   fmbStats st;
-  ENSURE(fmbt_run_read("scenes/fourbar.yaml", ov, 3, "tight_fourbar.csv", &c, &st) == 0);
+  ENSURE(fmbt_run_read("scenes/fourbar.yaml", ov, extra ? 4 : 3, "tight_fourbar.csv", &c, &st) == 0);
   const double *t = fmbt_col(&c, "t"), *th = fmbt_col(&c, "rocker.theta");
   double err = 0;
   if (t && th)
@@ -52,12 +54,15 @@ static double stiff_slider(const char* solver) {
 }
 
 int main(void) {
-  setenv("FMB_TEST_FAIL_REDUCED_SETUP", "20", 1);
-  const double fallback = fourbar("klu");
-  unsetenv("FMB_TEST_FAIL_REDUCED_SETUP");
+  const double fallback = fourbar("klu", "solver.fault_reduced_setup=20");
   printf("four-bar with the reduced solve failing from its 20th setup on: rocker error %.2e rad\n", fallback);
   ENSURE(fallback < 1e-10);
-  const double f = fourbar("klu"), ff = fourbar("klu_full"), s = stiff_slider("klu"), sf = stiff_slider("klu_full");
+  /* the reduced system's two LUs, forced either way (solver.schur_lu): both meet the closed form */
+  const double lu_klu = fourbar("klu", "solver.schur_lu=klu"), lu_dense = fourbar("klu", "solver.schur_lu=dense");
+  printf("four-bar, reduced system by KLU: rocker error %.2e rad; by the dense LU: %.2e rad\n", lu_klu, lu_dense);
+  ENSURE(lu_klu < 1e-10 && lu_dense < 1e-10);
+  const double f = fourbar("klu", NULL), ff = fourbar("klu_full", NULL), s = stiff_slider("klu"),
+               sf = stiff_slider("klu_full");
   printf("rtol = atol = 1e-12: four-bar rocker error %.2e rad (klu), %.2e (klu_full); stiff slider error %.2e m (klu), "
          "%.2e (klu_full)\n",
          f, ff, s, sf);

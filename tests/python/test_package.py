@@ -38,7 +38,7 @@ def test_struct_layouts_match_the_header(out):
     subprocess.run([cc, "-std=c11", "-I", os.path.join(SRC, "engine"), c, "-o", exe], check=True)
     got = [int(x) for x in subprocess.run([exe], capture_output=True, text=True, check=True).stdout.split()]
     assert got == expect
-    abi = [l for l in open(os.path.join(SRC, "engine", "flexmbd.h")) if l.startswith("#define FMB_ABI_VERSION")]
+    abi = [l for l in open(os.path.join(SRC, "engine", "flexmbd.h")) if l.startswith("#define FMB_SOVERSION")]
     assert int(abi[0].split()[2]) == _lib.ABI
 
 

@@ -16,7 +16,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include <flexmbd.h>
+#include <flexmbd_plugin.h>
 
 static void fail(int fault) {
   switch (fault) {
