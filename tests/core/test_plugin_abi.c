@@ -13,6 +13,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "flexmbd_plugin.h"
 
@@ -75,6 +76,13 @@ int main(int argc, char** argv) {
     return 2;
   }
   const char *flexmbd = argv[1], *dir = argv[2], *work = argv[3];
+  { /* the work folder and its parent (a fresh build has neither) */
+    char parent[4096];
+    snprintf(parent, sizeof parent, "%s", work);
+    char* slash = strrchr(parent, '/');
+    if (slash) *slash = '\0', mkdir(parent, 0755);
+    mkdir(work, 0755);
+  }
 
   /* the library's version against the program's (two builds of one number: a stale library
      beside a new program would differ) */
