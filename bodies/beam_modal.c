@@ -36,7 +36,7 @@ enum { MODAL_POINTS = 6 };
 
 typedef struct Modal {
   double L, rho, A, Izz, Emod, beta;
-  int ne, model, nbend, naxial, k, nb;
+  int ne, model, nbend, nstiff, naxial, k, nb; /* k = nbend + nstiff + naxial */
   double pos0[2], angle0, vel0[2], omega0;
   double le, r2, mass;
   double* omega2;    /* k: the retained modes' omega^2 (bending first, then axial) */
@@ -91,19 +91,130 @@ static int generalized_eigen(int n, double* K, double* M, double* w) {
   return info;
 }
 
+/* Cholesky solve K y = b for nrhs right-hand sides (LAPACK dpotrf/dpotrs, K overwritten) */
+extern void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+extern void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda, double* b,
+                    const int* ldb, int* info);
+
+/* x^T M y with M dense n x n (column-major, full) */
+static double m_inner(int n, const double* M, const double* x, const double* y) {
+  double s = 0.0;
+  for (int j = 0; j < n; ++j) {
+    double mj = 0.0;
+    const double* col = M + (size_t)j * n;
+    for (int i = 0; i < n; ++i) mj += col[i] * x[i];
+    s += mj * y[j];
+  }
+  return s;
+}
+
+/* The stiffening vectors (Eq. R1a): psi_i = K^-1 K_g1 phi_i, i < nstiff, with K_g1 the geometric
+   stiffness of unit spin about the root, int rho A (L^2 - x^2)/2 N2'N2'^T dx (the tension of
+   steady spin is Omega^2 times it). M-orthogonalised against the nbend eigenmodes (and each
+   other, twice: classical Gram-Schmidt reorthogonalised), then a Rayleigh-Ritz among themselves so
+   that Phi^T K Phi stays diagonal. K, M: the clamped bending matrices (n = nt, untouched); Phi: the
+   eigenvectors (column-major, n x n) whose columns nbend..nbend+nstiff-1 are replaced by the
+   vectors, w2 their Ritz values. 0 = ok, 1 = a vector is (numerically) in the span already. */
+static int stiffening_vectors(const Modal* m, int n, const double* K, const double* M, double* Phi, double* w2) {
+  const int nb = m->nbend, ns = m->nstiff, ne = m->ne;
+  const double le = m->le, rA = m->rho * m->A, L = m->L;
+  double* Kg = calloc((size_t)n * n, sizeof(double));
+  double* Kc = malloc(sizeof(double) * (size_t)n * n);
+  double* Psi = calloc((size_t)n * ns, sizeof(double));
+  double* Kr = calloc((size_t)ns * ns, sizeof(double));
+  double* Mr = calloc((size_t)ns * ns, sizeof(double));
+  double* wr = calloc((size_t)ns, sizeof(double));
+  int err = !Kg || !Kc || !Psi || !Kr || !Mr || !wr;
+  if (!err) {
+    double xg[4], wg[4];
+    fmb_gauss_legendre01(4, xg, wg); /* (L^2 - x^2) N'N': degree 6 */
+    for (int e = 0; e < ne; ++e) {
+      double kge[4][4] = {{0}};
+      for (int g = 0; g < 4; ++g) {
+        double ns4[4], nd[4];
+        const double x = (e + xg[g]) * le;
+        fmb_beam_hermite(xg[g], le, ns4, nd);
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) kge[i][j] += wg[g] * le * rA * 0.5 * (L * L - x * x) * nd[i] * nd[j];
+      }
+      for (int i = 0; i < 4; ++i) {
+        const int gi = 2 * (e + (i >= 2)) + (i & 1) - 2;
+        if (gi < 0) continue;
+        for (int j = 0; j < 4; ++j) {
+          const int gj = 2 * (e + (j >= 2)) + (j & 1) - 2;
+          if (gj >= 0) Kg[(size_t)gj * n + gi] += kge[i][j];
+        }
+      }
+    }
+    memcpy(Kc, K, sizeof(double) * (size_t)n * n);
+    for (int c = 0; c < ns; ++c) /* Psi = K_g1 Phi (the lowest ns eigenmodes) */
+      for (int j = 0; j < n; ++j) {
+        const double pj = Phi[(size_t)c * n + j];
+        if (pj != 0.0)
+          for (int i = 0; i < n; ++i) Psi[(size_t)c * n + i] += Kg[(size_t)j * n + i] * pj;
+      }
+    int info = 0;
+    dpotrf_("U", &n, Kc, &n, &info);
+    if (!info) dpotrs_("U", &n, &ns, Kc, &n, Psi, &n, &info);
+    err = info != 0;
+  }
+  for (int c = 0; c < ns && !err; ++c) {
+    double* y = Psi + (size_t)c * n;
+    const double n0 = sqrt(m_inner(n, M, y, y));
+    for (int pass = 0; pass < 2; ++pass) {
+      for (int j = 0; j < nb; ++j) {
+        const double* phi = Phi + (size_t)j * n;
+        const double h = m_inner(n, M, phi, y);
+        for (int i = 0; i < n; ++i) y[i] -= h * phi[i];
+      }
+      for (int j = 0; j < c; ++j) {
+        const double* q = Psi + (size_t)j * n;
+        const double h = m_inner(n, M, q, y);
+        for (int i = 0; i < n; ++i) y[i] -= h * q[i];
+      }
+    }
+    const double n1 = sqrt(m_inner(n, M, y, y));
+    if (!(n1 > 1e-8 * n0)) err = 1;
+    for (int i = 0; i < n && !err; ++i) y[i] /= n1;
+  }
+  if (!err) {
+    for (int a = 0; a < ns; ++a)
+      for (int b = 0; b < ns; ++b) {
+        Kr[(size_t)b * ns + a] = m_inner(n, K, Psi + (size_t)a * n, Psi + (size_t)b * n);
+        Mr[(size_t)b * ns + a] = m_inner(n, M, Psi + (size_t)a * n, Psi + (size_t)b * n);
+      }
+    err = generalized_eigen(ns, Kr, Mr, wr) != 0;
+  }
+  if (!err)
+    for (int c = 0; c < ns; ++c) {
+      double* out = Phi + (size_t)(nb + c) * n;
+      memset(out, 0, sizeof(double) * (size_t)n);
+      for (int a = 0; a < ns; ++a)
+        for (int i = 0; i < n; ++i) out[i] += Psi[(size_t)a * n + i] * Kr[(size_t)c * ns + a];
+      w2[nb + c] = wr[c];
+    }
+  free(Kg), free(Kc), free(Psi), free(Kr), free(Mr), free(wr);
+  return err;
+}
+
 /* The bending modes (2 ne dofs [v, v'] per node 1..ne) and the axial ones (ne dofs): the straight
    beam's mass and stiffness do not couple them (the cross term int rho N1 (-y N2') vanishes with
-   int y dA = 0), so each problem is solved alone. Fills ea, ed, ec and the frequencies. */
+   int y dA = 0), so each problem is solved alone. The nbend lowest bending eigenmodes are followed
+   by the nstiff stiffening vectors (stiffening_vectors), then the axial modes. Fills ea, ed, ec and
+   the frequencies (the vectors' Ritz values). 0 = ok, 1 = eigenproblem failed, 2 = a stiffening
+   vector is already in the span of the modes. */
 static int compute_modes(Modal* m) {
-  const int ne = m->ne, nt = 2 * ne, k = m->k;
+  const int ne = m->ne, nt = 2 * ne, k = m->k, nbend = m->nbend + m->nstiff;
   const double le = m->le, rA = m->rho * m->A, rI = m->rho * m->Izz;
   double* Kt = calloc((size_t)nt * nt, sizeof(double));
   double* Mt = calloc((size_t)nt * nt, sizeof(double));
+  double* K0 = malloc(sizeof(double) * (size_t)nt * nt);
+  double* M0 = malloc(sizeof(double) * (size_t)nt * nt);
   double* Ka = calloc((size_t)ne * ne, sizeof(double));
   double* Ma = calloc((size_t)ne * ne, sizeof(double));
   double* wt = calloc((size_t)nt, sizeof(double));
   double* wa = calloc((size_t)ne, sizeof(double));
-  int err = !Kt || !Mt || !Ka || !Ma || !wt || !wa;
+  int err = !Kt || !Mt || !K0 || !M0 || !Ka || !Ma || !wt || !wa;
   if (!err) {
     double xg[4], wg[4], me[4][4] = {{0}};
     fmb_gauss_legendre01(4, xg, wg); /* N N^T and N' N'^T: degree 6 */
@@ -141,13 +252,18 @@ static int compute_modes(Modal* m) {
         }
       }
     }
+    memcpy(K0, Kt, sizeof(double) * (size_t)nt * nt);
+    memcpy(M0, Mt, sizeof(double) * (size_t)nt * nt);
     err = generalized_eigen(nt, Kt, Mt, wt) || generalized_eigen(ne, Ka, Ma, wa);
   }
   if (!err) {
     m->next_bend = m->nbend < nt ? sqrt(fmax(wt[m->nbend], 0.0)) : 0.0;
     m->next_axial = m->naxial < ne ? sqrt(fmax(wa[m->naxial], 0.0)) : 0.0;
+    if (m->nstiff > 0 && stiffening_vectors(m, nt, K0, M0, Kt, wt)) err = 2;
+  }
+  if (!err) {
     for (int i = 0; i < k; ++i) {
-      const int axial = i >= m->nbend, col = axial ? i - m->nbend : i;
+      const int axial = i >= nbend, col = axial ? i - nbend : i;
       const double* phi = axial ? Ka + (size_t)col * ne : Kt + (size_t)col * nt;
       m->omega2[i] = axial ? wa[col] : wt[col];
       /* sign: the tip moves positively (deterministic modes, whatever LAPACK returns) */
@@ -168,7 +284,7 @@ static int compute_modes(Modal* m) {
       }
     }
   }
-  free(Kt), free(Mt), free(Ka), free(Ma), free(wt), free(wa);
+  free(Kt), free(Mt), free(K0), free(M0), free(Ka), free(Ma), free(wt), free(wa);
   return err;
 }
 
@@ -309,14 +425,20 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_int(p, red, "modes", FMB_REQUIRED, 0, 2 * (long)m->ne, &m->nbend);
   err |= fmb_get_int(p, red, "axial_modes", FMB_OPTIONAL, 0, m->ne, &m->naxial);
   if (err) return -1;
+  /* default: one stiffening vector per bending mode, as many as the mesh has room for */
+  const int room = m->nbend < 2 * m->ne - m->nbend ? m->nbend : 2 * m->ne - m->nbend;
+  m->nstiff = room;
+  err |= fmb_get_int(p, red, "stiffening_modes", FMB_OPTIONAL, 0, room, &m->nstiff);
+  if (err) return -1;
   /* its own keys only (the unknown-key check of the item would list every key of the beam) */
   for (yaml_node_pair_t* pr = rn->data.mapping.pairs.start; pr < rn->data.mapping.pairs.top; ++pr) {
     const yaml_node_t* key = fmbp_node(p, pr->key);
     const char* k = key && key->type == YAML_SCALAR_NODE ? (const char*)key->data.scalar.value : "";
-    if (strcmp(k, "modes") != 0 && strcmp(k, "axial_modes") != 0)
-      return fmb_parse_error(p, pr->key, "unknown key '%s' in 'reduction' (expected modes, axial_modes)", k);
+    if (strcmp(k, "modes") != 0 && strcmp(k, "axial_modes") != 0 && strcmp(k, "stiffening_modes") != 0)
+      return fmb_parse_error(p, pr->key,
+                             "unknown key '%s' in 'reduction' (expected modes, stiffening_modes, axial_modes)", k);
   }
-  m->k = m->nbend + m->naxial;
+  m->k = m->nbend + m->nstiff + m->naxial;
   if (m->k < 1)
     return fmb_parse_error(p, fmb_find_key(p, red, "modes"),
                            "expected at least one mode in 'reduction' (modes + axial_modes >= 1), got 0");
@@ -343,7 +465,14 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
   m->Snode = calloc(((size_t)m->ne + 1) * k * k, sizeof(double));
   m->G = calloc((size_t)m->nb * m->nb, sizeof(double));
   if (!m->omega2 || !m->ea || !m->ed || !m->ec || !m->Snode || !m->G) return fmb_parse_error(p, item, "out of memory");
-  if (compute_modes(m))
+  const int modes_err = compute_modes(m);
+  if (modes_err == 2)
+    return fmb_parse_error(
+        p, fmb_find_key(p, red, "stiffening_modes") >= 0 ? fmb_find_key(p, red, "stiffening_modes") : red,
+        "the beam's stiffening vectors K^-1 K_g phi_i are already in the span of its %d modes "
+        "(nothing left to add): give fewer 'stiffening_modes' or set it to 0",
+        m->nbend);
+  if (modes_err)
     return fmb_parse_error(p, red,
                            "the beam's clamped-free eigenproblem failed (LAPACK dsygv): its mass or stiffness "
                            "is not usable");
@@ -800,10 +929,14 @@ static void modal_describe(const void* self, FILE* f) {
   const Modal* m = self;
   static const char* const terms[] = {"w_c dropped (linear modal: no dynamic stiffening)", "w_c to first order",
                                       "w_c exact (quadratic in the modal coordinates)"};
-  fprintf(f, "%s model reduced to %d bending + %d axial clamped-free modes of its %d elements, %s%s; retained (rad/s):",
-          modal_model_names[m->model], m->nbend, m->naxial, m->ne, terms[m->model],
+  fprintf(f,
+          "%s model reduced to %d bending + %d stiffening + %d axial clamped-free modes of its %d elements, %s%s; "
+          "retained (rad/s):",
+          modal_model_names[m->model], m->nbend, m->nstiff, m->naxial, m->ne, terms[m->model],
           m->beta > 0.0 ? ", stiffness-proportional damping" : "");
-  for (int i = 0; i < m->k; ++i) fprintf(f, " %.6g%s", sqrt(fmax(m->omega2[i], 0.0)), i >= m->nbend ? "a" : "");
+  /* the stiffening vectors' Ritz values are not frequencies of the beam: marked s, after the modes */
+  for (int i = 0; i < m->k; ++i)
+    fprintf(f, " %.6g%s", sqrt(fmax(m->omega2[i], 0.0)), i >= m->nbend + m->nstiff ? "a" : i >= m->nbend ? "s" : "");
   fprintf(f, "; first dropped: ");
   if (m->next_bend > 0.0) fprintf(f, "bending %.6g", m->next_bend);
   if (m->next_bend > 0.0 && m->next_axial > 0.0) fprintf(f, ", ");

@@ -292,8 +292,10 @@ int fmb_cmd_plot(int argc, char** argv) {
   memset(&ref, 0, sizeof ref);
   char default_out[1024], err[1024], list[4096];
   int loaded = 0;
+  /* with --x the first column need not be t: `campbell -o` writes speed first (docs/models.md, the
+     reduced beam's Campbell diagram against the full mesh and ZOAC) */
   for (int i = 0; i < a.ncsv && !rc; ++i, ++loaded)
-    if (fmb_table_load(a.csv[i], &table[i], err, sizeof err)) {
+    if (fmb_table_load_keyed(a.csv[i], &table[i], a.x ? NULL : "t", err, sizeof err)) {
       fprintf(stderr, "flexmbd plot: %s\n", err);
       rc = FMB_EXIT_BAD_INPUT;
     }
