@@ -96,35 +96,47 @@ extern void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, i
 extern void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda, double* b,
                     const int* ldb, int* info);
 
-/* x^T M y with M dense n x n (column-major, full) */
-static double m_inner(int n, const double* M, const double* x, const double* y) {
+/* Y = A X for A dense n x n (column-major), X n x c */
+static void dense_apply(int n, int c, const double* A, const double* X, double* Y) {
+  memset(Y, 0, sizeof(double) * (size_t)n * c);
+  for (int col = 0; col < c; ++col)
+    for (int j = 0; j < n; ++j) {
+      const double xj = X[(size_t)col * n + j];
+      if (xj == 0.0) continue;
+      const double* a = A + (size_t)j * n;
+      double* y = Y + (size_t)col * n;
+      for (int i = 0; i < n; ++i) y[i] += a[i] * xj;
+    }
+}
+
+static double dot(int n, const double* x, const double* y) {
   double s = 0.0;
-  for (int j = 0; j < n; ++j) {
-    double mj = 0.0;
-    const double* col = M + (size_t)j * n;
-    for (int i = 0; i < n; ++i) mj += col[i] * x[i];
-    s += mj * y[j];
-  }
+  for (int i = 0; i < n; ++i) s += x[i] * y[i];
   return s;
 }
 
 /* The stiffening vectors (Eq. R1a): psi_i = K^-1 K_g1 phi_i, i < nstiff, with K_g1 the geometric
    stiffness of unit spin about the root, int rho A (L^2 - x^2)/2 N2'N2'^T dx (the tension of
-   steady spin is Omega^2 times it). M-orthogonalised against the nbend eigenmodes (and each
-   other, twice: classical Gram-Schmidt reorthogonalised), then a Rayleigh-Ritz among themselves so
-   that Phi^T K Phi stays diagonal. K, M: the clamped bending matrices (n = nt, untouched); Phi: the
-   eigenvectors (column-major, n x n) whose columns nbend..nbend+nstiff-1 are replaced by the
-   vectors, w2 their Ritz values. 0 = ok, 1 = a vector is (numerically) in the span already. */
+   steady spin is Omega^2 times it). Each is M-orthogonalised against the nbend eigenmodes and the
+   vectors before it (Gram-Schmidt, twice) and normalised; then one Rayleigh-Ritz over the whole
+   basis [modes, vectors] makes Phi^T K Phi diagonal and Phi^T M Phi = 1 to rounding (the modes
+   come back as themselves: a vector M-orthogonal to them has a Rayleigh quotient above
+   omega_(nbend+1)^2). K, M: the clamped bending matrices (n = nt, untouched); Phi: the
+   eigenvectors (column-major, n x n) whose first nbend + nstiff columns become the basis, w2 its
+   Ritz values. 0 = ok, -1 = out of memory or LAPACK, 1 = a vector is already in the span (what
+   is left of it after the projection is below 1e-10 of it: rounding would make its direction). */
 static int stiffening_vectors(const Modal* m, int n, const double* K, const double* M, double* Phi, double* w2) {
-  const int nb = m->nbend, ns = m->nstiff, ne = m->ne;
+  const int nb = m->nbend, ns = m->nstiff, ne = m->ne, nv = nb + ns;
   const double le = m->le, rA = m->rho * m->A, L = m->L;
   double* Kg = calloc((size_t)n * n, sizeof(double));
   double* Kc = malloc(sizeof(double) * (size_t)n * n);
-  double* Psi = calloc((size_t)n * ns, sizeof(double));
-  double* Kr = calloc((size_t)ns * ns, sizeof(double));
-  double* Mr = calloc((size_t)ns * ns, sizeof(double));
-  double* wr = calloc((size_t)ns, sizeof(double));
-  int err = !Kg || !Kc || !Psi || !Kr || !Mr || !wr;
+  double* V = malloc(sizeof(double) * (size_t)n * nv);  /* the basis [modes, vectors] */
+  double* MV = malloc(sizeof(double) * (size_t)n * nv); /* M V, column by column as V is built */
+  double* KV = malloc(sizeof(double) * (size_t)n * nv);
+  double* Kr = calloc((size_t)nv * nv, sizeof(double));
+  double* Mr = calloc((size_t)nv * nv, sizeof(double));
+  double* wr = calloc((size_t)nv, sizeof(double));
+  int err = !Kg || !Kc || !V || !MV || !KV || !Kr || !Mr || !wr ? -1 : 0;
   if (!err) {
     double xg[4], wg[4];
     fmb_gauss_legendre01(4, xg, wg); /* (L^2 - x^2) N'N': degree 6 */
@@ -146,54 +158,51 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
         }
       }
     }
+    memcpy(V, Phi, sizeof(double) * (size_t)n * nb);
+    dense_apply(n, nb, M, V, MV);
+    double* Psi = V + (size_t)n * nb;
+    dense_apply(n, ns, Kg, V, Psi); /* K_g1 phi_i, i < ns (ns <= nb) */
     memcpy(Kc, K, sizeof(double) * (size_t)n * n);
-    for (int c = 0; c < ns; ++c) /* Psi = K_g1 Phi (the lowest ns eigenmodes) */
-      for (int j = 0; j < n; ++j) {
-        const double pj = Phi[(size_t)c * n + j];
-        if (pj != 0.0)
-          for (int i = 0; i < n; ++i) Psi[(size_t)c * n + i] += Kg[(size_t)j * n + i] * pj;
-      }
     int info = 0;
     dpotrf_("U", &n, Kc, &n, &info);
     if (!info) dpotrs_("U", &n, &ns, Kc, &n, Psi, &n, &info);
-    err = info != 0;
+    if (info) err = -1;
   }
-  for (int c = 0; c < ns && !err; ++c) {
-    double* y = Psi + (size_t)c * n;
-    const double n0 = sqrt(m_inner(n, M, y, y));
-    for (int pass = 0; pass < 2; ++pass) {
-      for (int j = 0; j < nb; ++j) {
-        const double* phi = Phi + (size_t)j * n;
-        const double h = m_inner(n, M, phi, y);
-        for (int i = 0; i < n; ++i) y[i] -= h * phi[i];
-      }
+  for (int c = nb; c < nv && !err; ++c) {
+    double *y = V + (size_t)c * n, *My = MV + (size_t)c * n;
+    dense_apply(n, 1, M, y, My);
+    const double n0 = sqrt(dot(n, y, My));
+    for (int pass = 0; pass < 2; ++pass)
       for (int j = 0; j < c; ++j) {
-        const double* q = Psi + (size_t)j * n;
-        const double h = m_inner(n, M, q, y);
-        for (int i = 0; i < n; ++i) y[i] -= h * q[i];
+        const double h = dot(n, MV + (size_t)j * n, y);
+        for (int i = 0; i < n; ++i) y[i] -= h * V[(size_t)j * n + i];
       }
+    dense_apply(n, 1, M, y, My);
+    const double n1 = sqrt(dot(n, y, My));
+    if (!(n1 > 1e-10 * n0)) {
+      err = 1;
+      break;
     }
-    const double n1 = sqrt(m_inner(n, M, y, y));
-    if (!(n1 > 1e-8 * n0)) err = 1;
-    for (int i = 0; i < n && !err; ++i) y[i] /= n1;
+    for (int i = 0; i < n; ++i) y[i] /= n1, My[i] /= n1;
   }
   if (!err) {
-    for (int a = 0; a < ns; ++a)
-      for (int b = 0; b < ns; ++b) {
-        Kr[(size_t)b * ns + a] = m_inner(n, K, Psi + (size_t)a * n, Psi + (size_t)b * n);
-        Mr[(size_t)b * ns + a] = m_inner(n, M, Psi + (size_t)a * n, Psi + (size_t)b * n);
+    dense_apply(n, nv, K, V, KV);
+    for (int a = 0; a < nv; ++a)
+      for (int b = 0; b < nv; ++b) {
+        Kr[(size_t)b * nv + a] = dot(n, V + (size_t)a * n, KV + (size_t)b * n);
+        Mr[(size_t)b * nv + a] = dot(n, V + (size_t)a * n, MV + (size_t)b * n);
       }
-    err = generalized_eigen(ns, Kr, Mr, wr) != 0;
+    if (generalized_eigen(nv, Kr, Mr, wr)) err = -1;
   }
   if (!err)
-    for (int c = 0; c < ns; ++c) {
-      double* out = Phi + (size_t)(nb + c) * n;
+    for (int c = 0; c < nv; ++c) {
+      double* out = Phi + (size_t)c * n;
       memset(out, 0, sizeof(double) * (size_t)n);
-      for (int a = 0; a < ns; ++a)
-        for (int i = 0; i < n; ++i) out[i] += Psi[(size_t)a * n + i] * Kr[(size_t)c * ns + a];
-      w2[nb + c] = wr[c];
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < n; ++i) out[i] += V[(size_t)a * n + i] * Kr[(size_t)c * nv + a];
+      w2[c] = wr[c];
     }
-  free(Kg), free(Kc), free(Psi), free(Kr), free(Mr), free(wr);
+  free(Kg), free(Kc), free(V), free(MV), free(KV), free(Kr), free(Mr), free(wr);
   return err;
 }
 
@@ -259,7 +268,8 @@ static int compute_modes(Modal* m) {
   if (!err) {
     m->next_bend = m->nbend < nt ? sqrt(fmax(wt[m->nbend], 0.0)) : 0.0;
     m->next_axial = m->naxial < ne ? sqrt(fmax(wa[m->naxial], 0.0)) : 0.0;
-    if (m->nstiff > 0 && stiffening_vectors(m, nt, K0, M0, Kt, wt)) err = 2;
+    const int st = m->nstiff > 0 ? stiffening_vectors(m, nt, K0, M0, Kt, wt) : 0;
+    if (st) err = st > 0 ? 2 : 1;
   }
   if (!err) {
     for (int i = 0; i < k; ++i) {
