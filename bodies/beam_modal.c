@@ -1,11 +1,13 @@
 /*
- * beam_modal.c — `type: beam` with `reduction: {modes: k, axial_modes: m}`: the floating-frame
- * beam of beam.c (complete / FOAC / ZOAC) in k + m modal coordinates, with the coupling
+ * beam_modal.c — `type: beam` with `reduction: {modes: k, stiffening_modes: r, axial_modes: m}`: the
+ * floating-frame beam of beam.c (complete / FOAC / ZOAC) in k + r + m modal coordinates, with the coupling
  * deformation kept exactly (docs/models.md, "The reduced beam", Eqs. R1-R12).
  *
  * The modes are the clamped-free eigenmodes of the beam's own finite-element model (its
- * `elements`, the root node clamped to the frame as in beam.c): the k lowest bending modes and
- * the m lowest axial ones (the two decouple in the straight beam's mass and stiffness). With
+ * `elements`, the root node clamped to the frame as in beam.c): the k lowest bending modes, by
+ * default each followed by its spin-stiffening vector K^-1 K_g1 phi_i (Eq. R1a: the first-order
+ * change of the mode under spin, for every speed), and the m lowest axial ones (the two decouple
+ * in the straight beam's mass and stiffness); "k" below counts them all. With
  * p = Phi eta the deformation is w1 = a(x) eta, w2 = b(x) eta, w2' = c(x) eta and the coupling
  * deformation w_c = -1/2 eta^T S(x) eta, S(x) = int_0^x c^T c (Eq. R2): every displacement field
  * of the beam is then a linear combination of the "line functions"
@@ -37,6 +39,7 @@ enum { MODAL_POINTS = 6 };
 typedef struct Modal {
   double L, rho, A, Izz, Emod, beta;
   int ne, model, nbend, nstiff, naxial, k, nb; /* k = nbend + nstiff + naxial */
+  int stiff_given;                             /* stiffening_modes written: all of them or an error */
   double pos0[2], angle0, vel0[2], omega0;
   double le, r2, mass;
   double* omega2;    /* k: the retained modes' omega^2 (bending first, then axial) */
@@ -123,10 +126,13 @@ static double dot(int n, const double* x, const double* y) {
    come back as themselves: a vector M-orthogonal to them has a Rayleigh quotient above
    omega_(nbend+1)^2). K, M: the clamped bending matrices (n = nt, untouched); Phi: the
    eigenvectors (column-major, n x n) whose first nbend + nstiff columns become the basis, w2 its
-   Ritz values. 0 = ok, -1 = out of memory or LAPACK, 1 = a vector is already in the span (what
-   is left of it after the projection is below 1e-10 of it: rounding would make its direction). */
-static int stiffening_vectors(const Modal* m, int n, const double* K, const double* M, double* Phi, double* w2) {
-  const int nb = m->nbend, ns = m->nstiff, ne = m->ne, nv = nb + ns;
+   Ritz values. A vector already in the span (what is left of it after the projection is below
+   1e-10 of it: rounding would make its direction) is left out, and m->nstiff counts those kept;
+   when the scene gave stiffening_modes it is an error instead. 0 = ok, -1 = out of memory or
+   LAPACK, 1 = a vector asked for is in the span. */
+static int stiffening_vectors(Modal* m, int n, const double* K, const double* M, double* Phi, double* w2) {
+  const int nb = m->nbend, ns = m->nstiff, ne = m->ne;
+  int nv = nb + ns;
   const double le = m->le, rA = m->rho * m->A, L = m->L;
   double* Kg = calloc((size_t)n * n, sizeof(double));
   double* Kc = malloc(sizeof(double) * (size_t)n * n);
@@ -136,7 +142,8 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
   double* Kr = calloc((size_t)nv * nv, sizeof(double));
   double* Mr = calloc((size_t)nv * nv, sizeof(double));
   double* wr = calloc((size_t)nv, sizeof(double));
-  int err = !Kg || !Kc || !V || !MV || !KV || !Kr || !Mr || !wr ? -1 : 0;
+  double* Psi = malloc(sizeof(double) * (size_t)n * ns); /* the candidates K^-1 K_g1 phi_i */
+  int err = !Kg || !Kc || !V || !MV || !KV || !Kr || !Mr || !wr || !Psi ? -1 : 0;
   if (!err) {
     double xg[4], wg[4];
     fmb_gauss_legendre01(4, xg, wg); /* (L^2 - x^2) N'N': degree 6 */
@@ -160,7 +167,6 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
     }
     memcpy(V, Phi, sizeof(double) * (size_t)n * nb);
     dense_apply(n, nb, M, V, MV);
-    double* Psi = V + (size_t)n * nb;
     dense_apply(n, ns, Kg, V, Psi); /* K_g1 phi_i, i < ns (ns <= nb) */
     memcpy(Kc, K, sizeof(double) * (size_t)n * n);
     int info = 0;
@@ -168,8 +174,10 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
     if (!info) dpotrs_("U", &n, &ns, Kc, &n, Psi, &n, &info);
     if (info) err = -1;
   }
-  for (int c = nb; c < nv && !err; ++c) {
+  int c = nb; /* the next column of V */
+  for (int cand = 0; cand < ns && !err; ++cand) {
     double *y = V + (size_t)c * n, *My = MV + (size_t)c * n;
+    memcpy(y, Psi + (size_t)cand * n, sizeof(double) * (size_t)n);
     dense_apply(n, 1, M, y, My);
     const double n0 = sqrt(dot(n, y, My));
     for (int pass = 0; pass < 2; ++pass)
@@ -180,11 +188,13 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
     dense_apply(n, 1, M, y, My);
     const double n1 = sqrt(dot(n, y, My));
     if (!(n1 > 1e-10 * n0)) {
-      err = 1;
-      break;
+      if (m->stiff_given) err = 1;
+      continue;
     }
     for (int i = 0; i < n; ++i) y[i] /= n1, My[i] /= n1;
+    ++c;
   }
+  if (!err) nv = c, m->nstiff = c - nb;
   if (!err) {
     dense_apply(n, nv, K, V, KV);
     for (int a = 0; a < nv; ++a)
@@ -195,14 +205,14 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
     if (generalized_eigen(nv, Kr, Mr, wr)) err = -1;
   }
   if (!err)
-    for (int c = 0; c < nv; ++c) {
-      double* out = Phi + (size_t)c * n;
+    for (int col = 0; col < nv; ++col) {
+      double* out = Phi + (size_t)col * n;
       memset(out, 0, sizeof(double) * (size_t)n);
       for (int a = 0; a < nv; ++a)
-        for (int i = 0; i < n; ++i) out[i] += V[(size_t)a * n + i] * Kr[(size_t)c * nv + a];
-      w2[c] = wr[c];
+        for (int i = 0; i < n; ++i) out[i] += V[(size_t)a * n + i] * Kr[(size_t)col * nv + a];
+      w2[col] = wr[col];
     }
-  free(Kg), free(Kc), free(V), free(MV), free(KV), free(Kr), free(Mr), free(wr);
+  free(Kg), free(Kc), free(V), free(MV), free(KV), free(Kr), free(Mr), free(wr), free(Psi);
   return err;
 }
 
@@ -213,7 +223,7 @@ static int stiffening_vectors(const Modal* m, int n, const double* K, const doub
    the frequencies (the vectors' Ritz values). 0 = ok, 1 = eigenproblem failed, 2 = a stiffening
    vector is already in the span of the modes. */
 static int compute_modes(Modal* m) {
-  const int ne = m->ne, nt = 2 * ne, k = m->k, nbend = m->nbend + m->nstiff;
+  const int ne = m->ne, nt = 2 * ne;
   const double le = m->le, rA = m->rho * m->A, rI = m->rho * m->Izz;
   double* Kt = calloc((size_t)nt * nt, sizeof(double));
   double* Mt = calloc((size_t)nt * nt, sizeof(double));
@@ -271,6 +281,7 @@ static int compute_modes(Modal* m) {
     const int st = m->nstiff > 0 ? stiffening_vectors(m, nt, K0, M0, Kt, wt) : 0;
     if (st) err = st > 0 ? 2 : 1;
   }
+  const int nbend = m->nbend + m->nstiff, k = m->k = nbend + m->naxial; /* the vectors kept */
   if (!err) {
     for (int i = 0; i < k; ++i) {
       const int axial = i >= nbend, col = axial ? i - nbend : i;
@@ -435,9 +446,12 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_int(p, red, "modes", FMB_REQUIRED, 0, 2 * (long)m->ne, &m->nbend);
   err |= fmb_get_int(p, red, "axial_modes", FMB_OPTIONAL, 0, m->ne, &m->naxial);
   if (err) return -1;
-  /* default: one stiffening vector per bending mode, as many as the mesh has room for */
+  /* default: one stiffening vector per bending mode, as many as the mesh has room for and the
+     tensors allow (MODAL_MAX_MODES), those already in the span left out (stiffening_vectors) */
   const int room = m->nbend < 2 * m->ne - m->nbend ? m->nbend : 2 * m->ne - m->nbend;
-  m->nstiff = room;
+  const int left = MODAL_MAX_MODES - m->nbend - m->naxial;
+  m->nstiff = room < left ? room : left > 0 ? left : 0;
+  m->stiff_given = fmb_find_key(p, red, "stiffening_modes") >= 0;
   err |= fmb_get_int(p, red, "stiffening_modes", FMB_OPTIONAL, 0, room, &m->nstiff);
   if (err) return -1;
   /* its own keys only (the unknown-key check of the item would list every key of the beam) */
@@ -454,7 +468,8 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
                            "expected at least one mode in 'reduction' (modes + axial_modes >= 1), got 0");
   if (m->k > MODAL_MAX_MODES)
     return fmb_parse_error(p, red,
-                           "expected at most %d modes in 'reduction' (modes + axial_modes), got %d: the tensors grow "
+                           "expected at most %d modes in 'reduction' (modes + stiffening_modes + axial_modes), got "
+                           "%d: the tensors grow "
                            "like k^4; above that the full mesh (`assembly: banded`) is cheaper",
                            MODAL_MAX_MODES, m->k);
   m->le = m->L / m->ne;
@@ -466,15 +481,13 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
     fmb_beam_refuse_degenerate(p, item, m->L, m->ne, m->rho, m->A, m->Izz, m->Emod, me, kbend, kaxial);
     return -1;
   }
-  const int k = m->k;
-  m->nb = 2 + 3 * k + k * (k + 1) / 2;
+  const int k = m->k; /* at most: compute_modes may leave stiffening vectors out */
   m->omega2 = calloc((size_t)k, sizeof(double));
   m->ea = calloc((size_t)m->ne * k * 2, sizeof(double));
   m->ed = calloc((size_t)m->ne * k * 4, sizeof(double));
   m->ec = calloc((size_t)m->ne * k * 3, sizeof(double));
   m->Snode = calloc(((size_t)m->ne + 1) * k * k, sizeof(double));
-  m->G = calloc((size_t)m->nb * m->nb, sizeof(double));
-  if (!m->omega2 || !m->ea || !m->ed || !m->ec || !m->Snode || !m->G) return fmb_parse_error(p, item, "out of memory");
+  if (!m->omega2 || !m->ea || !m->ed || !m->ec || !m->Snode) return fmb_parse_error(p, item, "out of memory");
   const int modes_err = compute_modes(m);
   if (modes_err == 2)
     return fmb_parse_error(
@@ -486,7 +499,9 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
     return fmb_parse_error(p, red,
                            "the beam's clamped-free eigenproblem failed (LAPACK dsygv): its mass or stiffness "
                            "is not usable");
-  if (build_tensors(m)) return fmb_parse_error(p, item, "out of memory");
+  m->nb = 2 + 3 * m->k + m->k * (m->k + 1) / 2;
+  m->G = calloc((size_t)m->nb * m->nb, sizeof(double));
+  if (!m->G || build_tensors(m)) return fmb_parse_error(p, item, "out of memory");
   return 0;
 }
 

@@ -15,7 +15,8 @@
 #     and ZOAC's missing stiffening sqrt(w1^2 - W^2);
 #  G  bad `reduction:` input: exit 2 at file:line:column;
 #  H  the Campbell diagram of the reduced beam (default basis) against the full mesh's, 1e-3;
-#  I  tools/campbell_reduced.sh: full, reduced and ZOAC reduced in one figure.
+#  I  tools/campbell_reduced.sh: full, reduced and ZOAC reduced in one figure;
+#  J  the default basis loads for every number of modes the mesh has.
 . "$(dirname "$0")/../exact/cli_lib.sh" # F, SRC, OUT, check, near; in SRC
 # largest |a - b| of column COL over two CSVs with the same rows; largest |a| of a column
 maxdiff() {
@@ -144,6 +145,15 @@ echo "I: campbell_reduced.sh exit $rc, $n of 3 series in the figure; mode 1 at 1
 check "I: tools/campbell_reduced.sh draws full, reduced and ZOAC reduced in one figure" "[ $rc -eq 0 ] && [ $n -eq 3 ]"
 check "I: in it ZOAC lacks the stiffening (mode 1 negative at 15 rad/s) and the reduced complete has it (> 6 rad/s)" \
   "le '$zl' 0 && le 6 '$rl'"
+
+# J: the default basis loads for every `modes:` the mesh allows (16 elements: 1 ... 32), the
+#    stiffening vectors already in the span of many modes left out, never an error
+nload=0
+for k in $(seq 1 32); do
+  "$F" check $W15 --set "bodies.beam.reduction={modes: $k}" >"$OUT/j.txt" 2>&1 && nload=$((nload + 1))
+done
+echo "J: modes 1 ... 32 of 16 elements with the default basis: $nload of 32 load; modes: 31 -> $("$F" check $W15 --set 'bodies.beam.reduction={modes: 31}' 2>&1 | grep -o 'reduced to [^,]*modes')"
+check "J: every modes: 1 ... 32 loads with the default stiffening vectors" "[ $nload -eq 32 ]"
 
 # G: bad input in the scene file (a copy of the w15 scene with lines after `model: complete`): exit 2
 # at file:line:column (line 19, the first line added)
