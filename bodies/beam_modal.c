@@ -1,11 +1,13 @@
 /*
- * beam_modal.c — `type: beam` with `reduction: {modes: k, axial_modes: m}`: the floating-frame
- * beam of beam.c (complete / FOAC / ZOAC) in k + m modal coordinates, with the coupling
+ * beam_modal.c — `type: beam` with `reduction: {modes: k, stiffening_modes: r, axial_modes: m}`: the
+ * floating-frame beam of beam.c (complete / FOAC / ZOAC) in k + r + m modal coordinates, with the coupling
  * deformation kept exactly (docs/models.md, "The reduced beam", Eqs. R1-R12).
  *
  * The modes are the clamped-free eigenmodes of the beam's own finite-element model (its
- * `elements`, the root node clamped to the frame as in beam.c): the k lowest bending modes and
- * the m lowest axial ones (the two decouple in the straight beam's mass and stiffness). With
+ * `elements`, the root node clamped to the frame as in beam.c): the k lowest bending modes, by
+ * default each followed by its spin-stiffening vector K^-1 K_g1 phi_i (Eq. R1a: the first-order
+ * change of the mode under spin, for every speed), and the m lowest axial ones (the two decouple
+ * in the straight beam's mass and stiffness); "k" below counts them all. With
  * p = Phi eta the deformation is w1 = a(x) eta, w2 = b(x) eta, w2' = c(x) eta and the coupling
  * deformation w_c = -1/2 eta^T S(x) eta, S(x) = int_0^x c^T c (Eq. R2): every displacement field
  * of the beam is then a linear combination of the "line functions"
@@ -36,7 +38,8 @@ enum { MODAL_POINTS = 6 };
 
 typedef struct Modal {
   double L, rho, A, Izz, Emod, beta;
-  int ne, model, nbend, naxial, k, nb;
+  int ne, model, nbend, nstiff, naxial, k, nb; /* k = nbend + nstiff + naxial */
+  int stiff_given;                             /* stiffening_modes written: all of them or an error */
   double pos0[2], angle0, vel0[2], omega0;
   double le, r2, mass;
   double* omega2;    /* k: the retained modes' omega^2 (bending first, then axial) */
@@ -91,19 +94,146 @@ static int generalized_eigen(int n, double* K, double* M, double* w) {
   return info;
 }
 
+/* Cholesky solve K y = b for nrhs right-hand sides (LAPACK dpotrf/dpotrs, K overwritten) */
+extern void dpotrf_(const char* uplo, const int* n, double* a, const int* lda, int* info);
+extern void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, const int* lda, double* b,
+                    const int* ldb, int* info);
+
+/* Y = A X for A dense n x n (column-major), X n x c */
+static void dense_apply(int n, int c, const double* A, const double* X, double* Y) {
+  memset(Y, 0, sizeof(double) * (size_t)n * c);
+  for (int col = 0; col < c; ++col)
+    for (int j = 0; j < n; ++j) {
+      const double xj = X[(size_t)col * n + j];
+      if (xj == 0.0) continue;
+      const double* a = A + (size_t)j * n;
+      double* y = Y + (size_t)col * n;
+      for (int i = 0; i < n; ++i) y[i] += a[i] * xj;
+    }
+}
+
+static double dot(int n, const double* x, const double* y) {
+  double s = 0.0;
+  for (int i = 0; i < n; ++i) s += x[i] * y[i];
+  return s;
+}
+
+/* The stiffening vectors (Eq. R1a): psi_i = K^-1 K_g1 phi_i, i < nstiff, with K_g1 the geometric
+   stiffness of unit spin about the root, int rho A (L^2 - x^2)/2 N2'N2'^T dx (the tension of
+   steady spin is Omega^2 times it). Each is M-orthogonalised against the nbend eigenmodes and the
+   vectors before it (Gram-Schmidt, twice) and normalised; then one Rayleigh-Ritz over the whole
+   basis [modes, vectors] makes Phi^T K Phi diagonal and Phi^T M Phi = 1 to rounding (the modes
+   come back as themselves: a vector M-orthogonal to them has a Rayleigh quotient above
+   omega_(nbend+1)^2). K, M: the clamped bending matrices (n = nt, untouched); Phi: the
+   eigenvectors (column-major, n x n) whose first nbend + nstiff columns become the basis, w2 its
+   Ritz values. A vector already in the span (what is left of it after the projection is below
+   1e-10 of it: rounding would make its direction) is left out, and m->nstiff counts those kept;
+   when the scene gave stiffening_modes it is an error instead. 0 = ok, -1 = out of memory or
+   LAPACK, 1 = a vector asked for is in the span. */
+static int stiffening_vectors(Modal* m, int n, const double* K, const double* M, double* Phi, double* w2) {
+  const int nb = m->nbend, ns = m->nstiff, ne = m->ne;
+  int nv = nb + ns;
+  const double le = m->le, rA = m->rho * m->A, L = m->L;
+  double* Kg = calloc((size_t)n * n, sizeof(double));
+  double* Kc = malloc(sizeof(double) * (size_t)n * n);
+  double* V = malloc(sizeof(double) * (size_t)n * nv);  /* the basis [modes, vectors] */
+  double* MV = malloc(sizeof(double) * (size_t)n * nv); /* M V, column by column as V is built */
+  double* KV = malloc(sizeof(double) * (size_t)n * nv);
+  double* Kr = calloc((size_t)nv * nv, sizeof(double));
+  double* Mr = calloc((size_t)nv * nv, sizeof(double));
+  double* wr = calloc((size_t)nv, sizeof(double));
+  double* Psi = malloc(sizeof(double) * (size_t)n * ns); /* the candidates K^-1 K_g1 phi_i */
+  int err = !Kg || !Kc || !V || !MV || !KV || !Kr || !Mr || !wr || !Psi ? -1 : 0;
+  if (!err) {
+    double xg[4], wg[4];
+    fmb_gauss_legendre01(4, xg, wg); /* (L^2 - x^2) N'N': degree 6 */
+    for (int e = 0; e < ne; ++e) {
+      double kge[4][4] = {{0}};
+      for (int g = 0; g < 4; ++g) {
+        double ns4[4], nd[4];
+        const double x = (e + xg[g]) * le;
+        fmb_beam_hermite(xg[g], le, ns4, nd);
+        for (int i = 0; i < 4; ++i)
+          for (int j = 0; j < 4; ++j) kge[i][j] += wg[g] * le * rA * 0.5 * (L * L - x * x) * nd[i] * nd[j];
+      }
+      for (int i = 0; i < 4; ++i) {
+        const int gi = 2 * (e + (i >= 2)) + (i & 1) - 2;
+        if (gi < 0) continue;
+        for (int j = 0; j < 4; ++j) {
+          const int gj = 2 * (e + (j >= 2)) + (j & 1) - 2;
+          if (gj >= 0) Kg[(size_t)gj * n + gi] += kge[i][j];
+        }
+      }
+    }
+    memcpy(V, Phi, sizeof(double) * (size_t)n * nb);
+    dense_apply(n, nb, M, V, MV);
+    dense_apply(n, ns, Kg, V, Psi); /* K_g1 phi_i, i < ns (ns <= nb) */
+    memcpy(Kc, K, sizeof(double) * (size_t)n * n);
+    int info = 0;
+    dpotrf_("U", &n, Kc, &n, &info);
+    if (!info) dpotrs_("U", &n, &ns, Kc, &n, Psi, &n, &info);
+    if (info) err = -1;
+  }
+  int c = nb; /* the next column of V */
+  for (int cand = 0; cand < ns && !err; ++cand) {
+    double *y = V + (size_t)c * n, *My = MV + (size_t)c * n;
+    memcpy(y, Psi + (size_t)cand * n, sizeof(double) * (size_t)n);
+    dense_apply(n, 1, M, y, My);
+    const double n0 = sqrt(dot(n, y, My));
+    for (int pass = 0; pass < 2; ++pass)
+      for (int j = 0; j < c; ++j) {
+        const double h = dot(n, MV + (size_t)j * n, y);
+        for (int i = 0; i < n; ++i) y[i] -= h * V[(size_t)j * n + i];
+      }
+    dense_apply(n, 1, M, y, My);
+    const double n1 = sqrt(dot(n, y, My));
+    if (!(n1 > 1e-10 * n0)) {
+      if (m->stiff_given) err = 1;
+      continue;
+    }
+    for (int i = 0; i < n; ++i) y[i] /= n1, My[i] /= n1;
+    ++c;
+  }
+  if (!err) nv = c, m->nstiff = c - nb;
+  if (!err) {
+    dense_apply(n, nv, K, V, KV);
+    for (int a = 0; a < nv; ++a)
+      for (int b = 0; b < nv; ++b) {
+        Kr[(size_t)b * nv + a] = dot(n, V + (size_t)a * n, KV + (size_t)b * n);
+        Mr[(size_t)b * nv + a] = dot(n, V + (size_t)a * n, MV + (size_t)b * n);
+      }
+    if (generalized_eigen(nv, Kr, Mr, wr)) err = -1;
+  }
+  if (!err)
+    for (int col = 0; col < nv; ++col) {
+      double* out = Phi + (size_t)col * n;
+      memset(out, 0, sizeof(double) * (size_t)n);
+      for (int a = 0; a < nv; ++a)
+        for (int i = 0; i < n; ++i) out[i] += V[(size_t)a * n + i] * Kr[(size_t)col * nv + a];
+      w2[col] = wr[col];
+    }
+  free(Kg), free(Kc), free(V), free(MV), free(KV), free(Kr), free(Mr), free(wr), free(Psi);
+  return err;
+}
+
 /* The bending modes (2 ne dofs [v, v'] per node 1..ne) and the axial ones (ne dofs): the straight
    beam's mass and stiffness do not couple them (the cross term int rho N1 (-y N2') vanishes with
-   int y dA = 0), so each problem is solved alone. Fills ea, ed, ec and the frequencies. */
+   int y dA = 0), so each problem is solved alone. The nbend lowest bending eigenmodes are followed
+   by the nstiff stiffening vectors (stiffening_vectors), then the axial modes. Fills ea, ed, ec and
+   the frequencies (the vectors' Ritz values). 0 = ok, 1 = eigenproblem failed, 2 = a stiffening
+   vector is already in the span of the modes. */
 static int compute_modes(Modal* m) {
-  const int ne = m->ne, nt = 2 * ne, k = m->k;
+  const int ne = m->ne, nt = 2 * ne;
   const double le = m->le, rA = m->rho * m->A, rI = m->rho * m->Izz;
   double* Kt = calloc((size_t)nt * nt, sizeof(double));
   double* Mt = calloc((size_t)nt * nt, sizeof(double));
+  double* K0 = malloc(sizeof(double) * (size_t)nt * nt);
+  double* M0 = malloc(sizeof(double) * (size_t)nt * nt);
   double* Ka = calloc((size_t)ne * ne, sizeof(double));
   double* Ma = calloc((size_t)ne * ne, sizeof(double));
   double* wt = calloc((size_t)nt, sizeof(double));
   double* wa = calloc((size_t)ne, sizeof(double));
-  int err = !Kt || !Mt || !Ka || !Ma || !wt || !wa;
+  int err = !Kt || !Mt || !K0 || !M0 || !Ka || !Ma || !wt || !wa;
   if (!err) {
     double xg[4], wg[4], me[4][4] = {{0}};
     fmb_gauss_legendre01(4, xg, wg); /* N N^T and N' N'^T: degree 6 */
@@ -141,13 +271,20 @@ static int compute_modes(Modal* m) {
         }
       }
     }
+    memcpy(K0, Kt, sizeof(double) * (size_t)nt * nt);
+    memcpy(M0, Mt, sizeof(double) * (size_t)nt * nt);
     err = generalized_eigen(nt, Kt, Mt, wt) || generalized_eigen(ne, Ka, Ma, wa);
   }
   if (!err) {
     m->next_bend = m->nbend < nt ? sqrt(fmax(wt[m->nbend], 0.0)) : 0.0;
     m->next_axial = m->naxial < ne ? sqrt(fmax(wa[m->naxial], 0.0)) : 0.0;
+    const int st = m->nstiff > 0 ? stiffening_vectors(m, nt, K0, M0, Kt, wt) : 0;
+    if (st) err = st > 0 ? 2 : 1;
+  }
+  const int nbend = m->nbend + m->nstiff, k = m->k = nbend + m->naxial; /* the vectors kept */
+  if (!err) {
     for (int i = 0; i < k; ++i) {
-      const int axial = i >= m->nbend, col = axial ? i - m->nbend : i;
+      const int axial = i >= nbend, col = axial ? i - nbend : i;
       const double* phi = axial ? Ka + (size_t)col * ne : Kt + (size_t)col * nt;
       m->omega2[i] = axial ? wa[col] : wt[col];
       /* sign: the tip moves positively (deterministic modes, whatever LAPACK returns) */
@@ -168,7 +305,7 @@ static int compute_modes(Modal* m) {
       }
     }
   }
-  free(Kt), free(Mt), free(Ka), free(Ma), free(wt), free(wa);
+  free(Kt), free(Mt), free(K0), free(M0), free(Ka), free(Ma), free(wt), free(wa);
   return err;
 }
 
@@ -309,20 +446,30 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_int(p, red, "modes", FMB_REQUIRED, 0, 2 * (long)m->ne, &m->nbend);
   err |= fmb_get_int(p, red, "axial_modes", FMB_OPTIONAL, 0, m->ne, &m->naxial);
   if (err) return -1;
+  /* default: one stiffening vector per bending mode, as many as the mesh has room for and the
+     tensors allow (MODAL_MAX_MODES), those already in the span left out (stiffening_vectors) */
+  const int room = m->nbend < 2 * m->ne - m->nbend ? m->nbend : 2 * m->ne - m->nbend;
+  const int left = MODAL_MAX_MODES - m->nbend - m->naxial;
+  m->nstiff = room < left ? room : left > 0 ? left : 0;
+  m->stiff_given = fmb_find_key(p, red, "stiffening_modes") >= 0;
+  err |= fmb_get_int(p, red, "stiffening_modes", FMB_OPTIONAL, 0, room, &m->nstiff);
+  if (err) return -1;
   /* its own keys only (the unknown-key check of the item would list every key of the beam) */
   for (yaml_node_pair_t* pr = rn->data.mapping.pairs.start; pr < rn->data.mapping.pairs.top; ++pr) {
     const yaml_node_t* key = fmbp_node(p, pr->key);
     const char* k = key && key->type == YAML_SCALAR_NODE ? (const char*)key->data.scalar.value : "";
-    if (strcmp(k, "modes") != 0 && strcmp(k, "axial_modes") != 0)
-      return fmb_parse_error(p, pr->key, "unknown key '%s' in 'reduction' (expected modes, axial_modes)", k);
+    if (strcmp(k, "modes") != 0 && strcmp(k, "axial_modes") != 0 && strcmp(k, "stiffening_modes") != 0)
+      return fmb_parse_error(p, pr->key,
+                             "unknown key '%s' in 'reduction' (expected modes, stiffening_modes, axial_modes)", k);
   }
-  m->k = m->nbend + m->naxial;
+  m->k = m->nbend + m->nstiff + m->naxial;
   if (m->k < 1)
     return fmb_parse_error(p, fmb_find_key(p, red, "modes"),
                            "expected at least one mode in 'reduction' (modes + axial_modes >= 1), got 0");
   if (m->k > MODAL_MAX_MODES)
     return fmb_parse_error(p, red,
-                           "expected at most %d modes in 'reduction' (modes + axial_modes), got %d: the tensors grow "
+                           "expected at most %d modes in 'reduction' (modes + stiffening_modes + axial_modes), got "
+                           "%d: the tensors grow "
                            "like k^4; above that the full mesh (`assembly: banded`) is cheaper",
                            MODAL_MAX_MODES, m->k);
   m->le = m->L / m->ne;
@@ -334,20 +481,27 @@ static int modal_parse(fmbParser* p, fmbNode item, void** self) {
     fmb_beam_refuse_degenerate(p, item, m->L, m->ne, m->rho, m->A, m->Izz, m->Emod, me, kbend, kaxial);
     return -1;
   }
-  const int k = m->k;
-  m->nb = 2 + 3 * k + k * (k + 1) / 2;
+  const int k = m->k; /* at most: compute_modes may leave stiffening vectors out */
   m->omega2 = calloc((size_t)k, sizeof(double));
   m->ea = calloc((size_t)m->ne * k * 2, sizeof(double));
   m->ed = calloc((size_t)m->ne * k * 4, sizeof(double));
   m->ec = calloc((size_t)m->ne * k * 3, sizeof(double));
   m->Snode = calloc(((size_t)m->ne + 1) * k * k, sizeof(double));
-  m->G = calloc((size_t)m->nb * m->nb, sizeof(double));
-  if (!m->omega2 || !m->ea || !m->ed || !m->ec || !m->Snode || !m->G) return fmb_parse_error(p, item, "out of memory");
-  if (compute_modes(m))
+  if (!m->omega2 || !m->ea || !m->ed || !m->ec || !m->Snode) return fmb_parse_error(p, item, "out of memory");
+  const int modes_err = compute_modes(m);
+  if (modes_err == 2)
+    return fmb_parse_error(
+        p, fmb_find_key(p, red, "stiffening_modes") >= 0 ? fmb_find_key(p, red, "stiffening_modes") : red,
+        "the beam's stiffening vectors K^-1 K_g phi_i are already in the span of its %d modes "
+        "(nothing left to add): give fewer 'stiffening_modes' or set it to 0",
+        m->nbend);
+  if (modes_err)
     return fmb_parse_error(p, red,
                            "the beam's clamped-free eigenproblem failed (LAPACK dsygv): its mass or stiffness "
                            "is not usable");
-  if (build_tensors(m)) return fmb_parse_error(p, item, "out of memory");
+  m->nb = 2 + 3 * m->k + m->k * (m->k + 1) / 2;
+  m->G = calloc((size_t)m->nb * m->nb, sizeof(double));
+  if (!m->G || build_tensors(m)) return fmb_parse_error(p, item, "out of memory");
   return 0;
 }
 
@@ -800,10 +954,14 @@ static void modal_describe(const void* self, FILE* f) {
   const Modal* m = self;
   static const char* const terms[] = {"w_c dropped (linear modal: no dynamic stiffening)", "w_c to first order",
                                       "w_c exact (quadratic in the modal coordinates)"};
-  fprintf(f, "%s model reduced to %d bending + %d axial clamped-free modes of its %d elements, %s%s; retained (rad/s):",
-          modal_model_names[m->model], m->nbend, m->naxial, m->ne, terms[m->model],
+  fprintf(f,
+          "%s model reduced to %d bending + %d stiffening + %d axial clamped-free modes of its %d elements, %s%s; "
+          "retained (rad/s):",
+          modal_model_names[m->model], m->nbend, m->nstiff, m->naxial, m->ne, terms[m->model],
           m->beta > 0.0 ? ", stiffness-proportional damping" : "");
-  for (int i = 0; i < m->k; ++i) fprintf(f, " %.6g%s", sqrt(fmax(m->omega2[i], 0.0)), i >= m->nbend ? "a" : "");
+  /* the stiffening vectors' Ritz values are not frequencies of the beam: marked s, after the modes */
+  for (int i = 0; i < m->k; ++i)
+    fprintf(f, " %.6g%s", sqrt(fmax(m->omega2[i], 0.0)), i >= m->nbend + m->nstiff ? "a" : i >= m->nbend ? "s" : "");
   fprintf(f, "; first dropped: ");
   if (m->next_bend > 0.0) fprintf(f, "bending %.6g", m->next_bend);
   if (m->next_bend > 0.0 && m->next_axial > 0.0) fprintf(f, ", ");

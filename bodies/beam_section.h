@@ -59,12 +59,13 @@
     .doc = "initial frame angular velocity"                                                                           \
   }
 
-/* `reduction: {modes: k, axial_modes: m}` (bodies/beam_modal.c): declared by both tables */
+/* `reduction: {modes: k, stiffening_modes: r, axial_modes: m}` (bodies/beam_modal.c): declared by both tables */
 #define FMB_BEAM_REDUCTION_PARAM                                                                                    \
   {                                                                                                                 \
     .key = "reduction", .kind = FMB_PARAM_MAP, .fallback = "none (the full mesh)",                                  \
-    .doc = "{modes: k, axial_modes: m}: the beam in its k lowest clamped-free bending modes (and m axial ones) of " \
-           "its own elements, the coupling kept exactly (docs/models.md, reduced beam)"                             \
+    .doc = "{modes: k, stiffening_modes: r, axial_modes: m}: the beam in its k lowest clamped-free bending "        \
+           "modes of its own elements, r <= k spin-stiffening vectors (default k) and m axial modes, the coupling " \
+           "kept exactly (docs/models.md, reduced beam)"                                                            \
   }
 
 /* the parse error for a section whose element mass or stiffness is not a usable double (length

@@ -209,8 +209,10 @@ static int load_tables(PlotArgs* a, fmbTable* table, int* loaded, fmbTable* ref,
                        size_t len, const char** termp) {
   int rc = 0;
   char err[1024], list[4096];
+  /* with --x the first column need not be t: `campbell -o` writes speed first (docs/models.md, the
+     reduced beam's Campbell diagram against the full mesh and ZOAC) */
   for (int i = 0; i < a->ncsv && !rc; ++i, ++*loaded)
-    if (fmb_table_load(a->csv[i], &table[i], err, sizeof err)) {
+    if (fmb_table_load_keyed(a->csv[i], &table[i], a->x ? NULL : "t", err, sizeof err)) {
       fprintf(stderr, "flexmbd plot: %s\n", err);
       rc = FMB_EXIT_BAD_INPUT;
     }

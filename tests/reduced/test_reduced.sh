@@ -13,7 +13,10 @@
 #  E  the reduced pendulum conserves T + U_e + U_g over 5 s;
 #  F  the rotating beam's stiffened first frequency (modes) against the continuum at 4 and 15 rad/s,
 #     and ZOAC's missing stiffening sqrt(w1^2 - W^2);
-#  G  bad `reduction:` input: exit 2 at file:line:column.
+#  G  bad `reduction:` input: exit 2 at file:line:column;
+#  H  the Campbell diagram of the reduced beam (default basis) against the full mesh's, 1e-3;
+#  I  tools/campbell_reduced.sh: full, reduced and ZOAC reduced in one figure;
+#  J  the default basis loads for every number of modes the mesh has.
 . "$(dirname "$0")/../exact/cli_lib.sh" # F, SRC, OUT, check, near; in SRC
 # largest |a - b| of column COL over two CSVs with the same rows; largest |a| of a column
 maxdiff() {
@@ -40,8 +43,8 @@ for ref in 3.909343 24.499435 68.599127 134.426910; do
 done
 "$F" check $W15 --set 'bodies.beam.reduction={modes: 4}' >"$OUT/check.txt" 2>&1
 grep "body 'beam'" "$OUT/check.txt"
-check "A: check lists the retained frequencies and the first dropped one" \
-  "grep -q 'retained (rad/s): 3.90934 24.4995 68.6014 134.446; first dropped: bending 222.30' '$OUT/check.txt'"
+check "A: check lists the retained frequencies (modes, then the stiffening vectors' Ritz values) and the first dropped one" \
+  "grep -q 'reduced to 4 bending + 4 stiffening + 0 axial.*retained (rad/s): 3.90934 24.4995 68.6014 134.446 [0-9.]*s [0-9.]*s [0-9.]*s [0-9.]*s; first dropped: bending 222.30' '$OUT/check.txt'"
 
 # B: every mode kept reproduces the full mesh (8 elements: 16 bending + 8 axial modes)
 for model in complete foac zoac; do
@@ -103,12 +106,62 @@ w=$("$F" modes scenes/campbell_beam.yaml --count 1 --set joints.spin.speed=2 --s
 echo "F: ZOAC reduced at 2 rad/s: $w rad/s (sqrt(w1^2 - W^2) = 3.359011)"
 check "F: ZOAC reduced lacks the stiffening: sqrt(w1^2 - W^2) to 1e-5" "near '$w' 3.359011 3.4e-5"
 
+# H: the Campbell diagram of the reduced spinning beam against the full mesh's (the same 16-element
+#    mesh, complete model): with the default basis (4 bending modes + their 4 stiffening vectors)
+#    every retained mode within 1e-3 relative at 0, 5, 10, 15 rad/s; the eigenmodes alone
+#    (stiffening_modes: 0, the basis before) miss it at 15 rad/s (8.5e-3 on mode 1), so the check
+#    can fail
+CB="scenes/campbell_beam.yaml --speed joints.spin.speed --speeds 0:15:4 --count 4"
+"$F" campbell $CB -o - >"$OUT/campbell_full.csv" 2>"$OUT/campbell_full.err"
+"$F" campbell $CB --set 'bodies.beam.reduction={modes: 4}' -o - >"$OUT/campbell_k4.csv" 2>"$OUT/campbell_k4.err"
+"$F" campbell $CB --set 'bodies.beam.reduction={modes: 4, stiffening_modes: 0}' -o - >"$OUT/campbell_k4e.csv" \
+  2>"$OUT/campbell_k4e.err"
+# largest relative difference of modes 1..4 over the speeds (rows must match: same speeds)
+reldiff() {
+  awk -F, 'FNR == 1 { next } NR == FNR { for (i = 2; i <= NF; i++) a[FNR, i] = $i; n = NF; next }
+    { if ($1 != a[FNR, 1] && FNR > 1) bad = 1; for (i = 2; i <= NF; i++) { d = ($i - a[FNR, i]) / a[FNR, i];
+      if (d < 0) d = -d; if (d > m) m = d } r++ }
+    END { if (r != 4 || n != 5) print 1; else print m + 0 }' "$1" "$2"
+}
+dk=$(reldiff "$OUT/campbell_full.csv" "$OUT/campbell_k4.csv")
+de=$(reldiff "$OUT/campbell_full.csv" "$OUT/campbell_k4e.csv")
+echo "H: Campbell 0..15 rad/s, modes 1-4, reduced k = 4 vs full mesh: default basis $dk, eigenmodes alone $de (relative)"
+check "H: the reduced beam's Campbell diagram within 1e-3 of the full mesh's (retained modes)" "le '$dk' 1e-3"
+check "H: the eigenmodes alone do not meet 1e-3 at 15 rad/s (the check discriminates)" "le 1e-3 '$de'"
+
+# I: the documented plot of full, reduced and ZOAC reduced (tools/campbell_reduced.sh) runs and
+#    the figure holds the three series; ZOAC's first frequency goes negative (divergent) above
+#    omega1 while the reduced complete one stiffens
+rm -rf "$OUT/cplot"
+sh tools/campbell_reduced.sh "$OUT/cplot" "$F" "$OUT/cplot/campbell_reduced.svg" >"$OUT/cplot.log" 2>&1
+rc=$?
+n=0
+for label in 'full mesh (16 el.): mode1' 'reduced k = 4: mode1' 'ZOAC reduced k = 4: mode1'; do
+  grep -qF "$label" "$OUT/cplot/campbell_reduced.svg" 2>/dev/null && n=$((n + 1))
+done
+zl=$(tail -1 "$OUT/cplot/campbell_zoac_reduced.csv" | cut -d, -f2)
+rl=$(tail -1 "$OUT/cplot/campbell_reduced.csv" | cut -d, -f2)
+echo "I: campbell_reduced.sh exit $rc, $n of 3 series in the figure; mode 1 at 15 rad/s: reduced $rl, ZOAC reduced $zl rad/s"
+check "I: tools/campbell_reduced.sh draws full, reduced and ZOAC reduced in one figure" "[ $rc -eq 0 ] && [ $n -eq 3 ]"
+check "I: in it ZOAC lacks the stiffening (mode 1 negative at 15 rad/s) and the reduced complete has it (> 6 rad/s)" \
+  "le '$zl' 0 && le 6 '$rl'"
+
+# J: the default basis loads for every `modes:` the mesh allows (16 elements: 1 ... 32), the
+#    stiffening vectors already in the span of many modes left out, never an error
+nload=0
+for k in $(seq 1 32); do
+  "$F" check $W15 --set "bodies.beam.reduction={modes: $k}" >"$OUT/j.txt" 2>&1 && nload=$((nload + 1))
+done
+echo "J: modes 1 ... 32 of 16 elements with the default basis: $nload of 32 load; modes: 31 -> $("$F" check $W15 --set 'bodies.beam.reduction={modes: 31}' 2>&1 | grep -o 'reduced to [^,]*modes')"
+check "J: every modes: 1 ... 32 loads with the default stiffening vectors" "[ $nload -eq 32 ]"
+
 # G: bad input in the scene file (a copy of the w15 scene with lines after `model: complete`): exit 2
 # at file:line:column (line 19, the first line added)
 for bad in "reduction: 4|19:16:.*expected a mapping for .reduction." \
   "reduction: {modes: 33}|19:24:.*.modes." \
   "reduction: {modes: 2, mods: 1}|19:27:.*unknown key .mods." \
   "reduction: {modes: 0}|19:24:.*at least one mode" \
+  "reduction: {modes: 2, stiffening_modes: 3}|19:45:.*from 0 to 2 for .stiffening_modes." \
   "assembly: banded\n    reduction: {modes: 2}|19:15:.*does not apply with .reduction."; do
   lines=${bad%%|*}
   msg=${bad#*|}
