@@ -103,6 +103,7 @@ int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
 int fmb_cmd_view(int argc, char** argv);
 int fmb_cmd_sweep(int argc, char** argv);
+int fmb_cmd_refine(int argc, char** argv);
 /* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
 typedef struct fmbCliAnalysis {
   fmbStaticOptions opt; /* --at T, --quiet */

@@ -61,6 +61,12 @@ static const Command commands[] = {
      "      [--eigen dense|sparse|auto] [--set PATH=VALUE]...   modes against the hub speed, followed by shape (MAC);\n"
      "      under mpirun/srun the ranks share the speeds",
      0},
+    {"refine", fmb_cmd_refine,
+     "refine SCENE.yaml --elements N1,N2,... [--column COL] [--body NAME] [--time-factor F] [-o TABLE.csv] [--set "
+     "PATH=VALUE]...\n"
+     "      a mesh refinement study: per mesh the column's end value, the difference to the next finer mesh,\n"
+     "      the time error (against rtol/F) and the CPU (docs/refine.md)",
+     1},
     {"sweep", fmb_cmd_sweep,
      "sweep SCENE.yaml -o DIR [--grid PATH=A:B:N[:log]|PATH=v1,v2,...]... [--zip ...] [--samples F.csv] [--random "
      "...]\n"
