@@ -286,6 +286,13 @@ typedef struct fmbBodyType {
   /* ABI 3, optional: the SI unit of each name in output_names (same order; "1" for a pure number),
      for the axes of plots and of `view` (fmb_output_unit_in). NULL = not declared. */
   const char* const* output_units;
+  /* ABI 3, optional (added before any release of it): 1 when the auxiliary unknowns are a mixed
+     form's own fields, which Newton iterates on with the coordinates rather than eliminating
+     them (engine/system.c, fmb_system_residual_eliminated). The exact beam's axial forces at its
+     axial points: iterated, its Newton matrix keeps EA out of the coupling that turns with the
+     centreline, and Newton converges as for the complete model (docs/models.md, "Newton").
+     NULL or 0 = eliminated (the complete beam's coupling sums). */
+  int (*aux_iterated)(const void* self);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
