@@ -826,7 +826,8 @@ static const fmbParam exact_params[] = {
      .kind = FMB_PARAM_CHOICE,
      .fallback = "auto",
      .choices = exact_assemblies,
-     .doc = "body Jacobian layout: banded (O(n), the default from 64 elements) or dense"},
+     .doc = "body Jacobian layout: banded (O(n); auto: with the mixed form's axial strains, docs/models.md) or "
+            "dense (the displacement form)"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
