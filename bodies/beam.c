@@ -130,7 +130,8 @@ static void slope_products(const Beam* b, const double d[4], const double dd[4],
  * ------------------------------------------------------------------------------------------- */
 static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
 static const char* const assembly_names[] = {"auto", "dense", "banded", NULL};
-static const char* const integration_names[] = {"reduced", "full", NULL}; /* model: exact's */
+static const char* const integration_names[] = {"reduced", "full", NULL};      /* model: exact's */
+static const char* const axial_form_names[] = {"mixed", "displacement", NULL}; /* model: exact's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on: below it the dense blocks are small
    and the fewer unknowns win (docs/performance.md, "Scaling") */
@@ -189,8 +190,9 @@ static int beam_parse(fmbParser* p, fmbNode item, void** self) {
   /* `integration` chooses the exact model's quadrature (bodies/beam_exact.c); these three models
      have theirs in quadrature_points, so they check the word and ignore it: a scene written for
      `model: exact` then runs under every model (`run --models`, docs/models.md) */
-  int integration = 0;
+  int integration = 0, axial_form = 0;
   err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, integration_names, &integration);
+  err |= fmb_get_choice(p, item, "axial_form", FMB_OPTIONAL, axial_form_names, &axial_form);
   if (!err) {
     b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
     b->ng = default_points(b->model);
@@ -1614,6 +1616,12 @@ const fmbParam fmb_beam_params[] = {
      .fallback = "auto",
      .choices = assembly_names,
      .doc = "dense, or banded: the coupling sums as auxiliary unknowns, O(n) per step (auto: banded from 64 elements)"},
+    {.key = "axial_form",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "mixed",
+     .choices = axial_form_names,
+     .doc = "model: exact: the axial strains as unknowns Newton iterates on (mixed), or the displacement form "
+            "before it (to compare); the other models ignore it"},
     FMB_BEAM_REDUCTION_PARAM,
     {.key = "jacobian",
      .kind = FMB_PARAM_CHOICE,

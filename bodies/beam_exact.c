@@ -53,6 +53,7 @@ typedef struct BeamExact {
   double L, rho, A, Izz, Emod;
   int ne, integration;
   int banded; /* `assembly`: K, C, M over the banded pattern (exact_pattern) instead of dense */
+  int mixed;  /* the axial strains at the axial points are unknowns of their own (exact_naux) */
   double pos0[2], angle0, vel0[2], omega0;
   /* derived */
   double le, mu, EA, EI;
@@ -135,7 +136,7 @@ static void interp(const double w[4], const double X[8], double out[2]) {
  * off of positions near s ~ L. U depends on X only through eps and kappa: a rigid motion of X
  * leaves it unchanged.
  * ------------------------------------------------------------------------------------------- */
-static double element_elastic(const BeamExact* b, const double D[8], double f[8], double* K) {
+static double element_elastic(const BeamExact* b, const double D[8], const double* Naxial, double f[8], double* K) {
   double U = 0.0;
   memset(f, 0, 8 * sizeof(double));
   if (K) memset(K, 0, 64 * sizeof(double));
@@ -147,14 +148,17 @@ static double element_elastic(const BeamExact* b, const double D[8], double f[8]
     const double dx = dr[0], dy = dr[1], a[2] = {1.0 + dx, dy};
     const double len = sqrt(a[0] * a[0] + a[1] * a[1]);
     const double eps = (2.0 * dx + dx * dx + dy * dy) / (1.0 + len);
-    const double wq = b->axial.w[g] * b->le * b->EA;
+    const double wl = b->axial.w[g] * b->le, wq = wl * b->EA;
     const double t[2] = {a[0] / len, a[1] / len};
+    /* N = EA eps, or the unknown axial force of the mixed form (then K holds N's geometric part
+       only: its eps-gradient column is the z coupling, exact_fill) */
+    const double N = Naxial ? Naxial[g] : b->EA * eps;
     U += 0.5 * wq * eps * eps;
-    for (int l = 0; l < 8; ++l) f[l] += wq * eps * t[l & 1] * sh->d1[l >> 1];
+    for (int l = 0; l < 8; ++l) f[l] += wl * N * t[l & 1] * sh->d1[l >> 1];
     if (K) {
       double H[2][2];
       for (int i = 0; i < 2; ++i)
-        for (int j = 0; j < 2; ++j) H[i][j] = t[i] * t[j] + eps * ((i == j) - t[i] * t[j]) / len;
+        for (int j = 0; j < 2; ++j) H[i][j] = (Naxial ? 0.0 : t[i] * t[j]) + N / b->EA * ((i == j) - t[i] * t[j]) / len;
       for (int l2 = 0; l2 < 8; ++l2)
         for (int l1 = 0; l1 < 8; ++l1) K[l2 * 8 + l1] += wq * sh->d1[l1 >> 1] * sh->d1[l2 >> 1] * H[l1 & 1][l2 & 1];
     }
@@ -206,6 +210,7 @@ static double element_elastic(const BeamExact* b, const double D[8], double f[8]
 static const char* const exact_models[] = {"zoac", "foac", "complete", "exact", NULL}; /* as beam.c's */
 static const char* const exact_integrations[] = {"reduced", "full", NULL};
 static const char* const exact_assemblies[] = {"auto", "dense", "banded", NULL}; /* as beam.c's */
+static const char* const exact_axial_forms[] = {"mixed", "displacement", NULL};  /* as beam.c's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on. Unlike beam.c's (whose banded form adds
    auxiliary unknowns), this pattern adds nothing: measured (bench/exact_banded.sh, the omega0 = 15
@@ -227,6 +232,12 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   int assembly = ASSEMBLY_AUTO;
   err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, exact_assemblies, &assembly);
   b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
+  /* the mixed form (exact_naux) with reduced integration, whose axial points are the nodes and
+     midpoints; it needs the pattern (its unknowns' rows and columns), so it is banded */
+  int displacement_form = 0; /* axial_form: displacement keeps the form before the mixed one, to compare */
+  err |= fmb_get_choice(p, item, "axial_form", FMB_OPTIONAL, exact_axial_forms, &displacement_form);
+  b->mixed = !displacement_form && b->integration == INTEGRATION_REDUCED && assembly != ASSEMBLY_DENSE;
+  if (b->mixed) b->banded = 1;
   err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
   err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
   err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
@@ -284,6 +295,16 @@ static long exact_npair(const BeamExact* b) {
   const long nc = 3 + b->n;
   return 3 * nc + 3 * (nc - 3) + 25 + 64L * (b->ne - 1);
 }
+
+/* the mixed form's pairs after exact_npair's, per element e and axial point g: the point's Rz row
+   over the element's nd free dofs, the dofs' rows over its z column, and its diagonal */
+static size_t mixed_at(const BeamExact* b, int e, int g) {
+  const size_t per_e0 = 3 * (2 * 5 + 1), per_e = 3 * (2 * 8 + 1);
+  const int nd = e == 0 ? 5 : 8;
+  return (size_t)exact_npair(b) + (e == 0 ? 0 : per_e0 + per_e * (size_t)(e - 1)) + (size_t)g * (size_t)(2 * nd + 1);
+}
+
+static long exact_npair_all(const BeamExact* b) { return b->mixed ? (long)mixed_at(b, b->ne, 0) : exact_npair(b); }
 
 static size_t jac_at(const BeamExact* b, int banded, int e, int i, int li, int j, int lj) {
   const size_t nc = (size_t)(3 + b->n);
@@ -347,15 +368,33 @@ static void element_state(const BeamExact* b, const double* q, const double* v, 
   element_values(b, a, e, 0, Xdd);
 }
 
-static int exact_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                          double* R, double* work) {
-  (void)work;
-  const BeamExact* b = self;
+/* the axial point g of element e's aux unknown in the mixed form: the nodes' forces first (the
+   Lobatto end points, shared by the two elements at a node), then each element's midpoint */
+static int axial_aux(const BeamExact* b, int e, int g) { return g == 0 ? e : g == 2 ? e + 1 : b->ne + 1 + e; }
+
+/* eps at axial point g of an element with displacements D, and d eps / dD (the Hermite slope
+   weights along t = rho'/|rho'|) */
+static double axial_strain(const BeamExact* b, int g, const double D[8], double deps[8]) {
+  const Shape* sh = &b->axial.sh[g];
+  double dr[2];
+  interp(sh->d1, D, dr);
+  const double dx = dr[0], dy = dr[1], a[2] = {1.0 + dx, dy};
+  const double len = sqrt(a[0] * a[0] + a[1] * a[1]);
+  if (deps)
+    for (int l = 0; l < 8; ++l) deps[l] = a[l & 1] / len * sh->d1[l >> 1];
+  return (2.0 * dx + dx * dx + dy * dy) / (1.0 + len);
+}
+
+/* R (and, with z, the mixed form's Rz: per axial point, its weight times eps(q) - z, z the axial
+   point's strain as an unknown of its own, N = EA z; exact_naux) */
+static int exact_eval(const BeamExact* b, const fmbEnv* env, const double* q, const double* v, const double* a,
+                      const double* z, double* R, double* Rz) {
   double c, s, G0[2];
   frame_terms(env, q, a, &c, &s, G0);
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
+  if (Rz) memset(Rz, 0, sizeof(double) * (size_t)(2 * b->ne + 1));
   for (int e = 0; e < b->ne; ++e) {
-    double X[8], D[8], Xd[8], Xdd[8], f[8];
+    double X[8], D[8], Xd[8], Xdd[8], f[8], Ne[3];
     element_state(b, q, v, a, e, D, X, Xd, Xdd);
     for (int g = 0; g < b->mass.np; ++g) {
       PointFrame pf;
@@ -363,7 +402,12 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
       const double w = b->mu * b->mass.w[g] * b->le;
       for (int k = 0; k < pf.ncol; ++k) R[pf.col[k]] += w * (pf.J[k][0] * pf.F[0] + pf.J[k][1] * pf.F[1]);
     }
-    element_elastic(b, D, f, NULL);
+    if (z)
+      for (int g = 0; g < 3; ++g) {
+        Ne[g] = b->EA * z[axial_aux(b, e, g)];
+        Rz[axial_aux(b, e, g)] += b->axial.w[g] * b->le * (axial_strain(b, g, D, NULL) - z[axial_aux(b, e, g)]);
+      }
+    element_elastic(b, D, z ? Ne : NULL, f, NULL);
     for (int l = 0; l < 8; ++l) {
       const int i = edof(e, l);
       if (i >= 0) R[i] += f[l];
@@ -371,6 +415,42 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
   }
   for (int i = 0; i < 3 + b->n; ++i)
     if (!isfinite(R[i])) return 1; /* a wild trial step (|rho'| -> 0): IDA cuts the step */
+  return 0;
+}
+
+static int exact_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                          double* R, double* work) {
+  (void)work;
+  return exact_eval(self, env, q, v, a, NULL, R, NULL);
+}
+
+static int exact_naux(const void* self) {
+  const BeamExact* b = self;
+  return b->mixed ? 2 * b->ne + 1 : 0;
+}
+
+static int exact_residual_aux(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                              const double* z, double* R, double* Rz, double* work) {
+  (void)work;
+  return exact_eval(self, env, q, v, a, z, R, Rz);
+}
+
+/* fmbBodyType.aux_iterated: the axial strains are the mixed form's own unknowns */
+static int exact_aux_iterated(const void* self) {
+  (void)self;
+  return 1;
+}
+
+/* the strains z = eps(q) that make Rz = 0 */
+static int exact_aux_initial(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                             double* z, double* work) {
+  (void)env, (void)v, (void)a, (void)work;
+  const BeamExact* b = self;
+  for (int e = 0; e < b->ne; ++e) {
+    double D[8];
+    element_values(b, q, e, 0, D);
+    for (int g = 0; g < 3; ++g) z[axial_aux(b, e, g)] = axial_strain(b, g, D, NULL);
+  }
   return 0;
 }
 
@@ -383,8 +463,8 @@ static int exact_residual(const void* self, const fmbEnv* env, const double* q, 
    One assembly serves both layouts: entry (i, j) of element e's contribution goes to jac_at's
    slot, the dense column-major nc x nc block or the banded pattern's pair (exact_pattern). */
 static int exact_fill(const BeamExact* b, int banded, const fmbEnv* env, const double* q, const double* v,
-                      const double* a, double* K, double* C, double* M) {
-  const size_t nc = (size_t)(3 + b->n), nv = banded ? (size_t)exact_npair(b) : nc * nc;
+                      const double* a, const double* z, double* K, double* C, double* M) {
+  const size_t nc = (size_t)(3 + b->n), nv = banded ? (size_t)exact_npair_all(b) : nc * nc;
   double c, s, G0[2];
   frame_terms(env, q, a, &c, &s, G0);
   const double om = v[2], al = a[2];
@@ -432,7 +512,24 @@ static int exact_fill(const BeamExact* b, int banded, const fmbEnv* env, const d
       }
     }
     if (K) {
-      element_elastic(b, D, f, Ke);
+      double Ne[3];
+      for (int g = 0; z && g < 3; ++g) Ne[g] = b->EA * z[axial_aux(b, e, g)];
+      element_elastic(b, D, z ? Ne : NULL, f, Ke);
+      /* the mixed form's z coupling: dR/dz = EA w le d eps/dq, dRz/dq = w le d eps/dq, dRz/dz = -w le */
+      for (int g = 0; z && g < 3; ++g) {
+        double deps[8];
+        axial_strain(b, g, D, deps);
+        const double wl = b->axial.w[g] * b->le;
+        const size_t at = mixed_at(b, e, g);
+        const int nd = e == 0 ? 5 : 8;
+        for (int l = 0, li = 0; l < 8; ++l) {
+          if (edof(e, l) < 0) continue;
+          K[at + (size_t)li] += wl * deps[l];
+          K[at + (size_t)(nd + li)] += wl * b->EA * deps[l];
+          ++li;
+        }
+        K[at + (size_t)(2 * nd)] += -wl;
+      }
       for (int l2 = 0, lj = 0; l2 < 8; ++l2) {
         const int j = edof(e, l2);
         if (j < 0) continue;
@@ -450,14 +547,15 @@ static int exact_fill(const BeamExact* b, int banded, const fmbEnv* env, const d
 static int exact_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
                           double* K, double* C, double* M, double* work) {
   (void)work;
-  return exact_fill(self, 0, env, q, v, a, K, C, M);
+  return exact_fill(self, 0, env, q, v, a, NULL, K, C, M);
 }
 
 /* fmbBodyType.pattern_jacobian: the same K, C, M, one value per pair of exact_pattern */
 static int exact_pattern_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v,
                                   const double* a, const double* z, double* K, double* C, double* M, double* work) {
-  (void)z, (void)work;
-  return exact_fill(self, 1, env, q, v, a, K, C, M); /* the engine checks the values are finite */
+  (void)work;
+  const BeamExact* b = self;
+  return exact_fill(b, 1, env, q, v, a, b->mixed ? z : NULL, K, C, M); /* the engine checks the values are finite */
 }
 
 /* fmbBodyType.pattern (banded assembly only): the frame's columns x, y, theta over every row, its
@@ -470,7 +568,7 @@ static long exact_pattern(const void* self, int* rows, int* cols) {
   if (!b->banded) return -1;
   const int nc = 3 + b->n;
   long k = 0;
-  if (!rows) return exact_npair(b);
+  if (!rows) return exact_npair_all(b);
   for (int j = 0; j < 3; ++j)
     for (int i = 0; i < nc; ++i) rows[k] = i, cols[k++] = j;
   for (int i = 0; i < 3; ++i)
@@ -481,6 +579,17 @@ static long exact_pattern(const void* self, int* rows, int* cols) {
       if (edof(e, l) >= 0) dof[nd++] = edof(e, l);
     for (int lj = 0; lj < nd; ++lj)
       for (int li = 0; li < nd; ++li) rows[k] = dof[li], cols[k++] = dof[lj];
+  }
+  for (int e = 0; b->mixed && e < b->ne; ++e) { /* mixed_at's order */
+    int dof[8], nd = 0;
+    for (int l = 0; l < 8; ++l)
+      if (edof(e, l) >= 0) dof[nd++] = edof(e, l);
+    for (int g = 0; g < 3; ++g) {
+      const int zi = nc + axial_aux(b, e, g);
+      for (int li = 0; li < nd; ++li) rows[k] = zi, cols[k++] = dof[li];
+      for (int li = 0; li < nd; ++li) rows[k] = dof[li], cols[k++] = zi;
+      rows[k] = zi, cols[k++] = zi;
+    }
   }
   return k;
 }
@@ -576,7 +685,7 @@ static void exact_integrals(const BeamExact* b, const fmbEnv* env, const double*
       mrho[0] += w * rho[0];
       mrho[1] += w * rho[1];
     }
-    Ue += element_elastic(b, D, f, NULL);
+    Ue += element_elastic(b, D, NULL, f, NULL);
   }
   double Ug = 0.0;
   if (env && env->has_gravity) {
@@ -719,7 +828,14 @@ static const fmbParam exact_params[] = {
      .kind = FMB_PARAM_CHOICE,
      .fallback = "auto",
      .choices = exact_assemblies,
-     .doc = "body Jacobian layout: banded (O(n), the default from 64 elements) or dense"},
+     .doc = "body Jacobian layout: banded (O(n); auto: with the mixed form's axial strains, docs/models.md) or "
+            "dense (the displacement form)"},
+    {.key = "axial_form",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "mixed",
+     .choices = exact_axial_forms,
+     .doc = "mixed: the axial strains at the axial points are unknowns Newton iterates on (integration: reduced, "
+            "assembly not dense); displacement: the form before it, to compare (docs/models.md, \"Newton\")"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
@@ -754,6 +870,10 @@ const fmbBodyType fmb_body_beam_exact = {
     .reuse_blocks = exact_reuse_blocks,
     .pattern = exact_pattern,
     .pattern_jacobian = exact_pattern_jacobian,
+    .naux = exact_naux,
+    .residual_aux = exact_residual_aux,
+    .aux_initial = exact_aux_initial,
+    .aux_iterated = exact_aux_iterated,
     .length_scale = exact_length_scale,
     .centreline = exact_centreline,
     .params = exact_params,

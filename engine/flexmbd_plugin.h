@@ -27,9 +27,10 @@ extern "C" {
    "ABI 3" and also the SOVERSION): the stepping API, the warn callback, inputs (the joints'
    optional `input` op, fmb_eval_input), output_units. 3.1: the descriptor's `size`, in what was
    padding after `abi` on LP64, so that a 3.0 descriptor (and one whose source leaves `size` out)
-   reads as size 0: the fields 3.0 had. */
+   reads as size 0: the fields 3.0 had. 3.2: fmbBodyType.aux_iterated, appended; the engine reads
+   it only from a table whose `abi` says 3.2 or later (a table of an older minor ends before it). */
 #define FMB_PLUGIN_ABI_MAJOR 3
-#define FMB_PLUGIN_ABI_MINOR 1
+#define FMB_PLUGIN_ABI_MINOR 2
 /* what a table's and a descriptor's `abi` field holds: major * 1000 + minor (a 3.0 plugin wrote 3:
    a value below 1000 is a major alone, minor 0) */
 #define FMB_PLUGIN_ABI (FMB_PLUGIN_ABI_MAJOR * 1000 + FMB_PLUGIN_ABI_MINOR)
@@ -271,6 +272,13 @@ typedef struct fmbBodyType {
   /* ABI 3, optional: the SI unit of each name in output_names (same order; "1" for a pure number),
      for the axes of plots and of `view` (fmb_output_unit_in). NULL = not declared. */
   const char* const* output_units;
+  /* ABI 3.2, optional (read only from a table whose abi is 3.2 or later): 1 when the auxiliary
+     unknowns are a mixed form's own fields, which Newton iterates on with the coordinates rather
+     than eliminating them (engine/system.c, fmb_system_residual_eliminated). The exact beam's axial
+     strains at its axial points: iterated, its Newton matrix keeps EA out of the coupling that
+     turns with the centreline, and Newton converges as for the complete model (docs/models.md,
+     "Newton"). NULL or 0 = eliminated (the complete beam's coupling sums). */
+  int (*aux_iterated)(const void* self);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

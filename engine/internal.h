@@ -18,7 +18,8 @@ typedef struct fmbBodyInst {
   int qadr, nq; /* slice of the coordinate vector */
   fmbNode node; /* its item in the scene, for messages about it after parsing */
   size_t workadr, nwork;
-  int zadr, nz; /* auxiliary algebraic unknowns (fmbBodyType.naux): slice of z, at m->zoff in y */
+  int zadr, nz;     /* auxiliary algebraic unknowns (fmbBodyType.naux): slice of z, at m->zoff in y */
+  int aux_iterated; /* fmbBodyType.aux_iterated: Newton iterates on z (not eliminated) */
   /* sparse body block (fmbBodyType.pattern), CSC over nq + nz rows and columns; pnnz < 0: dense.
      Columns are grouped in colours that share no row, for differencing (fd.c). */
   long pnnz;
@@ -366,6 +367,10 @@ void fmb_sparse_pattern_into(const fmbModel* m, struct _generic_SUNMatrix* J);
 /* ---- vector.c: optimized serial N_Vector arithmetic for IDA ---- */
 struct _generic_N_Vector;
 void fmb_vector_use_fast_ops(struct _generic_N_Vector* v);
+
+/* ---- static.c: the analyses see a mixed form's body (aux_iterated) in its displacement form ---- */
+int fmb_aux_iterated_consistent(const fmbModel* m, fmbWorkspace* w, double* y, const double* yp);
+int fmb_aux_iterated_fold(const fmbModel* m, double* J); /* dense ny x ny; 0, -1 singular or no memory */
 
 /* ---- dense.c: small dense linear algebra (initial conditions, checks) ---- */
 int fmb_lu_factor(int n, double* A, int* piv); /* column-major, in place; 0 ok */

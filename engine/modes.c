@@ -351,11 +351,16 @@ static int linearize(const fmbModel* m, double t, const double* y, const double*
     rc = out_of_memory(m, diag);
   } else {
     for (int i = 0; i < ny; ++i) ewt[i] = 1.0 / (1e-8 * (1.0 + fabs(y[i])));
-    if (fmb_system_jacobian(m, w, t, 0.0, y, yp, ewt, 0, NULL, L->J0) ||
-        fmb_system_jacobian(m, w, t, 1.0, y, yp, ewt, 1, NULL, J1)) {
+    /* a mixed form's body in its displacement form (static.c): z consistent, then folded out */
+    double* yc = m->nz > 0 ? malloc(sizeof(double) * (size_t)ny) : NULL;
+    if (yc) memcpy(yc, y, sizeof(double) * (size_t)ny);
+    const double* ys = yc && !fmb_aux_iterated_consistent(m, w, yc, yp) ? yc : y;
+    if (fmb_system_jacobian(m, w, t, 0.0, ys, yp, ewt, 0, NULL, L->J0) ||
+        fmb_system_jacobian(m, w, t, 1.0, ys, yp, ewt, 1, NULL, J1) || fmb_aux_iterated_fold(m, L->J0)) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations cannot be differentiated at t = %g", t);
       rc = FMB_EXIT_SOLVER;
     }
+    free(yc);
   }
   if (!rc) {
     for (int j = 0; j < nq; ++j)

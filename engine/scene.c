@@ -281,6 +281,9 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     b->zadr = m->nz;
     b->nz = (b->type->naux && b->type->residual_aux && b->type->aux_initial) ? b->type->naux(b->self) : 0;
     m->nz += b->nz;
+    /* a field of ABI 3.2: a table of an older minor ends before it (flexmbd_plugin.h) */
+    const int has_aux_iterated = b->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 2;
+    b->aux_iterated = b->nz > 0 && has_aux_iterated && b->type->aux_iterated && b->type->aux_iterated(b->self);
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
     if (b->type->velocity_error_test && !b->type->velocity_error_test(b->self)) m->bodies_prefer_positions = 1;
     if (b->type->reuse_blocks && !b->type->reuse_blocks(b->self)) m->fresh_body_blocks = 1;

@@ -198,6 +198,62 @@ done:
   return rc;
 }
 
+/* A body whose auxiliary unknowns are a mixed form's own fields (fmbBodyType.aux_iterated: the
+   exact beam's axial forces) enters the analyses, which work on the coordinates alone, in its
+   displacement form: z consistent with q (its aux_initial), and z folded out of the dense
+   Jacobian J (ny x ny, column-major) by the Schur complement J_xx - J_xz J_zz^-1 J_zx, which is
+   the displacement form's tangent (the exact beam: EA t t^T back in its q block). Only the
+   columns and rows the body's z couple to are touched. */
+int fmb_aux_iterated_consistent(const fmbModel* m, fmbWorkspace* w, double* y, const double* yp) {
+  const int nq = m->nq;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->aux_iterated) continue;
+    const int rc = bi->type->aux_initial(bi->self, &m->env, y + bi->qadr, y + nq + bi->qadr, yp + nq + bi->qadr,
+                                         y + m->zoff + bi->zadr, fmb_workspace_plugin(w) + bi->workadr);
+    if (rc) return rc;
+  }
+  return 0;
+}
+
+int fmb_aux_iterated_fold(const fmbModel* m, double* J) {
+  const size_t ny = (size_t)m->ny;
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    if (!bi->aux_iterated) continue;
+    const int nz = bi->nz;
+    const size_t z0 = (size_t)(m->zoff + bi->zadr);
+    double* A = malloc(sizeof(double) * ((size_t)nz * nz + nz));
+    int* piv = malloc(sizeof(int) * (size_t)nz);
+    if (!A || !piv) {
+      free(A);
+      free(piv);
+      return -1;
+    }
+    double* x = A + (size_t)nz * nz;
+    for (int j = 0; j < nz; ++j)
+      for (int i = 0; i < nz; ++i) A[(size_t)j * nz + i] = J[(z0 + j) * ny + z0 + i];
+    int rc = fmb_lu_factor(nz, A, piv);
+    for (size_t c = 0; !rc && c < ny; ++c) {
+      if (c >= z0 && c < z0 + (size_t)nz) continue;
+      int any = 0;
+      for (int i = 0; i < nz; ++i) any |= (x[i] = J[c * ny + z0 + i]) != 0.0;
+      if (!any) continue;
+      fmb_lu_solve(nz, A, piv, x);
+      for (int k = 0; k < nz; ++k) {
+        const double* Jz = J + (z0 + k) * ny;
+        if (x[k] == 0.0) continue;
+        for (size_t r = 0; r < ny; ++r)
+          if ((r < z0 || r >= z0 + (size_t)nz) && Jz[r] != 0.0) J[c * ny + r] -= Jz[r] * x[k];
+      }
+    }
+    free(A);
+    free(piv);
+    if (rc) return -1;
+  }
+  return 0;
+}
+
 typedef struct {
   const fmbModel* m;
   fmbWorkspace* w;
@@ -217,6 +273,7 @@ static void make_state(Newton* s, const double* x) {
   memcpy(s->y + 2 * nq, x + nq, (size_t)nc * sizeof(double));
   fmb_rigid_rotation(m, s->speed, s->center, x, s->y + nq, s->yp + nq);
   memcpy(s->yp, s->y + nq, (size_t)nq * sizeof(double));
+  fmb_aux_iterated_consistent(m, s->w, s->y, s->yp); /* the mixed forms' z: their displacement form */
 }
 
 /* Fx = [F_v; F_lambda] at x; 0 or the residual's code */
@@ -238,6 +295,7 @@ static int factor_jacobian(Newton* s, const double* x) {
   for (int i = 0; i < ny; ++i) s->ewt[i] = 1.0 / (1e-8 * (1.0 + fabs(s->y[i])));
   int rc = fmb_system_jacobian(m, s->w, s->t, 0.0, s->y, s->yp, s->ewt, 0, NULL, s->J0);
   if (!rc && s->speed != 0.0) rc = fmb_system_jacobian(m, s->w, s->t, 1.0, s->y, s->yp, s->ewt, 1, NULL, s->J1);
+  if (!rc) rc = fmb_aux_iterated_fold(m, s->J0);
   if (rc) return rc;
   memset(s->A, 0, (size_t)n * n * sizeof(double));
   for (int j = 0; j < nq; ++j)

@@ -401,12 +401,13 @@ static int system_residual(const fmbModel* m, fmbWorkspace* w, double t, const d
   for (int i = 0; i < nq; ++i) Fq[i] = qp[i] - v[i];
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    if (bi->nz > 0 && eliminate_aux) memset(F + m->zoff + bi->zadr, 0, sizeof(double) * (size_t)bi->nz);
-    int rc = bi->nz > 0 && !eliminate_aux ? bi->type->residual_aux(bi->self, &m->env, q + bi->qadr, v + bi->qadr,
-                                                                   vp + bi->qadr, y + m->zoff + bi->zadr, Fv + bi->qadr,
-                                                                   F + m->zoff + bi->zadr, w->plugin + bi->workadr)
-                                          : bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr,
-                                                               vp + bi->qadr, Fv + bi->qadr, w->plugin + bi->workadr);
+    const int eliminate = eliminate_aux && !bi->aux_iterated; /* a mixed form's fields are iterated */
+    if (bi->nz > 0 && eliminate) memset(F + m->zoff + bi->zadr, 0, sizeof(double) * (size_t)bi->nz);
+    int rc = bi->nz > 0 && !eliminate ? bi->type->residual_aux(bi->self, &m->env, q + bi->qadr, v + bi->qadr,
+                                                               vp + bi->qadr, y + m->zoff + bi->zadr, Fv + bi->qadr,
+                                                               F + m->zoff + bi->zadr, w->plugin + bi->workadr)
+                                      : bi->type->residual(bi->self, &m->env, q + bi->qadr, v + bi->qadr, vp + bi->qadr,
+                                                           Fv + bi->qadr, w->plugin + bi->workadr);
     if (rc) return rc;
   }
   for (int j = 0; j < m->njoint; ++j) {
@@ -456,7 +457,9 @@ int fmb_system_residual(const fmbModel* m, fmbWorkspace* w, double t, const doub
    makes z mere placeholders; the banded Newton matrix, evaluated where z is consistent
    (fmb_system_aux_eliminate), then gives through its q, v part the Schur complement of its z
    block, which is the dense assembly's Newton matrix: the iteration is the dense assembly's,
-   at the banded factorization's cost (docs/performance.md, "Fine meshes"). */
+   at the banded factorization's cost (docs/performance.md, "Fine meshes"). A body whose z are a
+   mixed form's fields (fmbBodyType.aux_iterated: the exact beam's axial forces) is iterated on as
+   it is: eliminating them would give back the displacement form whose Newton matrix goes stale. */
 int fmb_system_residual_eliminated(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp,
                                    double* F) {
   return system_residual(m, w, t, y, yp, F, 1);

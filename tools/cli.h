@@ -88,7 +88,7 @@ int fmb_cli_compare(const fmbCliCompare* c);
 /* the commands: each one's options and usage (its fmbCommandSpec, tools/options.h) and its main */
 extern const fmbCommandSpec fmb_run_command, fmb_check_command, fmb_types_command, fmb_compare_command,
     fmb_regress_command, fmb_conform_command, fmb_plot_command, fmb_new_command, fmb_static_command, fmb_modes_command,
-    fmb_campbell_command, fmb_view_command, fmb_sweep_command;
+    fmb_campbell_command, fmb_view_command, fmb_sweep_command, fmb_refine_command;
 int fmb_cmd_run(int argc, char** argv);
 int fmb_cmd_check(int argc, char** argv);
 int fmb_cmd_types(int argc, char** argv);
@@ -102,6 +102,7 @@ int fmb_cmd_modes(int argc, char** argv);
 int fmb_cmd_campbell(int argc, char** argv);
 int fmb_cmd_view(int argc, char** argv);
 int fmb_cmd_sweep(int argc, char** argv);
+int fmb_cmd_refine(int argc, char** argv);
 /* what the analysis commands (static, modes, campbell) share, in cmd_static.c */
 typedef struct fmbCliAnalysis {
   fmbStaticOptions opt; /* --at T, --quiet */

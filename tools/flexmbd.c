@@ -19,7 +19,7 @@ static const Command commands[] = {
     {&fmb_plot_command, fmb_cmd_plot},       {&fmb_view_command, fmb_cmd_view},
     {&fmb_new_command, fmb_cmd_new},         {&fmb_static_command, fmb_cmd_static},
     {&fmb_modes_command, fmb_cmd_modes},     {&fmb_campbell_command, fmb_cmd_campbell},
-    {&fmb_sweep_command, fmb_cmd_sweep},
+    {&fmb_refine_command, fmb_cmd_refine},   {&fmb_sweep_command, fmb_cmd_sweep},
 };
 #define NCOMMANDS (int)(sizeof commands / sizeof commands[0])
 

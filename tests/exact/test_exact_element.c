@@ -78,6 +78,7 @@ static void banded_as_dense(const BeamExact* b, const fmbEnv* env, const double*
                             double* K, double* C, double* M) {
   BeamExact banded = *b;
   banded.banded = 1;
+  banded.mixed = 0; /* the displacement form's pattern (the mixed one: test_mixed_jacobian) */
   const int nc = et_nc(b);
   const long np = exact_pattern(&banded, NULL, NULL);
   ENSURE(np == exact_npair(&banded));
@@ -165,6 +166,73 @@ static void test_jacobian(int integration) {
   free(b);
 }
 
+/* A2. The mixed form (exact_naux: the axial strains at the axial points as unknowns z, N = EA z):
+   exact_pattern_jacobian's values over exact_pattern's pairs, rows [R; Rz], columns [q; z],
+   against Richardson differences of exact_residual_aux, in a strained state with z off eps
+   (so that N's geometric stiffness and the z coupling both show); and at z = aux_initial's
+   eps(q), Rz = 0 and R equal to the displacement form's exact_residual. */
+static void test_mixed_jacobian(void) {
+  BeamExact* b = et_beam(5, INTEGRATION_REDUCED);
+  b->mixed = b->banded = 1;
+  const int nc = et_nc(b), nz = exact_naux(b), nt = nc + nz;
+  const fmbEnv env0 = {{0.0, 0.0}, 0};
+  double* q = calloc(4 * (size_t)nt, sizeof(double));
+  double *v = q + nt, *a = v + nt, *z = a + nt; /* v = a = 0: the elastic and z parts */
+  for (int i = 3; i < nc; ++i) q[i] = 0.05 * et_rand();
+  ENSURE(exact_aux_initial(b, &env0, q, v, a, z, NULL) == 0);
+  double *R0 = calloc(3 * (size_t)nt, sizeof(double)), *Rz0 = R0 + nt, *Rd = Rz0 + nt;
+  ENSURE(exact_residual_aux(b, &env0, q, v, a, z, R0, Rz0, NULL) == 0);
+  exact_residual(b, &env0, q, v, a, Rd, NULL);
+  double rz = 0.0, rd = 0.0, rscale = 0.0;
+  for (int i = 0; i < nz; ++i) rz = fmax(rz, fabs(Rz0[i]));
+  for (int i = 0; i < nc; ++i) rd = fmax(rd, fabs(R0[i] - Rd[i])), rscale = fmax(rscale, fabs(Rd[i]));
+  for (int i = 0; i < nz; ++i) z[i] *= 1.0 + 0.3 * et_rand();
+  /* analytic, scattered into a dense nt x nt K */
+  const long np = exact_pattern(b, NULL, NULL);
+  int* rows = malloc(2 * sizeof(int) * (size_t)np);
+  int* cols = rows + np;
+  double* val = malloc(3 * sizeof(double) * (size_t)np);
+  ENSURE(exact_pattern(b, rows, cols) == np);
+  ENSURE(exact_pattern_jacobian(b, &env0, q, v, a, z, val, val + np, val + 2 * np, NULL) == 0);
+  double *K = calloc(2 * (size_t)nt * nt, sizeof(double)), *Kf = K + (size_t)nt * nt;
+  for (long k = 0; k < np; ++k) {
+    ENSURE(rows[k] >= 0 && rows[k] < nt && cols[k] >= 0 && cols[k] < nt);
+    K[(size_t)cols[k] * nt + (size_t)rows[k]] += val[k];
+  }
+  /* differences of [R; Rz] over [q; z] */
+  double* Rp = calloc(2 * (size_t)nt, sizeof(double));
+  double* Rm = calloc(2 * (size_t)nt, sizeof(double));
+  for (int j = 0; j < nt; ++j) {
+    double* x = j < nc ? q + j : z + (j - nc);
+    const double x0 = *x, h = j < nc ? (j == 2 ? 1e-2 : 1e-3) : 1e-3 * fmax(fabs(x0), 1e-6);
+    double d[2][1024];
+    for (int k = 0; k < 2; ++k) {
+      const double hk = k ? h / 2 : h;
+      *x = x0 + hk;
+      exact_residual_aux(b, &env0, q, v, a, z, Rp, Rp + nc, NULL);
+      *x = x0 - hk;
+      exact_residual_aux(b, &env0, q, v, a, z, Rm, Rm + nc, NULL);
+      for (int i = 0; i < nt; ++i) d[k][i] = (Rp[i] - Rm[i]) / (2 * hk);
+    }
+    *x = x0;
+    for (int i = 0; i < nt; ++i) Kf[(size_t)j * nt + i] = (4.0 * d[1][i] - d[0][i]) / 3.0;
+  }
+  const double err = column_error(nt, K, Kf);
+  printf("A2. mixed form: Jacobian over [q; z] vs differences %.2e (column-relative); at z = eps: |Rz| %.1e, "
+         "R - displacement form's %.1e of %.1e\n",
+         err, rz, rd, rscale);
+  ENSURE(err < 1e-8);
+  ENSURE(rz < 1e-12 && rd <= 1e-12 * rscale);
+  free(Rp);
+  free(Rm);
+  free(K);
+  free(val);
+  free(rows);
+  free(R0);
+  free(q);
+  free(b);
+}
+
 /* ---- B ---------------------------------------------------------------------------------------- */
 static void rotate(double phi, const double in[2], double out[2]) {
   out[0] = cos(phi) * in[0] - sin(phi) * in[1];
@@ -189,7 +257,7 @@ static void test_invariance(void) {
   }
   double D[8];
   to_displacement(le, X, D);
-  double U = element_elastic(b, D, f, NULL);
+  double U = element_elastic(b, D, NULL, f, NULL);
   for (int l = 0; l < 8; ++l) fmax_rigid = fmax(fmax_rigid, fabs(f[l]));
   /* a deformed element and its rotated copy */
   double Y[8], Yr[8], fy[8], fyr[8];
@@ -202,7 +270,8 @@ static void test_invariance(void) {
   double DY[8], DYr[8];
   to_displacement(le, Y, DY);
   to_displacement(le, Yr, DYr);
-  double Uy = element_elastic(b, DY, fy, NULL), Uyr = element_elastic(b, DYr, fyr, NULL), ferr = 0.0, fscale = 0.0;
+  double Uy = element_elastic(b, DY, NULL, fy, NULL), Uyr = element_elastic(b, DYr, NULL, fyr, NULL), ferr = 0.0,
+         fscale = 0.0;
   for (int k = 0; k < 4; ++k) {
     double fr[2];
     rotate(phi, fy + 2 * k, fr);
@@ -437,6 +506,7 @@ static void test_rotating(int ne, int integration, double freq_tol) {
 int main(void) {
   test_jacobian(INTEGRATION_REDUCED);
   test_jacobian(INTEGRATION_FULL);
+  test_mixed_jacobian();
   test_invariance();
   test_modes(INTEGRATION_REDUCED);
   test_modes(INTEGRATION_FULL);

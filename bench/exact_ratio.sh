@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# bench/exact_ratio.sh — the exact beam's CPU against the complete model's at the same settings
+# (issue 32 item 4: at most 3x). The three paper spin-ups (w1, w4, w15) and the flexible pendulum
+# (first T_PEND seconds, default 1) as shipped, with only bodies.beam.model changed, under the
+# default integrator (auto) and, with --integrators, others; each run REPS times (default 5),
+# interleaved, CPU the median of its stats line's cpu_s. Also the exact beam in its displacement
+# form (axial_form: displacement: its Newton before the mixed form) for the before/after picture.
+# Output: bench/results/exact_ratio.csv (one row per scene, integrator and variant) and a table
+# with the ratios on stdout.
+#   bash bench/exact_ratio.sh [--reps N] [--integrators "auto radau5 ida"] [--t-pend T]
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ROOT=$PWD
+F=${FLEXMBD:-$ROOT/build/flexmbd}
+RES=${RESULTS:-$ROOT/bench/results}
+. bench/lib.sh
+REPS=5
+INTEGRATORS="auto"
+TPEND=1
+while [ $# -gt 0 ]; do
+  case $1 in
+    --reps) REPS=$2; shift ;;
+    --integrators) INTEGRATORS=$2; shift ;;
+    --t-pend) TPEND=$2; shift ;;
+    -h|--help) sed -n 2,10p "$0"; exit 0 ;;
+    *) echo "exact_ratio.sh: unknown argument '$1'" >&2; exit 2 ;;
+  esac
+  shift
+done
+mkdir -p "$RES"
+WORK=$(mktemp -d)
+trap 'rm -rf "$WORK"' EXIT
+CSV=$RES/exact_ratio.csv
+echo "scene,integrator,variant,steps,jacobians,conv_fails,newton_iters,cpu_s_median" > "$CSV"
+scenes="spinup_w1 spinup_w4 spinup_w15 pendulum"
+variants="complete exact exact_displacement"
+run_one() { # scene integrator variant -> the stats line
+  local s=$1 i=$2 v=$3 extra=()
+  [ "$s" = pendulum ] && extra=(--set "solver.t_end=$TPEND")
+  local model=${v%_displacement}
+  if [ "$v" = exact_displacement ]; then
+    "$F" run "scenes/paper/$s.yaml" -o "$WORK/out.csv" --quiet --set "bodies.beam.model=$model" --set bodies.beam.axial_form=displacement \
+      --set "solver.integrator=$i" "${extra[@]}" 2>&1 | tail -1
+  else
+    "$F" run "scenes/paper/$s.yaml" -o "$WORK/out.csv" --quiet --set "bodies.beam.model=$model" \
+      --set "solver.integrator=$i" "${extra[@]}" 2>&1 | tail -1
+  fi
+}
+for s in $scenes; do
+  for i in $INTEGRATORS; do
+    for v in $variants; do : > "$WORK/cpu.$s.$i.$v"; done
+    for ((r = 0; r < REPS; ++r)); do
+      for v in $variants; do
+        line=$(run_one "$s" "$i" "$v")
+        echo "$line" | stat_field cpu_s >> "$WORK/cpu.$s.$i.$v"
+        echo "$line" > "$WORK/stats.$s.$i.$v"
+      done
+    done
+    for v in $variants; do
+      st=$(cat "$WORK/stats.$s.$i.$v")
+      med=$(median < "$WORK/cpu.$s.$i.$v")
+      echo "$s,$i,$v,$(echo "$st" | stat_field steps),$(echo "$st" | stat_field jacobians),$(echo "$st" | stat_field conv_fails),$(echo "$st" | stat_field newton_iters),$med" >> "$CSV"
+    done
+  done
+done
+echo "scene integrator: complete / exact / exact (displacement form) CPU s, ratio exact/complete (displacement/complete)"
+awk -F, 'NR > 1 { k = $1 " " $2; c[k, $3] = $8; j[k, $3] = $5; f[k, $3] = $6; if (!(k in seen)) { seen[k] = 1; order[++n] = k } }
+  END { for (m = 1; m <= n; ++m) { k = order[m];
+    printf "%-22s %.4f / %.4f / %.4f s  ratio %.2f (%.2f)  Jacobians %s / %s / %s  conv_fails %s / %s / %s\n", k,
+      c[k, "complete"], c[k, "exact"], c[k, "exact_displacement"], c[k, "exact"] / c[k, "complete"],
+      c[k, "exact_displacement"] / c[k, "complete"], j[k, "complete"], j[k, "exact"], j[k, "exact_displacement"],
+      f[k, "complete"], f[k, "exact"], f[k, "exact_displacement"] } }' "$CSV"
