@@ -547,7 +547,10 @@ static int newton(RadauRun* c, int* newt_out, double* hfac) {
   for (;;) {
     if (newt >= c->nit) {
       *newt_out = newt;
-      if (at_floor) break;
+      if (at_floor) { /* out of iterations at the floor: as a stall (below) */
+        c->theta = fmax(c->theta, 1.0);
+        break;
+      }
       return NEWTON_DIVERGED;
     }
     if (fmb_stop_requested(c->stop)) return NEWTON_FATAL;
