@@ -163,6 +163,18 @@ static void on_stop_signal(int sig) {
   (void)sig;
   stop_requested = 1;
 }
+void fmb_cli_tmp_template(const char* stem, char* buf, size_t len) {
+  const char* tmp = getenv("TMPDIR");
+  snprintf(buf, len, "%s/flexmbd-%s-XXXXXX", tmp && *tmp ? tmp : "/tmp", stem);
+}
+
+int fmb_cli_private_folder(const char* stem, char* dir, size_t len) {
+  fmb_cli_tmp_template(stem, dir, len);
+  if (mkdtemp(dir)) return 0;
+  fprintf(stderr, "flexmbd %s: cannot make a temporary folder %s: %s\n", stem, dir, strerror(errno));
+  return -1;
+}
+
 volatile sig_atomic_t* fmb_cli_catch_stop_signals(void) {
   struct sigaction sa;
   memset(&sa, 0, sizeof sa);

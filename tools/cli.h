@@ -48,6 +48,12 @@ int fmb_cli_check_output_not_input(const char* out, const char* const* inputs, i
 /* catch SIGINT/SIGTERM: the flag they set (work stops after the step in progress, keeps what
    it has and exits FMB_EXIT_INTERRUPTED) */
 volatile sig_atomic_t* fmb_cli_catch_stop_signals(void);
+/* "$TMPDIR/flexmbd-STEM-XXXXXX" (/tmp without TMPDIR) into buf: the template of a temporary file
+   (mkstemp) or folder of the command's own */
+void fmb_cli_tmp_template(const char* stem, char* buf, size_t len);
+/* a new private folder (mkdtemp: 0700, no link followed into it) from that template into dir;
+   0, or -1 after saying why ("flexmbd STEM: cannot make a temporary folder ...") */
+int fmb_cli_private_folder(const char* stem, char* dir, size_t len);
 /* `s` as a gnuplot string that gnuplot never expands (single-quoted; no command substitution);
    -1 and nothing written when s holds a control character (a line break would end the command) */
 int fmb_cli_gnuplot_string(FILE* g, const char* s);

@@ -74,10 +74,7 @@ int fmb_cmd_conform(int argc, char** argv) {
      removed afterwards; --work DIR keeps them in DIR for a look */
   char own[1100] = "";
   if (!rc && !work) {
-    const char* tmp = getenv("TMPDIR");
-    snprintf(own, sizeof own, "%s/flexmbd-conform-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-    if (!mkdtemp(own)) {
-      fprintf(stderr, "flexmbd conform: cannot make a work folder %s: %s\n", own, strerror(errno));
+    if (fmb_cli_private_folder("conform", own, sizeof own)) {
       rc = FMB_EXIT_BAD_INPUT;
       own[0] = '\0';
     }

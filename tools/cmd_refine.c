@@ -284,13 +284,8 @@ int fmb_cmd_refine(int argc, char** argv) {
   double rtol;
   if ((rc = reference_tolerances(&a, rtol_ov, atol_ov, sizeof rtol_ov, &atol_given, &rtol))) return rc;
   /* a private folder for the runs' CSVs, removed at the end with what was made in it */
-  const char* tmp = getenv("TMPDIR");
   char dir[4096];
-  snprintf(dir, sizeof dir, "%s/flexmbd-refine-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-  if (!mkdtemp(dir)) {
-    fprintf(stderr, "flexmbd refine: cannot make a temporary folder %s: %s\n", dir, strerror(errno));
-    return FMB_EXIT_SOLVER;
-  }
+  if (fmb_cli_private_folder("refine", dir, sizeof dir)) return FMB_EXIT_SOLVER;
   Mesh* mesh = calloc((size_t)a.nmesh, sizeof *mesh);
   double* rows = calloc((size_t)a.nmesh * REFINE_NCOL, sizeof(double));
   if (!mesh || !rows) {

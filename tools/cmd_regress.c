@@ -250,10 +250,7 @@ static int regress(const RegressOptions* op, const RegressList* sc, RegressList*
   if (!rc && (shared_reference(jobs, scenes.n) || (o.junit && junit_replaces_input(o.junit, jobs, scenes.n))))
     rc = FMB_EXIT_BAD_INPUT;
   if (rc) goto out;
-  const char* tmp = getenv("TMPDIR");
-  snprintf(o.tmpdir, sizeof o.tmpdir, "%s/flexmbd-regress-XXXXXX", tmp && *tmp ? tmp : "/tmp");
-  if (!mkdtemp(o.tmpdir)) {
-    fprintf(stderr, "flexmbd regress: cannot make a temporary folder %s: %s\n", o.tmpdir, strerror(errno));
+  if (fmb_cli_private_folder("regress", o.tmpdir, sizeof o.tmpdir)) {
     rc = FMB_EXIT_BAD_INPUT;
     goto out;
   }

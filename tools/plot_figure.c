@@ -272,8 +272,7 @@ static int load_tables(PlotArgs* a, fmbTable* table, int* loaded, fmbTable* ref,
 static int write_data(const Curve* curves, int ncurve, char* data_path, size_t len) {
   int rc = 0;
   {
-    const char* tmp = getenv("TMPDIR");
-    snprintf(data_path, len, "%s/flexmbd-plot-XXXXXX", tmp && *tmp ? tmp : "/tmp");
+    fmb_cli_tmp_template("plot", data_path, len);
     const int fd = mkstemp(data_path);
     FILE* df = fd >= 0 ? fdopen(fd, "w") : NULL;
     for (int k = 0; df && k < ncurve; ++k) {
