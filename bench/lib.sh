@@ -5,6 +5,14 @@
 #                           untouched) into DIR/build/flexmbd, once: reused when it is there
 median() { sort -g | awk '{a[NR]=$1} END {print (NR % 2) ? a[(NR+1)/2] : (a[NR/2] + a[NR/2+1]) / 2}'; }
 stat_field() { sed -n "s/.*[ :]$1=\([^ ]*\).*/\1/p" | tail -1; }
+# tip_err REF RUN [COLUMN]: max |COLUMN(run) - COLUMN(ref)| (default beam.tip_v) over the rows both
+# have (two runs of one scene at the same output_step)
+tip_err() {
+  awk -F, -v col="${3:-beam.tip_v}" 'FNR == 1 { for (i = 1; i <= NF; ++i) if ($i == col) c = i; next }
+    NR == FNR { ref[FNR] = $c; next }
+    (FNR in ref) { d = $c - ref[FNR]; if (d < 0) d = -d; if (d > m) m = d }
+    END { printf "%.3g", m }' "$1" "$2"
+}
 build_landed() {
   local commit=$1 dir=$2 root
   root=$(git rev-parse --show-toplevel)

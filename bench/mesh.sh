@@ -3,7 +3,7 @@
 # docs/performance.md, "Fine meshes").
 #
 #   bash bench/mesh.sh [--span T] [--ns "8 16 32 64 128 256"] [--integrators "ida radau5 radau9"]
-#                      [--timeout S] [--no-old] [--tag NAME]
+#                      [--timeout S] [--no-old] [--tag NAME] [--scene FILE] [--fit-from N]
 #
 # The paper's pendulum as shipped (scenes/paper/pendulum.yaml: rtol 1e-10, positions error
 # control; 64 elements and more are banded, assembly: auto) with bodies.beam.elements = n, for its
@@ -18,7 +18,9 @@
 # One run per setting (the spread of cpu_s on this shared machine is +-30 %: the counts are exact,
 # the times indicative). Results: bench/results/mesh.csv, and bench/results/mesh_exponents.txt
 # (least-squares slopes of log cost per step and log steps against log n, n >= 32, new build);
-# with --tag NAME, mesh_NAME.csv and mesh_NAME_exponents.txt.
+# with --tag NAME, mesh_NAME.csv and mesh_NAME_exponents.txt. --scene runs another scene with a beam
+# named `beam` (the spin-up, scenes/paper/spinup_w15.yaml: item 1 measures both); --fit-from N fits
+# the slopes over n >= N (default 32; 8 for the whole 8...1024 range of item 1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -34,6 +36,8 @@ INTS="ida radau5 radau9"
 TIMEOUT=120
 OLD=1
 TAG=
+S=scenes/paper/pendulum.yaml
+FIT_FROM=32
 while [ $# -gt 0 ]; do
   case $1 in
     --span) SPAN=$2; shift 2 ;;
@@ -42,6 +46,8 @@ while [ $# -gt 0 ]; do
     --timeout) TIMEOUT=$2; shift 2 ;;
     --no-old) OLD=0; shift ;;
     --tag) TAG=_$2; shift 2 ;;
+    --scene) S=$2; shift 2 ;;
+    --fit-from) FIT_FROM=$2; shift 2 ;;
     *) echo "bench/mesh.sh: unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -52,7 +58,6 @@ if [ $OLD = 1 ]; then
   BUILDS="old new"
 fi
 NEW_COMMIT=$(git rev-parse --short HEAD)
-S=scenes/paper/pendulum.yaml
 # output_step must not exceed the span
 OSTEP=$(awk -v s="$SPAN" 'BEGIN { print (s < 0.005 ? s : 0.005) }')
 OUT=$RES/mesh$TAG.csv
@@ -76,13 +81,13 @@ for b in $BUILDS; do
     done
   done
 done
-# slopes against n (n >= 32) of the new build's cost per step, per iteration, and steps
-awk -F, 'NR > 1 && $1 == "new" && $3 >= 32 && $5 == "ok" {
+# slopes against n (n >= FIT_FROM) of the new build's cost per step, per iteration, and steps
+awk -F, -v from="$FIT_FROM" -v scene="$S" 'NR > 1 && $1 == "new" && $3 >= from + 0 && $5 == "ok" {
     x = log($3); k = $4; n[k]++; sx[k] += x; sxx[k] += x * x
     y1 = log($14); y2 = log($15); y3 = log($7)
     s1[k] += x * y1; t1[k] += y1; s2[k] += x * y2; t2[k] += y2; s3[k] += x * y3; t3[k] += y3 }
   function slope(sxy, sy, k) { return (n[k] * sxy - sx[k] * sy) / (n[k] * sxx[k] - sx[k] * sx[k]) }
   END { for (k in n) if (n[k] >= 2)
-    printf "%s: cost per step n^%.2f, per Newton iteration n^%.2f, steps n^%.2f (n >= 32, %d meshes)\n", k,
-      slope(s1[k], t1[k], k), slope(s2[k], t2[k], k), slope(s3[k], t3[k], k), n[k] }' "$OUT" | sort |
+    printf "%s: cost per step n^%.2f, per Newton iteration n^%.2f, steps n^%.2f (n >= %d, %d meshes, %s)\n", k,
+      slope(s1[k], t1[k], k), slope(s2[k], t2[k], k), slope(s3[k], t3[k], k), from, n[k], scene }' "$OUT" | sort |
   tee "$RES/mesh${TAG}_exponents.txt"
