@@ -7,22 +7,36 @@
 # form (axial_form: displacement: its Newton before the mixed form) for the before/after picture.
 # Output: bench/results/exact_ratio.csv (one row per scene, integrator and variant) and a table
 # with the ratios on stdout.
+# --sweep instead: rtol 1e-4 ... 1e-8 x backends (radau9 radau5 ida: every one auto may pick for a
+# beam or that a user names) x {spin-up w4, spin-up w15, pendulum (first T_PEND s, default 0.2)} x
+# {complete, exact}, this build and a build BEFORE (default cf68845, the commit before radau judged
+# the exact beam's Newton from its third iteration) side by side in one run, REPS times interleaved
+# (default 3): steps, Jacobians, conv_fails, Newton iterations and the median CPU, into
+# bench/results/exact_rtol.csv, and per scene/backend whether the exact beam's CPU falls as rtol is
+# loosened. FLEXMBD_BEFORE=path uses that binary instead of building BEFORE (bench/lib.sh).
 #   bash bench/exact_ratio.sh [--reps N] [--integrators "auto radau5 ida"] [--t-pend T]
+#   bash bench/exact_ratio.sh --sweep [--reps N] [--before COMMIT] [--rtols "1e-4 1e-6"] [--t-pend T]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
 F=${FLEXMBD:-$ROOT/build/flexmbd}
 RES=${RESULTS:-$ROOT/bench/results}
 . bench/lib.sh
-REPS=5
+REPS=
 INTEGRATORS="auto"
-TPEND=1
+TPEND=
+SWEEP=0
+BEFORE=cf68845
+RTOLS="1e-4 1e-5 1e-6 1e-7 1e-8"
 while [ $# -gt 0 ]; do
   case $1 in
     --reps) REPS=$2; shift ;;
     --integrators) INTEGRATORS=$2; shift ;;
     --t-pend) TPEND=$2; shift ;;
-    -h|--help) sed -n 2,10p "$0"; exit 0 ;;
+    --sweep) SWEEP=1 ;;
+    --before) BEFORE=$2; shift ;;
+    --rtols) RTOLS=$2; shift ;;
+    -h|--help) sed -n 2,20p "$0"; exit 0 ;;
     *) echo "exact_ratio.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -30,6 +44,53 @@ done
 mkdir -p "$RES"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
+if [ "$SWEEP" = 1 ]; then
+  REPS=${REPS:-3}
+  TPEND=${TPEND:-0.2}
+  FB=${FLEXMBD_BEFORE:-}
+  if [ -z "$FB" ]; then
+    build_landed "$BEFORE" "${BENCH_CACHE:-$ROOT/build/bench-landed}/$BEFORE"
+    FB=${BENCH_CACHE:-$ROOT/build/bench-landed}/$BEFORE/build/flexmbd
+  fi
+  CSV=$RES/exact_rtol.csv
+  echo "build,scene,integrator,model,rtol,steps,jacobians,conv_fails,newton_iters,cpu_s_median" > "$CSV"
+  for s in spinup_w4 spinup_w15 pendulum; do
+    extra=()
+    [ "$s" = pendulum ] && extra=(--set "solver.t_end=$TPEND")
+    for i in radau9 radau5 ida; do
+      for r in $RTOLS; do
+        for b in before after; do for m in complete exact; do : > "$WORK/cpu.$b.$m"; done; done
+        for ((k = 0; k < REPS; ++k)); do
+          for b in before after; do
+            bin=$F
+            [ "$b" = before ] && bin=$FB
+            for m in complete exact; do
+              line=$("$bin" run "scenes/paper/$s.yaml" -o "$WORK/out.csv" --quiet --set "bodies.beam.model=$m" \
+                --set "solver.integrator=$i" --set "solver.rtol=$r" "${extra[@]}" 2>&1 | tail -1)
+              echo "$line" | stat_field cpu_s >> "$WORK/cpu.$b.$m"
+              echo "$line" > "$WORK/stats.$b.$m"
+            done
+          done
+        done
+        for b in before after; do
+          for m in complete exact; do
+            st=$(cat "$WORK/stats.$b.$m")
+            echo "$b,$s,$i,$m,$r,$(echo "$st" | stat_field steps),$(echo "$st" | stat_field jacobians),$(echo "$st" | stat_field conv_fails),$(echo "$st" | stat_field newton_iters),$(median < "$WORK/cpu.$b.$m")" >> "$CSV"
+          done
+        done
+      done
+    done
+  done
+  echo "scene integrator build: exact beam per rtol (loosest first): steps / Jacobians / conv_fails / CPU s, and exact/complete CPU"
+  awk -F, 'NR > 1 { k = $2 " " $3 " " $1; if (!(k in seen)) { seen[k] = 1; order[++n] = k }
+      if ($4 == "exact") { e[k] = e[k] sprintf("  %s: %s/%s/%s/%.4f", $5, $6, $7, $8, $10); x[k, $5] = $10; r[k] = r[k] " " $5 }
+      else c[k, $5] = $10 }
+    END { for (m = 1; m <= n; ++m) { k = order[m]; printf "%-30s%s\n   ratio", k, e[k]; nr = split(r[k], rr, " ")
+      for (j = 1; j <= nr; ++j) printf "  %.2f", x[k, rr[j]] / c[k, rr[j]]; printf "\n" } }' "$CSV"
+  exit 0
+fi
+REPS=${REPS:-5}
+TPEND=${TPEND:-1}
 CSV=$RES/exact_ratio.csv
 echo "scene,integrator,variant,steps,jacobians,conv_fails,newton_iters,cpu_s_median" > "$CSV"
 scenes="spinup_w1 spinup_w4 spinup_w15 pendulum"
