@@ -55,11 +55,10 @@ static double one_run(const fmbModel* m, int way, const char* out, long* steps, 
   fmbCsv* csv = way == WAY_CSV ? fmb_csv_open(out, &diag) : NULL;
   int rc = fmb_init(m, d, &diag);
   if (!rc && csv && fmb_csv_header(csv, m)) rc = -1;
-  const double dt = m->solver.output_step, t_end = m->solver.t_end, t0 = m->solver.t0;
-  const long nout = (long)ceil((t_end - t0) / dt - 1e-9);
+  const long nrow = fmb_row_count(m);
   *rows = 0;
-  for (long k = 0; !rc && k <= nout; ++k) {
-    if (k > 0 && (rc = fmb_advance(m, d, k == nout ? t_end : t0 + (double)k * dt, &diag))) break;
+  for (long k = 0; !rc && k < nrow; ++k) {
+    if (k > 0 && (rc = fmb_advance(m, d, fmb_row_time(m, k), &diag))) break;
     if (way == WAY_VALUES && fmb_outputs_eval(m, d->w, d->t, d->y, d->yp, d->row)) rc = -1;
     if (way == WAY_CSV && fmb_csv_row(csv, m, d->w, d->t, d->y, d->yp)) rc = -1;
     ++*rows;

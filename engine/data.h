@@ -24,6 +24,7 @@ struct fmbData {
   const fmbIntegratorOps* ops;
   void* integ;
   int restart;
+  int reinit_pending;    /* an input changed: integ starts again (its reinit op) at the next advance */
   fmbStats before;       /* counters of the backends retired so far */
   double* work_before;   /* njoint: work done before the current backend started */
   double* redundant_phi; /* nc: the redundant rows' residuals, checked after every advance */

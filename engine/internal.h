@@ -283,6 +283,7 @@ void fmb_workspace_inputs_reset(const fmbModel* m, fmbWorkspace* w);
 typedef struct {
   fmbWarnFn fn;
   void* user;
+  long warnings; /* messages starting "warning" said through this sink (fmbStats.warnings) */
 } fmbWarnSink;
 fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w);
 

@@ -45,10 +45,10 @@ static void step_run(const fmbModel* m, Table* tab) {
     return;
   }
   tab->rc = fmb_init(m, d, &diag);
-  const long nout = (long)ceil((si.t_end - si.t0) / si.output_step - 1e-9);
-  for (long k = 0; !tab->rc && k <= nout; ++k) {
+  const long nrow = fmb_row_count(m);
+  for (long k = 0; !tab->rc && k < nrow; ++k) {
     if (k > 0) {
-      const double tout = k == nout ? si.t_end : si.t0 + (double)k * si.output_step;
+      const double tout = fmb_row_time(m, k);
       if ((tab->rc = fmb_advance(m, d, tout, &diag))) break;
       tab->time_wrong += fmb_data_time(d) != tout;
     }
