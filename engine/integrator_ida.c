@@ -58,6 +58,8 @@ static int reuse_body_blocks(IdaRun* c) {
   long nst = 0, ncf = 0;
   IDAGetNumSteps(c->ida, &nst);
   IDAGetNumNonlinSolvConvFails(c->ida, &ncf);
+  nst += c->before_reinit.steps; /* the run's, across an IDAReInit (ida_reinit) */
+  ncf += c->before_reinit.conv_fails;
   const int reuse = !c->m->fresh_body_blocks && c->fresh > 0 && ncf == c->fresh_conv_fails && nst - c->fresh_steps < 50;
   if (reuse) {
     c->reused++;
@@ -353,11 +355,8 @@ static int ida_reinit(void* self, double t0, const double* y0, const double* yp0
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not restart IDA: %s", c->ida_msg);
     return -1;
   }
-  /* the bodies' blocks are evaluated anew at the first Jacobian (reuse_body_blocks counts IDA's
-     steps, which start again from 0) */
-  c->fresh = 0;
-  c->fresh_steps = 0;
-  c->fresh_conv_fails = 0;
+  /* the bodies' blocks (K, C, M: functions of the state, which is where it was) stay usable for
+     the first Jacobian after the restart, under reuse_body_blocks' rule on the run's counters */
   return 0;
 }
 

@@ -604,7 +604,7 @@ static int set_input(const fmbModel* m, fmbData* d, const char* fn, const char* 
      scale) is projected anew, and the motion its last setting led to is lost: a drive held by
      fmb_set_input comes to rest at every change. Said once per input, with what to do instead. */
   const fmbJointInst* j = &m->joint[m->input_joint[i]];
-  const double tol = m->solver.atol + m->solver.rtol * fmax(fabs(value), fabs(now_value));
+  const double tol = m->solver.atol + m->solver.rtol * fmax(in->magnitude, fmax(fabs(value), fabs(now_value)));
   const double h = fmax(d->t - in->t_set, 0.0); /* how long the last setting held */
   const double jump = fabs(value - now_value), rate_jump = fabs(rate - now_rate);
   const fmbInputSetting before = *in;
@@ -612,6 +612,7 @@ static int set_input(const fmbModel* m, fmbData* d, const char* fn, const char* 
   in->rate = rate;
   in->accel = accel;
   in->t_set = d->t;
+  in->magnitude = fmax(in->magnitude, fabs(value));
   /* a value a scene's `value:` would be refused for is refused here too (refused_value) */
   if (d->ic_done && fabs(value) * DBL_EPSILON > FMB_IC_PHI_TOL && refused_value(m, d, fn, name, value)) {
     *in = before;
