@@ -355,8 +355,7 @@ static int ida_reinit(void* self, double t0, const double* y0, const double* yp0
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not restart IDA: %s", c->ida_msg);
     return -1;
   }
-  /* the bodies' blocks (K, C, M: functions of the state, which is where it was) stay usable for
-     the first Jacobian after the restart, under reuse_body_blocks' rule on the run's counters */
+  c->fresh = 0; /* the first Jacobian evaluates the bodies' blocks anew, as a new backend did */
   return 0;
 }
 

@@ -310,6 +310,9 @@ static int radau_start(RadauRun* c, double t0, const double* y0, const double* y
   return 0;
 }
 
+/* fmb_set_input's restart: the start's step history and a new Jacobian (keeping the last one was
+   tried: its first Newton iteration after every restart then failed to converge, 965 times in the
+   docs/python.md speed controller's 1000 settings, +17 % CPU) */
 static int radau_reinit(void* self, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
   return radau_start(self, t0, y0, yp0, diag);
 }
@@ -980,7 +983,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       continue;
     }
     /* accepted; Gustafsson's predictive controller (IV.8 (8.25)) */
-    if (c->st.steps > 0) {
+    if (!c->first) { /* not on a start's first step (a run's, or radau_reinit's: no hacc, erracc yet) */
       double facgus = (c->hacc / c->h) * pow(err * err / c->erracc, c->expo) / FMB_RADAU_SAFE;
       facgus = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, facgus));
       quot = fmax(quot, facgus);
