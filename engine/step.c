@@ -59,8 +59,12 @@ static int misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDiag*
   return FMB_EXIT_BAD_INPUT;
 }
 
+int fmb_data_misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDiag* diag) {
+  return misused(m, d, fn, diag);
+}
+
 /* CPU seconds of the calling thread: two runs in two threads each count their own */
-static double thread_cpu_seconds(void) {
+double fmb_thread_cpu_seconds(void) {
   struct timespec ts;
   if (clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts)) return (double)clock() / CLOCKS_PER_SEC;
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
@@ -235,7 +239,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag);
   if (misused(m, d, "fmb_init", diag)) return FMB_EXIT_BAD_INPUT;
-  const double c0 = d->untimed ? 0.0 : thread_cpu_seconds();
+  const double c0 = d->untimed ? 0.0 : fmb_thread_cpu_seconds();
   fmbWorkspace* w = d->w;
   if (d->integ) d->ops->destroy(d->integ);
   d->integ = NULL;
@@ -272,7 +276,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   }
   d->initialised = rc == 0;
   d->failed = rc != 0;
-  if (!d->untimed) d->cpu_s += thread_cpu_seconds() - c0;
+  if (!d->untimed) d->cpu_s += fmb_thread_cpu_seconds() - c0;
   return rc;
 }
 
@@ -484,7 +488,7 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
     return interrupted(m, d, diag);
   }
   if (t_out == d->t) return 0;
-  const double c0 = d->untimed ? 0.0 : thread_cpu_seconds();
+  const double c0 = d->untimed ? 0.0 : fmb_thread_cpu_seconds();
   const int rc = step_to(m, d, t_out, diag);
   if (rc == FMB_EXIT_SOLVER && !state_finite(m, d)) { /* a check after the step found it so */
     back_to_start(m, d);
@@ -492,7 +496,7 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   }
   d->failed = rc != 0;
   d->interrupted = rc == FMB_EXIT_INTERRUPTED;
-  if (!d->untimed) d->cpu_s += thread_cpu_seconds() - c0;
+  if (!d->untimed) d->cpu_s += fmb_thread_cpu_seconds() - c0;
   return rc;
 }
 

@@ -350,9 +350,9 @@ class FlexmbdWarning(UserWarning):
 
 
 WarnFn = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
-#: fmbRowFn (fmb_run_rows): user, the row's time, its values, their count; non-zero stops the run
-RowFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.POINTER(ctypes.c_double),
-                         ctypes.c_int)
+#: fmbRowFn (fmb_run_rows): user, the row's time, its values (an address: a POINTER would be made
+#: anew for every row), their count; non-zero stops the run
+RowFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.c_void_p, ctypes.c_int)
 
 
 _capture = threading.local()  # .messages: a list while a call's messages are wanted as its error text

@@ -668,16 +668,18 @@ def _run_whole(model: Model, check: bool, cancel: Optional[Cancel], warn) -> "Re
     def work() -> None:
         lib = _lib.library()
         sim = box["sim"] = Simulation(model, warn=warn, cancel=stop, _init=False)
-        values = box["values"] = np.zeros((lib.fmb_row_count(sim._mptr), len(names)))
-        base, row_bytes, count = values.ctypes.data, values.strides[0], [0]
+        ncol = len(names)
+        values = box["values"] = np.zeros((lib.fmb_row_count(sim._mptr), ncol))
+        flat = (ctypes.c_double * values.size).from_address(values.ctypes.data)  # values' memory
+        base, row_bytes, count = values.ctypes.data, 8 * ncol, [0]
         memmove = ctypes.memmove
 
-        def on_row(user, t, vals, n):  # one call per row, with the GIL: keep it short
+        def on_row(user, t, vals, n):  # one call per row, with the GIL: kept to a few operations
             k = count[0]
-            values[k, 0] = t
+            flat[k * ncol] = t
             memmove(base + k * row_bytes + 8, vals, 8 * n)
             count[0] = k + 1
-            return stop.is_set()
+            return stop._set
 
         row_fn = _lib.RowFn(on_row)
         diag = _lib.Diag()
