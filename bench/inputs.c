@@ -25,26 +25,11 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_cpu.h"
 #include "builtin.h"
 #include "flexmbd.h"
 
 enum { WAY_LAW, WAY_HOLD, WAY_MOTION, NWAY };
-
-static double cpu_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_d(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* v, int n) {
-  qsort(v, (size_t)n, sizeof *v, cmp_d);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 typedef struct {
   const char* load;

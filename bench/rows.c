@@ -20,27 +20,12 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_cpu.h"
 #include "builtin.h"
 #include "data.h"
 
 enum { WAY_NONE, WAY_VALUES, WAY_CSV, NWAY };
 static const char* const way_names[NWAY] = {"none", "values", "csv"};
-
-static double cpu_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_d(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* v, int n) {
-  qsort(v, (size_t)n, sizeof *v, cmp_d);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* one run the given way: its CPU seconds, its steps in *steps; -1 when it failed */
 static double one_run(const fmbModel* m, int way, const char* out, long* steps, long* rows) {
