@@ -20,27 +20,12 @@
 #include <string.h>
 #include <time.h>
 
+#include "bench_cpu.h"
 #include "builtin.h"
 #include "data.h"
 
 enum { WAY_NONE, WAY_VALUES, WAY_CSV, NWAY };
 static const char* const way_names[NWAY] = {"none", "values", "csv"};
-
-static double cpu_now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_d(const void* a, const void* b) {
-  const double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-static double median(double* v, int n) {
-  qsort(v, (size_t)n, sizeof *v, cmp_d);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 /* one run the given way: its CPU seconds, its steps in *steps; -1 when it failed */
 static double one_run(const fmbModel* m, int way, const char* out, long* steps, long* rows) {
@@ -55,11 +40,10 @@ static double one_run(const fmbModel* m, int way, const char* out, long* steps, 
   fmbCsv* csv = way == WAY_CSV ? fmb_csv_open(out, &diag) : NULL;
   int rc = fmb_init(m, d, &diag);
   if (!rc && csv && fmb_csv_header(csv, m)) rc = -1;
-  const double dt = m->solver.output_step, t_end = m->solver.t_end, t0 = m->solver.t0;
-  const long nout = (long)ceil((t_end - t0) / dt - 1e-9);
+  const long nrow = fmb_row_count(m);
   *rows = 0;
-  for (long k = 0; !rc && k <= nout; ++k) {
-    if (k > 0 && (rc = fmb_advance(m, d, k == nout ? t_end : t0 + (double)k * dt, &diag))) break;
+  for (long k = 0; !rc && k < nrow; ++k) {
+    if (k > 0 && (rc = fmb_advance(m, d, fmb_row_time(m, k), &diag))) break;
     if (way == WAY_VALUES && fmb_outputs_eval(m, d->w, d->t, d->y, d->yp, d->row)) rc = -1;
     if (way == WAY_CSV && fmb_csv_row(csv, m, d->w, d->t, d->y, d->yp)) rc = -1;
     ++*rows;

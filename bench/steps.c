@@ -104,16 +104,15 @@ int main(int argc, char** argv) {
   const clock_t c0 = clock();
   int rc = fmb_init(m, d, &diag);
   if (!rc) rc = fmb_csv_header(csv, m) || fmb_csv_row(csv, m, d->w, d->t, d->y, d->yp);
-  const double dt = m->solver.output_step, t_end = m->solver.t_end, t0 = m->solver.t0;
-  const long nout = (long)ceil((t_end - t0) / dt - 1e-9);
+  const double t_end = m->solver.t_end, t0 = m->solver.t0;
+  const long nout = fmb_row_count(m) - 1;
   const int nper = (int)ceil((t_end - t0) / period - 1e-9);
   long* per = calloc((size_t)nper + 1, sizeof(long));
   if (!per) rc = 1;
   long steps_before = 0;
   fmbStats st;
   for (long k = 1; !rc && k <= nout; ++k) {
-    const double tout = k == nout ? t_end : t0 + (double)k * dt;
-    if ((rc = fmb_advance(m, d, tout, &diag))) break;
+    if ((rc = fmb_advance(m, d, fmb_row_time(m, k), &diag))) break;
     if ((rc = fmb_csv_row(csv, m, d->w, d->t, d->y, d->yp))) break;
     fmb_data_stats(d, &st);
     int p = (int)floor((d->t - t0) / period - 1e-9);

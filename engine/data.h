@@ -24,6 +24,7 @@ struct fmbData {
   const fmbIntegratorOps* ops;
   void* integ;
   int restart;
+  int reinit_pending;    /* an input changed: integ starts again (its reinit op) at the next advance */
   fmbStats before;       /* counters of the backends retired so far */
   double* work_before;   /* njoint: work done before the current backend started */
   double* redundant_phi; /* nc: the redundant rows' residuals, checked after every advance */
@@ -51,6 +52,11 @@ struct fmbData {
                    (two system calls an output row, ~5 % of the w15 spin-up) */
 };
 
+/* the misuse every call on (m, d) refuses (NULL, freed, another model's): FMB_EXIT_BAD_INPUT with
+   *diag naming fn; 0 when usable */
+int fmb_data_misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDiag* diag);
+/* CPU seconds of the calling thread (fmbData.cpu_s) */
+double fmb_thread_cpu_seconds(void);
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
 /* free a data object that never left the engine (fmb_run's) at once, without the quarantine */

@@ -104,6 +104,9 @@ typedef struct fmbStats {
   /* the integrator backend that ran last ("ida", "radau5", "projected"; solver.integrator: auto
      picks one per model, formulation: auto may switch to projected mid-run); NULL if none ran */
   const char* integrator;
+  /* messages of the run that were warnings (text starting "warning"), through its warn handler;
+     notes and progress lines are not counted. The stats line ends with warnings=N. */
+  long warnings;
 } fmbStats;
 
 typedef struct fmbRunOptions {
@@ -270,8 +273,24 @@ FMB_API int fmb_data_state(const fmbData* d, double* y, double* yp);
 FMB_API int fmb_noutput(const fmbModel* m);
 FMB_API const char* fmb_output_name(const fmbModel* m, int i);
 FMB_API int fmb_outputs(const fmbModel* m, fmbData* d, double* out);
+/* The output grid fmb_run writes, one row at each time: row k (0 <= k < fmb_row_count(m)) is at
+   t0 + k output_step, the last one at t_end (the scene's solver settings). fmb_row_count: 0 for
+   NULL; fmb_row_time: NaN for NULL or k out of range. Every loop over the rows (fmb_run, the
+   Python package, bench/) takes the times from here. */
+FMB_API long fmb_row_count(const fmbModel* m);
+FMB_API double fmb_row_time(const fmbModel* m, long k);
+/* One output row for fmb_run_rows: its time and the fmb_noutput(m) values of fmb_outputs (valid
+   during the call only). Return 0 to go on; non-zero stops the run after this row. */
+typedef int (*fmbRowFn)(void* user, double t, const double* values, int nvalues);
+/* A whole run through the library's one loop (the loop fmb_run writes its CSV from): fmb_init,
+   then row(t, values) at t0 and after fmb_advance to every later time of the grid (fmb_row_time).
+   Returns 0; FMB_EXIT_INTERRUPTED when row returned non-zero (before t_end) or the run was cancelled
+   (fmb_data_cancel); FMB_EXIT_SOLVER with *diag when an advance failed or an output is not finite
+   (that row is not delivered); FMB_EXIT_BAD_INPUT for misuse. The rows delivered before stay
+   delivered; fmb_data_stats tells where the run got to. */
+FMB_API int fmb_run_rows(const fmbModel* m, fmbData* d, fmbRowFn row, void* user, fmbDiag* diag);
 /* the integrator's counters so far (all backends of this run), t_reached = time(), the CPU time
-   spent in fmb_init and fmb_advance: 0, or FMB_EXIT_BAD_INPUT */
+   spent in fmb_init and fmb_advance, the warnings given since fmb_init: 0, or FMB_EXIT_BAD_INPUT */
 FMB_API int fmb_data_stats(const fmbData* d, fmbStats* st);
 /* ask the advance in progress, or the next one, to stop: it returns FMB_EXIT_INTERRUPTED with the
    state at the last good step, and the request is used up (a later advance goes on from there).

@@ -71,6 +71,14 @@ typedef struct fmbIntegratorOps {
      last step size tried. */
   int (*advance)(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
                  size_t why_len);
+  /* optional: start again from the consistent state y, yp at t0 as create would (no step
+     history: first order or first step, the step size estimated anew; the work integrals from 0),
+     keeping what does not depend on the state (vectors, matrices, the linear solver's symbolic
+     analysis). Called by fmb_set_input's restart instead of destroy + create, so a controller
+     that sets an input every millisecond does not pay the set-up each time. The counters (stats)
+     go on from where they were. 0, or non-zero with *diag set (the caller then destroys the
+     backend and creates a new one). NULL: destroy + create. */
+  int (*reinit)(void* self, double t0, const double* y, const double* yp, fmbDiag* diag);
   /* the work integrals at the last t_reached (called only when m->need_work) */
   void (*work)(void* self, double* work);
   /* counters so far (steps, residuals, jacobians, newton_iters, error_test_fails, conv_fails,

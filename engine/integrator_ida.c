@@ -44,7 +44,7 @@ typedef struct {
   long fresh, reused;
   StepWatch watch;
   int fell_back;          /* the reduced Newton solve failed once: KLU on the whole matrix since */
-  fmbStats before_reinit; /* IDA's counters up to the fallback's IDAReInit (which zeroes them) */
+  fmbStats before_reinit; /* IDA's counters up to the last IDAReInit (fallback, ida_reinit: it zeroes them) */
 } IdaRun;
 
 static int stop_requested(const IdaRun* c) { return fmb_stop_requested(c->stop); }
@@ -58,6 +58,8 @@ static int reuse_body_blocks(IdaRun* c) {
   long nst = 0, ncf = 0;
   IDAGetNumSteps(c->ida, &nst);
   IDAGetNumNonlinSolvConvFails(c->ida, &ncf);
+  nst += c->before_reinit.steps; /* the run's, across an IDAReInit (ida_reinit) */
+  ncf += c->before_reinit.conv_fails;
   const int reuse = !c->m->fresh_body_blocks && c->fresh > 0 && ncf == c->fresh_conv_fails && nst - c->fresh_steps < 50;
   if (reuse) {
     c->reused++;
@@ -204,11 +206,12 @@ static void failure_advice(const fmbModel* m, int flag, double ymax, char* buf, 
    the first 2 % of the run) and the velocities' weighted local error estimate exceeds 30x the
    positions', say so and what to set. */
 
-static void watch_step_rate(const fmbModel* m, fmbWorkspace* w_run, void* ida, N_Vector ele, N_Vector ewt, double t,
-                            StepWatch* sw) {
+static void watch_step_rate(const fmbModel* m, fmbWorkspace* w_run, void* ida, long steps_before, N_Vector ele,
+                            N_Vector ewt, double t, StepWatch* sw) {
   const fmbSolverSettings* so = &m->solver;
   long nst = 0;
   IDAGetNumSteps(ida, &nst);
+  nst += steps_before; /* the run's steps, also across an IDAReInit (ida_reinit) */
   const double span = so->t_end - so->t0, elapsed = t - so->t0;
   if (sw->t_early == 0.0 && elapsed >= 0.02 * span) {
     sw->t_early = elapsed;
@@ -336,6 +339,26 @@ oom:
   return NULL;
 }
 
+/* fmb_set_input's restart: IDA from the new consistent state with no step history (IDAReInit:
+   order 1, its first step estimated anew), the work integrals from 0, while the vectors, the
+   matrix and the linear solver with its KLU symbolic analysis stay (destroying and creating them
+   again at every setting of a 1 kHz controller cost more than the steps between). IDAReInit
+   zeroes IDA's counters: they are kept in before_reinit, as the fallback does. */
+static int ida_reinit(void* self, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  IdaRun* c = self;
+  const fmbModel* m = c->m;
+  add_counters(c->ida, &c->before_reinit);
+  memcpy(N_VGetArrayPointer(c->y), y0, sizeof(double) * (size_t)m->ny);
+  memcpy(N_VGetArrayPointer(c->yp), yp0, sizeof(double) * (size_t)m->ny);
+  if (c->work) N_VConst(0.0, c->work);
+  if (IDAReInit(c->ida, t0, c->y, c->yp) != IDA_SUCCESS || (c->work && IDAQuadReInit(c->ida, c->work) != IDA_SUCCESS)) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "could not restart IDA: %s", c->ida_msg);
+    return -1;
+  }
+  c->fresh = 0; /* the first Jacobian evaluates the bodies' blocks anew, as a new backend did */
+  return 0;
+}
+
 /* The default solver (schur.c) is a modified Newton iteration: it drops the O(|mu|) part of the
    position rows. If IDA gives up while using it, the cause may be that approximation rather than
    the model, so the interval is retried once from the last good step with KLU on the whole matrix
@@ -410,7 +433,7 @@ static void ida_work(void* self, double* work) {
 
 static void ida_stats(const void* self, fmbStats* st) {
   const IdaRun* c = self;
-  fmbStats acc = c->before_reinit; /* zero unless the run fell back to klu_full */
+  fmbStats acc = c->before_reinit; /* zero unless the run fell back to klu_full or was restarted */
   add_counters(c->ida, &acc);
   st->steps = acc.steps;
   st->residuals = acc.residuals;
@@ -424,7 +447,7 @@ static void ida_stats(const void* self, fmbStats* st) {
 
 static void ida_after_row(void* self, double t) {
   IdaRun* c = self;
-  watch_step_rate(c->m, c->w, c->ida, c->watch_ele, c->ewt, t, &c->watch);
+  watch_step_rate(c->m, c->w, c->ida, c->before_reinit.steps, c->watch_ele, c->ewt, t, &c->watch);
 }
 
 const fmbIntegratorOps fmb_integrator_ida = {
@@ -432,6 +455,7 @@ const fmbIntegratorOps fmb_integrator_ida = {
     .projected = 0,
     .check = NULL,
     .create = ida_create,
+    .reinit = ida_reinit,
     .advance = ida_advance,
     .work = ida_work,
     .stats = ida_stats,

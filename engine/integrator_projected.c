@@ -82,6 +82,7 @@ typedef struct {
   double* lambda; /* nc */
   int nwork;      /* work integrals carried (njoint or 0) */
   char msg[512];
+  fmbStats before_reinit; /* CVODE's counters up to the last CVodeReInit (proj_reinit: it zeroes them) */
 } ProjRun;
 
 /* the powers of the joints (their work's rates) at (q, v) with the multipliers lambda */
@@ -205,6 +206,25 @@ oom:
   return NULL;
 }
 
+static void proj_stats(const void* self, fmbStats* st);
+
+/* fmb_set_input's restart (integrator.h): CVODE from (q, v) at t0 with no step history, the work
+   integrals from 0; the vectors, the matrix or GMRES and the projection stay */
+static int proj_reinit(void* self, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  (void)yp0;
+  ProjRun* c = self;
+  const int nq = c->m->nq;
+  proj_stats(c, &c->before_reinit);
+  double* y = N_VGetArrayPointer(c->y);
+  memcpy(y, y0, sizeof(double) * 2 * (size_t)nq);
+  for (int j = 0; j < c->nwork; ++j) y[2 * nq + j] = 0.0;
+  if (CVodeReInit(c->cvode, t0, c->y) != CV_SUCCESS) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, c->m->path, 0, 0, "could not restart CVODE: %s", c->msg);
+    return -1;
+  }
+  return 0;
+}
+
 static int proj_advance(void* self, double tout, double* t_reached, double* y, double* yp, double* h, char* why,
                         size_t why_len) {
   ProjRun* c = self;
@@ -250,12 +270,18 @@ static void proj_stats(const void* self, fmbStats* st) {
   const ProjRun* c = self;
   long v = 0;
   void* cv = c->cvode;
-  if (CVodeGetNumSteps(cv, &v) == CV_SUCCESS) st->steps = v;
-  if (CVodeGetNumRhsEvals(cv, &v) == CV_SUCCESS) st->residuals = v;
-  if (CVodeGetNumJacEvals(cv, &v) == CV_SUCCESS) st->jacobians = v;
-  if (CVodeGetNumNonlinSolvIters(cv, &v) == CV_SUCCESS) st->newton_iters = v;
-  if (CVodeGetNumErrTestFails(cv, &v) == CV_SUCCESS) st->error_test_fails = v;
-  if (CVodeGetNumNonlinSolvConvFails(cv, &v) == CV_SUCCESS) st->conv_fails = v;
+  st->steps = c->before_reinit.steps;
+  st->residuals = c->before_reinit.residuals;
+  st->jacobians = c->before_reinit.jacobians;
+  st->newton_iters = c->before_reinit.newton_iters;
+  st->error_test_fails = c->before_reinit.error_test_fails;
+  st->conv_fails = c->before_reinit.conv_fails;
+  if (CVodeGetNumSteps(cv, &v) == CV_SUCCESS) st->steps += v;
+  if (CVodeGetNumRhsEvals(cv, &v) == CV_SUCCESS) st->residuals += v;
+  if (CVodeGetNumJacEvals(cv, &v) == CV_SUCCESS) st->jacobians += v;
+  if (CVodeGetNumNonlinSolvIters(cv, &v) == CV_SUCCESS) st->newton_iters += v;
+  if (CVodeGetNumErrTestFails(cv, &v) == CV_SUCCESS) st->error_test_fails += v;
+  if (CVodeGetNumNonlinSolvConvFails(cv, &v) == CV_SUCCESS) st->conv_fails += v;
   st->jacobians_reused = 0;
   st->integrator = fmb_integrator_projected.name;
 }
@@ -283,6 +309,7 @@ const fmbIntegratorOps fmb_integrator_projected = {
     .projected = 1,
     .check = proj_check,
     .create = proj_create,
+    .reinit = proj_reinit,
     .advance = proj_advance,
     .work = proj_work,
     .stats = proj_stats,

@@ -285,6 +285,53 @@ static int powers(RadauRun* c, double t, const double* y, double* p) {
   return 0;
 }
 
+/* The step history set for a start from (y0, yp0) at t0: what create does after allocating, and
+   fmb_set_input's restart (integrator.h) without allocating. The factorizations' symbolic
+   analysis (KLU, schur.c) and the counters stay; the fallback to klu_full (fell_back) too. */
+static int radau_start(RadauRun* c, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  const fmbSolverSettings* so = &c->m->solver;
+  memcpy(c->y, y0, sizeof(double) * (size_t)c->ny);
+  memcpy(c->yp, yp0, sizeof(double) * (size_t)c->ny);
+  c->t = t0;
+  /* a small first step: RADAU5 leaves it to the caller; the first-step rejection (h / 10) and
+     the growth bound (8x per step) reach the dynamics' step within a few steps */
+  c->h = fmin(c->hmax, 1e-3 * so->output_step);
+  c->h = fmax(c->h, 10.0 * so->min_step);
+  c->hold = 0.0;
+  c->first = 1;
+  c->need_jac = 1;
+  c->caljac = 0;
+  c->reject = 0;
+  c->have_cont = 0;
+  c->nsing = 0;
+  c->kept = 0;
+  c->h_lu = 0.0;
+  c->hacc = 0.0;
+  c->erracc = 0.0;
+  c->faccon = 1.0;
+  c->theta = 1.0;
+  update_scal(c);
+  if (c->nwork) {
+    const size_t nw = (size_t)c->nwork;
+    memset(c->work_old, 0, sizeof(double) * nw);
+    memset(c->work_new, 0, sizeof(double) * nw);
+    memset(c->work_out, 0, sizeof(double) * nw);
+    if (powers(c, t0, c->y, c->pend)) {
+      fmb_diag_set(diag, FMB_EXIT_SOLVER, c->m->path, 0, 0, "%s: a joint's power is not finite at t = %g",
+                   c->tab->s == 3 ? "radau5" : "radau9", t0);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+/* fmb_set_input's restart: the start's step history and a new Jacobian (keeping the last one was
+   tried: its first Newton iteration after every restart then failed to converge, 965 times in the
+   docs/python.md speed controller's 1000 settings, +17 % CPU) */
+static int radau_reinit(void* self, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
+  return radau_start(self, t0, y0, yp0, diag);
+}
+
 static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup* s, double t0, const double* y0,
                               const double* yp0, fmbDiag* diag) {
   const fmbModel* m = s->m;
@@ -364,20 +411,8 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   /* Newton's stopping tolerance, relative to the error weights (IV.8 (8.12), RADAU5's FNEWT) */
   c->fnewt = fmax(10.0 * 2.220446049250313e-16 / c->rtol, fmin(0.03, sqrt(c->rtol)));
 
-  memcpy(c->y, y0, sizeof(double) * n);
-  memcpy(c->yp, yp0, sizeof(double) * n);
-  c->t = t0;
   c->t_end = so->t_end;
   c->hmax = so->max_step > 0 ? so->max_step : so->t_end - so->t0;
-  /* a small first step: RADAU5 leaves it to the caller; the first-step rejection (h / 10) and
-     the growth bound (8x per step) reach the dynamics' step within a few steps */
-  c->h = fmin(c->hmax, 1e-3 * so->output_step);
-  c->h = fmax(c->h, 10.0 * so->min_step);
-  c->first = 1;
-  c->need_jac = 1;
-  c->faccon = 1.0;
-  c->theta = 1.0;
-  update_scal(c);
 
   if (m->need_work && m->njoint > 0) {
     c->nwork = m->njoint;
@@ -401,11 +436,10 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
         c->work_atol[j] = so->atol * quot;
         c->nwork_err++;
       }
-    if (powers(c, t0, c->y, c->pend)) {
-      fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: a joint's power is not finite at t = %g", t0);
-      radau_destroy(c);
-      return NULL;
-    }
+  }
+  if (radau_start(c, t0, y0, yp0, diag)) {
+    radau_destroy(c);
+    return NULL;
   }
   return c;
 oom:
@@ -979,7 +1013,7 @@ static FailKind radau_step(RadauRun* c, int* interrupted) {
       continue;
     }
     /* accepted; Gustafsson's predictive controller (IV.8 (8.25)) */
-    if (c->st.steps > 0) {
+    if (!c->first) { /* not on a start's first step (a run's, or radau_reinit's: no hacc, erracc yet) */
       double facgus = (c->hacc / c->h) * pow(err * err / c->erracc, c->expo) / FMB_RADAU_SAFE;
       facgus = fmax(FMB_RADAU_FACR, fmin(FMB_RADAU_FACL, facgus));
       quot = fmax(quot, facgus);
@@ -1132,6 +1166,7 @@ const fmbIntegratorOps fmb_integrator_radau5 = {
     .projected = 0,
     .check = radau_check,
     .create = radau5_create,
+    .reinit = radau_reinit,
     .advance = radau_advance,
     .work = radau_work,
     .stats = radau_stats,
@@ -1147,6 +1182,7 @@ const fmbIntegratorOps fmb_integrator_radau9 = {
     .projected = 0,
     .check = radau_check,
     .create = radau9_create,
+    .reinit = radau_reinit,
     .advance = radau_advance,
     .work = radau_work,
     .stats = radau_stats,

@@ -106,10 +106,10 @@ void fmb_print_stats(const fmbStats* s, FILE* f) {
   fprintf(
       f,
       "stats: status=%s t_reached=%.10g steps=%ld residuals=%ld jacobians=%ld newton_iters=%ld error_test_fails=%ld "
-      "conv_fails=%ld jacobians_reused=%ld integrator=%s cpu_s=%.4f\n",
+      "conv_fails=%ld jacobians_reused=%ld integrator=%s cpu_s=%.4f warnings=%ld\n",
       s->status_ok     ? "ok"
       : s->interrupted ? "interrupted"
                        : "failed",
       s->t_reached, s->steps, s->residuals, s->jacobians, s->newton_iters, s->error_test_fails, s->conv_fails,
-      s->jacobians_reused, s->integrator ? s->integrator : "none", s->cpu_s);
+      s->jacobians_reused, s->integrator ? s->integrator : "none", s->cpu_s, s->warnings);
 }

@@ -179,6 +179,9 @@ struct fmbJointEval {
 typedef struct fmbInputSetting {
   double value, rate, accel, t_set;
   int jumps; /* times a drive's setting has jumped away from where its last one led (warned once) */
+  /* the largest |value| set so far: the input's scale, on which a setting within the solver's
+     tolerance of where the last one led is no jump (step.c; a value near a zero crossing is not) */
+  double magnitude;
 } fmbInputSetting;
 /* the setting's value and its rate and second rate at time t */
 void fmb_input_at(const fmbInputSetting* s, double t, double* value, double* rate, double* accel);
@@ -283,6 +286,7 @@ void fmb_workspace_inputs_reset(const fmbModel* m, fmbWorkspace* w);
 typedef struct {
   fmbWarnFn fn;
   void* user;
+  long warnings; /* messages starting "warning" said through this sink (fmbStats.warnings) */
 } fmbWarnSink;
 fmbWarnSink* fmb_workspace_warn(fmbWorkspace* w);
 

@@ -175,7 +175,7 @@ fmbInputSetting* fmb_workspace_inputs(fmbWorkspace* w) { return w->input; }
 
 void fmb_workspace_inputs_reset(const fmbModel* m, fmbWorkspace* w) {
   for (int i = 0; i < m->ninput; ++i) {
-    const fmbInputSetting at_rest = {m->input_initial[i], 0.0, 0.0, m->solver.t0, 0};
+    const fmbInputSetting at_rest = {m->input_initial[i], 0.0, 0.0, m->solver.t0, 0, fabs(m->input_initial[i])};
     w->input[i] = at_rest;
   }
 }

@@ -8,6 +8,7 @@
  * without a lock. */
 #include <stdarg.h>
 #include <stdio.h>
+#include <string.h>
 
 #include "internal.h"
 
@@ -29,7 +30,8 @@ void fmb_warn(fmbWorkspace* w, const char* fmt, ...) {
   va_start(ap, fmt);
   vsnprintf(message, sizeof message, fmt, ap);
   va_end(ap);
-  const fmbWarnSink* own = w ? fmb_workspace_warn(w) : NULL;
+  fmbWarnSink* own = w ? fmb_workspace_warn(w) : NULL;
+  if (own && strncmp(message, "warning", 7) == 0) own->warnings++; /* a run's count, wherever it goes */
   if (own && own->fn)
     own->fn(own->user, message);
   else if (thread_default.set) {

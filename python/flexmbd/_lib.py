@@ -193,6 +193,9 @@ _PROTOTYPES = {
     "fmb_output_name": (ctypes.c_char_p, [_P, ctypes.c_int]),
     "fmb_outputs": (ctypes.c_int, [_P, _P, ctypes.POINTER(ctypes.c_double)]),
     "fmb_data_stats": (ctypes.c_int, [_P, _P]),
+    "fmb_row_count": (ctypes.c_long, [_P]),
+    "fmb_row_time": (ctypes.c_double, [_P, ctypes.c_long]),
+    "fmb_run_rows": (ctypes.c_int, [_P, _P, _P, _P, _D]),
     "fmb_data_cancel": (None, [_P]),
     "fmb_data_set_warn": (None, [_P, _P, _P]),
     "fmb_set_warn": (None, [_P, _P]),
@@ -347,6 +350,9 @@ class FlexmbdWarning(UserWarning):
 
 
 WarnFn = ctypes.CFUNCTYPE(None, ctypes.c_void_p, ctypes.c_char_p)
+#: fmbRowFn (fmb_run_rows): user, the row's time, its values (an address: a POINTER would be made
+#: anew for every row), their count; non-zero stops the run
+RowFn = ctypes.CFUNCTYPE(ctypes.c_int, ctypes.c_void_p, ctypes.c_double, ctypes.c_void_p, ctypes.c_int)
 
 
 _capture = threading.local()  # .messages: a list while a call's messages are wanted as its error text

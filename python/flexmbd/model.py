@@ -243,7 +243,8 @@ class Model(_Owned):
         m._source = source
         info = _lib.SolverInfo()
         lib.fmb_model_solver(ptr, ctypes.byref(info))
-        m.solver = {k: getattr(info, k) for k, _ in _lib.SolverInfo._fields_}
+        m.solver = _SolverSettings({k: getattr(info, k) for k, _ in _lib.SolverInfo._fields_})
+        m.solver._model = weakref.ref(m)
         m.bodies = {}
         name, typ = ctypes.c_char_p(), ctypes.c_char_p()
         for i in range(lib.fmb_model_nbody(ptr)):
@@ -381,18 +382,27 @@ class Cancel:
             sim.cancel()
 
 
-def _output_grid(solver: Mapping[str, float]) -> Tuple[int, Callable[[int], float]]:
-    """The rows `flexmbd run` writes: their count - 1 (nout) and the time of row k, t0 + k
-    output_step, the last one t_end (engine/run.c's grid, which fmb_run steps to as well)."""
-    t0, t_end, dt = solver["t0"], solver["t_end"], solver["output_step"]
-    nout = int(math.ceil((t_end - t0) / dt - 1e-9))
-    return nout, (lambda k: t_end if k == nout else t0 + float(k) * dt)  # t0 + (double)k * dt, as in C
+class _SolverSettings(dict):
+    """Model.solver: the solver settings as a dict, which knows its model (output_times)."""
+    _model: Optional[Callable[[], Optional["Model"]]] = None
 
 
-def output_times(solver: Mapping[str, float]) -> np.ndarray:
-    """The times of the rows `flexmbd run` writes for these solver settings (Model.solver)."""
-    nout, at = _output_grid(solver)
-    return np.array([at(k) for k in range(nout + 1)])
+def _row_times(model: "Model") -> np.ndarray:
+    """The times of the rows `flexmbd run` writes, from the library's grid (fmb_row_time)."""
+    lib = _lib.library()
+    with model._use() as ptr:
+        return np.array([lib.fmb_row_time(ptr, k) for k in range(lib.fmb_row_count(ptr))])
+
+
+def output_times(solver: Union["Model", Mapping[str, float]]) -> np.ndarray:
+    """The times of the rows `flexmbd run` writes for a model (or its ``Model.solver``): t0 +
+    k output_step, the last one t_end, as the library computes them (fmb_row_time)."""
+    model = solver if isinstance(solver, Model) else (solver._model() if isinstance(solver, _SolverSettings)
+                                                      and solver._model is not None else None)
+    if model is None:
+        raise TypeError("flexmbd.output_times: pass the Model (or its .solver); the grid is the library's "
+                        "(fmb_row_time), computed for a loaded scene")
+    return _row_times(model)
 
 
 class Simulation(_Owned):
@@ -417,7 +427,7 @@ class Simulation(_Owned):
     _free = "fmb_data_free"
 
     def __init__(self, model: Model, warn: Optional[Callable[[str], None]] = None,
-                 cancel: Optional[Cancel] = None) -> None:
+                 cancel: Optional[Cancel] = None, _init: bool = True) -> None:
         lib = _lib.library()
         self.model = model
         # the model stays allocated while this run exists, whoever closes it meanwhile
@@ -440,7 +450,8 @@ class Simulation(_Owned):
         self._row_ptr = self._row.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
         if cancel is not None:
             cancel._watch(self)
-        self.restart()
+        if _init:  # not for _run_whole: fmb_run_rows initialises
+            self.restart()
 
     def _released(self) -> None:
         use, self._model_use = getattr(self, "_model_use", None), None
@@ -643,42 +654,44 @@ def _ctrl_c_waits(work: Callable[[], None], on_ctrl_c: Callable[[], None]) -> bo
 
 
 def _run_whole(model: Model, check: bool, cancel: Optional[Cancel], warn) -> "Result":
-    """fmb_run's loop (engine/run.c) on the stepping API: the row at t0 after fmb_init, then one
-    fmb_advance and one row per output time; the rows go straight into one NumPy array. Ctrl-C
-    stops it after the step in progress (not the output row: the advance is cancelled inside the
-    library) and keeps the rows so far, status "interrupted" (_ctrl_c_waits)."""
-    nout, time_of = _output_grid(model.solver)
+    """The library's run loop (fmb_run_rows, the loop fmb_run writes its CSV from): fmb_init, then
+    each output row handed to a ctypes callback that copies it into one NumPy array, sized from
+    the library's grid (fmb_row_count). Ctrl-C stops it after the step in progress (not the output
+    row: the advance is cancelled inside the library) and keeps the rows so far, status
+    "interrupted" (_ctrl_c_waits)."""
     names = ["t"] + model.output_names
-    box: Dict[str, Any] = {"values": np.zeros((min(nout + 1, 4096), len(names))), "nrow": 0, "error": None,
-                           "sim": None}
+    box: Dict[str, Any] = {"values": np.zeros((0, len(names))), "nrow": 0, "error": None, "sim": None}
     stop = Cancel()  # set by Ctrl-C, and by the caller's Cancel
     if cancel is not None:
         cancel._also(stop)
 
     def work() -> None:
-        try:
-            sim = box["sim"] = Simulation(model, warn=warn, cancel=stop)
-            values = box["values"]
-            for k in range(nout + 1):
-                if k > 0:
-                    sim.advance(time_of(k))
-                if k == len(values):
-                    values = box["values"] = np.concatenate([values, np.zeros_like(values)])
-                row = values[k]
-                row[0] = sim.t
-                rc = sim._outputs_into(row[1:].ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
-                if rc:  # fmb_run stops here too, without the row
-                    raise _lib.SolverError(rc, model._shown_path, 0, 0,
-                                           f"stopped at t = {sim.t:.6g}: an output is not finite (the solution blew up)")
-                box["nrow"] = k + 1
-                if stop.is_set() and k < nout:
-                    raise _lib.Interrupted(_lib.EXIT_INTERRUPTED, model._shown_path, 0, 0, "")
-        except (_lib.SolverError, _lib.Interrupted) as e:
-            box["error"] = e
+        lib = _lib.library()
+        sim = box["sim"] = Simulation(model, warn=warn, cancel=stop, _init=False)
+        ncol = len(names)
+        values = box["values"] = np.zeros((lib.fmb_row_count(sim._mptr), ncol))
+        flat = (ctypes.c_double * values.size).from_address(values.ctypes.data)  # values' memory
+        base, row_bytes, count = values.ctypes.data, 8 * ncol, [0]
+        memmove = ctypes.memmove
+
+        def on_row(user, t, vals, n):  # one call per row, with the GIL: kept to a few operations
+            k = count[0]
+            flat[k * ncol] = t
+            memmove(base + k * row_bytes + 8, vals, 8 * n)
+            count[0] = k + 1
+            return stop._set
+
+        row_fn = _lib.RowFn(on_row)
+        diag = _lib.Diag()
+        with sim._use() as d:
+            rc = lib.fmb_run_rows(sim._mptr, d, row_fn, None, ctypes.byref(diag))
+        box["nrow"] = count[0]
+        if rc:
+            box["error"] = model._error(diag, rc)
 
     pressed = _ctrl_c_waits(work, stop.set)
     error, sim, nrow = box["error"], box["sim"], box["nrow"]
-    if isinstance(error, _lib.Interrupted) or (pressed and error is None and nrow < nout + 1):
+    if isinstance(error, _lib.Interrupted) or (pressed and error is None and nrow < len(box["values"])):
         t_stop = sim.t if sim is not None and sim._ptr else model.solver["t0"]
         how = "Ctrl-C (SIGINT)" if pressed else "Cancel.set()"
         cls = _lib.KeyboardInterrupted if pressed else _lib.Interrupted
