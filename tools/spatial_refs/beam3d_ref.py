@@ -28,6 +28,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reflib import Checks, read_csv, write_csv  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REF_DIR = os.path.normpath(os.path.join(HERE, "..", "..", "tests", "spatial", "ref"))
 
@@ -204,7 +207,6 @@ def energy_rate(beam, model, r0, Rm, p, nu, grav, h=1e-5, flow_model=None):
     returns (dE/dt, a power scale |nu| |Q|); flow_model: take M, Q of another model"""
     M, Q = mass_forces(beam, flow_model or model, Rm, p, nu, grav)
     nud = np.linalg.solve(M, Q)
-    n = beam.n
 
     def E_at(s):
         return energy(beam, model, r0 + s * Rm @ nu[:3], Rm @ rodrigues(s * nu[3:6]), p + s * nu[6:], nu + s * nud, grav)
@@ -490,23 +492,15 @@ def table():
     return rows
 
 
-def write_csv(path, rows, comment):
+def write_rows(path, rows, comment):
+    """rows: dicts with the same keys (the header)"""
     cols = list(rows[0].keys())
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        for line in comment:
-            f.write("# " + line + "\n")
-        f.write(",".join(cols) + "\n")
-        for r in rows:
-            f.write(",".join("nan" if isinstance(r[c], float) and math.isnan(r[c]) else repr(float(r[c])) for c in cols) + "\n")
-    os.replace(tmp, path)
+    write_csv(path, cols, [[r[c] for c in cols] for r in rows], comment)
 
 
-def read_csv(path):
-    with open(path) as f:
-        lines = [ln for ln in f if not ln.startswith("#")]
-    cols = lines[0].strip().split(",")
-    return [dict(zip(cols, map(float, ln.strip().split(",")))) for ln in lines[1:]]
+def read_rows(path):
+    cols, data = read_csv(path)
+    return [dict(zip(cols, map(float, row))) for row in data]
 
 
 SEED = dict(L=1.8, rho=2767.0, A=2.5e-4, Iy=1.302e-10, Iz=1.302e-10, E=68.95e9)
@@ -533,7 +527,7 @@ def main(argv):
     write = "--write" in argv
     if write:
         rows = table()
-        write_csv(os.path.join(REF_DIR, "rotating_cantilever.csv"), rows, [
+        write_rows(os.path.join(REF_DIR, "rotating_cantilever.csv"), rows, [
             "Rotating uniform Euler-Bernoulli cantilever, no hub radius, spin about the hub axis (z), made by",
             "tools/spatial_refs/beam3d_ref.py --write. lambda = Omega sqrt(rho A L^4/EI), mu = omega sqrt(rho A L^4/EI).",
             "mu_flap_series: Frobenius series of w'''' - (lambda^2/2)((1-xi^2)w')' = mu^2 w (400 terms, bisection to 1e-15);",
@@ -543,7 +537,7 @@ def main(argv):
             "mu_*_feNE: the spatial element of docs/formulation-3d.md, complete model, NE elements, no rotary",
             "inertia, chordwise with the axial DOFs removed (inextensible); foac/zoac: 64 elements. ZOAC has",
             "no stiffening: flap stays at mu(0), chord = sqrt(mu(0)^2 - lambda^2), nan once unstable."])
-        write_csv(os.path.join(REF_DIR, "rotating_cantilever_seed.csv"), seed_rows(), [
+        write_rows(os.path.join(REF_DIR, "rotating_cantilever_seed.csv"), seed_rows(), [
             "The seed beam (L 1.8 m, rho 2767, A 2.5e-4, I 1.302e-10 both ways, E 68.95e9, GJ 6.77e0 N m^2)",
             "spinning at Omega rad/s about the hub axis, first chordwise and flapwise frequencies (rad/s) of the",
             "spatial element WITH axial DOFs and rotary inertia (complete model; chord also FOAC), 16 and 32 elements.",
@@ -553,12 +547,7 @@ def main(argv):
 
 
 def check():
-    fails = []
-
-    def expect(ok, what):
-        print(("ok   " if ok else "FAIL ") + what)
-        if not ok:
-            fails.append(what)
+    expect = Checks()
 
     # 1. two independent continuum solutions agree, and reproduce the published values
     for lam, pub in PUBLISHED:
@@ -576,7 +565,7 @@ def check():
 
     # 2. the stored table: remade values equal (spot check of the coarse mesh) and FE converges
     path = os.path.join(REF_DIR, "rotating_cantilever.csv")
-    rows = read_csv(path)
+    rows = read_rows(path)
     for r in rows:
         lam, ref = r["lambda"], r["mu_flap_series"]
         e64 = abs(r["mu_flap_fe64"] - ref) / ref
@@ -665,15 +654,14 @@ def check():
         expect(np.abs(Q3[out_of_plane]).max() < 1e-12 * np.abs(Q3).max(), f"{model}: planar motion has no out-of-plane force")
 
     # 6. the seed beam with axial DOFs: chordwise against the planar note's continuum values
-    rows = read_csv(os.path.join(REF_DIR, "rotating_cantilever_seed.csv"))
+    rows = read_rows(os.path.join(REF_DIR, "rotating_cantilever_seed.csv"))
     # the continuum value has the tension of the undeformed beam: FOAC's linearization; the complete
     # model adds the axial pre-stretch (3D.33), 3.5e-5 relative at 15 rad/s. Linear axial elements
     # make the Coriolis part converge as h^2 (16 -> 32 elements moves 6.3354 -> 6.3352).
     for r, ref in zip(rows[1:], (3.93387, 4.26118, 6.3351)):
         expect(abs(r["chord_foac_fe32"] - ref) < 1e-5 * ref and abs(r["chord_fe32"] - ref) < 5e-5 * ref,
                f"seed beam Omega={r['Omega']}: chord FOAC {r['chord_foac_fe32']:.6f}, complete {r['chord_fe32']:.6f} vs {ref} (Coriolis included)")
-    print(f"{len(fails)} failure(s)")
-    return 1 if fails else 0
+    return expect.done()
 
 
 if __name__ == "__main__":

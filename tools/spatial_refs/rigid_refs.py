@@ -24,6 +24,9 @@ import sys
 
 import numpy as np
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from reflib import Checks, read_csv, write_csv  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REF_DIR = os.path.normpath(os.path.join(HERE, "..", "..", "tests", "spatial", "ref"))
 
@@ -41,49 +44,6 @@ def ellipk_from_kp2(kp2):
             break
         a, b = 0.5 * (a + b), math.sqrt(a * b)
     return math.pi / (a + b)
-
-
-def write_csv(name, header, rows, comment):
-    path = os.path.join(REF_DIR, name)
-    tmp = path + ".tmp"
-    with open(tmp, "w") as f:
-        for line in comment:
-            f.write("# " + line + "\n")
-        f.write(",".join(header) + "\n")
-        for r in rows:
-            f.write(",".join(repr(float(v)) for v in r) + "\n")
-    os.replace(tmp, path)
-
-
-def read_csv(name):
-    with open(os.path.join(REF_DIR, name)) as f:
-        lines = [ln for ln in f if not ln.startswith("#")]
-    cols = lines[0].strip().split(",")
-    return cols, np.array([[float(v) for v in ln.split(",")] for ln in lines[1:]])
-
-
-def cross(a, b):
-    """3-vector cross product (np.cross costs ~50 us a call; this integrator makes millions)"""
-    return np.array([a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]])
-
-
-def rk4(f, y, h):
-    k1 = f(y)
-    k2 = f(y + 0.5 * h * k1)
-    k3 = f(y + 0.5 * h * k2)
-    k4 = f(y + h * k3)
-    return y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
-
-
-def qmul(a, b):
-    return np.array([a[0] * b[0] - a[1:] @ b[1:], *(a[0] * b[1:] + b[0] * a[1:] + cross(a[1:], b[1:]))])
-
-
-def qmat(q):
-    w, x, y, z = q / np.linalg.norm(q)
-    return np.array([[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-                     [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-                     [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]])
 
 
 # ------------------------------------------------------------------------------------------------
@@ -272,7 +232,7 @@ def main(argv):
         # torque-free
         full, flip = tf_period()
         rows, _ = tf_integrate(TF, 1e-3, 500)
-        write_csv("torque_free.csv", ["t", "w1", "w2", "w3"], rows, [
+        write_csv(os.path.join(REF_DIR, "torque_free.csv"), ["t", "w1", "w2", "w3"], rows, [
             "Torque-free body, principal moments (1, 2, 3) kg m^2, omega(0) = (0.01, 1, 0) rad/s in the body frame",
             "(near the intermediate axis). Made by tools/spatial_refs/rigid_refs.py --write: RK4 of Euler's equations,",
             "h = 1e-3 s, every 0.5 s for 100 s; agrees with h = 5e-4 to 1e-9 (--check). Closed form (Landau-Lifshitz §37,",
@@ -283,7 +243,7 @@ def main(argv):
             t = i * SC["T"] / 200
             s, sd, sdd, d = sc_closed(t)
             rows.append((t, SC["Omega"] * t, s, sd, sdd, *d))
-        write_csv("slider_crank.csv", ["t", "crank_angle", "slider_s", "slider_v", "slider_a", "rod_dx", "rod_dy", "rod_dz"], rows, [
+        write_csv(os.path.join(REF_DIR, "slider_crank.csv"), ["t", "crank_angle", "slider_s", "slider_v", "slider_a", "rod_dx", "rod_dy", "rod_dz"], rows, [
             "Spatial slider-crank, closed form (tools/spatial_refs/rigid_refs.py --write). Crank radius 0.08 m about the",
             "global z axis through the origin, angle = 2 pi t (rad, constant rate); crank pin (r cos, r sin, 0), spherical;",
             "rod 0.3 m to the slider (universal joint), which slides along the line (s, 0.1, 0.12) (prismatic, axis x).",
@@ -294,12 +254,7 @@ def main(argv):
 
 
 def check():
-    fails = []
-
-    def expect(ok, what):
-        print(("ok   " if ok else "FAIL ") + what)
-        if not ok:
-            fails.append(what)
+    expect = Checks()
 
     # AGM against a known value: K(sin 45 deg) = 1.854074677301372
     expect(abs(ellipk(0.5) - 1.854074677301372) < 1e-15, f"K(k^2 = 1/2) = {ellipk(0.5):.15f}")
@@ -353,7 +308,7 @@ def check():
     gaps = np.diff(cr2)
     expect(len(gaps) >= 2 and np.abs(gaps - flip).max() < 1e-8 * flip,
            f"torque-free: {len(cr2)} flips of omega_2, spacing {gaps.mean():.10f} s vs 2K/lambda = {flip:.10f} s")
-    _, stored = read_csv("torque_free.csv")
+    _, stored = read_csv(os.path.join(REF_DIR, "torque_free.csv"))
     expect(np.abs(stored[:, 1:] - rows1[:, 1:]).max() < 1e-13, "torque_free.csv reproduced")
 
     # slider-crank: derivatives by differences, loop closure
@@ -370,8 +325,7 @@ def check():
         worst_l = max(worst_l, abs(np.linalg.norm(S - P) - SC["l"]), np.abs((S - P) / SC["l"] - d).max())
     expect(worst_v < 1e-7 and worst_a < 1e-5 and worst_l < 1e-15,
            f"slider-crank: v by differences {worst_v:.1e}, a {worst_a:.1e}, rod length {worst_l:.1e}")
-    print(f"{len(fails)} failure(s)")
-    return 1 if fails else 0
+    return expect.done()
 
 
 if __name__ == "__main__":
