@@ -31,6 +31,9 @@ typedef struct fmbBodyInst {
      (duplicates share one), so the op's values in pair order are summed into place */
   long npair;
   long* ppos;
+  /* fmbBodyType.marker3 when the table has it (ABI 3.3 or later), else NULL */
+  int (*marker3)(const void* self, const double* q, const double local[3], double pos[3], double R[9], double* dpos_dq,
+                 double* rot_dq, int ld, double* work);
 } fmbBodyInst;
 
 typedef struct fmbJointInst {
@@ -137,7 +140,8 @@ struct fmbModel {
   fmbSolverSettings solver;
   int noutput;
   fmbOutput* output;
-  int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
+  int assemble;  /* `initial: assemble`: the initial projection may move bodies by any amount */
+  int dimension; /* the scene's `dimension:`, 2 (planar, the default) or 3 (docs/spatial.md) */
   int need_energy, need_constraint, check_definiteness;
   int need_work;               /* a work or energy.balance column: integrate every joint's power */
   int nredundant;              /* constraint rows that repeat the others at t0 (found at load, ic.c) */

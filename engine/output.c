@@ -25,6 +25,7 @@ static const char* const frame_names[] = {"x", "y", "theta", "omega", "vx", "vy"
 static int body_has_frame(fmbParser* p, const fmbModel* m, int b) {
   static const double origin[2] = {0.0, 0.0};
   double pos[2], angle;
+  if (m->dimension == 3) return 0; /* a spatial body's x, y, z, ... are its own outputs (docs/spatial.md) */
   return m->body[b].nq >= 3 || fmb_initial_marker(p, b, origin, pos, &angle) == 0;
 }
 
@@ -237,14 +238,14 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
         o->kind = o->id == 0 ? FMB_OUT_JOINT_POWER : FMB_OUT_JOINT_WORK;
         if (o->id == 1) m->need_work = 1;
         if (o->id == 0 && ji->nrows > 0) m->need_multipliers = 1;
-      } else if (ji->nrows > 0 && (o->id = lookup(reaction_names, qty)) >= 0) {
+      } else if (ji->nrows > 0 && m->dimension == 2 && (o->id = lookup(reaction_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT_REACTION;
         m->need_multipliers = 1;
       } else if ((o->id = fmb_type_output_id(ji->type->output_lookup, ji->self, ji->type->output_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT;
       }
       if (has_power) list_names(avail, sizeof avail, power_names);
-      if (ji->nrows > 0) list_names(avail, sizeof avail, reaction_names);
+      if (ji->nrows > 0 && m->dimension == 2) list_names(avail, sizeof avail, reaction_names); /* planar for now */
       list_names(avail, sizeof avail, ji->type->output_names);
     }
   }
@@ -311,6 +312,7 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle) {
   const fmbBodyInst* bi = &m->body[b];
+  if (!bi->type->marker) return -1; /* a spatial-only body */
   return bi->type->marker(bi->self, q + bi->qadr, local, pos, angle, NULL, NULL, fmb_workspace_plugin(w) + bi->workadr);
 }
 
@@ -350,12 +352,34 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
   return 0;
 }
 
+/* a spatial scene's default columns: each body's position and Euler parameters, those of
+   BODY.x, y, z, qw, qx, qy, qz that its type answers (docs/spatial.md) */
+static void outputs_default_spatial(fmbModel* m) {
+  static const char* const pose[] = {"x", "y", "z", "qw", "qx", "qy", "qz", NULL};
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    for (int k = 0; pose[k] && bi->nq > 0; ++k) {
+      const int id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, pose[k]);
+      if (id < 0) continue;
+      fmbOutput* o = &m->output[m->noutput++];
+      o->kind = FMB_OUT_BODY;
+      o->owner = b;
+      o->id = id;
+      snprintf(o->name, sizeof o->name, "%s.%s", bi->name, pose[k]);
+    }
+  }
+}
+
 int fmb_outputs_default(fmbParser* p, fmbModel* m) {
-  m->output = calloc(1 + 4 * (size_t)m->nbody, sizeof *m->output);
+  m->output = calloc(1 + 7 * (size_t)m->nbody, sizeof *m->output);
   if (!m->output) return -1;
   m->output[0].kind = FMB_OUT_TIME;
   snprintf(m->output[0].name, sizeof m->output[0].name, "t");
   m->noutput = 1;
+  if (m->dimension == 3) {
+    outputs_default_spatial(m);
+    return 0;
+  }
   for (int b = 1; b < m->nbody; ++b) {
     if (m->body[b].nq == 0 || !body_has_frame(p, m, b)) continue; /* a fixed frame's columns are constants */
     for (int k = 0; k < 4; ++k) {

@@ -123,7 +123,10 @@ static const char* missing_body_op(const fmbBodyType* t) {
   if (!t->ncoord) return "ncoord";
   if (!t->initial) return "initial";
   if (!t->residual) return "residual";
-  if (!t->marker) return "marker";
+  /* a spatial-only type (ABI 3.3) answers marker3 instead of the planar marker */
+  const unsigned dims = fmb_type_dimensions(t->abi, t->dimensions);
+  if ((dims & FMB_DIM_SPATIAL) && !t->marker3) return "marker3 (the type declares FMB_DIM_SPATIAL)";
+  if ((dims & FMB_DIM_PLANAR) && !t->marker) return "marker";
   if ((t->output_lookup || t->output_names) && !t->output) return "output (output_names or output_lookup is set)";
   return NULL;
 }

@@ -102,7 +102,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->fdcol = calloc(nblk, sizeof(double));
   w->fd = calloc(nfd, sizeof(double));
   w->mk = calloc(3 * nb, sizeof(double));
-  w->js = calloc(2 * mc, sizeof(double));
+  w->js = calloc(6 * mc, sizeof(double)); /* fmb_eval_scratch: 6 x the columns from ABI 3.3 */
   w->qpert = calloc(nq, sizeof(double));
   w->vpert = calloc(nq, sizeof(double));
   w->ewt_default = calloc(2 * nq, sizeof(double));
@@ -256,6 +256,7 @@ int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[
     if (angle) *angle = 0.0;
     return 0;
   }
+  if (!bi->type->marker) return -1; /* a spatial-only body: refused in a planar scene at parse */
   const int n = bi->nq;
   double* dp = dpos_dq ? ev->mk : NULL;
   int rc = bi->type->marker(bi->self, ev->q + bi->qadr, local, pos, angle, dp, dangle_dq, ev->work + bi->workadr);
