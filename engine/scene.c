@@ -207,6 +207,50 @@ static int check_library_keys(fmbParser* p, fmbNode lib, const char* what) {
   return 0;
 }
 
+/* the FMB_DIM_* of registered type i */
+static unsigned registered_dimensions(const fmbRegistry* reg, int joints, int i) {
+  return joints ? fmb_type_dimensions(reg->joints[i]->abi, reg->joints[i]->dimensions)
+                : fmb_type_dimensions(reg->bodies[i]->abi, reg->bodies[i]->dimensions);
+}
+
+/* an item's `type:`, one of the registered types that work in the scene's dimension (they are
+   the choices a message lists); a type of the other dimension is refused as such. *t is the
+   registry index. */
+static int get_type(fmbParser* p, fmbNode item, int joints, const char* const* names, int* t) {
+  const char* kind = joints ? "joint" : "body";
+  const unsigned need = p->model->dimension == 3 ? FMB_DIM_SPATIAL : FMB_DIM_PLANAR;
+  int n = 0;
+  while (names[n]) ++n;
+  const char** offered = calloc((size_t)n + 1, sizeof *offered);
+  int* index = calloc((size_t)n + 1, sizeof *index);
+  if (!offered || !index) {
+    free(offered), free(index);
+    return fmb_parse_error(p, item, "out of memory");
+  }
+  int k = 0;
+  for (int i = 0; i < n; ++i)
+    if (registered_dimensions(p->reg, joints, i) & need) offered[k] = names[i], index[k++] = i;
+  const fmbNode node = fmb_find_key(p, item, "type");
+  const char* given = fmbp_scalar(p, node);
+  int other = -1; /* a registered type of the other dimension, named as given */
+  for (int i = 0; given && i < n; ++i)
+    if (strcmp(names[i], given) == 0 && !(registered_dimensions(p->reg, joints, i) & need)) other = i;
+  int choice = 0, rc = 0;
+  if (other >= 0)
+    rc = fmb_parse_error(p, node,
+                         "%s type '%s' is %s; this scene is %s (the top-level 'dimension: %d'%s): `flexmbd types` "
+                         "lists the types of each dimension",
+                         kind, given, need == FMB_DIM_SPATIAL ? "planar" : "spatial (dimension 3)",
+                         need == FMB_DIM_SPATIAL ? "spatial" : "planar", p->model->dimension,
+                         need == FMB_DIM_SPATIAL ? "" : ", the default");
+  else
+    rc = fmb_get_choice(p, item, "type", FMB_REQUIRED, offered, &choice);
+  if (rc == 0) *t = index[choice];
+  free(offered);
+  free(index);
+  return rc ? -1 : 0;
+}
+
 /* What every body and joint item shares: a mapping with a fresh name and a registered type, read
    by its plugin with no key left unread. On success *self belongs to the caller; on error
    nothing is left allocated. */
@@ -222,7 +266,7 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   if (name_taken(m, name))
     return fmb_parse_error(p, fmb_find_key(p, item, "name"),
                            "duplicate or reserved name '%s': every body and joint needs its own name", name);
-  if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
+  if (get_type(p, item, joints, names, t)) return -1;
   if (resolve_references(p, item)) return -1;
   p->item = item;
   /* a type with implementations behind one name picks this item's (fmbBodyType.variant) */
@@ -233,19 +277,7 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   }
   if (body_type) *body_type = bt;
   const char* type_name = joints ? p->reg->joints[*t]->name : bt->name;
-  /* a type works in the dimensions it declares (ABI 3.3; an older table is planar) */
-  const unsigned dims = fmb_type_dimensions(joints ? p->reg->joints[*t]->abi : bt->abi,
-                                            joints ? p->reg->joints[*t]->dimensions : bt->dimensions);
-  const unsigned need = p->model->dimension == 3 ? FMB_DIM_SPATIAL : FMB_DIM_PLANAR;
-  if (!(dims & need)) {
-    p->item = p->inherited[0] = p->inherited[1] = -1;
-    return fmb_parse_error(p, fmb_find_key(p, item, "type"),
-                           "%s type '%s' is %s; this scene is %s (the top-level 'dimension: %d'%s): `flexmbd types` "
-                           "lists the types of each dimension",
-                           kind, type_name, need == FMB_DIM_SPATIAL ? "planar" : "spatial (dimension 3)",
-                           need == FMB_DIM_SPATIAL ? "spatial" : "planar", p->model->dimension,
-                           need == FMB_DIM_SPATIAL ? "" : ", the default");
-  }
+
   int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : bt->parse;
   void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : bt->destroy;
   char what[FMB_NAME_MAX + 40];

@@ -35,11 +35,8 @@ typedef struct {
   {                                                                                                                    \
     .key = "point2", .kind = FMB_PARAM_VEC3, .unit = "m", .fallback = "[0, 0, 0]", .doc = "point on body2, body frame" \
   }
-#define FMBJ_SPATIAL_AXIS_PARAM(what)                                            \
-  {                                                                              \
-    .key = "axis", .kind = FMB_PARAM_VEC3, .fallback = "[0, 0, 1]", \
-    .doc = what " (global frame, in the scene's pose)"                           \
-  }
+#define FMBJ_SPATIAL_AXIS_PARAM(what) \
+  { .key = "axis", .kind = FMB_PARAM_VEC3, .fallback = "[0, 0, 1]", .doc = what " (global frame, in the scene's pose)" }
 
 /* body1, body2, point1, point2; with `axis_key` (or NULL: the global axes) the joint frame's z
    axis, a global direction in the scene's pose, carried into both bodies' frames */

@@ -49,16 +49,14 @@ static void universal_describe(const void* self, FILE* out) {
   fprintf(out, "the points coincide, the two pins stay perpendicular (4 rows)\n");
 }
 
-static const fmbParam universal_params[] = {FMBJ_SPATIAL_PAIR_PARAMS,
-                                            {.key = "axis1",
-                                             .kind = FMB_PARAM_VEC3,
-                                             .fallback = "[1, 0, 0]",
-                                             .doc = "pin on body1 (global, scene pose)"},
-                                            {.key = "axis2",
-                                             .kind = FMB_PARAM_VEC3,
-                                             .fallback = "[0, 1, 0]",
-                                             .doc = "pin on body2 (global, scene pose), perpendicular to axis1"},
-                                            {.key = NULL}};
+static const fmbParam universal_params[] = {
+    FMBJ_SPATIAL_PAIR_PARAMS,
+    {.key = "axis1", .kind = FMB_PARAM_VEC3, .fallback = "[1, 0, 0]", .doc = "pin on body1 (global, scene pose)"},
+    {.key = "axis2",
+     .kind = FMB_PARAM_VEC3,
+     .fallback = "[0, 1, 0]",
+     .doc = "pin on body2 (global, scene pose), perpendicular to axis1"},
+    {.key = NULL}};
 
 const fmbJointType fmb_joint_universal = {
     .name = "universal",
