@@ -30,7 +30,7 @@ extern "C" {
    reads as size 0: the fields 3.0 had. 3.2: fmbBodyType.aux_iterated, appended; the engine reads
    it only from a table whose `abi` says 3.2 or later (a table of an older minor ends before it).
    3.3: space (docs/spatial.md): fmbBodyType.dimensions and .marker3, fmbJointType.dimensions,
-   fmbEnv.gravity3, FMB_PARAM_VEC3/QUAT, appended; fmb_marker3, fmb_get_vec3, fmb_get_quat, fmb_get_point3, fmb_initial_marker3,
+   fmbJointType.attachment3, fmbEnv.gravity3, FMB_PARAM_VEC3/QUAT, appended; fmb_marker3, fmb_get_vec3, fmb_get_quat, fmb_get_point3, fmb_initial_marker3,
    fmb_scene_dimension, fmb_frame3_point. A table of an older minor is planar. */
 #define FMB_PLUGIN_ABI_MAJOR 3
 #define FMB_PLUGIN_ABI_MINOR 3
@@ -361,6 +361,9 @@ typedef struct fmbJointType {
   const char* const* output_units;
   /* ABI 3.3, read only from a table whose abi is 3.3 or later: FMB_DIM_* (0 = planar) */
   unsigned dimensions;
+  /* ABI 3.3, optional: attachment's spatial twin, body and local point [x, y, z] of attachment k
+     of a spatial joint with constraint rows: where the engine reports its reaction torque */
+  int (*attachment3)(const void* self, int k, int* body, double local[3]);
 } fmbJointType;
 
 /* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,

@@ -348,6 +348,12 @@ double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
    on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
 int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        const double* lambda, double out[3]);
+/* its spatial twin (dimension 3): force (global) and torque (global, about the joint's point,
+   fmbJointType.attachment3, else about the body's origin) on body2 (body1's negated when body2
+   is the ground), from a body's marker3: the wrench [F; tau] whose generalized force
+   (dr/dq)^T F + G^T tau is the constraint force on the body's coordinates (least squares) */
+int fmb_joint_reaction3(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                        const double* lambda, double out[6]);
 /* work done by each joint since t0 (njoint entries, filled by the integrator before each row) and
    the force elements' potential energy at t0 (energy.balance) */
 double* fmb_workspace_work(fmbWorkspace* w);

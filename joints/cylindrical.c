@@ -77,6 +77,7 @@ const fmbJointType fmb_joint_cylindrical = {
     .describe = cylindrical_describe,
     .destroy = cylindrical_destroy,
     .bodies = fmbj3_bodies,
+    .attachment3 = fmbj3_attachment,
     .nrows = cylindrical_nrows,
     .constraint = cylindrical_constraint,
     .output_names = cylindrical_outputs,

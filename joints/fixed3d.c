@@ -51,6 +51,7 @@ const fmbJointType fmb_joint_fixed3d = {
     .describe = fixed3d_describe,
     .destroy = fixed3d_destroy,
     .bodies = fmbj3_bodies,
+    .attachment3 = fmbj3_attachment,
     .nrows = fixed3d_nrows,
     .constraint = fixed3d_constraint,
     .params = fixed3d_params,

@@ -67,6 +67,7 @@ const fmbJointType fmb_joint_prismatic3d = {
     .describe = prismatic3d_describe,
     .destroy = prismatic3d_destroy,
     .bodies = fmbj3_bodies,
+    .attachment3 = fmbj3_attachment,
     .nrows = prismatic3d_nrows,
     .constraint = prismatic3d_constraint,
     .output_names = prismatic3d_outputs,

@@ -70,6 +70,7 @@ const fmbJointType fmb_joint_revolute3d = {
     .describe = revolute3d_describe,
     .destroy = revolute3d_destroy,
     .bodies = fmbj3_bodies,
+    .attachment3 = fmbj3_attachment,
     .nrows = revolute3d_nrows,
     .constraint = revolute3d_constraint,
     .output_names = revolute3d_outputs,

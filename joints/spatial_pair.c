@@ -64,6 +64,14 @@ void fmbj3_bodies(const void* self, int body[2]) {
   body[1] = sp->body[1];
 }
 
+int fmbj3_attachment(const void* self, int k, int* body, double local[3]) {
+  const fmbSpatialPair* sp = self;
+  if (k != 0 && k != 1) return -1;
+  *body = sp->body[k];
+  for (int i = 0; i < 3; ++i) local[i] = sp->point[k][i];
+  return 0;
+}
+
 int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, double* phi_q, int ld, fmbSpatialEval* e) {
   double pos[2][3], R[2][9];
   double* G = phi_q ? fmb_eval_scratch(ev) : NULL;

@@ -50,6 +50,8 @@ void fmbj3_frame_about(const double z[3], double F[9]);
 int fmbj3_set_frame(fmbParser* p, fmbNode item, const double F[9], fmbSpatialPair* sp);
 /* the `bodies` op of a joint whose state begins with its fmbSpatialPair */
 void fmbj3_bodies(const void* self, int body[2]);
+/* its `attachment3` op: body and point of attachment k */
+int fmbj3_attachment(const void* self, int k, int* body, double local[3]);
 /* the gap, the frames and (phi_q not NULL) the gap's rows 0..2 of phi_q with stride ld and the
    bodies' virtual rotations */
 int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, double* phi_q, int ld, fmbSpatialEval* e);

@@ -46,6 +46,7 @@ const fmbJointType fmb_joint_spherical = {
     .describe = spherical_describe,
     .destroy = spherical_destroy,
     .bodies = fmbj3_bodies,
+    .attachment3 = fmbj3_attachment,
     .nrows = spherical_nrows,
     .constraint = spherical_constraint,
     .params = spherical_params,

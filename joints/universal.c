@@ -65,6 +65,7 @@ const fmbJointType fmb_joint_universal = {
     .describe = universal_describe,
     .destroy = universal_destroy,
     .bodies = fmbj3_bodies,
+    .attachment3 = fmbj3_attachment,
     .nrows = universal_nrows,
     .constraint = universal_constraint,
     .params = universal_params,

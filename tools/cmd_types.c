@@ -85,7 +85,7 @@ int fmb_cmd_types(int argc, char** argv) {
     print_outputs(frame, planar, t->centreline ? "shape shape_N" : NULL, t->output_names);
   }
   printf("joints and forces (power and work: a joint with constraint rows or a force; reaction_*: with "
-         "constraint rows, planar; dimension 3: a type for `dimension: 3` scenes, docs/spatial.md):\n");
+         "constraint rows; dimension 3: a type for `dimension: 3` scenes, docs/spatial.md):\n");
   for (int i = 0; i < fmb_registry_njoints(reg); ++i) {
     const fmbJointType* t = fmb_registry_joint(reg, i);
     const int planar = (fmb_type_dimensions(t->abi, t->dimensions) & FMB_DIM_PLANAR) != 0;
@@ -95,7 +95,7 @@ int fmb_cmd_types(int argc, char** argv) {
     const char* const* engine_given[2];
     int n = 0;
     if (t->nrows || t->force) engine_given[n++] = fmb_engine_outputs("power");
-    if (t->nrows && planar) engine_given[n++] = fmb_engine_outputs("reaction"); /* planar for now */
+    if (t->nrows) engine_given[n++] = fmb_engine_outputs(planar ? "reaction" : "reaction3");
     print_outputs(engine_given, n, NULL, t->output_names);
   }
   printf("scene-wide:\n    outputs:");
