@@ -487,6 +487,10 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
       return fmb_parse_error(p, vtk, "expected a directory name for 'vtk' (where the ParaView animation goes)");
     snprintf(m->vtk_dir, sizeof m->vtk_dir, "%s", dir);
   }
+  if (m->initial_static && m->dimension == 3)
+    return fmb_parse_error(p, fmb_find_key(p, root, "initial"),
+                           "'initial: static' is planar for now: statics of spatial scenes (dimension: 3) are not "
+                           "implemented yet");
   if (vtk >= 0 && m->dimension == 3)
     return fmb_parse_error(p, vtk,
                            "'vtk' is planar for now: a spatial scene (dimension: 3) has no ParaView output yet");
@@ -603,6 +607,7 @@ unsigned fmb_type_dimensions(int abi, unsigned dimensions) {
 }
 
 int fmb_model_nbody(const fmbModel* m) { return m ? m->nbody - 1 : 0; }
+int fmb_model_dimension(const fmbModel* m) { return m ? m->dimension : 0; }
 
 int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type) {
   if (!m || i < 0 || i >= m->nbody - 1) return -1;
