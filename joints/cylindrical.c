@@ -4,42 +4,27 @@
  * Outputs `angle` (as revolute3d's) and `displacement` ((p2 - p1) . z1). */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 
 #include "spatial_pair.h"
 
 static int cylindrical_parse(fmbParser* p, fmbNode item, void** self) {
-  fmbSpatialPair* sp = calloc(1, sizeof *sp);
-  if (!sp) return fmb_parse_error(p, item, "out of memory");
-  *self = sp;
+  fmbSpatialPair* sp = NULL;
+  if (fmbj3_new(p, item, self, &sp)) return -1;
   return fmbj3_parse(p, item, "axis", sp);
 }
 
-static void cylindrical_destroy(void* self) { free(self); }
+static const fmbj3Row cylindrical_rows[] = {
+    {FMBJ3_AXES, 2, 0}, {FMBJ3_AXES, 2, 1}, {FMBJ3_GAP_ALONG, 0, 0}, {FMBJ3_GAP_ALONG, 1, 0}};
+
 static int cylindrical_nrows(const void* self) {
   (void)self;
-  return 4;
+  return (int)(sizeof cylindrical_rows / sizeof cylindrical_rows[0]);
 }
 
 static int cylindrical_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                                   double* phi_tt) {
   (void)phi_t, (void)phi_tt; /* scleronomic */
-  const int n0 = fmb_eval_ncoord(ev, 0), ld = n0 + fmb_eval_ncoord(ev, 1);
-  fmbSpatialEval e;
-  const int rc = fmbj3_eval(ev, self, phi_q, ld, &e);
-  if (rc) return rc;
-#define ROW(r) (phi_q ? phi_q + (size_t)(r)*ld : NULL)
-  /* the gap's derivative sits in rows 0..2 until the two gap rows are made from it; the second
-     waits in the scratch after the virtual rotations (3 rows of ld) */
-  double* tmp = phi_q ? fmb_eval_scratch(ev) + 3 * (size_t)ld : NULL;
-  phi[3] = fmbj3_gap_row(&e, 0, phi_q, ROW(3), n0, ld);
-  const double gy = fmbj3_gap_row(&e, 1, phi_q, tmp, n0, ld);
-  phi[0] = fmbj3_axes_row(&e, 2, 0, ROW(0), n0, ld);
-  phi[1] = fmbj3_axes_row(&e, 2, 1, ROW(1), n0, ld);
-  phi[2] = gy;
-  for (int c = 0; tmp && c < ld; ++c) phi_q[2 * (size_t)ld + c] = tmp[c];
-#undef ROW
-  return 0;
+  return fmbj3_rows(ev, self, cylindrical_rows, cylindrical_nrows(self), phi, phi_q);
 }
 
 static void cylindrical_describe(const void* self, FILE* out) {
@@ -51,19 +36,9 @@ static const char* const cylindrical_outputs[] = {"angle", "displacement", NULL}
 static const char* const cylindrical_output_units[] = {"rad", "m", NULL};
 static int cylindrical_output(const void* self, int id, const fmbJointEval* ev, double* value) {
   fmbSpatialEval e;
-  const int rc = fmbj3_eval(ev, self, NULL, 0, &e);
+  const int rc = fmbj3_eval(ev, self, 0, 0, &e);
   if (rc) return rc;
-  /* the turn of body2's frame x axis from body1's, about body1's z axis: (-pi, pi] */
-  double c[3];
-  const double* X1 = e.X[0];
-  const double* X2 = e.X[1];
-  c[0] = X1[3] * X2[6] - X1[6] * X2[3];
-  c[1] = X1[6] * X2[0] - X1[0] * X2[6];
-  c[2] = X1[0] * X2[3] - X1[3] * X2[0];
-  const double angle = atan2(c[0] * X1[2] + c[1] * X1[5] + c[2] * X1[8], X1[0] * X2[0] + X1[3] * X2[3] + X1[6] * X2[6]);
-  const double displacement =
-      -(e.gap[0] * e.X[0][2] + e.gap[1] * e.X[0][5] + e.gap[2] * e.X[0][8]); /* (p2 - p1) . z1 */
-  *value = id == 0 ? angle : displacement;
+  *value = id == 0 ? fmbj3_turn(&e) : fmbj3_slide(&e);
   return 0;
 }
 
@@ -75,7 +50,7 @@ const fmbJointType fmb_joint_cylindrical = {
     .abi = FMB_ABI_VERSION,
     .parse = cylindrical_parse,
     .describe = cylindrical_describe,
-    .destroy = cylindrical_destroy,
+    .destroy = fmbj3_destroy,
     .bodies = fmbj3_bodies,
     .attachment3 = fmbj3_attachment,
     .nrows = cylindrical_nrows,

@@ -4,37 +4,27 @@
  * assembled, and to first order they hold the three small relative rotations about z, x and y). */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 
 #include "spatial_pair.h"
 
 static int fixed3d_parse(fmbParser* p, fmbNode item, void** self) {
-  fmbSpatialPair* sp = calloc(1, sizeof *sp);
-  if (!sp) return fmb_parse_error(p, item, "out of memory");
-  *self = sp;
+  fmbSpatialPair* sp = NULL;
+  if (fmbj3_new(p, item, self, &sp)) return -1;
   return fmbj3_parse(p, item, NULL, sp);
 }
 
-static void fixed3d_destroy(void* self) { free(self); }
+static const fmbj3Row fixed3d_rows[] = {{FMBJ3_GAP, 0, 0},  {FMBJ3_GAP, 1, 0},  {FMBJ3_GAP, 2, 0},
+                                        {FMBJ3_AXES, 0, 1}, {FMBJ3_AXES, 1, 2}, {FMBJ3_AXES, 2, 0}};
+
 static int fixed3d_nrows(const void* self) {
   (void)self;
-  return 6;
+  return (int)(sizeof fixed3d_rows / sizeof fixed3d_rows[0]);
 }
 
 static int fixed3d_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                               double* phi_tt) {
   (void)phi_t, (void)phi_tt; /* scleronomic */
-  const int n0 = fmb_eval_ncoord(ev, 0), ld = n0 + fmb_eval_ncoord(ev, 1);
-  fmbSpatialEval e;
-  const int rc = fmbj3_eval(ev, self, phi_q, ld, &e);
-  if (rc) return rc;
-#define ROW(r) (phi_q ? phi_q + (size_t)(r)*ld : NULL)
-  for (int i = 0; i < 3; ++i) phi[i] = e.gap[i];
-  phi[3] = fmbj3_axes_row(&e, 0, 1, ROW(3), n0, ld);
-  phi[4] = fmbj3_axes_row(&e, 1, 2, ROW(4), n0, ld);
-  phi[5] = fmbj3_axes_row(&e, 2, 0, ROW(5), n0, ld);
-#undef ROW
-  return 0;
+  return fmbj3_rows(ev, self, fixed3d_rows, fixed3d_nrows(self), phi, phi_q);
 }
 
 static void fixed3d_describe(const void* self, FILE* out) {
@@ -49,7 +39,7 @@ const fmbJointType fmb_joint_fixed3d = {
     .abi = FMB_ABI_VERSION,
     .parse = fixed3d_parse,
     .describe = fixed3d_describe,
-    .destroy = fixed3d_destroy,
+    .destroy = fmbj3_destroy,
     .bodies = fmbj3_bodies,
     .attachment3 = fmbj3_attachment,
     .nrows = fixed3d_nrows,

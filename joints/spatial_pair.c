@@ -2,6 +2,7 @@
 #include "spatial_pair.h"
 
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 static void cross(const double a[3], const double b[3], double c[3]) {
@@ -72,16 +73,25 @@ int fmbj3_attachment(const void* self, int k, int* body, double local[3]) {
   return 0;
 }
 
-int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, double* phi_q, int ld, fmbSpatialEval* e) {
+int fmbj3_new(fmbParser* p, fmbNode item, void** self, fmbSpatialPair** sp) {
+  *sp = calloc(1, sizeof **sp);
+  *self = *sp;
+  return *sp ? 0 : fmb_parse_error(p, item, "out of memory");
+}
+
+void fmbj3_destroy(void* self) { free(self); }
+
+int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, int derivatives, int ld, fmbSpatialEval* e) {
   double pos[2][3], R[2][9];
-  double* G = phi_q ? fmb_eval_scratch(ev) : NULL;
+  double* G = derivatives ? fmb_eval_scratch(ev) : NULL;
+  double* gap_q = G ? G + 3 * (size_t)ld : NULL;
   for (int k = 0; k < 2; ++k) {
     const int c0 = fmb_eval_col0(ev, k), n = fmb_eval_ncoord(ev, k);
-    const int rc = fmb_marker3(ev, k, sp->point[k], pos[k], R[k], phi_q ? phi_q + c0 : NULL, G ? G + c0 : NULL, ld);
+    const int rc = fmb_marker3(ev, k, sp->point[k], pos[k], R[k], gap_q ? gap_q + c0 : NULL, G ? G + c0 : NULL, ld);
     if (rc) return rc;
-    if (k == 1 && phi_q)
+    if (k == 1 && gap_q)
       for (int i = 0; i < 3; ++i)
-        for (int c = 0; c < n; ++c) phi_q[(size_t)i * ld + c0 + c] = -phi_q[(size_t)i * ld + c0 + c];
+        for (int c = 0; c < n; ++c) gap_q[(size_t)i * ld + c0 + c] = -gap_q[(size_t)i * ld + c0 + c];
     for (int i = 0; i < 3; ++i) /* X = R frame */
       for (int c = 0; c < 3; ++c)
         e->X[k][3 * i + c] = R[k][3 * i] * sp->frame[k][c] + R[k][3 * i + 1] * sp->frame[k][3 + c] +
@@ -89,17 +99,19 @@ int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, double* phi_q, 
   }
   for (int i = 0; i < 3; ++i) e->gap[i] = pos[0][i] - pos[1][i];
   e->G = G;
+  e->gap_q = gap_q;
   e->ld = ld;
   return 0;
 }
 
-double fmbj3_axes_row(const fmbSpatialEval* e, int ca, int cb, double* row, int ncol0, int ncol) {
+/* row of d(A . B)/dq, A = axis ca of frame 1, B = axis cb of frame 2; returns A . B */
+static double axes_row(const fmbSpatialEval* e, int ca, int cb, double* row, int ncol0) {
   const double A[3] = {e->X[0][ca], e->X[0][3 + ca], e->X[0][6 + ca]};
   const double B[3] = {e->X[1][cb], e->X[1][3 + cb], e->X[1][6 + cb]};
   if (row && e->G) {
     double AxB[3];
     cross(A, B, AxB);
-    for (int c = 0; c < ncol; ++c) {
+    for (int c = 0; c < e->ld; ++c) {
       const double s = c < ncol0 ? 1.0 : -1.0; /* body2 sees B x A */
       row[c] = s * (e->G[c] * AxB[0] + e->G[e->ld + c] * AxB[1] + e->G[2 * (size_t)e->ld + c] * AxB[2]);
     }
@@ -107,15 +119,50 @@ double fmbj3_axes_row(const fmbSpatialEval* e, int ca, int cb, double* row, int 
   return A[0] * B[0] + A[1] * B[1] + A[2] * B[2];
 }
 
-double fmbj3_gap_row(const fmbSpatialEval* e, int ca, const double* gap_q, double* row, int ncol0, int ncol) {
+/* row of d(gap . A)/dq, A = axis ca of frame 1 (turning with body1); returns gap . A */
+static double gap_row(const fmbSpatialEval* e, int ca, double* row, int ncol0) {
   const double A[3] = {e->X[0][ca], e->X[0][3 + ca], e->X[0][6 + ca]};
+  const size_t ld = (size_t)e->ld;
   if (row && e->G) {
     double Axd[3];
     cross(A, e->gap, Axd);
-    for (int c = 0; c < ncol; ++c) {
-      row[c] = gap_q[c] * A[0] + gap_q[e->ld + c] * A[1] + gap_q[2 * (size_t)e->ld + c] * A[2];
-      if (c < ncol0) row[c] += e->G[c] * Axd[0] + e->G[e->ld + c] * Axd[1] + e->G[2 * (size_t)e->ld + c] * Axd[2];
+    for (int c = 0; c < e->ld; ++c) {
+      row[c] = e->gap_q[c] * A[0] + e->gap_q[ld + c] * A[1] + e->gap_q[2 * ld + c] * A[2];
+      if (c < ncol0) row[c] += e->G[c] * Axd[0] + e->G[ld + c] * Axd[1] + e->G[2 * ld + c] * Axd[2];
     }
   }
   return e->gap[0] * A[0] + e->gap[1] * A[1] + e->gap[2] * A[2];
+}
+
+int fmbj3_rows(const fmbJointEval* ev, const fmbSpatialPair* sp, const fmbj3Row* rows, int nrows, double* phi,
+               double* phi_q) {
+  const int n0 = fmb_eval_ncoord(ev, 0), ld = n0 + fmb_eval_ncoord(ev, 1);
+  fmbSpatialEval e;
+  const int rc = fmbj3_eval(ev, sp, phi_q != NULL, ld, &e);
+  if (rc) return rc;
+  for (int r = 0; r < nrows; ++r) {
+    double* row = phi_q ? phi_q + (size_t)r * ld : NULL;
+    const fmbj3Row* w = &rows[r];
+    if (w->kind == FMBJ3_GAP) {
+      phi[r] = e.gap[w->a];
+      for (int c = 0; row && c < ld; ++c) row[c] = e.gap_q[(size_t)w->a * ld + c];
+    } else if (w->kind == FMBJ3_AXES) {
+      phi[r] = axes_row(&e, w->a, w->b, row, n0);
+    } else {
+      phi[r] = gap_row(&e, w->a, row, n0);
+    }
+  }
+  return 0;
+}
+
+double fmbj3_turn(const fmbSpatialEval* e) {
+  const double *X1 = e->X[0], *X2 = e->X[1];
+  const double x1[3] = {X1[0], X1[3], X1[6]}, z1[3] = {X1[2], X1[5], X1[8]}, x2[3] = {X2[0], X2[3], X2[6]};
+  double c[3];
+  cross(x1, x2, c);
+  return atan2(c[0] * z1[0] + c[1] * z1[1] + c[2] * z1[2], x1[0] * x2[0] + x1[1] * x2[1] + x1[2] * x2[2]);
+}
+
+double fmbj3_slide(const fmbSpatialEval* e) {
+  return -(e->gap[0] * e->X[0][2] + e->gap[1] * e->X[0][5] + e->gap[2] * e->X[0][8]);
 }

@@ -20,9 +20,17 @@ typedef struct {
 typedef struct {
   double gap[3];
   double X[2][9];
-  const double* G; /* 3 rows of ld, or NULL when no derivatives were asked for */
+  const double* G;     /* 3 rows of ld, or NULL when no derivatives were asked for */
+  const double* gap_q; /* d(p1 - p2)/dq, 3 rows of ld after G in the scratch, or NULL */
   int ld;
 } fmbSpatialEval;
+
+/* one constraint row: the gap's component a; axis a of frame 1 . axis b of frame 2; the gap along
+   axis a of frame 1 */
+enum { FMBJ3_GAP, FMBJ3_AXES, FMBJ3_GAP_ALONG };
+typedef struct {
+  int kind, a, b;
+} fmbj3Row;
 
 #define FMBJ_SPATIAL_PAIR_PARAMS                                                                                       \
   {.key = "body1", .kind = FMB_PARAM_BODY, .flags = FMB_REQUIRED, .doc = "first body (or ground)"},                    \
@@ -52,11 +60,17 @@ int fmbj3_set_frame(fmbParser* p, fmbNode item, const double F[9], fmbSpatialPai
 void fmbj3_bodies(const void* self, int body[2]);
 /* its `attachment3` op: body and point of attachment k */
 int fmbj3_attachment(const void* self, int k, int* body, double local[3]);
-/* the gap, the frames and (phi_q not NULL) the gap's rows 0..2 of phi_q with stride ld and the
-   bodies' virtual rotations */
-int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, double* phi_q, int ld, fmbSpatialEval* e);
-/* row of d(A . B)/dq, A = axis ca of frame 1, B = axis cb of frame 2; returns A . B */
-double fmbj3_axes_row(const fmbSpatialEval* e, int ca, int cb, double* row, int ncol0, int ncol);
-/* row of d(gap . A)/dq, A = axis ca of frame 1, from the gap's rows gap_q (3 rows of ld); returns gap . A */
-double fmbj3_gap_row(const fmbSpatialEval* e, int ca, const double* gap_q, double* row, int ncol0, int ncol);
+/* the gap, the frames and (derivatives) the gap's and the bodies' virtual rotations' rows over the
+   joint's ld columns, in fmb_eval_scratch */
+int fmbj3_eval(const fmbJointEval* ev, const fmbSpatialPair* sp, int derivatives, int ld, fmbSpatialEval* e);
+/* a joint's constraint op from its list of rows: phi and (not NULL) phi_q */
+int fmbj3_rows(const fmbJointEval* ev, const fmbSpatialPair* sp, const fmbj3Row* rows, int nrows, double* phi,
+               double* phi_q);
+/* the turn of frame 2's x axis from frame 1's about frame 1's z axis, in (-pi, pi]; the slide
+   (p2 - p1) . z1 */
+double fmbj3_turn(const fmbSpatialEval* e);
+double fmbj3_slide(const fmbSpatialEval* e);
+/* a joint's state (an fmbSpatialPair) allocated into *self; its destroy op */
+int fmbj3_new(fmbParser* p, fmbNode item, void** self, fmbSpatialPair** sp);
+void fmbj3_destroy(void* self);
 #endif

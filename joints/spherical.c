@@ -2,34 +2,26 @@
  * Phi = p1 - p2 (3 rows). The bodies turn freely about the point. */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 
 #include "spatial_pair.h"
 
 static int spherical_parse(fmbParser* p, fmbNode item, void** self) {
-  fmbSpatialPair* sp = calloc(1, sizeof *sp);
-  if (!sp) return fmb_parse_error(p, item, "out of memory");
-  *self = sp;
+  fmbSpatialPair* sp = NULL;
+  if (fmbj3_new(p, item, self, &sp)) return -1;
   return fmbj3_parse(p, item, NULL, sp);
 }
 
-static void spherical_destroy(void* self) { free(self); }
+static const fmbj3Row spherical_rows[] = {{FMBJ3_GAP, 0, 0}, {FMBJ3_GAP, 1, 0}, {FMBJ3_GAP, 2, 0}};
+
 static int spherical_nrows(const void* self) {
   (void)self;
-  return 3;
+  return (int)(sizeof spherical_rows / sizeof spherical_rows[0]);
 }
 
 static int spherical_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                                 double* phi_tt) {
   (void)phi_t, (void)phi_tt; /* scleronomic */
-  const int n0 = fmb_eval_ncoord(ev, 0), ld = n0 + fmb_eval_ncoord(ev, 1);
-  fmbSpatialEval e;
-  const int rc = fmbj3_eval(ev, self, phi_q, ld, &e);
-  if (rc) return rc;
-#define ROW(r) (phi_q ? phi_q + (size_t)(r)*ld : NULL)
-  for (int i = 0; i < 3; ++i) phi[i] = e.gap[i];
-#undef ROW
-  return 0;
+  return fmbj3_rows(ev, self, spherical_rows, spherical_nrows(self), phi, phi_q);
 }
 
 static void spherical_describe(const void* self, FILE* out) {
@@ -44,7 +36,7 @@ const fmbJointType fmb_joint_spherical = {
     .abi = FMB_ABI_VERSION,
     .parse = spherical_parse,
     .describe = spherical_describe,
-    .destroy = spherical_destroy,
+    .destroy = fmbj3_destroy,
     .bodies = fmbj3_bodies,
     .attachment3 = fmbj3_attachment,
     .nrows = spherical_nrows,

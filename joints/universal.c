@@ -4,14 +4,12 @@
  *   Phi = [p1 - p2; x1 . y2]        (4 rows). */
 #include <math.h>
 #include <stdio.h>
-#include <stdlib.h>
 
 #include "spatial_pair.h"
 
 static int universal_parse(fmbParser* p, fmbNode item, void** self) {
-  fmbSpatialPair* sp = calloc(1, sizeof *sp);
-  if (!sp) return fmb_parse_error(p, item, "out of memory");
-  *self = sp;
+  fmbSpatialPair* sp = NULL;
+  if (fmbj3_new(p, item, self, &sp)) return -1;
   double a1[3] = {1.0, 0.0, 0.0}, a2[3] = {0.0, 1.0, 0.0};
   if (fmbj3_parse_points(p, item, sp) || fmbj3_direction(p, item, "axis1", a1) || fmbj3_direction(p, item, "axis2", a2))
     return -1;
@@ -24,24 +22,17 @@ static int universal_parse(fmbParser* p, fmbNode item, void** self) {
   return fmbj3_set_frame(p, item, F, sp);
 }
 
-static void universal_destroy(void* self) { free(self); }
+static const fmbj3Row universal_rows[] = {{FMBJ3_GAP, 0, 0}, {FMBJ3_GAP, 1, 0}, {FMBJ3_GAP, 2, 0}, {FMBJ3_AXES, 0, 1}};
+
 static int universal_nrows(const void* self) {
   (void)self;
-  return 4;
+  return (int)(sizeof universal_rows / sizeof universal_rows[0]);
 }
 
 static int universal_constraint(const void* self, const fmbJointEval* ev, double* phi, double* phi_q, double* phi_t,
                                 double* phi_tt) {
   (void)phi_t, (void)phi_tt; /* scleronomic */
-  const int n0 = fmb_eval_ncoord(ev, 0), ld = n0 + fmb_eval_ncoord(ev, 1);
-  fmbSpatialEval e;
-  const int rc = fmbj3_eval(ev, self, phi_q, ld, &e);
-  if (rc) return rc;
-#define ROW(r) (phi_q ? phi_q + (size_t)(r)*ld : NULL)
-  for (int i = 0; i < 3; ++i) phi[i] = e.gap[i];
-  phi[3] = fmbj3_axes_row(&e, 0, 1, ROW(3), n0, ld);
-#undef ROW
-  return 0;
+  return fmbj3_rows(ev, self, universal_rows, universal_nrows(self), phi, phi_q);
 }
 
 static void universal_describe(const void* self, FILE* out) {
@@ -63,7 +54,7 @@ const fmbJointType fmb_joint_universal = {
     .abi = FMB_ABI_VERSION,
     .parse = universal_parse,
     .describe = universal_describe,
-    .destroy = universal_destroy,
+    .destroy = fmbj3_destroy,
     .bodies = fmbj3_bodies,
     .attachment3 = fmbj3_attachment,
     .nrows = universal_nrows,
