@@ -174,7 +174,7 @@ enum {
    the scene's `dimension:` is refused at its `type:`. */
 enum { FMB_DIM_PLANAR = 1 << 0, FMB_DIM_SPATIAL = 1 << 1 };
 /* the FMB_DIM_* of a table: its `dimensions` when its abi is 3.3 or later and it set them, else
-   FMB_DIM_PLANAR (engine/scene.c) */
+   FMB_DIM_PLANAR (engine/registry.c) */
 FMB_API unsigned fmb_type_dimensions(int abi, unsigned dimensions);
 
 /* ---------------------------------------------------------------------------------------------

@@ -116,6 +116,11 @@ static int add_one(fmbRegistry* reg, int joints, const void* table, const char* 
   return 0;
 }
 
+unsigned fmb_type_dimensions(int abi, unsigned dimensions) {
+  /* a field of ABI 3.3: a table of an older minor ends before it and is planar */
+  return abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 && dimensions ? dimensions : FMB_DIM_PLANAR;
+}
+
 /* the first required op a table lacks, or NULL */
 static const char* missing_body_op(const fmbBodyType* t) {
   if (!t->parse) return "parse";

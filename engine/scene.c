@@ -601,11 +601,6 @@ int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
 
 int fmb_scene_dimension(const fmbParser* p) { return p && p->model ? p->model->dimension : 2; }
 
-unsigned fmb_type_dimensions(int abi, unsigned dimensions) {
-  /* a field of ABI 3.3: a table of an older minor ends before it and is planar */
-  return abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 && dimensions ? dimensions : FMB_DIM_PLANAR;
-}
-
 int fmb_model_nbody(const fmbModel* m) { return m ? m->nbody - 1 : 0; }
 int fmb_model_dimension(const fmbModel* m) { return m ? m->dimension : 0; }
 
