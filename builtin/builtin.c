@@ -8,20 +8,35 @@
 #include <stddef.h>
 #include <stdio.h>
 
-extern const fmbBodyType fmb_body_ground, fmb_body_rigid, fmb_body_beam;
+extern const fmbBodyType fmb_body_ground, fmb_body_rigid, fmb_body_beam, fmb_body_rigid3d;
 extern const fmbJointType fmb_joint_revolute, fmb_joint_fixed, fmb_joint_drive, fmb_joint_spring, fmb_joint_force,
-    fmb_joint_prismatic, fmb_joint_torsion;
+    fmb_joint_prismatic, fmb_joint_torsion, fmb_joint_spherical, fmb_joint_revolute3d, fmb_joint_fixed3d,
+    fmb_joint_universal, fmb_joint_prismatic3d, fmb_joint_cylindrical;
 
 static const fmbBodyType* const builtin_bodies[] = {
     &fmb_body_ground,
     &fmb_body_rigid,
-    &fmb_body_beam, /* and, behind it, model: exact (fmb_body_beam_exact) */
+    &fmb_body_beam,    /* and, behind it, model: exact (fmb_body_beam_exact) */
+    &fmb_body_rigid3d, /* dimension: 3 (docs/spatial.md) */
     NULL,
 };
 
 static const fmbJointType* const builtin_joints[] = {
-    &fmb_joint_revolute, &fmb_joint_fixed,     &fmb_joint_drive,   &fmb_joint_spring,
-    &fmb_joint_force,    &fmb_joint_prismatic, &fmb_joint_torsion, NULL,
+    &fmb_joint_revolute,
+    &fmb_joint_fixed,
+    &fmb_joint_drive,
+    &fmb_joint_spring,
+    &fmb_joint_force,
+    &fmb_joint_prismatic,
+    &fmb_joint_torsion,
+    /* dimension: 3 (docs/spatial.md) */
+    &fmb_joint_spherical,
+    &fmb_joint_revolute3d,
+    &fmb_joint_fixed3d,
+    &fmb_joint_universal,
+    &fmb_joint_prismatic3d,
+    &fmb_joint_cylindrical,
+    NULL,
 };
 
 static const fmbPlugin builtin_plugin = {

@@ -159,6 +159,8 @@ FMB_API int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out);
 /* the scene's bodies (the fixed ground excluded): their count, and body i's name and `type:`
    (0 <= i < count; 0, or -1 when out of range). Lets a program address them with --set. */
 FMB_API int fmb_model_nbody(const fmbModel* m);
+/* the scene's `dimension:`: 2 (planar) or 3 (spatial, docs/spatial.md); 0 for NULL */
+FMB_API int fmb_model_dimension(const fmbModel* m);
 FMB_API int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type);
 /* the scene's joints: their count, and joint i's name and `type:` (0 <= i < count; 0, or -1) */
 FMB_API int fmb_model_njoint(const fmbModel* m);

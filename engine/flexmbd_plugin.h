@@ -28,9 +28,12 @@ extern "C" {
    optional `input` op, fmb_eval_input), output_units. 3.1: the descriptor's `size`, in what was
    padding after `abi` on LP64, so that a 3.0 descriptor (and one whose source leaves `size` out)
    reads as size 0: the fields 3.0 had. 3.2: fmbBodyType.aux_iterated, appended; the engine reads
-   it only from a table whose `abi` says 3.2 or later (a table of an older minor ends before it). */
+   it only from a table whose `abi` says 3.2 or later (a table of an older minor ends before it).
+   3.3: space (docs/spatial.md): fmbBodyType.dimensions and .marker3, fmbJointType.dimensions,
+   fmbJointType.attachment3, fmbEnv.gravity3, FMB_PARAM_VEC3/QUAT, appended; fmb_marker3, fmb_get_vec3, fmb_get_quat, fmb_get_point3, fmb_initial_marker3,
+   fmb_scene_dimension, fmb_frame3_point. A table of an older minor is planar. */
 #define FMB_PLUGIN_ABI_MAJOR 3
-#define FMB_PLUGIN_ABI_MINOR 2
+#define FMB_PLUGIN_ABI_MINOR 3
 /* what a table's and a descriptor's `abi` field holds: major * 1000 + minor (a 3.0 plugin wrote 3:
    a value below 1000 is a major alone, minor 0) */
 #define FMB_PLUGIN_ABI (FMB_PLUGIN_ABI_MAJOR * 1000 + FMB_PLUGIN_ABI_MINOR)
@@ -66,6 +69,8 @@ enum {
 FMB_API int fmb_get_double(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
 FMB_API int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long lo, long hi, int* out);
 FMB_API int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]);
+/* ABI 3.3: a list of three numbers [x, y, z] */
+FMB_API int fmb_get_vec3(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[3]);
 /* an angle in radians: a bare number is radians, `120 deg` / `2.1 rad` say their unit. With
    FMB_POSE a bare number beyond 2*pi in magnitude draws a warning (degrees written as radians?) */
 FMB_API int fmb_get_angle(fmbParser* p, fmbNode map, const char* key, unsigned flags, double* out);
@@ -80,6 +85,12 @@ FMB_API int fmb_get_choice(fmbParser* p, fmbNode map, const char* key, unsigned 
    the body cannot place (its `marker` fails in the pose the scene gives, e.g. beyond a beam's
    length) is refused here, at the point, instead of failing the run later with a false cause */
 FMB_API int fmb_get_point(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[2]);
+/* ABI 3.3: Euler parameters [w, x, y, z] (an orientation), normalized; a zero list is refused */
+FMB_API int fmb_get_quat(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[4]);
+/* ABI 3.3: fmb_get_point's spatial twin, [x, y, z] in the body's frame, checked with marker3 */
+FMB_API int fmb_get_point3(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[3]);
+/* ABI 3.3: the scene's `dimension:` (2, the default, or 3) */
+FMB_API int fmb_scene_dimension(const fmbParser* p);
 /* a body by name ("ground" is always defined); *out is the body index */
 FMB_API int fmb_get_body(fmbParser* p, fmbNode map, const char* key, unsigned flags, int* out);
 /* a joint defined earlier in the file, by name; *out is the joint index */
@@ -91,6 +102,9 @@ FMB_API int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, doub
    (before any assembly), e.g. for a joint whose default is the configuration as assembled.
    Returns 0, or -1 (bad arguments, or the body cannot place the point). */
 FMB_API int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle);
+/* ABI 3.3: its spatial twin: position and rotation matrix R (3 x 3 row-major, the body frame's
+   axes at the point as columns) of material point `local` in the scene's pose (ground: local, I) */
+FMB_API int fmb_initial_marker3(fmbParser* p, int body, const double local[3], double pos[3], double R[9]);
 /* a plugin-level check failed at `node` (a value node or the item's mapping) */
 FMB_API int fmb_parse_error(fmbParser* p, fmbNode node, const char* fmt, ...)
 #if defined(__GNUC__)
@@ -106,6 +120,8 @@ FMB_API fmbNode fmb_find_key(fmbParser* p, fmbNode map, const char* key);
 typedef struct fmbEnv {
   double gravity[2]; /* m/s^2, global frame */
   int has_gravity;   /* 0 when the scene has g = 0: plugins skip gravity terms entirely */
+  /* ABI 3.3: gravity in space, global frame; a planar scene's is [gravity[0], gravity[1], 0] */
+  double gravity3[3];
 } fmbEnv;
 
 typedef struct fmbEnergy {
@@ -126,7 +142,9 @@ typedef enum {
   FMB_PARAM_BODY,   /* fmb_get_body */
   FMB_PARAM_JOINT,  /* fmb_get_joint */
   FMB_PARAM_TABLE,  /* fmb_get_table: [[t, value], ...] or a CSV file name */
-  FMB_PARAM_MAP     /* a mapping of sub-keys, which `doc` names (beam's `reduction: {modes: k}`) */
+  FMB_PARAM_MAP,    /* a mapping of sub-keys, which `doc` names (beam's `reduction: {modes: k}`) */
+  FMB_PARAM_VEC3,   /* ABI 3.3: fmb_get_vec3 */
+  FMB_PARAM_QUAT    /* ABI 3.3: fmb_get_quat */
 } fmbParamKind;
 
 typedef struct fmbParam {
@@ -150,6 +168,14 @@ enum {
      and point2 (a pin joining two bodies' points) */
   FMB_TYPE_CONFORM_FIXTURE = 1 << 1
 };
+
+/* ABI 3.3: the scene dimensions a type works in (fmbBodyType.dimensions, fmbJointType.dimensions);
+   0 (and every table of an older minor) = FMB_DIM_PLANAR. An item of a type that does not work in
+   the scene's `dimension:` is refused at its `type:`. */
+enum { FMB_DIM_PLANAR = 1 << 0, FMB_DIM_SPATIAL = 1 << 1 };
+/* the FMB_DIM_* of a table: its `dimensions` when its abi is 3.3 or later and it set them, else
+   FMB_DIM_PLANAR (engine/registry.c) */
+FMB_API unsigned fmb_type_dimensions(int abi, unsigned dimensions);
 
 /* ---------------------------------------------------------------------------------------------
  * Body plugins. A body owns `ncoord` generalized coordinates q (frame x, y, theta first when the
@@ -279,6 +305,17 @@ typedef struct fmbBodyType {
      turns with the centreline, and Newton converges as for the complete model (docs/models.md,
      "Newton"). NULL or 0 = eliminated (the complete beam's coupling sums). */
   int (*aux_iterated)(const void* self);
+  /* ABI 3.3, read only from a table whose abi is 3.3 or later: FMB_DIM_* the type works in
+     (0 = planar). A spatial-only type may leave `marker` NULL and must give marker3. */
+  unsigned dimensions;
+  /* ABI 3.3: the spatial marker (docs/spatial.md). Position pos[3] of the material point `local`
+     (body frame) and the rotation matrix R[9] (row-major; its columns are the body frame's axes at
+     the point, global frame) with, when not NULL, dpos_dq (3 rows of ncoord at dpos_dq,
+     dpos_dq + ld, dpos_dq + 2 ld) and rot_dq (3 rows likewise): the virtual rotation G, global
+     frame, so that d(R u)/dq_k = G[:, k] x (R u) for every vector u of the body frame. R and
+     either derivative may be NULL. Joints see spatial bodies only this way (fmb_marker3). */
+  int (*marker3)(const void* self, const double* q, const double local[3], double pos[3], double R[9], double* dpos_dq,
+                 double* rot_dq, int ld, double* work);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------
@@ -322,6 +359,11 @@ typedef struct fmbJointType {
   int (*input)(const void* self, double* initial);
   /* ABI 3, optional: output_names' units, as for bodies */
   const char* const* output_units;
+  /* ABI 3.3, read only from a table whose abi is 3.3 or later: FMB_DIM_* (0 = planar) */
+  unsigned dimensions;
+  /* ABI 3.3, optional: attachment's spatial twin, body and local point [x, y, z] of attachment k
+     of a spatial joint with constraint rows: where the engine reports its reaction torque */
+  int (*attachment3)(const void* self, int k, int* body, double local[3]);
 } fmbJointType;
 
 /* what a joint may ask of the evaluation context (a NULL context or k other than 0, 1 gives NaN,
@@ -335,7 +377,14 @@ FMB_API const double* fmb_eval_v(const fmbJointEval* ev, int k);
    either may be NULL. Use ld = the joint's column count to write straight into phi_q rows. */
 FMB_API int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[2], double* angle,
                        double* dpos_dq, int ld, double* dangle_dq);
-/* scratch for the joint: at least 2 x (ncoord(body 0) + ncoord(body 1)) doubles */
+/* ABI 3.3: fmb_marker's spatial twin (fmbBodyType.marker3): position, rotation matrix (row-major,
+   may be NULL) and, when not NULL, the rows of dpos/dq and of the virtual rotation G wrt body k's
+   coordinates at stride ld (use the joint's column count and fmb_eval_col0 to write into phi_q).
+   The ground answers local and the identity; a planar body answers -1. */
+FMB_API int fmb_marker3(const fmbJointEval* ev, int k, const double local[3], double pos[3], double R[9],
+                        double* dpos_dq, double* rot_dq, int ld);
+/* scratch for the joint: at least 6 x (ncoord(body 0) + ncoord(body 1)) doubles (2 x before ABI 3.3):
+   a spatial joint keeps both bodies' virtual rotations there (3 rows of its columns, fmb_marker3) */
 FMB_API double* fmb_eval_scratch(const fmbJointEval* ev);
 /* first column of body k in phi_q / Q (0 for body 0, ncoord(body 0) for body 1); -1 for a NULL
    context or another k (0 would be body 0's column: a wrong place, silently) */
@@ -366,6 +415,16 @@ FMB_API int fmb_gauss_lobatto01(int n, double* x, double* w);
    (q = its frame) answers `marker` with exactly this call. */
 FMB_API void fmb_frame_point(const double frame[3], const double local[2], double pos[2], double* angle,
                              double* dpos_dframe, double* dangle_dframe);
+/* ABI 3.3, its spatial twin (engine/frame3.c): a frame [x, y, z, p0, p1, p2, p3] with Euler
+   parameters p of any nonzero length (R = R(p / |p|), docs/spatial.md): position of `local`, R
+   (row-major, may be NULL) and, when not NULL, dpos/dframe and the virtual rotation G/dframe, each
+   3 rows of 7 at stride ld. Returns 0, or -1 for p = 0. */
+FMB_API int fmb_frame3_point(const double frame[7], const double local[3], double pos[3], double R[9],
+                             double* dpos_dframe, double* rot_dframe, int ld);
+/* ABI 3.3: R(p / |p|) (row-major) of Euler parameters p = [w, x, y, z] of any nonzero length; -1 for p = 0 */
+FMB_API int fmb_quat_matrix(const double p[4], double R[9]);
+/* ABI 3.3: the Euler parameters (unit, w >= 0) of a rotation matrix (row-major) */
+FMB_API void fmb_matrix_quat(const double R[9], double p[4]);
 
 /* ---------------------------------------------------------------------------------------------
  * The plugin descriptor. A shared object exports it as

@@ -31,6 +31,9 @@ typedef struct fmbBodyInst {
      (duplicates share one), so the op's values in pair order are summed into place */
   long npair;
   long* ppos;
+  /* fmbBodyType.marker3 when the table has it (ABI 3.3 or later), else NULL */
+  int (*marker3)(const void* self, const double* q, const double local[3], double pos[3], double R[9], double* dpos_dq,
+                 double* rot_dq, int ld, double* work);
 } fmbBodyInst;
 
 typedef struct fmbJointInst {
@@ -137,7 +140,8 @@ struct fmbModel {
   fmbSolverSettings solver;
   int noutput;
   fmbOutput* output;
-  int assemble; /* `initial: assemble`: the initial projection may move bodies by any amount */
+  int assemble;  /* `initial: assemble`: the initial projection may move bodies by any amount */
+  int dimension; /* the scene's `dimension:`, 2 (planar, the default) or 3 (docs/spatial.md) */
   int need_energy, need_constraint, check_definiteness;
   int need_work;               /* a work or energy.balance column: integrate every joint's power */
   int nredundant;              /* constraint rows that repeat the others at t0 (found at load, ic.c) */
@@ -348,6 +352,12 @@ double fmb_joint_power(const fmbModel* m, fmbWorkspace* w, int j, double t, cons
    on body2 (on body1, negated, when body2 has no frame); 0 or non-zero when not available */
 int fmb_joint_reaction(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
                        const double* lambda, double out[3]);
+/* its spatial twin (dimension 3): force (global) and torque (global, about the joint's point,
+   fmbJointType.attachment3, else about the body's origin) on body2 (body1's negated when body2
+   is the ground), from a body's marker3: the wrench [F; tau] whose generalized force
+   (dr/dq)^T F + G^T tau is the constraint force on the body's coordinates (least squares) */
+int fmb_joint_reaction3(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                        const double* lambda, double out[6]);
 /* work done by each joint since t0 (njoint entries, filled by the integrator before each row) and
    the force elements' potential energy at t0 (energy.balance) */
 double* fmb_workspace_work(fmbWorkspace* w);

@@ -756,6 +756,11 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     return FMB_EXIT_BAD_INPUT;
   }
   *out = NULL;
+  if (m->dimension == 3) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "modes of spatial scenes (dimension: 3) are not implemented yet (docs/spatial.md)");
+    return FMB_EXIT_BAD_INPUT;
+  }
   /* an unknown method once ran the dense path silently; a time of nan linearized at nan */
   if (method != FMB_EIGEN_AUTO && method != FMB_EIGEN_DENSE && method != FMB_EIGEN_SPARSE) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,

@@ -25,6 +25,7 @@ static const char* const frame_names[] = {"x", "y", "theta", "omega", "vx", "vy"
 static int body_has_frame(fmbParser* p, const fmbModel* m, int b) {
   static const double origin[2] = {0.0, 0.0};
   double pos[2], angle;
+  if (m->dimension == 3) return 0; /* a spatial body's x, y, z, ... are its own outputs (docs/spatial.md) */
   return m->body[b].nq >= 3 || fmb_initial_marker(p, b, origin, pos, &angle) == 0;
 }
 
@@ -56,21 +57,22 @@ static const char* const energy_names[] = {"kinetic", "strain", "gravity", "spri
    applies forces, the reaction for a constraining one */
 static const char* const power_names[] = {"power", "work", NULL};
 static const char* const reaction_names[] = {"reaction_x", "reaction_y", "reaction_torque", NULL};
+/* in space (dimension 3): force and torque about the joint's point, global frame */
+static const char* const reaction3_names[] = {
+    "reaction_x", "reaction_y", "reaction_z", "reaction_torque_x", "reaction_torque_y", "reaction_torque_z", NULL};
 static const char* const constraint_names[] = {"position", "velocity", NULL};
 /* the units of the quantities above, in their order (constraint norms mix m and rad: none) */
 static const char* const frame_units[] = {"m", "m", "rad", "rad/s", "m/s", "m/s"};
 static const char* const power_units[] = {"W", "J"};
 static const char* const reaction_units[] = {"N", "N", "N m"};
+static const char* const reaction3_units[] = {"N", "N", "N", "N m", "N m", "N m"};
 
 const char* const* fmb_engine_outputs(const char* group) {
   static const struct {
     const char* group;
     const char* const* names;
-  } groups[] = {{"frame", frame_names},
-                {"power", power_names},
-                {"reaction", reaction_names},
-                {"energy", energy_names},
-                {"constraint", constraint_names}};
+  } groups[] = {{"frame", frame_names},         {"power", power_names},   {"reaction", reaction_names},
+                {"reaction3", reaction3_names}, {"energy", energy_names}, {"constraint", constraint_names}};
   for (size_t i = 0; group && i < sizeof groups / sizeof groups[0]; ++i)
     if (strcmp(group, groups[i].group) == 0) return groups[i].names;
   return NULL;
@@ -110,6 +112,7 @@ const char* fmb_output_unit(const char* column) {
   if ((k = lookup(frame_names, q)) >= 0) return frame_units[k];
   if ((k = lookup(power_names, q)) >= 0) return power_units[k];
   if ((k = lookup(reaction_names, q)) >= 0) return reaction_units[k];
+  if ((k = lookup(reaction3_names, q)) >= 0) return reaction3_units[k];
   /* BODY.shapeK_x, BODY.shapeK_y: a centreline station, global frame */
   if (strncmp(q, "shape", 5) == 0 && (strcmp(q + strlen(q) - 2, "_x") == 0 || strcmp(q + strlen(q) - 2, "_y") == 0)) {
     const char* d = q + 5;
@@ -237,14 +240,14 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
         o->kind = o->id == 0 ? FMB_OUT_JOINT_POWER : FMB_OUT_JOINT_WORK;
         if (o->id == 1) m->need_work = 1;
         if (o->id == 0 && ji->nrows > 0) m->need_multipliers = 1;
-      } else if (ji->nrows > 0 && (o->id = lookup(reaction_names, qty)) >= 0) {
+      } else if (ji->nrows > 0 && (o->id = lookup(m->dimension == 3 ? reaction3_names : reaction_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT_REACTION;
         m->need_multipliers = 1;
       } else if ((o->id = fmb_type_output_id(ji->type->output_lookup, ji->self, ji->type->output_names, qty)) >= 0) {
         o->kind = FMB_OUT_JOINT;
       }
       if (has_power) list_names(avail, sizeof avail, power_names);
-      if (ji->nrows > 0) list_names(avail, sizeof avail, reaction_names);
+      if (ji->nrows > 0) list_names(avail, sizeof avail, m->dimension == 3 ? reaction3_names : reaction_names);
       list_names(avail, sizeof avail, ji->type->output_names);
     }
   }
@@ -311,6 +314,7 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle) {
   const fmbBodyInst* bi = &m->body[b];
+  if (!bi->type->marker) return -1; /* a spatial-only body */
   return bi->type->marker(bi->self, q + bi->qadr, local, pos, angle, NULL, NULL, fmb_workspace_plugin(w) + bi->workadr);
 }
 
@@ -350,12 +354,34 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
   return 0;
 }
 
+/* a spatial scene's default columns: each body's position and Euler parameters, those of
+   BODY.x, y, z, qw, qx, qy, qz that its type answers (docs/spatial.md) */
+static void outputs_default_spatial(fmbModel* m) {
+  static const char* const pose[] = {"x", "y", "z", "qw", "qx", "qy", "qz", NULL};
+  for (int b = 1; b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    for (int k = 0; pose[k] && bi->nq > 0; ++k) {
+      const int id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, pose[k]);
+      if (id < 0) continue;
+      fmbOutput* o = &m->output[m->noutput++];
+      o->kind = FMB_OUT_BODY;
+      o->owner = b;
+      o->id = id;
+      snprintf(o->name, sizeof o->name, "%s.%s", bi->name, pose[k]);
+    }
+  }
+}
+
 int fmb_outputs_default(fmbParser* p, fmbModel* m) {
-  m->output = calloc(1 + 4 * (size_t)m->nbody, sizeof *m->output);
+  m->output = calloc(1 + 7 * (size_t)m->nbody, sizeof *m->output);
   if (!m->output) return -1;
   m->output[0].kind = FMB_OUT_TIME;
   snprintf(m->output[0].name, sizeof m->output[0].name, "t");
   m->noutput = 1;
+  if (m->dimension == 3) {
+    outputs_default_spatial(m);
+    return 0;
+  }
   for (int b = 1; b < m->nbody; ++b) {
     if (m->body[b].nq == 0 || !body_has_frame(p, m, b)) continue; /* a fixed frame's columns are constants */
     for (int k = 0; k < 4; ++k) {
@@ -571,8 +597,11 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
       case FMB_OUT_JOINT_POWER: val = fmb_joint_power(m, w, o->owner, t, q, v, lam); break;
       case FMB_OUT_JOINT_WORK: val = fmb_workspace_work(w)[o->owner]; break;
       case FMB_OUT_JOINT_REACTION: {
-        double r[3];
-        val = fmb_joint_reaction(m, w, o->owner, t, q, v, lam, r) ? NAN : r[o->id];
+        double r[6];
+        if (m->dimension == 3)
+          val = fmb_joint_reaction3(m, w, o->owner, t, q, v, lam, r) ? NAN : r[o->id];
+        else
+          val = fmb_joint_reaction(m, w, o->owner, t, q, v, lam, r) ? NAN : r[o->id];
         break;
       }
       case FMB_OUT_ENERGY: {

@@ -116,6 +116,11 @@ static int add_one(fmbRegistry* reg, int joints, const void* table, const char* 
   return 0;
 }
 
+unsigned fmb_type_dimensions(int abi, unsigned dimensions) {
+  /* a field of ABI 3.3: a table of an older minor ends before it and is planar */
+  return abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 && dimensions ? dimensions : FMB_DIM_PLANAR;
+}
+
 /* the first required op a table lacks, or NULL */
 static const char* missing_body_op(const fmbBodyType* t) {
   if (!t->parse) return "parse";
@@ -123,7 +128,10 @@ static const char* missing_body_op(const fmbBodyType* t) {
   if (!t->ncoord) return "ncoord";
   if (!t->initial) return "initial";
   if (!t->residual) return "residual";
-  if (!t->marker) return "marker";
+  /* a spatial-only type (ABI 3.3) answers marker3 instead of the planar marker */
+  const unsigned dims = fmb_type_dimensions(t->abi, t->dimensions);
+  if ((dims & FMB_DIM_SPATIAL) && !t->marker3) return "marker3 (the type declares FMB_DIM_SPATIAL)";
+  if ((dims & FMB_DIM_PLANAR) && !t->marker) return "marker";
   if ((t->output_lookup || t->output_names) && !t->output) return "output (output_names or output_lookup is set)";
   return NULL;
 }

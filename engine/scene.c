@@ -207,6 +207,50 @@ static int check_library_keys(fmbParser* p, fmbNode lib, const char* what) {
   return 0;
 }
 
+/* the FMB_DIM_* of registered type i */
+static unsigned registered_dimensions(const fmbRegistry* reg, int joints, int i) {
+  return joints ? fmb_type_dimensions(reg->joints[i]->abi, reg->joints[i]->dimensions)
+                : fmb_type_dimensions(reg->bodies[i]->abi, reg->bodies[i]->dimensions);
+}
+
+/* an item's `type:`, one of the registered types that work in the scene's dimension (they are
+   the choices a message lists); a type of the other dimension is refused as such. *t is the
+   registry index. */
+static int get_type(fmbParser* p, fmbNode item, int joints, const char* const* names, int* t) {
+  const char* kind = joints ? "joint" : "body";
+  const unsigned need = p->model->dimension == 3 ? FMB_DIM_SPATIAL : FMB_DIM_PLANAR;
+  int n = 0;
+  while (names[n]) ++n;
+  const char** offered = calloc((size_t)n + 1, sizeof *offered);
+  int* index = calloc((size_t)n + 1, sizeof *index);
+  if (!offered || !index) {
+    free(offered), free(index);
+    return fmb_parse_error(p, item, "out of memory");
+  }
+  int k = 0;
+  for (int i = 0; i < n; ++i)
+    if (registered_dimensions(p->reg, joints, i) & need) offered[k] = names[i], index[k++] = i;
+  const fmbNode node = fmb_find_key(p, item, "type");
+  const char* given = fmbp_scalar(p, node);
+  int other = -1; /* a registered type of the other dimension, named as given */
+  for (int i = 0; given && i < n; ++i)
+    if (strcmp(names[i], given) == 0 && !(registered_dimensions(p->reg, joints, i) & need)) other = i;
+  int choice = 0, rc = 0;
+  if (other >= 0)
+    rc = fmb_parse_error(p, node,
+                         "%s type '%s' is %s; this scene is %s (the top-level 'dimension: %d'%s): `flexmbd types` "
+                         "lists the types of each dimension",
+                         kind, given, need == FMB_DIM_SPATIAL ? "planar" : "spatial (dimension 3)",
+                         need == FMB_DIM_SPATIAL ? "spatial" : "planar", p->model->dimension,
+                         need == FMB_DIM_SPATIAL ? "" : ", the default");
+  else
+    rc = fmb_get_choice(p, item, "type", FMB_REQUIRED, offered, &choice);
+  if (rc == 0) *t = index[choice];
+  free(offered);
+  free(index);
+  return rc ? -1 : 0;
+}
+
 /* What every body and joint item shares: a mapping with a fresh name and a registered type, read
    by its plugin with no key left unread. On success *self belongs to the caller; on error
    nothing is left allocated. */
@@ -222,7 +266,7 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   if (name_taken(m, name))
     return fmb_parse_error(p, fmb_find_key(p, item, "name"),
                            "duplicate or reserved name '%s': every body and joint needs its own name", name);
-  if (fmb_get_choice(p, item, "type", FMB_REQUIRED, names, t)) return -1;
+  if (get_type(p, item, joints, names, t)) return -1;
   if (resolve_references(p, item)) return -1;
   p->item = item;
   /* a type with implementations behind one name picks this item's (fmbBodyType.variant) */
@@ -233,6 +277,7 @@ static int parse_item(fmbParser* p, const fmbModel* m, fmbNode item, int joints,
   }
   if (body_type) *body_type = bt;
   const char* type_name = joints ? p->reg->joints[*t]->name : bt->name;
+
   int (*parse)(fmbParser*, fmbNode, void**) = joints ? p->reg->joints[*t]->parse : bt->parse;
   void (*destroy)(void*) = joints ? p->reg->joints[*t]->destroy : bt->destroy;
   char what[FMB_NAME_MAX + 40];
@@ -284,6 +329,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     /* a field of ABI 3.2: a table of an older minor ends before it (flexmbd_plugin.h) */
     const int has_aux_iterated = b->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 2;
     b->aux_iterated = b->nz > 0 && has_aux_iterated && b->type->aux_iterated && b->type->aux_iterated(b->self);
+    b->marker3 = b->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 ? b->type->marker3 : NULL; /* ABI 3.3 */
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
     if (b->type->velocity_error_test && !b->type->velocity_error_test(b->self)) m->bodies_prefer_positions = 1;
     if (b->type->reuse_blocks && !b->type->reuse_blocks(b->self)) m->fresh_body_blocks = 1;
@@ -405,8 +451,8 @@ static int check_resources(fmbParser* p, fmbModel* m) {
 
 /* the top-level keys, in the order parse_scene reads them (solver and bodies, the required ones,
    first: yaml_get.c's messages rely on it) */
-const char* const fmb_scene_keys[] = {"solver",  "bodies", "joints",    "outputs",  "plugins", "gravity",
-                                      "initial", "vtk",    "materials", "sections", NULL};
+const char* const fmb_scene_keys[] = {"solver",  "bodies", "joints",    "outputs",  "plugins",   "gravity",
+                                      "initial", "vtk",    "materials", "sections", "dimension", NULL};
 
 static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode root = fmbp_root(p);
@@ -417,13 +463,18 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   fmbNode joints = fmb_find_key(p, root, "joints");
   fmbNode outputs = fmb_find_key(p, root, "outputs");
   fmbNode plugins = fmb_find_key(p, root, "plugins");
-  double g[2] = {0.0, 0.0};
+  double g[3] = {0.0, 0.0, 0.0};
   /* initial: given (default) = the poses must satisfy the joints (to FMB_ASSEMBLY_TOL);
      assemble = the initial projection may move the bodies onto the joints (ic.c);
      static = runs start from the static or steady state (engine/static.c) */
   static const char* const initial_modes[] = {"given", "assemble", "static", NULL};
   int initial = 0;
-  if (fmb_get_vec2(p, root, "gravity", 0, g) || fmb_get_choice(p, root, "initial", 0, initial_modes, &initial))
+  /* dimension: 2 (planar, the default) or 3 (spatial: docs/spatial.md); read first, since the
+     gravity's length and every item's type depend on it */
+  m->dimension = 2;
+  if (fmb_get_int(p, root, "dimension", 0, 2, 3, &m->dimension)) return -1;
+  if ((m->dimension == 3 ? fmb_get_vec3(p, root, "gravity", 0, g) : fmb_get_vec2(p, root, "gravity", 0, g)) ||
+      fmb_get_choice(p, root, "initial", 0, initial_modes, &initial))
     return -1;
   m->assemble = initial == 1;
   m->initial_static = initial == 2;
@@ -436,9 +487,16 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
       return fmb_parse_error(p, vtk, "expected a directory name for 'vtk' (where the ParaView animation goes)");
     snprintf(m->vtk_dir, sizeof m->vtk_dir, "%s", dir);
   }
-  m->env.gravity[0] = g[0];
-  m->env.gravity[1] = g[1];
-  m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0);
+  if (m->initial_static && m->dimension == 3)
+    return fmb_parse_error(p, fmb_find_key(p, root, "initial"),
+                           "'initial: static' is planar for now: statics of spatial scenes (dimension: 3) are not "
+                           "implemented yet");
+  if (vtk >= 0 && m->dimension == 3)
+    return fmb_parse_error(p, vtk,
+                           "'vtk' is planar for now: a spatial scene (dimension: 3) has no ParaView output yet");
+  if (m->dimension == 2) m->env.gravity[0] = g[0], m->env.gravity[1] = g[1];
+  for (int i = 0; i < 3; ++i) m->env.gravity3[i] = g[i];
+  m->env.has_gravity = (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0);
   for (int k = 0; k < 2; ++k)
     if (check_library(p, library[k], library_keys[k])) return -1;
   if (fmb_scene_plugins(p, plugins) || parse_solver(p, m, solver) || parse_bodies(p, m, bodies) ||
@@ -541,7 +599,10 @@ int fmb_model_solver(const fmbModel* m, fmbSolverInfo* out) {
   return 0;
 }
 
+int fmb_scene_dimension(const fmbParser* p) { return p && p->model ? p->model->dimension : 2; }
+
 int fmb_model_nbody(const fmbModel* m) { return m ? m->nbody - 1 : 0; }
+int fmb_model_dimension(const fmbModel* m) { return m ? m->dimension : 0; }
 
 int fmb_model_body(const fmbModel* m, int i, const char** name, const char** type) {
   if (!m || i < 0 || i >= m->nbody - 1) return -1;

@@ -102,7 +102,7 @@ fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
   w->fdcol = calloc(nblk, sizeof(double));
   w->fd = calloc(nfd, sizeof(double));
   w->mk = calloc(3 * nb, sizeof(double));
-  w->js = calloc(2 * mc, sizeof(double));
+  w->js = calloc(6 * mc, sizeof(double)); /* fmb_eval_scratch: 6 x the columns from ABI 3.3 */
   w->qpert = calloc(nq, sizeof(double));
   w->vpert = calloc(nq, sizeof(double));
   w->ewt_default = calloc(2 * nq, sizeof(double));
@@ -256,6 +256,7 @@ int fmb_marker(const fmbJointEval* ev, int k, const double local[2], double pos[
     if (angle) *angle = 0.0;
     return 0;
   }
+  if (!bi->type->marker) return -1; /* a spatial-only body: refused in a planar scene at parse */
   const int n = bi->nq;
   double* dp = dpos_dq ? ev->mk : NULL;
   int rc = bi->type->marker(bi->self, ev->q + bi->qadr, local, pos, angle, dp, dangle_dq, ev->work + bi->workadr);
@@ -893,4 +894,54 @@ int fmb_joint_output(const fmbModel* m, fmbWorkspace* w, int j, int id, double t
   const fmbJointInst* ji = &m->joint[j];
   fmbJointEval ev = {m, ji, t, q, v, w->plugin, w->mk, w->js, w->input};
   return ji->type->output(ji->self, id, &ev, value);
+}
+
+int fmb_joint_reaction3(const fmbModel* m, fmbWorkspace* w, int j, double t, const double* q, const double* v,
+                        const double* lam, double out[6]) {
+  const fmbJointInst* ji = &m->joint[j];
+  const int k = ji->body[1] >= 0 && m->body[ji->body[1]].marker3 ? 1 : 0;
+  if (ji->nrows == 0 || ji->body[k] < 0 || !m->body[ji->body[k]].marker3) return -1;
+  const fmbBodyInst* bi = &m->body[ji->body[k]];
+  if (joint_eval(m, w, j, t, q, v, w->phi, w->phi_q, w->phi_t, w->phi_tt)) return -1;
+  const int n = bi->nq, c0 = k == 0 ? 0 : (ji->body[0] >= 0 ? m->body[ji->body[0]].nq : 0);
+  double* Q = w->jQ; /* the constraint force -Phi_q^T lambda on the body's coordinates */
+  for (int i = 0; i < n; ++i) {
+    Q[i] = 0.0;
+    for (int r = 0; r < ji->nrows; ++r) Q[i] -= w->phi_q[(size_t)r * ji->ncol + c0 + i] * lam[ji->rowadr + r];
+  }
+  /* the body's origin O: its dr/dq and G (6 rows of n, in the joint scratch) */
+  static const double origin[3] = {0.0, 0.0, 0.0};
+  double O[3], P[3], local[3];
+  double* Jw = w->js;
+  const double* qb = q + bi->qadr;
+  if (bi->marker3(bi->self, qb, origin, O, NULL, Jw, Jw + 3 * (size_t)n, n, w->plugin + bi->workadr)) return -1;
+  /* least squares J^T [F; tau] = Q: (J J^T) x = J Q, J 6 x n of full row rank for a body with a frame */
+  double N[36], x[6];
+  for (int a = 0; a < 6; ++a) {
+    x[a] = 0.0;
+    for (int i = 0; i < n; ++i) x[a] += Jw[(size_t)a * n + i] * Q[i];
+    for (int b = 0; b < 6; ++b) {
+      double s = 0.0;
+      for (int i = 0; i < n; ++i) s += Jw[(size_t)a * n + i] * Jw[(size_t)b * n + i];
+      N[b * 6 + a] = s;
+    }
+  }
+  int piv[6];
+  if (fmb_lu_factor(6, N, piv)) return -1;
+  fmb_lu_solve(6, N, piv, x);
+  /* the torque about the joint's point P = tau_O - (P - O) x F */
+  int body = -1;
+  for (int i = 0; i < 3; ++i) P[i] = O[i];
+  if (ji->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 && ji->type->attachment3 &&
+      ji->type->attachment3(ji->self, k, &body, local) == 0 && body == ji->body[k] &&
+      bi->marker3(bi->self, qb, local, P, NULL, NULL, NULL, 0, w->plugin + bi->workadr))
+    return -1;
+  const double d[3] = {P[0] - O[0], P[1] - O[1], P[2] - O[2]}, *F = x;
+  const double dxF[3] = {d[1] * F[2] - d[2] * F[1], d[2] * F[0] - d[0] * F[2], d[0] * F[1] - d[1] * F[0]};
+  const double sign = k == 1 ? 1.0 : -1.0; /* Newton's third law: what body1 feels, reversed */
+  for (int i = 0; i < 3; ++i) {
+    out[i] = sign * F[i];
+    out[3 + i] = sign * (x[3 + i] - dxF[i]);
+  }
+  return 0;
 }

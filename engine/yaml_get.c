@@ -459,18 +459,52 @@ int fmb_get_int(fmbParser* p, fmbNode map, const char* key, unsigned flags, long
   return 0;
 }
 
-int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]) {
+/* a list of n numbers (2 or 3), named `shape` in messages */
+static int get_vecn(fmbParser* p, fmbNode map, const char* key, unsigned flags, int n_want, const char* shape,
+                    double* out) {
   if (!p || !key || !out) return -1; /* a plugin bug: no parser to report it through */
   fmbNode n = fmb_find_key(p, map, key);
-  if (n < 0) return absent(p, map, key, flags, "a list of two numbers [x, y]");
-  if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != 2)
-    return fmb_parse_error(p, n, "expected a list of two numbers [x, y] for '%s', found %s", key,
+  if (n < 0) return absent(p, map, key, flags, shape);
+  if (!fmbp_is_seq(p, n) || fmbp_seq_len(p, n) != n_want)
+    return fmb_parse_error(p, n, "expected %s for '%s', found %s", shape, key,
                            fmbp_is_seq(p, n) ? "a list of another length" : node_kind(fmbp_node(p, n)));
-  double v[2];
-  for (int i = 0; i < 2; ++i)
+  double v[4];
+  for (int i = 0; i < n_want; ++i)
     if (number_at(p, fmbp_seq_item(p, n, i), key, flags & ~(unsigned)FMB_REQUIRED, &v[i])) return -1;
-  out[0] = v[0];
-  out[1] = v[1];
+  for (int i = 0; i < n_want; ++i) out[i] = v[i];
+  return 0;
+}
+
+int fmb_get_vec2(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[2]) {
+  return get_vecn(p, map, key, flags, 2, "a list of two numbers [x, y]", out);
+}
+
+int fmb_get_vec3(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[3]) {
+  return get_vecn(p, map, key, flags, 3, "a list of three numbers [x, y, z]", out);
+}
+
+int fmb_get_quat(fmbParser* p, fmbNode map, const char* key, unsigned flags, double out[4]) {
+  double q[4] = {out ? out[0] : 1.0, out ? out[1] : 0.0, out ? out[2] : 0.0, out ? out[3] : 0.0};
+  if (get_vecn(p, map, key, flags, 4, "a list of four numbers [w, x, y, z] (Euler parameters)", q)) return -1;
+  const double n = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  if (!(n > 0.0) || !isfinite(n))
+    return fmb_parse_error(p, fmb_find_key(p, map, key),
+                           "expected Euler parameters [w, x, y, z] for '%s' that are not all zero ([1, 0, 0, 0] is "
+                           "no rotation)",
+                           key);
+  for (int i = 0; i < 4; ++i) out[i] = q[i] / n;
+  return 0;
+}
+
+int fmb_get_point3(fmbParser* p, fmbNode map, const char* key, unsigned flags, int body, double out[3]) {
+  if (!p || !key || !out || !p->model || body < 0 || body >= p->model->nbody) return -1;
+  if (fmb_get_vec3(p, map, key, flags, out)) return -1;
+  const fmbBodyInst* b = &p->model->body[body];
+  double pos[3], R[9];
+  if (b->type && fmb_initial_marker3(p, body, out, pos, R))
+    return fmb_parse_error(p, fmb_find_key(p, map, key),
+                           "%s [%g, %g, %g] is not on body '%s' (type %s): the body cannot place it in space", key,
+                           out[0], out[1], out[2], b->name, b->type->name);
   return 0;
 }
 
@@ -731,6 +765,15 @@ int fmb_joint_attachment(fmbParser* p, int joint, int k, int* body, double local
   return j->type->attachment(j->self, k, body, local);
 }
 
+/* the body's scene pose into q (and its velocities, its scratch after them): 2 nq + nwork doubles,
+   malloc'ed (setup-time, for one call), or NULL */
+static double* initial_pose(const fmbBodyInst* b) {
+  const size_t n = (size_t)b->nq;
+  double* q = calloc(2 * n + b->nwork + 1, sizeof(double));
+  if (q) b->type->initial(b->self, q, q + n);
+  return q;
+}
+
 int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos[2], double* angle) {
   if (!p || !p->model || !local || !pos || body < 0 || body >= p->model->nbody) return -1;
   const fmbBodyInst* b = &p->model->body[body];
@@ -740,12 +783,27 @@ int fmb_initial_marker(fmbParser* p, int body, const double local[2], double pos
     if (angle) *angle = 0.0;
     return 0;
   }
-  /* setup-time: the body's initial coordinates and its scratch, allocated for this one call */
-  const size_t n = (size_t)b->nq;
-  double* q = calloc(2 * n + b->nwork + 1, sizeof(double));
+  if (!b->type->marker) return -1; /* a spatial-only body */
+  double* q = initial_pose(b);
   if (!q) return -1;
-  b->type->initial(b->self, q, q + n);
-  const int rc = b->type->marker(b->self, q, local, pos, angle, NULL, NULL, q + 2 * n);
+  const int rc = b->type->marker(b->self, q, local, pos, angle, NULL, NULL, q + 2 * (size_t)b->nq);
+  free(q);
+  return rc ? -1 : 0;
+}
+
+int fmb_initial_marker3(fmbParser* p, int body, const double local[3], double pos[3], double R[9]) {
+  if (!p || !p->model || !local || !pos || body < 0 || body >= p->model->nbody) return -1;
+  const fmbBodyInst* b = &p->model->body[body];
+  if (!b->type) { /* the world frame */
+    for (int i = 0; i < 3; ++i) pos[i] = local[i];
+    if (R)
+      for (int i = 0; i < 9; ++i) R[i] = i % 4 == 0 ? 1.0 : 0.0;
+    return 0;
+  }
+  if (!b->marker3) return -1; /* a planar body */
+  double* q = initial_pose(b);
+  if (!q) return -1;
+  const int rc = b->marker3(b->self, q, local, pos, R, NULL, NULL, 0, q + 2 * (size_t)b->nq);
   free(q);
   return rc ? -1 : 0;
 }

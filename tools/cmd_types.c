@@ -29,6 +29,8 @@ static void print_params(const fmbParam* params) {
   for (const fmbParam* p = params; p->key; ++p) {
     printf("    %-18s", p->key);
     if (p->kind == FMB_PARAM_VEC2) printf(" [x, y]");
+    if (p->kind == FMB_PARAM_VEC3) printf(" [x, y, z]");
+    if (p->kind == FMB_PARAM_QUAT) printf(" [w, x, y, z]");
     if (p->unit) printf(" %s", strcmp(p->unit, "1") == 0 ? "(count)" : p->unit);
     print_range(p);
     if (p->flags & FMB_REQUIRED)
@@ -77,21 +79,23 @@ int fmb_cmd_types(int argc, char** argv) {
          "K = 0 .. elements; shape_N: N stations):\n");
   for (int i = 0; i < fmb_registry_nbodies(reg); ++i) {
     const fmbBodyType* t = fmb_registry_body(reg, i);
-    printf("  %s  (%s)\n", t->name, fmb_registry_body_origin(reg, i));
+    const int planar = (fmb_type_dimensions(t->abi, t->dimensions) & FMB_DIM_PLANAR) != 0;
+    printf("  %s  (%s)%s\n", t->name, fmb_registry_body_origin(reg, i), planar ? "" : ", dimension 3");
     print_params(t->params);
-    print_outputs(frame, 1, t->centreline ? "shape shape_N" : NULL, t->output_names);
+    print_outputs(frame, planar, t->centreline ? "shape shape_N" : NULL, t->output_names);
   }
   printf("joints and forces (power and work: a joint with constraint rows or a force; reaction_*: with "
-         "constraint rows):\n");
+         "constraint rows; dimension 3: a type for `dimension: 3` scenes, docs/spatial.md):\n");
   for (int i = 0; i < fmb_registry_njoints(reg); ++i) {
     const fmbJointType* t = fmb_registry_joint(reg, i);
-    printf("  %s  (%s)%s\n", t->name, fmb_registry_joint_origin(reg, i),
-           t->flags & FMB_TYPE_DOES_WORK ? ", feeds energy in" : "");
+    const int planar = (fmb_type_dimensions(t->abi, t->dimensions) & FMB_DIM_PLANAR) != 0;
+    printf("  %s  (%s)%s%s\n", t->name, fmb_registry_joint_origin(reg, i),
+           t->flags & FMB_TYPE_DOES_WORK ? ", feeds energy in" : "", planar ? "" : ", dimension 3");
     print_params(t->params);
     const char* const* engine_given[2];
     int n = 0;
     if (t->nrows || t->force) engine_given[n++] = fmb_engine_outputs("power");
-    if (t->nrows) engine_given[n++] = fmb_engine_outputs("reaction");
+    if (t->nrows) engine_given[n++] = fmb_engine_outputs(planar ? "reaction" : "reaction3");
     print_outputs(engine_given, n, NULL, t->output_names);
   }
   printf("scene-wide:\n    outputs:");

@@ -421,6 +421,13 @@ static void say_missing(const char* csv, const fmbTable* tb, const ViewBody* vb,
 
 /* the page of the run (a->csv, its table tb) drawn with the scene's model m into a->out */
 static int view_write(const fmbViewArgs* a, const fmbTable* tb, const fmbModel* m, const fmbDrawing* d) {
+  if (fmb_model_dimension(m) == 3) {
+    fprintf(stderr,
+            "flexmbd view: %s is spatial (dimension: 3); the viewer draws planar scenes for now "
+            "(docs/spatial.md): plot its columns with flexmbd plot\n",
+            a->s.scene);
+    return FMB_EXIT_BAD_INPUT;
+  }
   const int nb = fmb_model_nbody(m);
   ViewBody* vb = calloc((size_t)nb + 1, sizeof *vb);
   char** notes = calloc((size_t)nb + 2, sizeof *notes);

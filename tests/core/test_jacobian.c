@@ -116,6 +116,8 @@ int main(void) {
   check_scene("scenes/pendulum.yaml", NULL, 0);
   check_scene("scenes/fourbar.yaml", NULL, 0);
   check_scene("tests/core/scenes/conformance_rigid.yaml", NULL, 0);
+  /* dimension 3: rigid3d and every spatial joint (docs/spatial.md) */
+  check_scene("tests/spatial/scenes/chain.yaml", NULL, 0);
   static const char* const models[][1] = {
       {"bodies.beam.model=complete"}, {"bodies.beam.model=foac"}, {"bodies.beam.model=zoac"}};
   for (int k = 0; k < 3; ++k) check_scene("tests/core/scenes/conformance_beam.yaml", models[k], 1);

@@ -3,6 +3,7 @@
  * on every registered type once overflowed a fixed list of 256 names (issue 27). Also a loaded
  * plugin file, which no output may replace (tests/failures/inputs_overwritten.sh). */
 #include <stdio.h>
+#include <string.h>
 
 #include "flexmbd_plugin.h"
 
@@ -17,7 +18,8 @@ FMB_PLUGIN_EXPORT const fmbPlugin* fmb_plugin_descriptor(void) {
     const fmbPlugin* builtin = fmb_builtin_plugin();
     const fmbBodyType* rigid = NULL;
     for (int i = 0; builtin->bodies[i]; ++i)
-      if (builtin->bodies[i]->name[0] == 'r') rigid = builtin->bodies[i];
+      if (strcmp(builtin->bodies[i]->name, "rigid") == 0)
+        rigid = builtin->bodies[i]; /* not rigid3d: conform skips it */
     for (int i = 0; rigid && i < MANY; ++i) {
       types[i] = *rigid;
       snprintf(names[i], sizeof names[i], "many%d", i);
