@@ -67,7 +67,7 @@ static inline void bt_mass(const Beam* b, const double* q, const double* v, doub
   int nc = 3 + b->n;
   double* a = calloc((size_t)nc, sizeof(double));
   double* R0 = calloc((size_t)nc, sizeof(double));
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   bt_residual(b, &env0, q, v, a, R0);
   for (int j = 0; j < nc; ++j) {
     /* a large acceleration keeps the cancellation against R0 (elastic, velocity terms) small */

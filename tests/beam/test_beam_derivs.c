@@ -29,8 +29,8 @@ static double out(const Beam* b, const char* name, const double* q, const double
 
 int main(void) {
   const char* names[] = {"zoac", "foac", "complete"};
-  fmbEnv env = {{0.7, -9.81}, 1};
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env = {.gravity = {0.7, -9.81}, .has_gravity = 1};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   for (int model = 0; model < 3; ++model) {
     Beam* b = bt_seed_beam(model, 6);
     int nc = 3 + b->n;

@@ -49,7 +49,7 @@ static Beam* test_beam(int model, int banded) {
   return b;
 }
 
-static const fmbEnv grav = {{0.3, -9.81}, 1};
+static const fmbEnv grav = {.gravity = {0.3, -9.81}, .has_gravity = 1};
 
 static void check_dense(int model) {
   Beam* b = test_beam(model, 0);

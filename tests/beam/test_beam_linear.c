@@ -49,7 +49,7 @@ static void stiffness(const Beam* b, double* K) {
   int nc = 3 + b->n, n = b->n;
   double* q = calloc(3 * (size_t)nc, sizeof(double));
   double *z = q + nc, *R = z + nc;
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   for (int j = 0; j < n; ++j) {
     q[3 + j] = 1.0;
     bt_residual(b, &env0, q, z, z, R);
@@ -71,7 +71,7 @@ static void static_cantilever(int model) {
   ENSURE(bt_cholesky(K, n) == 0);
   double* q = calloc(3 * (size_t)nc, sizeof(double));
   double *z = q + nc, *R = z + nc;
-  fmbEnv env = {{0.0, -g}, 1};
+  fmbEnv env = {.gravity = {0.0, -g}, .has_gravity = 1};
   /* Newton with the linear stiffness as the iteration matrix (the load depends on p only weakly) */
   double step = 0.0;
   for (int it = 0; it < 20; ++it) {
@@ -140,7 +140,7 @@ static void rp_spin(const Beam* b, double Om, const double* p, const double* pd,
   memcpy(q + 3, p, sizeof(double) * (size_t)n);
   memcpy(v + 3, pd, sizeof(double) * (size_t)n);
   v[2] = Om;
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   bt_residual(b, &env0, q, v, a, R);
   memcpy(Rp, R + 3, sizeof(double) * (size_t)n);
   free(buf);

@@ -344,7 +344,7 @@ static void seed_form(const Beam* b, const fmbEnv* env, const Slow* S, const dou
 
 int main(void) {
   const char* names[] = {"zoac", "foac", "complete"};
-  fmbEnv env = {{0.3, -9.81}, 1};
+  fmbEnv env = {.gravity = {0.3, -9.81}, .has_gravity = 1};
   /* 1. fast vs slow, all three models, with and without gravity and damping */
   for (int model = 0; model < 3; ++model) {
     for (int trial = 0; trial < 3; ++trial) {
@@ -354,7 +354,7 @@ int main(void) {
       int nc = 3 + b->n;
       double *q = malloc(sizeof(double) * 4 * (size_t)nc), *v = q + nc, *a = v + nc, *Rf = a + nc;
       random_state(b, 0.05 * (trial + 1), q, v, a);
-      fmbEnv* e = trial == 2 ? &(fmbEnv){{0.0, 0.0}, 0} : &env;
+      fmbEnv* e = trial == 2 ? &(fmbEnv){.gravity = {0.0, 0.0}, .has_gravity = 0} : &env;
       bt_residual(b, e, q, v, a, Rf);
       Slow S;
       slow_alloc(&S, b->n);

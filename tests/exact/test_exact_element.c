@@ -144,7 +144,7 @@ static void test_jacobian(int integration) {
   inertial.Emod = 0.0;
   exact_setup(&inertial);
   const int nc = et_nc(b);
-  fmbEnv env = {{0.3, -9.81}, 1}, env0 = {{0.0, 0.0}, 0};
+  fmbEnv env = {.gravity = {0.3, -9.81}, .has_gravity = 1}, env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   double *q = calloc(4 * (size_t)nc, sizeof(double)), *v = q + nc, *a = v + nc, *z = a + nc;
   q[0] = 0.4, q[1] = -0.2, q[2] = 0.7;
   for (int i = 3; i < nc; ++i) q[i] = 0.05 * et_rand();
@@ -175,7 +175,7 @@ static void test_mixed_jacobian(void) {
   BeamExact* b = et_beam(5, INTEGRATION_REDUCED);
   b->mixed = b->banded = 1;
   const int nc = et_nc(b), nz = exact_naux(b), nt = nc + nz;
-  const fmbEnv env0 = {{0.0, 0.0}, 0};
+  const fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   double* q = calloc(4 * (size_t)nt, sizeof(double));
   double *v = q + nt, *a = v + nt, *z = a + nt; /* v = a = 0: the elastic and z parts */
   for (int i = 3; i < nc; ++i) q[i] = 0.05 * et_rand();
@@ -290,7 +290,7 @@ static void test_invariance(void) {
   double* q = calloc(3 * (size_t)nc, sizeof(double));
   double *z = q + nc, *R = z + nc, rmax = 0.0;
   q[0] = 12.0, q[1] = -4.0, q[2] = -2.5;
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   exact_residual(b, &env0, q, z, z, R, NULL);
   for (int i = 0; i < nc; ++i) rmax = fmax(rmax, fabs(R[i]));
   printf("B. undeformed beam with its frame moved: max |R| = %.2e\n", rmax);
@@ -323,7 +323,7 @@ static void test_modes(int integration) {
   double* z = q + nc;
   double* K = calloc(4 * (size_t)nc * nc, sizeof(double));
   double *C = K + (size_t)nc * nc, *M = C + (size_t)nc * nc, *S = M + (size_t)nc * nc;
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   for (int curved = 0; curved < 2; ++curved) {
     if (curved) arc_state(b, 0.5, q);
     exact_jacobian(b, &env0, q, z, z, K, C, M, NULL);
@@ -373,7 +373,7 @@ static void test_mass(void) {
   for (int i = 0; i < nc; ++i) v[i] = et_rand();
   double* K = calloc(3 * (size_t)nc * nc, sizeof(double));
   double *C = K + (size_t)nc * nc, *M = C + (size_t)nc * nc;
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   exact_jacobian(b, &env0, q, v, z, K, C, M, NULL);
   double vMv = 0.0;
   for (int j = 0; j < nc; ++j)
@@ -403,7 +403,7 @@ static int static_solve(const BeamExact* b, double* q, const double* v, const do
   double *C = K + (size_t)nc * nc, *M = C + (size_t)nc * nc;
   double* Kp = malloc(sizeof(double) * (size_t)n * n);
   double* dx = malloc(sizeof(double) * (size_t)n);
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   int it;
   for (it = 1; it <= 50; ++it) {
     exact_residual(b, &env0, q, v, z, R, NULL);
@@ -488,7 +488,7 @@ static void test_rotating(int ne, int integration, double freq_tol) {
   double *C = K + (size_t)nc * nc, *M = C + (size_t)nc * nc;
   double* P = malloc(3 * sizeof(double) * (size_t)n * n);
   double *G = P + (size_t)n * n, *Mp = G + (size_t)n * n;
-  fmbEnv env0 = {{0.0, 0.0}, 0};
+  fmbEnv env0 = {.gravity = {0.0, 0.0}, .has_gravity = 0};
   exact_jacobian(b, &env0, q, v, z, K, C, M, NULL);
   et_sub(K, nc, 3, P);
   et_sub(C, nc, 3, G);
