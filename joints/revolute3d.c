@@ -107,28 +107,15 @@ static int revolute3d_output(const void* self, int id, const fmbJointEval* ev, d
   return 0;
 }
 
-static const fmbParam revolute3d_params[] = {
-    FMBJ_SPATIAL_PAIR_PARAMS,
-    FMBJ_SPATIAL_AXIS_PARAM("the joint axis"),
-    {.key = "angle0",
-     .kind = FMB_PARAM_NUMBER,
-     .unit = "rad",
-     .fallback = "0",
-     .doc = "turn at f = 0 (with a profile)"},
-    {.key = "profile",
-     .kind = FMB_PARAM_CHOICE,
-     .choices = fmbj_motion_names,
-     .doc = "optional: prescribed turn f(t), as a drive's"},
-    {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .doc = "profile constant, ramp: (final) speed"},
-    {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = "rad/s", .doc = "profile spinup: final speed"},
-    {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = "rad", .doc = "profile harmonic"},
-    {.key = "value",
-     .kind = FMB_PARAM_NUMBER,
-     .unit = "rad",
-     .fallback = "0",
-     .doc = "profile input: f until a program sets it"},
-    FMBJ_LAW_KEYS("profile "),
-    {.key = NULL}};
+static const fmbParam revolute3d_params[] = {FMBJ_SPATIAL_PAIR_PARAMS,
+                                             FMBJ_SPATIAL_AXIS_PARAM("the joint axis"),
+                                             {.key = "angle0",
+                                              .kind = FMB_PARAM_NUMBER,
+                                              .unit = "rad",
+                                              .fallback = "0",
+                                              .doc = "turn at f = 0 (with a profile)"},
+                                             FMBJ_OPTIONAL_MOTION_PARAMS("rad", "turn"),
+                                             {.key = NULL}};
 
 const fmbJointType fmb_joint_revolute3d = {
     .name = "revolute3d",

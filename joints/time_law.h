@@ -94,6 +94,22 @@ extern const char *const fmbj_law_names[], *const fmbj_motion_names[];
       {.key = "phase", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", .doc = what "harmonic"}, {  \
     .key = "table", .kind = FMB_PARAM_TABLE, .doc = what "table: [[t, value], ...] or a CSV file (required)" \
   }
+/* the keys of an optional prescribed motion on a joint that also stands alone (a prismatic's slide, a
+   spatial hinge's turn: `profile` present = driven), UNIT of f ("m" or "rad"), WHAT it prescribes */
+#define FMBJ_OPTIONAL_MOTION_PARAMS(UNIT, WHAT)                                                                      \
+  {.key = "profile",                                                                                                 \
+   .kind = FMB_PARAM_CHOICE,                                                                                         \
+   .choices = fmbj_motion_names,                                                                                     \
+   .doc = "optional: prescribed " WHAT " f(t), as a drive's"},                                                       \
+      {.key = "speed", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "profile constant, ramp: (final) speed"}, \
+      {.key = "omega0", .kind = FMB_PARAM_NUMBER, .unit = UNIT "/s", .doc = "profile spinup: final speed"},          \
+      {.key = "amplitude", .kind = FMB_PARAM_NUMBER, .unit = UNIT, .doc = "profile harmonic"},                       \
+      {.key = "value",                                                                                               \
+       .kind = FMB_PARAM_NUMBER,                                                                                     \
+       .unit = UNIT,                                                                                                 \
+       .fallback = "0",                                                                                              \
+       .doc = "profile input: f until a program sets it"},                                                           \
+      FMBJ_LAW_KEYS("profile ")
 #define FMBJ_LAW_PARAMS                                                     \
   {.key = "law",                                                            \
    .kind = FMB_PARAM_CHOICE,                                                \
