@@ -252,6 +252,16 @@ static const fmbParam rigid3_params[] = {
     {.key = NULL},
 };
 
+/* ABI 3.4: the one gauge direction, the length of the Euler parameters (R depends on p / |p|) */
+static int rigid3_gauge(const void* self, const double* q, double* dir) {
+  (void)self;
+  if (dir) {
+    memset(dir, 0, 7 * sizeof *dir);
+    memcpy(dir + 3, q + 3, 4 * sizeof *dir);
+  }
+  return 1;
+}
+
 const fmbBodyType fmb_body_rigid3d = {
     .name = "rigid3d",
     .abi = FMB_ABI_VERSION,
@@ -271,4 +281,5 @@ const fmbBodyType fmb_body_rigid3d = {
                "angular_velocity: [0.3, 1.0, 0.2]\n",
     .dimensions = FMB_DIM_SPATIAL,
     .marker3 = rigid3_marker3,
+    .gauge = rigid3_gauge,
 };

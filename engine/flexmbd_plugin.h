@@ -31,9 +31,11 @@ extern "C" {
    it only from a table whose `abi` says 3.2 or later (a table of an older minor ends before it).
    3.3: space (docs/spatial.md): fmbBodyType.dimensions and .marker3, fmbJointType.dimensions,
    fmbJointType.attachment3, fmbEnv.gravity3, FMB_PARAM_VEC3/QUAT, appended; fmb_marker3, fmb_get_vec3, fmb_get_quat, fmb_get_point3, fmb_initial_marker3,
-   fmb_scene_dimension, fmb_frame3_point. A table of an older minor is planar. */
+   fmb_scene_dimension, fmb_frame3_point. A table of an older minor is planar.
+   3.4: fmbBodyType.gauge (the coordinate directions no marker sees: a spatial body's Euler-parameter
+   length), appended; read only from a table whose abi says 3.4 or later. */
 #define FMB_PLUGIN_ABI_MAJOR 3
-#define FMB_PLUGIN_ABI_MINOR 3
+#define FMB_PLUGIN_ABI_MINOR 4
 /* what a table's and a descriptor's `abi` field holds: major * 1000 + minor (a 3.0 plugin wrote 3:
    a value below 1000 is a major alone, minor 0) */
 #define FMB_PLUGIN_ABI (FMB_PLUGIN_ABI_MAJOR * 1000 + FMB_PLUGIN_ABI_MINOR)
@@ -316,6 +318,14 @@ typedef struct fmbBodyType {
      either derivative may be NULL. Joints see spatial bodies only this way (fmb_marker3). */
   int (*marker3)(const void* self, const double* q, const double local[3], double pos[3], double R[9], double* dpos_dq,
                  double* rot_dq, int ld, double* work);
+  /* ABI 3.4, optional, read only from a table whose abi is 3.4 or later: the gauge directions of
+     the coordinates at q, directions d (ncoord each) along which nothing physical changes (no
+     marker, no energy, no output): a spatial frame's Euler parameters p of any length, R = R(p/|p|),
+     have one, d = [0, p, 0]. With dir == NULL it returns their count; else it writes them to
+     dir[k * ncoord .. (k + 1) * ncoord) and returns the count. Integration needs no gauge (the body's
+     own equations fix it); statics and modes do: they hold d^T dq = 0 as extra rows, so that the
+     static Newton matrix is regular and no zero-frequency gauge mode appears. NULL = none. */
+  int (*gauge)(const void* self, const double* q, double* dir);
 } fmbBodyType;
 
 /* ---------------------------------------------------------------------------------------------

@@ -34,6 +34,8 @@ typedef struct fmbBodyInst {
   /* fmbBodyType.marker3 when the table has it (ABI 3.3 or later), else NULL */
   int (*marker3)(const void* self, const double* q, const double local[3], double pos[3], double R[9], double* dpos_dq,
                  double* rot_dq, int ld, double* work);
+  /* fmbBodyType.gauge when the table has it (ABI 3.4 or later), else NULL */
+  int (*gauge)(const void* self, const double* q, double* dir);
 } fmbBodyInst;
 
 typedef struct fmbJointInst {

@@ -330,6 +330,7 @@ static int parse_bodies(fmbParser* p, fmbModel* m, fmbNode list) {
     const int has_aux_iterated = b->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 2;
     b->aux_iterated = b->nz > 0 && has_aux_iterated && b->type->aux_iterated && b->type->aux_iterated(b->self);
     b->marker3 = b->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 ? b->type->marker3 : NULL; /* ABI 3.3 */
+    b->gauge = b->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 4 ? b->type->gauge : NULL;     /* ABI 3.4 */
     if (b->type->indefinite_mass && b->type->indefinite_mass(b->self)) m->check_definiteness = 1;
     if (b->type->velocity_error_test && !b->type->velocity_error_test(b->self)) m->bodies_prefer_positions = 1;
     if (b->type->reuse_blocks && !b->type->reuse_blocks(b->self)) m->fresh_body_blocks = 1;
