@@ -103,7 +103,7 @@ expect 2 "noplugins.yaml:[0-9]+:[0-9]+: error: .*foundation_bar" "$F" run "$work
 expect 0 "foundation_bar +\\($pc/build/foundation.so\\)" "$F" types --plugin "$pc/build/foundation.so"
 expect 0 'N/m\^2 > 0, required' "$F" types --plugin "$pc/build/foundation.so"
 expect 0 'ok   foundation_bar: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$ex/build/foundation.so" foundation_bar
-expect 0 'conform: 17 types, 0 failed checks' "$F" conform --work "$work/conform"
+expect 0 'conform: 19 types, 0 failed checks' "$F" conform --work "$work/conform"
 expect 0 'agrees with the analytic solution' "$ex/build/check_foundation" "$ex/foundation.yaml" "$work/check.csv"
 expect 0 'agrees with the analytic solution' env LD_LIBRARY_PATH="$libdir" "$pc/check_foundation" "$pc/foundation.yaml" "$work/check_pc.csv"
 cat "$work/out"
