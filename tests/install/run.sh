@@ -13,7 +13,9 @@
 #  5. deliberately broken plugins (tests/install/broken.c) are each caught, with a clear message:
 #     another plugin ABI major or a newer minor, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
 #     matrix that is not symmetric, energy that leaks (conform, exit 1);
-#  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc).
+#  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc);
+#  examples/joint_plugin and the spatial examples/plugin3d are built out of the tree too, each conform and
+#  its check program against its closed form.
 . "$(dirname "$0")/prefix.sh"
 fails=0
 fail() {
@@ -123,6 +125,19 @@ expect 0 'N m/rad >= 0, required' "$F" types --plugin "$jx/build/torsion.so"
 expect 0 'wrote .*torsion.html \(11 rows, 1 of 1 bodies drawn' "$F" view "$work/torsion_draw.csv" "$jx/torsion.yaml" \
   -o "$work/torsion.html"
 grep -q '"part":4,"points"' "$work/torsion.html" || fail "view: the torsion spring is not drawn as a force element"
+# the spatial example (examples/plugin3d: a ball spring-damper for `dimension: 3` scenes) out of the
+# tree the same way: built, conform in its spatial fixture, its check program against the 3D damped
+# oscillator, refused in a planar scene at its `type:`
+px=$work/plugin3d_example
+mkdir -p "$px"
+cp "$share"/examples/plugin3d/*.c "$share"/examples/plugin3d/CMakeLists.txt "$share"/examples/plugin3d/*.yaml "$px"/
+(cmake -S "$px" -B "$px/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$px/build") \
+  >"$work/cmake_plugin3d.log" 2>&1 || fail "examples/plugin3d does not build: $(tail -n 5 "$work/cmake_plugin3d.log")"
+expect 0 'ok   ball_spring energy: a damped run loses energy' "$F" conform --plugin "$px/build/ball_spring.so" ball_spring
+expect 0 'agrees with the analytic solution' "$px/build/check_ball_spring" "$px/ball_spring.yaml" "$work/ball_spring.csv"
+printf 'plugins: [%s]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\njoints: [{name: s, type: ball_spring, body1: ground, body2: a, stiffness: 1}]\n' \
+  "$px/build/ball_spring.so" >"$work/ball_planar.yaml"
+expect 2 'ball_planar.yaml:4:' "$F" check "$work/ball_planar.yaml"
 # a scene naming a plugin that is not there: located error
 printf 'plugins: [nowhere.so]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\n' >"$work/missing.yaml"
 expect 2 'missing.yaml:1:11: error: plugin .*nowhere.so: cannot load plugin' "$F" check "$work/missing.yaml"
