@@ -13,6 +13,7 @@
 #include <stdlib.h>
 
 #include "spatial_pair.h"
+#include "two_point.h" /* FMBJ_ROTATIONAL_SPRING_PARAMS, the planar torsion's keys */
 
 typedef struct {
   fmbSpatialPair sp; /* first: the fmbj3_* helpers take the state as a pair */
@@ -95,22 +96,7 @@ static void torsion3d_describe(const void* self, FILE* out) {
 static const fmbParam torsion3d_params[] = {
     FMBJ_SPATIAL_PAIR_PARAMS,
     FMBJ_SPATIAL_AXIS_PARAM("the axis of the turn"),
-    {.key = "stiffness",
-     .kind = FMB_PARAM_NUMBER,
-     .flags = FMB_REQUIRED | FMB_NONNEGATIVE,
-     .unit = "N m/rad",
-     .doc = "rate k"},
-    {.key = "damping",
-     .kind = FMB_PARAM_NUMBER,
-     .flags = FMB_NONNEGATIVE,
-     .unit = "N m s/rad",
-     .fallback = "0",
-     .doc = "rate c"},
-    {.key = "angle0",
-     .kind = FMB_PARAM_NUMBER,
-     .unit = "rad",
-     .fallback = "0",
-     .doc = "turn from the scene's pose where it is relaxed (set point)"},
+    FMBJ_ROTATIONAL_SPRING_PARAMS,
     {.key = NULL},
 };
 

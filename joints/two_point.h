@@ -18,9 +18,26 @@ typedef struct {
        .kind = FMB_PARAM_VEC2,                                                                                      \
        .unit = "m",                                                                                                 \
        .fallback = "[0, 0]",                                                                                        \
-       .doc = "point on body1, body frame ([x, y, z] in dimension 3)"},                                             \
+       .doc = "point on body1, body frame"},                                             \
   {                                                                                                                 \
     .key = "point2", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body2, body frame" \
+  }
+/* the keys of a rotational spring-damper (torsion, torsion3d): stiffness, damping, angle0 */
+#define FMBJ_ROTATIONAL_SPRING_PARAMS                                          \
+  {.key = "stiffness",                                                         \
+   .kind = FMB_PARAM_NUMBER,                                                   \
+   .flags = FMB_REQUIRED | FMB_NONNEGATIVE,                                    \
+   .unit = "N m/rad",                                                          \
+   .doc = "rate k"},                                                           \
+      {.key = "damping",                                                       \
+       .kind = FMB_PARAM_NUMBER,                                               \
+       .flags = FMB_NONNEGATIVE,                                               \
+       .unit = "N m s/rad",                                                    \
+       .fallback = "0",                                                        \
+       .doc = "rate c"},                                                       \
+  {                                                                            \
+    .key = "angle0", .kind = FMB_PARAM_NUMBER, .unit = "rad", .fallback = "0", \
+    .doc = "relative angle where it is relaxed (set point)"                    \
   }
 int fmbj_parse_two_points(fmbParser* p, fmbNode item, fmbTwoPoint* tp);
 /* the `bodies` and `attachment` ops of a joint whose state begins with its fmbTwoPoint */
