@@ -112,11 +112,15 @@ cat "$work/out"
 # the joint example (examples/joint_plugin: a torsional spring-damper) out of the tree, as a user
 # copies it from the installed share/flexmbd/examples: built, conform, its check program against
 # the damped oscillator, listed by types with its keys, drawn (its attachment) by view
+# build_example NAME DIR: copy share/flexmbd/examples/NAME to DIR and build it with find_package(flexmbd)
+build_example() {
+  mkdir -p "$2"
+  cp "$share/examples/$1"/*.c "$share/examples/$1/CMakeLists.txt" "$share/examples/$1"/*.yaml "$2"/
+  (cmake -S "$2" -B "$2/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$2/build") \
+    >"$work/cmake_$1.log" 2>&1 || fail "examples/$1 does not build: $(tail -n 5 "$work/cmake_$1.log")"
+}
 jx=$work/joint_example
-mkdir -p "$jx"
-cp "$share"/examples/joint_plugin/*.c "$share"/examples/joint_plugin/CMakeLists.txt "$share"/examples/joint_plugin/*.yaml "$jx"/
-(cmake -S "$jx" -B "$jx/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$jx/build") \
-  >"$work/cmake_joint.log" 2>&1 || fail "examples/joint_plugin does not build: $(tail -n 5 "$work/cmake_joint.log")"
+build_example joint_plugin "$jx"
 expect 0 'ok   torsion_spring: 0 failed checks' "$F" conform --plugin "$jx/build/torsion.so" torsion_spring
 expect 0 'agrees with the analytic solution' "$jx/build/check_torsion" "$jx/torsion.yaml" "$work/torsion.csv"
 expect 0 'N m/rad >= 0, required' "$F" types --plugin "$jx/build/torsion.so"
@@ -129,10 +133,7 @@ grep -q '"part":4,"points"' "$work/torsion.html" || fail "view: the torsion spri
 # tree the same way: built, conform in its spatial fixture, its check program against the 3D damped
 # oscillator, refused in a planar scene at its `type:`
 px=$work/plugin3d_example
-mkdir -p "$px"
-cp "$share"/examples/plugin3d/*.c "$share"/examples/plugin3d/CMakeLists.txt "$share"/examples/plugin3d/*.yaml "$px"/
-(cmake -S "$px" -B "$px/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$px/build") \
-  >"$work/cmake_plugin3d.log" 2>&1 || fail "examples/plugin3d does not build: $(tail -n 5 "$work/cmake_plugin3d.log")"
+build_example plugin3d "$px"
 expect 0 'ok   ball_spring energy: a damped run loses energy' "$F" conform --plugin "$px/build/ball_spring.so" ball_spring
 expect 0 'agrees with the analytic solution' "$px/build/check_ball_spring" "$px/ball_spring.yaml" "$work/ball_spring.csv"
 printf 'plugins: [%s]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\njoints: [{name: s, type: ball_spring, body1: ground, body2: a, stiffness: 1}]\n' \
