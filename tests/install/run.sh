@@ -184,6 +184,14 @@ expect 1 'FAIL oscillator energy: a free run keeps the total energy' \
 expect 2 "broken_NAME.so: error: body type 'rigid' is already registered \\(from built-in\\)" \
   "$F" types --plugin "$work/broken_NAME.so"
 expect 0 'oscillator' "$F" types --plugin "$work/unbroken.so" --plugin "$work/unbroken.so" # the same file twice: a no-op
+# conform's spatial fixture catches a wrong derivative too: examples/plugin3d's ball_spring with
+# body1's columns of dd/dq left unnegated (its force is then not -dV/dq)
+sed 's/D\[i \* ld + c\] = -D\[i \* ld + c\]/D[i * ld + c] = D[i * ld + c]/' "$px/ball_spring.c" >"$work/ball_broken.c"
+grep -q 'D\[i \* ld + c\] = D\[i \* ld + c\]' "$work/ball_broken.c" || fail "ball_broken.c: the sign to break is not in ball_spring.c"
+cc -std=c11 -shared -fPIC "$work/ball_broken.c" $(pkg-config --cflags --libs flexmbd) -lm -o "$work/ball_broken.so" ||
+  fail "ball_broken.c does not build"
+expect 1 'FAIL ball_spring force: generalized force vs -dV/dq' \
+  "$F" conform --work "$work/conform" --plugin "$work/ball_broken.so" ball_spring
 
 # 6. relocatable: the prefix moved, pkg-config still points into it
 mv "$T" "$work/moved"
