@@ -18,7 +18,7 @@ typedef struct {
        .kind = FMB_PARAM_VEC2,                                                                                      \
        .unit = "m",                                                                                                 \
        .fallback = "[0, 0]",                                                                                        \
-       .doc = "point on body1, body frame"},                                             \
+       .doc = "point on body1, body frame"},                                                                        \
   {                                                                                                                 \
     .key = "point2", .kind = FMB_PARAM_VEC2, .unit = "m", .fallback = "[0, 0]", .doc = "point on body2, body frame" \
   }
