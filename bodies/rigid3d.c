@@ -280,6 +280,7 @@ const fmbBodyType fmb_body_rigid3d = {
     .example = "mass: 2\ninertia: [0.1, 0.2, 0.25]\nposition: [0, 0, 1]\norientation: [1, 0.2, 0, 0]\n"
                "angular_velocity: [0.3, 1.0, 0.2]\n",
     .dimensions = FMB_DIM_SPATIAL,
+    .flags = FMB_TYPE_CONFORM_FIXTURE, /* conform's two bodies a and b in space */
     .marker3 = rigid3_marker3,
     .gauge = rigid3_gauge,
 };

@@ -11,7 +11,7 @@
 extern const fmbBodyType fmb_body_ground, fmb_body_rigid, fmb_body_beam, fmb_body_rigid3d;
 extern const fmbJointType fmb_joint_revolute, fmb_joint_fixed, fmb_joint_drive, fmb_joint_spring, fmb_joint_force,
     fmb_joint_prismatic, fmb_joint_torsion, fmb_joint_spherical, fmb_joint_revolute3d, fmb_joint_fixed3d,
-    fmb_joint_universal, fmb_joint_prismatic3d, fmb_joint_cylindrical;
+    fmb_joint_universal, fmb_joint_prismatic3d, fmb_joint_cylindrical, fmb_joint_torsion3d, fmb_joint_force3d;
 
 static const fmbBodyType* const builtin_bodies[] = {
     &fmb_body_ground,
@@ -36,6 +36,8 @@ static const fmbJointType* const builtin_joints[] = {
     &fmb_joint_universal,
     &fmb_joint_prismatic3d,
     &fmb_joint_cylindrical,
+    &fmb_joint_torsion3d,
+    &fmb_joint_force3d,
     NULL,
 };
 

@@ -8,7 +8,8 @@
  *   pattern   the sparse analytic Jacobian (pattern_jacobian) against central differences of
  *             [R; Rz] over every entry, and the declared pattern holding every nonzero
  *   mass      M = dR/da symmetric and positive definite (Cholesky)
- *   marker    position and angle derivatives against central differences
+ *   marker    position and angle derivatives against central differences (a spatial body: position
+ *             and the virtual rotation G of marker3, dR/dq_k = [G_k]x R, against differences)
  *   gravity   with has_gravity = 0 the residual and energy do not read env->gravity (it is NaN
  *             there): the leave-out contract
  *   phi_q     a joint's constraint derivative against central differences of its rows
@@ -16,6 +17,8 @@
  *   energy    a free run keeps the total energy (unless the type feeds energy in); a damped run
  *             (the example plus example_damped) loses it and never gains any
  *   outputs   every output of the type stays finite along the run
+ * A planar type (or one working in both dimensions) runs in the planar fixture, a spatial-only type
+ * in the spatial one: each is the fixture types (FMB_TYPE_CONFORM_FIXTURE) of that dimension.
  * Every check can fail: tests/plugins/bad_*.c are plugins that each break one. */
 #include <fcntl.h>
 #include <math.h>
@@ -100,23 +103,38 @@ typedef struct {
   const char* outputs; /* the outputs list, or NULL */
   /* the fixture's body and joint types (FMB_TYPE_CONFORM_FIXTURE): the engine names no type */
   const char *fixture_body, *fixture_joint;
+  int spatial; /* the spatial fixture (dimension: 3): a probe of a spatial-only type */
 } SceneSpec;
 
-/* the first registered body or joint type that declares itself fit for the fixture, or NULL */
-static const char* fixture_type(const fmbRegistry* reg, int joint) {
+/* the first registered body or joint type that declares itself fit for the fixture and works in
+   the fixture's dimension (FMB_DIM_PLANAR or FMB_DIM_SPATIAL), or NULL */
+static const char* fixture_type(const fmbRegistry* reg, int joint, unsigned dim) {
   if (joint) {
-    for (int i = 0; i < reg->njoints; ++i)
-      if (reg->joints[i]->flags & FMB_TYPE_CONFORM_FIXTURE) return reg->joints[i]->name;
+    for (int i = 0; i < reg->njoints; ++i) {
+      const fmbJointType* t = reg->joints[i];
+      if ((t->flags & FMB_TYPE_CONFORM_FIXTURE) && (fmb_type_dimensions(t->abi, t->dimensions) & dim)) return t->name;
+    }
   } else {
-    for (int i = 0; i < reg->nbodies; ++i)
-      if (reg->bodies[i]->flags & FMB_TYPE_CONFORM_FIXTURE) return reg->bodies[i]->name;
+    for (int i = 0; i < reg->nbodies; ++i) {
+      const fmbBodyType* t = reg->bodies[i];
+      if ((t->flags & FMB_TYPE_CONFORM_FIXTURE) && (fmb_type_dimensions(t->abi, t->dimensions) & dim)) return t->name;
+    }
   }
   return NULL;
 }
 
+/* the scene spec of a probe: the fixture of the type's dimension */
+static SceneSpec scene_spec(const fmbRegistry* reg, int joint, int spatial, const char* outputs) {
+  const unsigned dim = spatial ? FMB_DIM_SPATIAL : FMB_DIM_PLANAR;
+  SceneSpec s = {joint, -9.81, outputs, fixture_type(reg, 0, dim), fixture_type(reg, 1, dim), spatial};
+  return s;
+}
+
 /* Writes the scene; returns the file line (1-based) of the probe's first item line. The fixture
    (fmbJointType's comment): body a pinned to ground at its left end, body b to its right, of the
-   types flagged FMB_TYPE_CONFORM_FIXTURE (a rigid body and a pin). */
+   types flagged FMB_TYPE_CONFORM_FIXTURE (a rigid body and a pin). The spatial fixture is the same
+   in space: a (centre [0.5, 0, 0]) on a ball joint at its end [-0.5, 0, 0], b at [1.5, 0, 0], both
+   turning about all three axes, gravity along -y as in the plane. */
 static int scene_write(const char* path, const char* type, const Lines* l, const SceneSpec* s) {
   /* never through a link that someone else put in the work folder (O_NOFOLLOW) */
   const int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC | O_NOFOLLOW | O_CLOEXEC, 0666);
@@ -128,19 +146,34 @@ static int scene_write(const char* path, const char* type, const Lines* l, const
   int line = 1;
 #define EMIT(...) (fprintf(f, __VA_ARGS__), line++)
   EMIT("solver: {t_end: %g, rtol: 1e-10, atol: 1e-12, output_step: %g}\n", CONFORM_T_END, CONFORM_T_END / 100);
-  EMIT("gravity: [0, %g]\n", s->gravity);
-  EMIT("bodies:\n");
-  EMIT("  - {name: a, type: %s, mass: 1, inertia: 0.1, position: [0.5, 0], velocity: [0, 0.5], angular_velocity: 1}\n",
-       s->fixture_body);
-  EMIT("  - {name: b, type: %s, mass: 1.5, inertia: 0.2, position: [1.5, 0], velocity: [0.3, -0.2], angular_velocity: "
-       "-1}\n",
-       s->fixture_body);
+  if (s->spatial) {
+    EMIT("dimension: 3\n");
+    EMIT("gravity: [0, %g, 0]\n", s->gravity);
+    EMIT("bodies:\n");
+    /* a's velocity is omega x [0.5, 0, 0]: consistent with the ball joint */
+    EMIT("  - {name: a, type: %s, mass: 1, inertia: [0.1, 0.08, 0.05], position: [0.5, 0, 0], velocity: [0, 0.5, 0.2], "
+         "angular_velocity: [0.3, -0.4, 1]}\n",
+         s->fixture_body);
+    EMIT("  - {name: b, type: %s, mass: 1.5, inertia: [0.2, 0.15, 0.1], position: [1.5, 0, 0], velocity: [0.3, -0.2, "
+         "0.1], angular_velocity: [0.5, 0.2, -1]}\n",
+         s->fixture_body);
+  } else {
+    EMIT("gravity: [0, %g]\n", s->gravity);
+    EMIT("bodies:\n");
+    EMIT("  - {name: a, type: %s, mass: 1, inertia: 0.1, position: [0.5, 0], velocity: [0, 0.5], angular_velocity: "
+         "1}\n",
+         s->fixture_body);
+    EMIT("  - {name: b, type: %s, mass: 1.5, inertia: 0.2, position: [1.5, 0], velocity: [0.3, -0.2], "
+         "angular_velocity: -1}\n",
+         s->fixture_body);
+  }
   if (!s->joint) EMIT("  - name: probe\n    type: %s\n", type), line++;
   const int first_body_line = line;
   if (!s->joint)
     for (int i = 0; i < l->n; ++i) EMIT("    %s\n", l->line[i]);
   EMIT("joints:\n");
-  EMIT("  - {name: pin, type: %s, body1: ground, body2: a, point2: [-0.5, 0]}\n", s->fixture_joint);
+  EMIT("  - {name: pin, type: %s, body1: ground, body2: a, point2: [-0.5, 0%s]}\n", s->fixture_joint,
+       s->spatial ? ", 0" : "");
   if (s->joint) EMIT("  - name: probe\n    type: %s\n", type), line++;
   const int first_joint_line = line;
   if (s->joint)
@@ -278,7 +311,40 @@ static double rel_err(const double* A, const double* B, int n, double floor_) {
   return e / s;
 }
 
-static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b, const double* y) {
+/* a spatial body's marker3 at two material points: dpos/dq against differences of pos, and the
+   virtual rotation G against differences of R (dR/dq_k = [G_k]x R); the worst error relative to
+   1 + |difference|. dp, G: 3 x n each */
+static double marker3_error(const fmbBodyType* t, const void* self, double* q, int n, double* dp, double* G,
+                            double* work) {
+  static const double locals[2][3] = {{0.0, 0.0, 0.0}, {0.3, 0.05, -0.1}};
+  double worst = 0.0;
+  for (int k = 0; k < 2; ++k) {
+    double pos[3], R[9], p1[3], p2[3], R1[9], R2[9];
+    if (t->marker3(self, q, locals[k], pos, R, dp, G, n, work)) return INFINITY;
+    for (int j = 0; j < n; ++j) {
+      const double x0 = q[j], h = 1e-6 * (1.0 + fabs(x0));
+      q[j] = x0 + h;
+      t->marker3(self, q, locals[k], p1, R1, NULL, NULL, n, work);
+      q[j] = x0 - h;
+      t->marker3(self, q, locals[k], p2, R2, NULL, NULL, n, work);
+      q[j] = x0;
+      const double g[3] = {G[j], G[n + j], G[2 * n + j]};
+      for (int i = 0; i < 3; ++i) {
+        const double fd = (p1[i] - p2[i]) / (2 * h);
+        worst = fmax(worst, fabs(dp[(size_t)i * n + j] - fd) / (1.0 + fabs(fd)));
+        for (int c = 0; c < 3; ++c) { /* ([g]x R)_ic = (g x column c of R)_i */
+          const int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+          const double an = g[i1] * R[3 * i2 + c] - g[i2] * R[3 * i1 + c];
+          const double fdR = (R1[3 * i + c] - R2[3 * i + c]) / (2 * h);
+          worst = fmax(worst, fabs(an - fdR) / (1.0 + fabs(fdR)));
+        }
+      }
+    }
+  }
+  return worst;
+}
+
+static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b, const double* y, int spatial) {
   const fmbBodyInst* bi = &m->body[b];
   const fmbBodyType* t = bi->type;
   const int n = bi->nq;
@@ -337,7 +403,8 @@ static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b,
   /* marker: derivatives against differences, at two material points */
   static const double locals[2][2] = {{0.0, 0.0}, {0.3, 0.05}};
   double worst = 0.0;
-  for (int k = 0; k < 2; ++k) {
+  if (spatial) worst = marker3_error(t, bi->self, q, n, K, C, work);
+  for (int k = 0; k < 2 && !spatial; ++k) {
     double pos[2], ang, p1[2], p2[2], a1, a2;
     double* dp = K; /* 2 x n */
     double* da = C;
@@ -354,7 +421,8 @@ static void check_body_ops(Report* r, const fmbModel* m, fmbWorkspace* w, int b,
       for (int i = 0; i < 3; ++i) worst = fmax(worst, fabs(an[i] - fd[i]) / (1.0 + fabs(fd[i])));
     }
   }
-  result(r, worst < FD_TOL, "marker", "position and angle derivatives vs central differences: %.2g", worst);
+  result(r, worst < FD_TOL, "marker", "%s derivatives vs central differences: %.2g",
+         spatial ? "position and virtual rotation (marker3)" : "position and angle", worst);
   /* leave-out: no gravity in the scene, so env->gravity must not be read (it is NaN here) */
   fmbEnv nog = {{NAN, NAN}, 0, {NAN, NAN, NAN}};
   rc = t->residual(bi->self, &nog, q, v, a, R0, work);
@@ -617,9 +685,10 @@ static int energy_run(Report* r, const char* scene, const char* csv, const fmbRe
 }
 
 static void check_energy(Report* r, const char* base, const char* type, const Lines* ex, const char* damped,
-                         unsigned flags, int has_energy, const char* outputs, int joint, const fmbRegistry* reg) {
+                         unsigned flags, int has_energy, const char* outputs, int joint, int spatial,
+                         const fmbRegistry* reg) {
   char scene[1100], csv[1100];
-  SceneSpec s = {joint, -9.81, outputs, fixture_type(reg, 0), fixture_type(reg, 1)};
+  SceneSpec s = scene_spec(reg, joint, spatial, outputs);
   double drift, rise, lost;
   snprintf(scene, sizeof scene, "%s-free.yaml", base);
   snprintf(csv, sizeof csv, "%s-free.csv", base);
@@ -680,15 +749,9 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   type_name = name;
   Report r = {report, label, 0};
   const int joint = jt != NULL;
-  /* the fixture is planar (a rigid body pinned in the plane): a spatial-only type is checked by
-     its own tests (tests/spatial), said here rather than passed in silence */
-  if (!(fmb_type_dimensions(joint ? jt->abi : bt->abi, joint ? jt->dimensions : bt->dimensions) & FMB_DIM_PLANAR)) {
-    result(&r, SKIP, "example",
-           "a spatial-only type (dimension 3): conform's fixture is planar; tests/spatial checks its derivatives "
-           "and physics");
-    fprintf(report, "ok   %s: 0 failed checks (skipped: spatial)\n", type_name);
-    return 0;
-  }
+  /* a spatial-only type is probed in the spatial fixture; a type of both dimensions in the planar one */
+  const int spatial =
+      !(fmb_type_dimensions(joint ? jt->abi : bt->abi, joint ? jt->dimensions : bt->dimensions) & FMB_DIM_PLANAR);
   const char* example = joint ? jt->example : bt->example;
   if (!example) {
     result(&r, 0, "example", "the type declares no example instance (fmbBodyType.example): nothing can be checked");
@@ -716,12 +779,12 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
     e += len;
   }
   snprintf(scene, sizeof scene, "%s.yaml", base);
-  SceneSpec s = {joint, -9.81, NULL, fixture_type(reg, 0), fixture_type(reg, 1)};
+  SceneSpec s = scene_spec(reg, joint, spatial, NULL);
   if (!s.fixture_body || !s.fixture_joint) {
     result(&r, 0, "example",
-           "no %s type in the registry declares FMB_TYPE_CONFORM_FIXTURE: the conformance scene has "
+           "no %s%s type in the registry declares FMB_TYPE_CONFORM_FIXTURE: the conformance scene has "
            "no fixture (register the built-in types too)",
-           !s.fixture_body ? "body" : "joint");
+           spatial ? "spatial " : "", !s.fixture_body ? "body" : "joint");
     return r.failed;
   }
   /* the declared parameters are the registered table's: a variant's own keys are checked by
@@ -756,19 +819,19 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
     if (joint)
       check_joint_ops(&r, m, w, m->njoint - 1, y);
     else if (m->body[m->nbody - 1].nq > 0) {
-      check_body_ops(&r, m, w, m->nbody - 1, y);
+      check_body_ops(&r, m, w, m->nbody - 1, y, spatial);
       check_pattern_jacobian(&r, m, w, m->nbody - 1, y);
     } else
       result(&r, 1, "dynamics", "no coordinates: nothing to differentiate");
   }
-  if (!joint && m->body[m->nbody - 1].nq >= 3)
+  if (!joint && !spatial && m->body[m->nbody - 1].nq >= 3)
     strncat(outputs, ", probe.x, probe.omega", sizeof outputs - strlen(outputs) - 1);
   free(y), free(yp);
   fmb_workspace_free(w);
   fmb_free(m);
   if (ic == 0)
     check_energy(&r, base, type_name, &ex, joint ? jt->example_damped : bt->example_damped,
-                 joint ? jt->flags : bt->flags, joint || bt->energy || !has_coordinates, outputs, joint, reg);
+                 joint ? jt->flags : bt->flags, joint || bt->energy || !has_coordinates, outputs, joint, spatial, reg);
   fprintf(report, "%s %s: %d failed checks\n", r.failed ? "FAIL" : "ok  ", type_name, r.failed);
   return r.failed;
 }

@@ -167,7 +167,9 @@ enum {
   /* conform's fixture (fmb_conform) is made of the first registered body type and joint type
      with this flag, so that the engine names no type: the body must take mass, inertia,
      position, velocity and angular_velocity (a rigid body with a frame), the joint body1, body2
-     and point2 (a pin joining two bodies' points) */
+     and point2 (a pin joining two bodies' points). A spatial-only probe gets the first flagged
+     types that work in space (FMB_DIM_SPATIAL: rigid3d and spherical), a planar one the first
+     that work in the plane */
   FMB_TYPE_CONFORM_FIXTURE = 1 << 1
 };
 
@@ -358,7 +360,9 @@ typedef struct fmbJointType {
   void (*describe)(const void* self, FILE* f);
   /* declarations (ABI 2), as for bodies. conform's fixture has two rigid bodies `a` (centre at
      [0.5, 0], pinned to ground at its end [-0.5, 0]) and `b` (centre at [1.5, 0]), 1 m long each,
-     and a revolute joint `pin` (ground to a): the example refers to them by these names. */
+     and a revolute joint `pin` (ground to a): the example refers to them by these names. A
+     spatial-only type's example is placed in the spatial fixture: the same bodies in space (centres
+     [0.5, 0, 0] and [1.5, 0, 0]) and `pin` a ball joint at a's end [-0.5, 0, 0]. */
   const fmbParam* params;
   const char* example;
   const char* example_damped;

@@ -59,6 +59,6 @@ const fmbJointType fmb_joint_cylindrical = {
     .output_units = cylindrical_output_units,
     .output = cylindrical_output,
     .params = cylindrical_params,
-    .example = "body1: ground\nbody2: a\npoint2: [0, 0, 0.5]\naxis: [0, 0, 1]\n",
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0, 0]\npoint2: [-0.5, 0, 0]\naxis: [1, 0, 0]\n",
     .dimensions = FMB_DIM_SPATIAL,
 };

@@ -45,6 +45,6 @@ const fmbJointType fmb_joint_fixed3d = {
     .nrows = fixed3d_nrows,
     .constraint = fixed3d_constraint,
     .params = fixed3d_params,
-    .example = "body1: ground\nbody2: a\npoint2: [0, 0, 0.5]\n",
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0, 0]\npoint2: [-0.5, 0, 0]\n",
     .dimensions = FMB_DIM_SPATIAL,
 };

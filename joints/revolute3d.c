@@ -132,6 +132,6 @@ const fmbJointType fmb_joint_revolute3d = {
     .output_units = revolute3d_output_units,
     .output = revolute3d_output,
     .params = revolute3d_params,
-    .example = "body1: ground\nbody2: a\npoint2: [0, 0, 0.5]\naxis: [1, 0, 0]\n",
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0, 0]\npoint2: [-0.5, 0, 0]\naxis: [0, 0, 1]\n",
     .dimensions = FMB_DIM_SPATIAL,
 };

@@ -163,6 +163,23 @@ double fmbj3_turn(const fmbSpatialEval* e) {
   return atan2(c[0] * z1[0] + c[1] * z1[1] + c[2] * z1[2], x1[0] * x2[0] + x1[1] * x2[1] + x1[2] * x2[2]);
 }
 
+double fmbj3_turn_row(const fmbSpatialEval* e, double* row, int ncol0) {
+  if (!row || !e->G) return fmbj3_turn(e);
+  double* ds = row; /* d(y1 . x2) first, then combined in place with d(x1 . x2) column by column */
+  const double s = axes_row(e, 1, 0, ds, ncol0);
+  const double c = axes_row(e, 0, 0, NULL, ncol0);
+  const double A[3] = {e->X[0][0], e->X[0][3], e->X[0][6]}, B[3] = {e->X[1][0], e->X[1][3], e->X[1][6]};
+  double AxB[3];
+  cross(A, B, AxB);
+  const double r2 = s * s + c * c;
+  for (int k = 0; k < e->ld; ++k) {
+    const double sign = k < ncol0 ? 1.0 : -1.0; /* as axes_row: body2 sees B x A */
+    const double dc = sign * (e->G[k] * AxB[0] + e->G[e->ld + k] * AxB[1] + e->G[2 * (size_t)e->ld + k] * AxB[2]);
+    row[k] = (c * ds[k] - s * dc) / r2;
+  }
+  return atan2(s, c);
+}
+
 double fmbj3_slide(const fmbSpatialEval* e) {
   return -(e->gap[0] * e->X[0][2] + e->gap[1] * e->X[0][5] + e->gap[2] * e->X[0][8]);
 }

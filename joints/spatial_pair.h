@@ -69,6 +69,11 @@ int fmbj3_rows(const fmbJointEval* ev, const fmbSpatialPair* sp, const fmbj3Row*
 /* the turn of frame 2's x axis from frame 1's about frame 1's z axis, in (-pi, pi]; the slide
    (p2 - p1) . z1 */
 double fmbj3_turn(const fmbSpatialEval* e);
+/* the same turn, atan2(y1 . x2, x1 . x2), and (row not NULL, e from fmbj3_eval with derivatives)
+   its exact gradient over the joint's columns, off the hinge's manifold too (so that a potential of
+   the turn and its generalized force agree everywhere):
+   dturn = (c ds - s dc) / (s^2 + c^2), s = y1 . x2, c = x1 . x2, each an axes row */
+double fmbj3_turn_row(const fmbSpatialEval* e, double* row, int ncol0);
 double fmbj3_slide(const fmbSpatialEval* e);
 /* a joint's state (an fmbSpatialPair) allocated into *self; its destroy op */
 int fmbj3_new(fmbParser* p, fmbNode item, void** self, fmbSpatialPair** sp);

@@ -42,6 +42,7 @@ const fmbJointType fmb_joint_spherical = {
     .nrows = spherical_nrows,
     .constraint = spherical_constraint,
     .params = spherical_params,
-    .example = "body1: ground\nbody2: a\npoint2: [0, 0, 0.5]\n",
+    .example = "body1: a\nbody2: b\npoint1: [0.5, 0, 0]\npoint2: [-0.5, 0, 0]\n",
     .dimensions = FMB_DIM_SPATIAL,
+    .flags = FMB_TYPE_CONFORM_FIXTURE, /* conform's ball joint of body a to ground in space */
 };

@@ -86,22 +86,7 @@ static void torsion_describe(const void* self, FILE* out) {
 
 static const fmbParam torsion_params[] = {
     FMBJ_TWO_POINT_PARAMS,
-    {.key = "stiffness",
-     .kind = FMB_PARAM_NUMBER,
-     .flags = FMB_REQUIRED | FMB_NONNEGATIVE,
-     .unit = "N m/rad",
-     .doc = "rate k"},
-    {.key = "damping",
-     .kind = FMB_PARAM_NUMBER,
-     .flags = FMB_NONNEGATIVE,
-     .unit = "N m s/rad",
-     .fallback = "0",
-     .doc = "rate c"},
-    {.key = "angle0",
-     .kind = FMB_PARAM_NUMBER,
-     .unit = "rad",
-     .fallback = "0",
-     .doc = "relative angle where it is relaxed (set point)"},
+    FMBJ_ROTATIONAL_SPRING_PARAMS,
     {.key = NULL},
 };
 

@@ -88,9 +88,13 @@ int fmb_cmd_types(int argc, char** argv) {
          "constraint rows; dimension 3: a type for `dimension: 3` scenes, docs/spatial.md):\n");
   for (int i = 0; i < fmb_registry_njoints(reg); ++i) {
     const fmbJointType* t = fmb_registry_joint(reg, i);
-    const int planar = (fmb_type_dimensions(t->abi, t->dimensions) & FMB_DIM_PLANAR) != 0;
+    const unsigned dims = fmb_type_dimensions(t->abi, t->dimensions);
+    const int planar = (dims & FMB_DIM_PLANAR) != 0;
     printf("  %s  (%s)%s%s\n", t->name, fmb_registry_joint_origin(reg, i),
-           t->flags & FMB_TYPE_DOES_WORK ? ", feeds energy in" : "", planar ? "" : ", dimension 3");
+           t->flags & FMB_TYPE_DOES_WORK ? ", feeds energy in" : "",
+           !planar                    ? ", dimension 3"
+           : (dims & FMB_DIM_SPATIAL) ? ", dimensions 2 and 3"
+                                      : "");
     print_params(t->params);
     const char* const* engine_given[2];
     int n = 0;

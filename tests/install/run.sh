@@ -13,7 +13,9 @@
 #  5. deliberately broken plugins (tests/install/broken.c) are each caught, with a clear message:
 #     another plugin ABI major or a newer minor, a missing required op, no entry symbol, a name already taken (loader, exit 2), a wrong Jacobian, a mass
 #     matrix that is not symmetric, energy that leaks (conform, exit 1);
-#  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc).
+#  6. the prefix moved elsewhere still works through pkg-config (relocatable .pc);
+#  examples/joint_plugin and the spatial examples/plugin3d are built out of the tree too, each conform and
+#  its check program against its closed form.
 . "$(dirname "$0")/prefix.sh"
 fails=0
 fail() {
@@ -103,18 +105,22 @@ expect 2 "noplugins.yaml:[0-9]+:[0-9]+: error: .*foundation_bar" "$F" run "$work
 expect 0 "foundation_bar +\\($pc/build/foundation.so\\)" "$F" types --plugin "$pc/build/foundation.so"
 expect 0 'N/m\^2 > 0, required' "$F" types --plugin "$pc/build/foundation.so"
 expect 0 'ok   foundation_bar: 0 failed checks' "$F" conform --work "$work/conform" --plugin "$ex/build/foundation.so" foundation_bar
-expect 0 'conform: 17 types, 0 failed checks' "$F" conform --work "$work/conform"
+expect 0 'conform: 19 types, 0 failed checks' "$F" conform --work "$work/conform"
 expect 0 'agrees with the analytic solution' "$ex/build/check_foundation" "$ex/foundation.yaml" "$work/check.csv"
 expect 0 'agrees with the analytic solution' env LD_LIBRARY_PATH="$libdir" "$pc/check_foundation" "$pc/foundation.yaml" "$work/check_pc.csv"
 cat "$work/out"
 # the joint example (examples/joint_plugin: a torsional spring-damper) out of the tree, as a user
 # copies it from the installed share/flexmbd/examples: built, conform, its check program against
 # the damped oscillator, listed by types with its keys, drawn (its attachment) by view
+# build_example NAME DIR: copy share/flexmbd/examples/NAME to DIR and build it with find_package(flexmbd)
+build_example() {
+  mkdir -p "$2"
+  cp "$share/examples/$1"/*.c "$share/examples/$1/CMakeLists.txt" "$share/examples/$1"/*.yaml "$2"/
+  (cmake -S "$2" -B "$2/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$2/build") \
+    >"$work/cmake_$1.log" 2>&1 || fail "examples/$1 does not build: $(tail -n 5 "$work/cmake_$1.log")"
+}
 jx=$work/joint_example
-mkdir -p "$jx"
-cp "$share"/examples/joint_plugin/*.c "$share"/examples/joint_plugin/CMakeLists.txt "$share"/examples/joint_plugin/*.yaml "$jx"/
-(cmake -S "$jx" -B "$jx/build" -DCMAKE_PREFIX_PATH="$T" -DCMAKE_BUILD_TYPE=Release && cmake --build "$jx/build") \
-  >"$work/cmake_joint.log" 2>&1 || fail "examples/joint_plugin does not build: $(tail -n 5 "$work/cmake_joint.log")"
+build_example joint_plugin "$jx"
 expect 0 'ok   torsion_spring: 0 failed checks' "$F" conform --plugin "$jx/build/torsion.so" torsion_spring
 expect 0 'agrees with the analytic solution' "$jx/build/check_torsion" "$jx/torsion.yaml" "$work/torsion.csv"
 expect 0 'N m/rad >= 0, required' "$F" types --plugin "$jx/build/torsion.so"
@@ -123,6 +129,16 @@ expect 0 'N m/rad >= 0, required' "$F" types --plugin "$jx/build/torsion.so"
 expect 0 'wrote .*torsion.html \(11 rows, 1 of 1 bodies drawn' "$F" view "$work/torsion_draw.csv" "$jx/torsion.yaml" \
   -o "$work/torsion.html"
 grep -q '"part":4,"points"' "$work/torsion.html" || fail "view: the torsion spring is not drawn as a force element"
+# the spatial example (examples/plugin3d: a ball spring-damper for `dimension: 3` scenes) out of the
+# tree the same way: built, conform in its spatial fixture, its check program against the 3D damped
+# oscillator, refused in a planar scene at its `type:`
+px=$work/plugin3d_example
+build_example plugin3d "$px"
+expect 0 'ok   ball_spring energy: a damped run loses energy' "$F" conform --plugin "$px/build/ball_spring.so" ball_spring
+expect 0 'agrees with the analytic solution' "$px/build/check_ball_spring" "$px/ball_spring.yaml" "$work/ball_spring.csv"
+printf 'plugins: [%s]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\njoints: [{name: s, type: ball_spring, body1: ground, body2: a, stiffness: 1}]\n' \
+  "$px/build/ball_spring.so" >"$work/ball_planar.yaml"
+expect 2 'ball_planar.yaml:4:' "$F" check "$work/ball_planar.yaml"
 # a scene naming a plugin that is not there: located error
 printf 'plugins: [nowhere.so]\nsolver: {t_end: 1}\nbodies: [{name: a, type: rigid, mass: 1, inertia: 1}]\n' >"$work/missing.yaml"
 expect 2 'missing.yaml:1:11: error: plugin .*nowhere.so: cannot load plugin' "$F" check "$work/missing.yaml"
@@ -168,6 +184,14 @@ expect 1 'FAIL oscillator energy: a free run keeps the total energy' \
 expect 2 "broken_NAME.so: error: body type 'rigid' is already registered \\(from built-in\\)" \
   "$F" types --plugin "$work/broken_NAME.so"
 expect 0 'oscillator' "$F" types --plugin "$work/unbroken.so" --plugin "$work/unbroken.so" # the same file twice: a no-op
+# conform's spatial fixture catches a wrong derivative too: examples/plugin3d's ball_spring with
+# body1's columns of dd/dq left unnegated (its force is then not -dV/dq)
+sed 's/D\[i \* ld + c\] = -D\[i \* ld + c\]/D[i * ld + c] = D[i * ld + c]/' "$px/ball_spring.c" >"$work/ball_broken.c"
+grep -q 'D\[i \* ld + c\] = D\[i \* ld + c\]' "$work/ball_broken.c" || fail "ball_broken.c: the sign to break is not in ball_spring.c"
+cc -std=c11 -shared -fPIC "$work/ball_broken.c" $(pkg-config --cflags --libs flexmbd) -lm -o "$work/ball_broken.so" ||
+  fail "ball_broken.c does not build"
+expect 1 'FAIL ball_spring force: generalized force vs -dV/dq' \
+  "$F" conform --work "$work/conform" --plugin "$work/ball_broken.so" ball_spring
 
 # 6. relocatable: the prefix moved, pkg-config still points into it
 mv "$T" "$work/moved"
