@@ -170,7 +170,12 @@ FMB_API int fmb_model_joint(const fmbModel* m, int i, const char** name, const c
    `centreline` is a polyline through its stations; any other body with a frame (ncoord >= 3) is the
    outline through the points its joints attach to (closed from three points) and its frame's x and
    y axes; a joint with constraint rows is a vertex at its first point; a force element with two
-   points (a spring) is the line between them. */
+   points (a spring) is the line between them.
+   In a spatial scene (dimension 3, docs/spatial.md) the drawing is the same from the spatial ops:
+   points are material points of a body's marker3 (local3, 3 per point; fmbDrawPoint.local holds
+   their x, y); a centreline's stations [x, y] are the body's [x, y, 0]; any other spatial body is
+   the line or polygon through its joints' attachment3 points (in the joints' order) and its
+   frame's x, y and z axes; a joint is a vertex at its first attachment3 point. */
 enum {
   FMB_DRAW_CENTRELINE = 0,
   FMB_DRAW_OUTLINE = 1,
@@ -193,6 +198,10 @@ typedef struct fmbDrawing {
   fmbDrawPoint* point;
   fmbDrawCell* cell;
   int* conn;
+  /* appended (issue 34): the scene's dimension, 2 or 3, and for 3 the points' body-frame
+     coordinates [x, y, z] (3 per point, point i at 3 i; NULL in a planar drawing) */
+  int dimension;
+  double* local3;
 } fmbDrawing;
 /* the SI unit of a CSV column the engine itself defines ("t": s; BODY.x: m; BODY.omega: rad/s;
    JOINT.power: W; JOINT.work and energy.*: J; JOINT.reaction_x: N; reaction_torque: N m;

@@ -445,6 +445,10 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
 /* global position of a body's material point (its marker); 0 ok */
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle);
+/* its spatial twin (dimension 3): position and rotation matrix (row-major; R may be NULL) of a
+   material point from the body's marker3; 0 ok, -1 for a body without one */
+int fmb_body_point3(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[3], double pos[3],
+                    double R[9]);
 /* no `outputs:` list: x, y, theta, omega of every moving body with a frame; 0, or -1 out of memory */
 int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;

@@ -318,6 +318,13 @@ int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, c
   return bi->type->marker(bi->self, q + bi->qadr, local, pos, angle, NULL, NULL, fmb_workspace_plugin(w) + bi->workadr);
 }
 
+int fmb_body_point3(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[3], double pos[3],
+                    double R[9]) {
+  const fmbBodyInst* bi = &m->body[b];
+  if (!bi->marker3) return -1; /* a planar body */
+  return bi->marker3(bi->self, q + bi->qadr, local, pos, R, NULL, NULL, 0, fmb_workspace_plugin(w) + bi->workadr);
+}
+
 static double shape_value(const fmbModel* m, fmbWorkspace* w, const fmbOutput* o, const double* q) {
   double pos[2];
   if (fmb_body_point(m, w, o->owner, q, o->local, pos, NULL)) return NAN;
