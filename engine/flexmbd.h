@@ -277,6 +277,17 @@ FMB_API double fmb_data_time(const fmbData* d); /* NaN for NULL (or before fmb_i
 /* the DAE state y = [q, v, lambda, mu, z] and y' (fmb_state_size(m) doubles each; either may be
    NULL): 0, or FMB_EXIT_BAD_INPUT (NULL or freed d, before fmb_init) */
 FMB_API int fmb_data_state(const fmbData* d, double* y, double* yp);
+/* set the state (issue 34): time() = t (t0 <= t <= t_end) and y (and y', NULL = zeros) as
+   fmb_data_state gives them, e.g. one saved earlier, of another data object of the same model, or
+   changed by the program. No step history crosses the jump: the next advance first makes the state
+   consistent at t, as after an input's jump (q onto the constraints, v onto their rates, then the
+   accelerations and multipliers), so the y' and multipliers given are only a start. A spatial
+   body's coordinates are [r, p] with Euler parameters p of any nonzero length (docs/spatial.md):
+   a p scaled by any factor is the same pose. The joints' work integrals go on from their values.
+   0, or FMB_EXIT_BAD_INPUT (misuse, before fmb_init, y NULL, a value not finite, t outside
+   [t0, t_end]: nothing changed, *diag says why). */
+FMB_API int fmb_data_set_state(const fmbModel* m, fmbData* d, double t, const double* y, const double* yp,
+                               fmbDiag* diag);
 /* the scene's outputs: their number (the CSV's columns after t), the name of output i (e.g.
    "beam.tip_v"; NULL out of range) and their values at time() into out[fmb_noutput(m)], the very
    numbers the CSV row at that time holds. fmb_outputs: 0, FMB_EXIT_SOLVER when a value is not
