@@ -63,7 +63,8 @@ typedef enum {
   FMB_OUT_JOINT_REACTION, /* 0 x, 1 y: force on body2 at its point; 2 torque about that point */
   FMB_OUT_ENERGY,         /* 0 kinetic 1 strain 2 gravity 3 spring 4 total 5 balance */
   FMB_OUT_CONSTRAINT,     /* 0 position 1 velocity */
-  FMB_OUT_SHAPE           /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
+  FMB_OUT_SHAPE,          /* a centreline station of BODY.shape: id 0 x, 1 y (2 z in space) at body point `local` */
+  FMB_OUT_POSE3           /* space: a body's origin and frame from marker3 (id: index into pose3_names) */
 } fmbOutKind;
 
 typedef struct fmbOutput {
