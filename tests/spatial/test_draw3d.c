@@ -34,10 +34,10 @@ static fmbBodyType rod_type;
 static const fmbBodyType* rod_types[] = {&rod_type, NULL};
 static const fmbPlugin rod_plugin = {.abi = FMB_ABI_VERSION, .name = "rod3d", .version = "1", .bodies = rod_types};
 
-#define SCENE(TYPE)                                                                                        \
-  "dimension: 3\ngravity: [0, 0, -9.81]\nsolver: {t_end: 0.5, rtol: 1e-9, output_step: 0.05}\n"           \
+#define SCENE(TYPE)                                                                                         \
+  "dimension: 3\ngravity: [0, 0, -9.81]\nsolver: {t_end: 0.5, rtol: 1e-9, output_step: 0.05}\n"             \
   "bodies:\n  - {name: rod, type: " TYPE ", mass: 1, inertia: [0.001, 0.08, 0.08], position: [0.5, 0, 0], " \
-  "velocity: [0, 1, 0], angular_velocity: [3, 0, 2]}\n"                                                  \
+  "velocity: [0, 1, 0], angular_velocity: [3, 0, 2]}\n"                                                     \
   "joints:\n  - {name: ball, type: spherical, body1: ground, body2: rod, point2: [-0.5, 0, 0]}\n"
 
 static fmbModel* load_text(fmbRegistry* reg, const char* name, const char* text, fmbDiag* diag) {
@@ -85,10 +85,11 @@ int main(void) {
   if (fmbt_failures) return fmbt_finish("test_draw3d");
 
   /* the twin: rigid3d's own columns */
-  fmbModel* twin = load_text(reg, "twin3d.yaml",
-                             SCENE("rigid3d") "outputs: [rod.x, rod.y, rod.z, rod.qw, rod.qx, rod.qy, rod.qz]\n", &diag);
-  fmbModel* rod = load_text(reg, "rod3d.yaml", SCENE("rod3d") "outputs: [rod.x, rod.y, rod.z, rod.qw, rod.qx, rod.qy, "
-                                                              "rod.qz, rod.shape]\n",
+  fmbModel* twin = load_text(
+      reg, "twin3d.yaml", SCENE("rigid3d") "outputs: [rod.x, rod.y, rod.z, rod.qw, rod.qx, rod.qy, rod.qz]\n", &diag);
+  fmbModel* rod = load_text(reg, "rod3d.yaml",
+                            SCENE("rod3d") "outputs: [rod.x, rod.y, rod.z, rod.qw, rod.qx, rod.qy, "
+                                           "rod.qz, rod.shape]\n",
                             &diag);
   ENSURE(twin && rod);
   if (!twin || !rod) return fmbt_finish("test_draw3d");
@@ -97,8 +98,8 @@ int main(void) {
   fmbt_out_path("rod3d.csv", rod_csv, sizeof rod_csv);
   fmbt_out_path("rod3d_vtk", vtk_dir, sizeof vtk_dir);
   fmbStats st;
-  fmbRunOptions opt_twin = {.csv_path = twin_csv, .quiet = 1}, opt_rod = {.csv_path = rod_csv, .vtk_dir = vtk_dir,
-                                                                          .quiet = 1};
+  fmbRunOptions opt_twin = {.csv_path = twin_csv, .quiet = 1},
+                opt_rod = {.csv_path = rod_csv, .vtk_dir = vtk_dir, .quiet = 1};
   ENSURE(fmb_run(twin, &opt_twin, &st, &diag) == 0);
   ENSURE(fmb_run(rod, &opt_rod, &st, &diag) == 0);
   fmbtCsv ct, cr;
@@ -151,7 +152,8 @@ int main(void) {
     ENSURE(d->local3[3 * i] == -0.5 + 0.25 * s && d->local3[3 * i + 1] == 0.0 && d->local3[3 * i + 2] == 0.0);
   }
   const int j = d->conn[d->cell[vertex].first];
-  ENSURE(d->point[j].body == 0 && d->local3[3 * j] == 0.0 && d->local3[3 * j + 1] == 0.0 && d->local3[3 * j + 2] == 0.0);
+  ENSURE(d->point[j].body == 0 && d->local3[3 * j] == 0.0 && d->local3[3 * j + 1] == 0.0 &&
+         d->local3[3 * j + 2] == 0.0);
 
   /* the last VTK step: the centreline's points and cross-section frames */
   char vtu[1200];
@@ -164,7 +166,8 @@ int main(void) {
   double* fy = calloc(3 * (size_t)np, sizeof *fy);
   double* fz = calloc(3 * (size_t)np, sizeof *fz);
   ENSURE(text && vtu_array(text, len, "Points", pts, 3 * np) == 3 * np &&
-         vtu_array(text, len, "frame_y", fy, 3 * np) == 3 * np && vtu_array(text, len, "frame_z", fz, 3 * np) == 3 * np);
+         vtu_array(text, len, "frame_y", fy, 3 * np) == 3 * np &&
+         vtu_array(text, len, "frame_z", fz, 3 * np) == 3 * np);
   const int last = cr.nrow - 1;
   double q[4], R[9], worst_vtk = 0.0;
   for (int k = 0; k < 4; ++k) q[k] = fmbt_col(&ct, pose[3 + k])[last];
