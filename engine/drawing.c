@@ -108,6 +108,51 @@ static int attachments3_of(const fmbModel* m, int b, double* local, int cap) {
   return n;
 }
 
+/* a point in the drawing's dimension: local [x, y, z] (z read in space only) */
+static int add_point_in(fmbDrawing* d, int body, const double local[3], int station) {
+  return d->local3 ? add_point3(d, body, local, station) : add_point(d, body, local, station);
+}
+
+/* attachment k of a joint in the scene's dimension (attachment3 in space, ABI 3.3); 0 ok */
+static int joint_point(const fmbModel* m, const fmbJointInst* ji, int k, int* body, double pt[3]) {
+  if (m->dimension == 3)
+    return ji->type->abi >= FMB_PLUGIN_ABI_MAJOR * 1000 + 3 && ji->type->attachment3
+               ? ji->type->attachment3(ji->self, k, body, pt)
+               : -1;
+  return ji->type->attachment ? ji->type->attachment(ji->self, k, body, pt) : -1;
+}
+
+/* body b's centreline: a polyline through its stations (in space the body's [x, y, 0]); 0 ok */
+static int add_centreline(fmbDrawing* d, const fmbBodyInst* bi, int b) {
+  const int n = bi->type->centreline(bi->self, 0, NULL);
+  double* st = calloc(2 * (size_t)n + 2, sizeof *st);
+  if (!st) return -1;
+  bi->type->centreline(bi->self, n, st);
+  const int first = d->npoint;
+  for (int i = 0; i < n; ++i) add_point_in(d, b, (const double[3]){st[2 * i], st[2 * i + 1], 0.0}, i);
+  add_cell(d, NULL, first, n, FMB_DRAW_CENTRELINE, b);
+  free(st);
+  return 0;
+}
+
+/* every joint: one with constraint rows a vertex at its first point, a force element with two
+   points (a spring) the line between them */
+static void add_joints(const fmbModel* m, fmbDrawing* d) {
+  for (int j = 0; j < m->njoint; ++j) {
+    const fmbJointInst* ji = &m->joint[j];
+    int body[2];
+    double pt[2][3] = {{0.0, 0.0, 0.0}, {0.0, 0.0, 0.0}};
+    if (joint_point(m, ji, 0, &body[0], pt[0])) continue;
+    const int first = add_point_in(d, body[0], pt[0], -1);
+    if (ji->nrows == 0 && joint_point(m, ji, 1, &body[1], pt[1]) == 0) {
+      add_point_in(d, body[1], pt[1], -1);
+      add_cell(d, NULL, first, 2, FMB_DRAW_FORCE_ELEMENT, j);
+    } else {
+      add_cell(d, NULL, first, 1, FMB_DRAW_JOINT, j);
+    }
+  }
+}
+
 /* the drawing of a spatial scene (the file's comment): the planar one's parts from the spatial ops */
 static int drawing_new3(const fmbModel* m, fmbDrawing* d) {
   int npt = 0, ncell = 0;
@@ -132,18 +177,8 @@ static int drawing_new3(const fmbModel* m, fmbDrawing* d) {
   int rc = (d->point && d->local3 && d->cell && d->conn && local) ? 0 : -1;
   for (int b = 1; b < m->nbody && rc == 0; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    if (bi->type->centreline) { /* stations [x, y] of the body, at z = 0 */
-      const int n = bi->type->centreline(bi->self, 0, NULL);
-      double* st = calloc(2 * (size_t)n + 2, sizeof *st);
-      if (!st) {
-        rc = -1;
-        break;
-      }
-      bi->type->centreline(bi->self, n, st);
-      const int first = d->npoint;
-      for (int i = 0; i < n; ++i) add_point3(d, b, (const double[3]){st[2 * i], st[2 * i + 1], 0.0}, i);
-      add_cell(d, NULL, first, n, FMB_DRAW_CENTRELINE, b);
-      free(st);
+    if (bi->type->centreline) {
+      rc = add_centreline(d, bi, b);
     } else if (bi->nq > 0 && bi->marker3) {
       int n = attachments3_of(m, b, local, MAX_ATTACH);
       double size = 0.0;
@@ -170,20 +205,7 @@ static int drawing_new3(const fmbModel* m, fmbDrawing* d) {
       }
     }
   }
-  for (int j = 0; j < m->njoint && rc == 0; ++j) {
-    const fmbJointInst* ji = &m->joint[j];
-    if (ji->type->abi < FMB_PLUGIN_ABI_MAJOR * 1000 + 3 || !ji->type->attachment3) continue;
-    int body[2];
-    double pt[2][3];
-    if (ji->type->attachment3(ji->self, 0, &body[0], pt[0])) continue;
-    const int first = add_point3(d, body[0], pt[0], -1);
-    if (ji->nrows == 0 && ji->type->attachment3(ji->self, 1, &body[1], pt[1]) == 0) {
-      add_point3(d, body[1], pt[1], -1);
-      add_cell(d, NULL, first, 2, FMB_DRAW_FORCE_ELEMENT, j);
-    } else {
-      add_cell(d, NULL, first, 1, FMB_DRAW_JOINT, j);
-    }
-  }
+  if (rc == 0) add_joints(m, d);
   free(local);
   return rc;
 }
@@ -221,17 +243,7 @@ fmbDrawing* fmb_drawing_new(const fmbModel* m) {
   for (int b = 1; b < m->nbody && rc == 0; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     if (bi->type->centreline) {
-      int n = bi->type->centreline(bi->self, 0, NULL);
-      double* st = calloc(2 * (size_t)n + 2, sizeof *st);
-      if (!st) {
-        rc = -1;
-        break;
-      }
-      bi->type->centreline(bi->self, n, st);
-      int first = d->npoint;
-      for (int i = 0; i < n; ++i) add_point(d, b, st + 2 * i, i);
-      add_cell(d, NULL, first, n, FMB_DRAW_CENTRELINE, b);
-      free(st);
+      rc = add_centreline(d, bi, b);
     } else if (bi->nq >= 3) {
       int n = attachments_of(m, b, local, MAX_ATTACH);
       double size = 0.0;
@@ -261,20 +273,7 @@ fmbDrawing* fmb_drawing_new(const fmbModel* m) {
       add_cell(d, y_axis, 0, 2, FMB_DRAW_FRAME_AXIS, b);
     }
   }
-  for (int j = 0; j < m->njoint && rc == 0; ++j) {
-    const fmbJointInst* ji = &m->joint[j];
-    if (!ji->type->attachment) continue;
-    int body[2];
-    double pt[2][2];
-    if (ji->type->attachment(ji->self, 0, &body[0], pt[0])) continue;
-    int first = add_point(d, body[0], pt[0], -1);
-    if (ji->nrows == 0 && ji->type->attachment(ji->self, 1, &body[1], pt[1]) == 0) {
-      add_point(d, body[1], pt[1], -1);
-      add_cell(d, NULL, first, 2, FMB_DRAW_FORCE_ELEMENT, j);
-    } else {
-      add_cell(d, NULL, first, 1, FMB_DRAW_JOINT, j);
-    }
-  }
+  if (rc == 0) add_joints(m, d);
   free(local);
   if (rc) {
     fmb_drawing_free(d);
