@@ -153,21 +153,33 @@ static void add_joints(const fmbModel* m, fmbDrawing* d) {
   }
 }
 
-/* the drawing of a spatial scene (the file's comment): the planar one's parts from the spatial ops */
-static int drawing_new3(const fmbModel* m, fmbDrawing* d) {
-  int npt = 0, ncell = 0;
+/* does body b get an outline and a frame (planar: a frame in its first coordinates; spatial: a marker3)? */
+static int framed(const fmbModel* m, const fmbBodyInst* bi) {
+  return m->dimension == 3 ? bi->nq > 0 && bi->marker3 != NULL : bi->nq >= 3;
+}
+
+/* the most points and cells the scene's parts take */
+static void count_parts(const fmbModel* m, int* npt, int* ncell) {
+  const int axes = m->dimension == 3 ? 3 : 2;
+  *npt = *ncell = 0;
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     if (bi->type->centreline) {
-      npt += bi->type->centreline(bi->self, 0, NULL);
-      ncell += 1;
-    } else if (bi->nq > 0 && bi->marker3) {
-      npt += MAX_ATTACH + 1 + 4; /* outline (closed: +1), origin, frame axes */
-      ncell += 4;
+      *npt += bi->type->centreline(bi->self, 0, NULL);
+      *ncell += 1;
+    } else if (framed(m, bi)) {
+      *npt += MAX_ATTACH + 2 + axes; /* outline (closed: +1), origin, frame axes */
+      *ncell += 1 + axes;
     }
   }
-  npt += 2 * m->njoint;
-  ncell += m->njoint;
+  *npt += 2 * m->njoint;
+  *ncell += m->njoint;
+}
+
+/* the drawing of a spatial scene (the file's comment): the planar one's parts from the spatial ops */
+static int drawing_new3(const fmbModel* m, fmbDrawing* d) {
+  int npt, ncell;
+  count_parts(m, &npt, &ncell);
   d->dimension = 3;
   d->point = calloc((size_t)npt + 1, sizeof *d->point);
   d->local3 = calloc(3 * (size_t)npt + 3, sizeof *d->local3);
@@ -179,7 +191,7 @@ static int drawing_new3(const fmbModel* m, fmbDrawing* d) {
     const fmbBodyInst* bi = &m->body[b];
     if (bi->type->centreline) {
       rc = add_centreline(d, bi, b);
-    } else if (bi->nq > 0 && bi->marker3) {
+    } else if (framed(m, bi)) {
       int n = attachments3_of(m, b, local, MAX_ATTACH);
       double size = 0.0;
       for (int i = 0; i < n; ++i) size = fmax(size, hypot(hypot(local[3 * i], local[3 * i + 1]), local[3 * i + 2]));
@@ -222,19 +234,8 @@ fmbDrawing* fmb_drawing_new(const fmbModel* m) {
     }
     return d;
   }
-  int npt = 0, ncell = 0;
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    if (bi->type->centreline) {
-      npt += bi->type->centreline(bi->self, 0, NULL);
-      ncell += 1;
-    } else if (bi->nq >= 3) {
-      npt += MAX_ATTACH + 2 + 3; /* outline (closed: +1), origin, frame axes */
-      ncell += 3;
-    }
-  }
-  npt += 2 * m->njoint;
-  ncell += m->njoint;
+  int npt, ncell;
+  count_parts(m, &npt, &ncell);
   d->point = calloc((size_t)npt + 1, sizeof *d->point);
   d->cell = calloc((size_t)ncell + 1, sizeof *d->cell);
   d->conn = calloc(2 * (size_t)npt + 1, sizeof *d->conn); /* a frame draws 3 points in 4 entries */
@@ -244,7 +245,7 @@ fmbDrawing* fmb_drawing_new(const fmbModel* m) {
     const fmbBodyInst* bi = &m->body[b];
     if (bi->type->centreline) {
       rc = add_centreline(d, bi, b);
-    } else if (bi->nq >= 3) {
+    } else if (framed(m, bi)) {
       int n = attachments_of(m, b, local, MAX_ATTACH);
       double size = 0.0;
       for (int i = 0; i < n; ++i) size = fmax(size, hypot(local[2 * i], local[2 * i + 1]));
