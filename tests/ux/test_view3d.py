@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""test_view3d.py FLEXMBD SOURCE_DIR OUTDIR — `flexmbd view` of a spatial run (issue 34), read back.
+"""test_view3d.py FLEXMBD SOURCE_DIR OUTDIR [ROD3D_PLUGIN] — `flexmbd view` of a spatial run (issue 34), read back.
 
 The heavy top and the spherical pendulum of tests/ux/scenes/spatial_view.yaml are run and drawn:
   - the page is self-contained (no http(s) URL, no <script src>, no <link>) and holds the 3D view:
@@ -11,7 +11,10 @@ The heavy top and the spherical pendulum of tests/ux/scenes/spatial_view.yaml ar
     the CSV's: the bob's origin bob.x/y/z and the top's axis tips origin + 0.02 R(q) e_k (1e-12),
     the hook's vertex at [1, 0, 0]; no console error;
   - the view turns: screenshots at two camera angles (?yaw=&pitch=) differ, neither is blank;
-  - a CSV without the Euler parameters names them and the --set that adds them (exit 2)."""
+  - a CSV without the Euler parameters names them and the --set that adds them (exit 2);
+  - with ROD3D_PLUGIN (tests/ux/rod3d_plugin.c: a spatial body with a centreline, the path the
+    spatial beam takes): the page maps each station to its shapeK_x, _y, _z columns and draws the
+    stations there (1e-12), which lie on r + R(q) [sK, 0, 0] of the frame columns (1e-10)."""
 import csv
 import json
 import os
@@ -25,6 +28,7 @@ import numpy as np
 from png_read import png_pixels
 
 flexmbd, source, out = sys.argv[1:4]
+plugin = sys.argv[4] if len(sys.argv) > 4 else None
 shutil.rmtree(out, ignore_errors=True)
 os.makedirs(out)
 scene = os.path.join(source, "tests", "ux", "scenes", "spatial_view.yaml")
@@ -145,6 +149,36 @@ flexmbd_run(["run", scene, "-o", bare, "--quiet", "--set", "outputs=[top.x, top.
 r = flexmbd_run(["view", bare, scene, "-o", os.path.join(out, "bare.html")], 2)
 check("nothing to draw" in r.stderr and "top.qw, top.qx, top.qy, top.qz" in r.stderr and "bob.y, bob.z, bob.qw" in r.stderr,
       f"the missing columns named: {r.stderr}")
+
+# a spatial centreline (the test plugin's rod3d): stations from shapeK_x, _y, _z
+if plugin:
+    rod_scene = os.path.join(source, "tests", "ux", "scenes", "rod3d.yaml")
+    rod_csv, page = os.path.join(out, "rod.csv"), os.path.join(out, "rod.html")
+    flexmbd_run(["run", rod_scene, "--plugin", plugin, "-o", rod_csv, "--quiet"], 0)
+    flexmbd_run(["view", rod_csv, rod_scene, "--plugin", plugin, "-o", page], 0)
+    text = open(page, encoding="utf-8").read()
+    D = json.loads(re.search(r"const D = (\{.*?\});\n", text, re.S).group(1))
+    rod_rows = list(csv.DictReader(open(rod_csv)))
+    names = D["columns"]
+    rod = D["bodies"][0]
+    check(rod["shape"] == [[names.index(f"rod.shape{k}_{c}") for c in "xyz"] for k in range(5)],
+          f"the page maps the 5 stations to their x, y, z columns: {rod['shape']}")
+    check(rod["stations"] == [[-0.5 + 0.25 * k, 0, 0] for k in range(5)], f"the stations' places: {rod['stations']}")
+    last = {key: float(v) for key, v in rod_rows[-1].items()}
+    R = rotation([last[f"rod.q{c}"] for c in "wxyz"])
+    r0 = np.array([last[f"rod.{c}"] for c in "xyz"])
+    on_rod = max(np.abs(np.array([last[f"rod.shape{k}_{c}"] for c in "xyz"]) - (r0 + R @ [-0.5 + 0.25 * k, 0, 0])).max()
+                 for k in range(5))
+    check(on_rod < 1e-10, f"the shape columns lie on the rod's axis (off {on_rod:.3g} m)")
+    r = chrome(f"?t={rod_rows[-1]['t']}", "--dump-dom")
+    got = re.search(r'<pre id="drawn">(.*?)</pre>', r.stdout, re.S)
+    check(got is not None, "the rod's page has its drawn coordinates")
+    if got:
+        d = json.loads(got.group(1).replace("&quot;", '"').replace("&amp;", "&"))
+        st = sorted((p["station"], [p["x"], p["y"], p["z"]]) for p in d["points"] if p["body"] == "rod" and p["station"] >= 0)
+        check(len(st) == 5 and all(np.abs(np.array(xyz) - [last[f"rod.shape{k}_{c}"] for c in "xyz"]).max() <= 1e-12
+                                   for k, xyz in st), f"the rod's stations drawn at the CSV's: {st}")
+        print(f"rod3d: 5 stations drawn at their shape columns, on the rod's axis to {on_rod:.2g} m")
 if failures:
     sys.exit(f"{len(failures)} failure(s)")
 print("view 3D: all checks passed")
