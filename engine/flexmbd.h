@@ -170,7 +170,12 @@ FMB_API int fmb_model_joint(const fmbModel* m, int i, const char** name, const c
    `centreline` is a polyline through its stations; any other body with a frame (ncoord >= 3) is the
    outline through the points its joints attach to (closed from three points) and its frame's x and
    y axes; a joint with constraint rows is a vertex at its first point; a force element with two
-   points (a spring) is the line between them. */
+   points (a spring) is the line between them.
+   In a spatial scene (dimension 3, docs/spatial.md) the drawing is the same from the spatial ops:
+   points are material points of a body's marker3 (local3, 3 per point; fmbDrawPoint.local holds
+   their x, y); a centreline's stations [x, y] are the body's [x, y, 0]; any other spatial body is
+   the line or polygon through its joints' attachment3 points (in the joints' order) and its
+   frame's x, y and z axes; a joint is a vertex at its first attachment3 point. */
 enum {
   FMB_DRAW_CENTRELINE = 0,
   FMB_DRAW_OUTLINE = 1,
@@ -193,6 +198,10 @@ typedef struct fmbDrawing {
   fmbDrawPoint* point;
   fmbDrawCell* cell;
   int* conn;
+  /* appended (issue 34): the scene's dimension, 2 or 3, and for 3 the points' body-frame
+     coordinates [x, y, z] (3 per point, point i at 3 i; NULL in a planar drawing) */
+  int dimension;
+  double* local3;
 } fmbDrawing;
 /* the SI unit of a CSV column the engine itself defines ("t": s; BODY.x: m; BODY.omega: rad/s;
    JOINT.power: W; JOINT.work and energy.*: J; JOINT.reaction_x: N; reaction_torque: N m;
@@ -268,6 +277,17 @@ FMB_API double fmb_data_time(const fmbData* d); /* NaN for NULL (or before fmb_i
 /* the DAE state y = [q, v, lambda, mu, z] and y' (fmb_state_size(m) doubles each; either may be
    NULL): 0, or FMB_EXIT_BAD_INPUT (NULL or freed d, before fmb_init) */
 FMB_API int fmb_data_state(const fmbData* d, double* y, double* yp);
+/* set the state (issue 34): time() = t (t0 <= t <= t_end) and y (and y', NULL = zeros) as
+   fmb_data_state gives them, e.g. one saved earlier, of another data object of the same model, or
+   changed by the program. No step history crosses the jump: the next advance first makes the state
+   consistent at t, as after an input's jump (q onto the constraints, v onto their rates, then the
+   accelerations and multipliers), so the y' and multipliers given are only a start. A spatial
+   body's coordinates are [r, p] with Euler parameters p of any nonzero length (docs/spatial.md):
+   a p scaled by any factor is the same pose. The joints' work integrals go on from their values.
+   0, or FMB_EXIT_BAD_INPUT (misuse, before fmb_init, y NULL, a value not finite, t outside
+   [t0, t_end]: nothing changed, *diag says why). */
+FMB_API int fmb_data_set_state(const fmbModel* m, fmbData* d, double t, const double* y, const double* yp,
+                               fmbDiag* diag);
 /* the scene's outputs: their number (the CSV's columns after t), the name of output i (e.g.
    "beam.tip_v"; NULL out of range) and their values at time() into out[fmb_noutput(m)], the very
    numbers the CSV row at that time holds. fmb_outputs: 0, FMB_EXIT_SOLVER when a value is not

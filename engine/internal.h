@@ -63,7 +63,8 @@ typedef enum {
   FMB_OUT_JOINT_REACTION, /* 0 x, 1 y: force on body2 at its point; 2 torque about that point */
   FMB_OUT_ENERGY,         /* 0 kinetic 1 strain 2 gravity 3 spring 4 total 5 balance */
   FMB_OUT_CONSTRAINT,     /* 0 position 1 velocity */
-  FMB_OUT_SHAPE           /* a centreline station of BODY.shape: id 0 x, 1 y at body point `local` */
+  FMB_OUT_SHAPE,          /* a centreline station of BODY.shape: id 0 x, 1 y (2 z in space) at body point `local` */
+  FMB_OUT_POSE3           /* space: a body's origin and frame from marker3 (id: index into pose3_names) */
 } fmbOutKind;
 
 typedef struct fmbOutput {
@@ -445,6 +446,10 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);
 /* global position of a body's material point (its marker); 0 ok */
 int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[2], double pos[2],
                    double* angle);
+/* its spatial twin (dimension 3): position and rotation matrix (row-major; R may be NULL) of a
+   material point from the body's marker3; 0 ok, -1 for a body without one */
+int fmb_body_point3(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[3], double pos[3],
+                    double R[9]);
 /* no `outputs:` list: x, y, theta, omega of every moving body with a frame; 0, or -1 out of memory */
 int fmb_outputs_default(fmbParser* p, fmbModel* m);
 typedef struct fmbCsv fmbCsv;

@@ -61,6 +61,10 @@ static const char* const reaction_names[] = {"reaction_x", "reaction_y", "reacti
 static const char* const reaction3_names[] = {
     "reaction_x", "reaction_y", "reaction_z", "reaction_torque_x", "reaction_torque_y", "reaction_torque_z", NULL};
 static const char* const constraint_names[] = {"position", "velocity", NULL};
+/* in space: the pose of a body's origin (its marker3 at [0, 0, 0]) and its frame as unit Euler
+   parameters (w >= 0), for a spatial body whose type gives no such output of its own (rigid3d
+   gives its own, from its coordinates) */
+static const char* const pose3_names[] = {"x", "y", "z", "qw", "qx", "qy", "qz", NULL};
 /* the units of the quantities above, in their order (constraint norms mix m and rad: none) */
 static const char* const frame_units[] = {"m", "m", "rad", "rad/s", "m/s", "m/s"};
 static const char* const power_units[] = {"W", "J"};
@@ -113,8 +117,9 @@ const char* fmb_output_unit(const char* column) {
   if ((k = lookup(power_names, q)) >= 0) return power_units[k];
   if ((k = lookup(reaction_names, q)) >= 0) return reaction_units[k];
   if ((k = lookup(reaction3_names, q)) >= 0) return reaction3_units[k];
-  /* BODY.shapeK_x, BODY.shapeK_y: a centreline station, global frame */
-  if (strncmp(q, "shape", 5) == 0 && (strcmp(q + strlen(q) - 2, "_x") == 0 || strcmp(q + strlen(q) - 2, "_y") == 0)) {
+  /* BODY.shapeK_x, BODY.shapeK_y (BODY.shapeK_z in space): a centreline station, global frame */
+  if (strncmp(q, "shape", 5) == 0 && (strcmp(q + strlen(q) - 2, "_x") == 0 || strcmp(q + strlen(q) - 2, "_y") == 0 ||
+                                      strcmp(q + strlen(q) - 2, "_z") == 0)) {
     const char* d = q + 5;
     while (*d >= '0' && *d <= '9') ++d;
     if (d > q + 5 && d == q + strlen(q) - 2) return "m";
@@ -228,8 +233,11 @@ static int resolve_one(fmbParser* p, fmbModel* m, fmbNode node, const char* text
         o->kind = FMB_OUT_FRAME;
       } else if ((o->id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, qty)) >= 0) {
         o->kind = FMB_OUT_BODY;
+      } else if (m->dimension == 3 && bi->marker3 && (o->id = lookup(pose3_names, qty)) >= 0) {
+        o->kind = FMB_OUT_POSE3;
       }
       if (framed) list_names(avail, sizeof avail, frame_names);
+      if (m->dimension == 3 && bi->marker3) list_names(avail, sizeof avail, pose3_names);
       none = "none: no frame (its marker cannot place the point [0, 0]) and no outputs of its own";
       list_names(avail, sizeof avail, bi->type->output_names);
     } else {
@@ -275,6 +283,7 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
     return fmb_parse_error(p, node, "output '%s': a %s body has no centreline (shape is a beam's output)", text,
                            bi->type->name);
   int n = bi->type->centreline(bi->self, 0, NULL);
+  const int ncomp = m->dimension == 3 ? 3 : 2; /* x, y (, z in space) per station */
   if (dot[6] == '_') {
     char* end = NULL;
     long v = strtol(dot + 7, &end, 10);
@@ -283,8 +292,8 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
                              text, FMB_SHAPE_STATIONS_MAX);
     n = (int)v;
   }
-  if (m->noutput + 2 * n > *cap) {
-    *cap = m->noutput + 2 * n + 16;
+  if (m->noutput + ncomp * n > *cap) {
+    *cap = m->noutput + ncomp * n + 16;
     fmbOutput* grown = realloc(m->output, (size_t)*cap * sizeof *grown);
     if (!grown) return fmb_parse_error(p, node, "out of memory");
     m->output = grown;
@@ -297,15 +306,15 @@ static int resolve_shape(fmbParser* p, fmbModel* m, fmbNode node, const char* te
   double* local = malloc(2 * (size_t)n * sizeof *local);
   if (!local) return fmb_parse_error(p, node, "out of memory");
   bi->type->centreline(bi->self, n, local);
-  for (int k = 0; k < 2 * n; ++k) {
+  for (int k = 0; k < ncomp * n; ++k) {
     fmbOutput* o = &m->output[m->noutput++];
     memset(o, 0, sizeof *o);
     o->kind = FMB_OUT_SHAPE;
     o->owner = b;
-    o->id = k % 2;
-    o->local[0] = local[2 * (k / 2)];
-    o->local[1] = local[2 * (k / 2) + 1];
-    snprintf(o->name, sizeof o->name, "%s.shape%d_%c", bi->name, k / 2, "xy"[k % 2]);
+    o->id = k % ncomp;
+    o->local[0] = local[2 * (k / ncomp)];
+    o->local[1] = local[2 * (k / ncomp) + 1];
+    snprintf(o->name, sizeof o->name, "%s.shape%d_%c", bi->name, k / ncomp, "xyz"[k % ncomp]);
   }
   free(local);
   return 1;
@@ -318,10 +327,32 @@ int fmb_body_point(const fmbModel* m, fmbWorkspace* w, int b, const double* q, c
   return bi->type->marker(bi->self, q + bi->qadr, local, pos, angle, NULL, NULL, fmb_workspace_plugin(w) + bi->workadr);
 }
 
+int fmb_body_point3(const fmbModel* m, fmbWorkspace* w, int b, const double* q, const double local[3], double pos[3],
+                    double R[9]) {
+  const fmbBodyInst* bi = &m->body[b];
+  if (!bi->marker3) return -1; /* a planar body */
+  return bi->marker3(bi->self, q + bi->qadr, local, pos, R, NULL, NULL, 0, fmb_workspace_plugin(w) + bi->workadr);
+}
+
 static double shape_value(const fmbModel* m, fmbWorkspace* w, const fmbOutput* o, const double* q) {
-  double pos[2];
+  double pos[3];
+  if (m->dimension == 3) { /* the station [x, y] of the body is its point [x, y, 0] */
+    const double local[3] = {o->local[0], o->local[1], 0.0};
+    double R[9];
+    return fmb_body_point3(m, w, o->owner, q, local, pos, R) ? NAN : pos[o->id];
+  }
   if (fmb_body_point(m, w, o->owner, q, o->local, pos, NULL)) return NAN;
   return pos[o->id];
+}
+
+/* pose output `id` (pose3_names) of a spatial body: its marker3 at the origin */
+static double pose3_value(const fmbModel* m, fmbWorkspace* w, int b, int id, const double* q) {
+  static const double origin[3] = {0.0, 0.0, 0.0};
+  double pos[3], R[9], p[4];
+  if (fmb_body_point3(m, w, b, q, origin, pos, R)) return NAN;
+  if (id < 3) return pos[id];
+  fmb_matrix_quat(R, p);
+  return p[id - 3];
 }
 
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
@@ -354,19 +385,19 @@ int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list) {
   return 0;
 }
 
-/* a spatial scene's default columns: each body's position and Euler parameters, those of
-   BODY.x, y, z, qw, qx, qy, qz that its type answers (docs/spatial.md) */
+/* a spatial scene's default columns: each body's position and Euler parameters BODY.x, y, z, qw,
+   qx, qy, qz, its type's own where it answers them, else the engine's from marker3 (docs/spatial.md) */
 static void outputs_default_spatial(fmbModel* m) {
-  static const char* const pose[] = {"x", "y", "z", "qw", "qx", "qy", "qz", NULL};
+  const char* const* pose = pose3_names;
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     for (int k = 0; pose[k] && bi->nq > 0; ++k) {
       const int id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, pose[k]);
-      if (id < 0) continue;
+      if (id < 0 && !bi->marker3) continue;
       fmbOutput* o = &m->output[m->noutput++];
-      o->kind = FMB_OUT_BODY;
+      o->kind = id >= 0 ? FMB_OUT_BODY : FMB_OUT_POSE3; /* the type's own, else the engine's from marker3 */
       o->owner = b;
-      o->id = id;
+      o->id = id >= 0 ? id : k;
       snprintf(o->name, sizeof o->name, "%s.%s", bi->name, pose[k]);
     }
   }
@@ -618,6 +649,7 @@ int fmb_outputs_eval(const fmbModel* m, fmbWorkspace* w, double t, const double*
       }
       case FMB_OUT_CONSTRAINT: val = o->id == 0 ? cpos : cvel; break;
       case FMB_OUT_SHAPE: val = shape_value(m, w, o, q); break;
+      case FMB_OUT_POSE3: val = pose3_value(m, w, o->owner, o->id, q); break;
     }
     row[i] = val;
     not_finite |= !isfinite(val);

@@ -511,6 +511,34 @@ int fmb_data_state(const fmbData* d, double* y, double* yp) {
   return 0;
 }
 
+int fmb_data_set_state(const fmbModel* m, fmbData* d, double t, const double* y, const double* yp, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (misused(m, d, "fmb_data_set_state", diag)) return FMB_EXIT_BAD_INPUT;
+  const char* why = !d->ic_done                                    ? "before fmb_init"
+                    : !y                                           ? "no state (y is NULL)"
+                    : !(t >= m->solver.t0 && t <= m->solver.t_end) ? "t outside the scene's [t0, t_end]"
+                                                                   : NULL;
+  for (int i = 0; !why && i < m->ny; ++i)
+    if (!isfinite(y[i]) || (yp && !isfinite(yp[i]))) why = "a value that is not finite";
+  if (why) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_data_set_state: %s; the state is unchanged", why);
+    return FMB_EXIT_BAD_INPUT;
+  }
+  /* no step history crosses the jump: the next advance makes the state consistent at t (the
+     constraints, then the accelerations and multipliers) and starts a new backend from it */
+  retire_backend(d, 1);
+  d->t = t;
+  memcpy(d->y, y, sizeof(double) * (size_t)m->ny);
+  if (yp)
+    memcpy(d->yp, yp, sizeof(double) * (size_t)m->ny);
+  else
+    memset(d->yp, 0, sizeof(double) * (size_t)m->ny);
+  d->failed = d->interrupted = 0;
+  return 0;
+}
+
 int fmb_noutput(const fmbModel* m) { return m && m->noutput > 0 ? m->noutput - 1 : 0; }
 
 const char* fmb_output_name(const fmbModel* m, int i) {

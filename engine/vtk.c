@@ -7,7 +7,10 @@
  * a third of the ASCII size and no number formatting per point.
  *
  * What is drawn is engine/drawing.c's (the same as `flexmbd view`); a beam's centreline stations
- * carry the deformation (body frame) and the cross-section rotation as point data.
+ * carry the deformation (body frame) and the cross-section rotation as point data. In a spatial
+ * scene (dimension 3) every point of a body carries instead the axes of the frame there, the
+ * columns of the marker3's rotation R as point vectors frame_x, frame_y, frame_z (a centreline's
+ * cross-section frame: frame_y, frame_z span the section); the ground's points carry zeros.
  * Every file goes through fmb_safe_open: written beside its target and renamed into place (each
  * .vtu when complete, the .pvd when the run ends, also when it stops early, so a run that stops
  * leaves a valid collection of the steps written so far, like its CSV). */
@@ -45,6 +48,7 @@ struct fmbVtk {
   /* one step's arrays, allocated once: points (3 per point), deformation (3), rotation (1),
      cell and connectivity integers */
   double *pts, *deform, *rot;
+  double* frame; /* spatial: R's columns at each point, frame_x, frame_y, frame_z (3 x 3 np) */
   int32_t* i32;
   int64_t* i64;
   uint8_t* u8;
@@ -61,6 +65,7 @@ void fmb_vtk_close(fmbVtk* v) {
   free(v->pts);
   free(v->deform);
   free(v->rot);
+  free(v->frame);
   free(v->i32);
   free(v->i64);
   free(v->u8);
@@ -86,11 +91,12 @@ fmbVtk* fmb_vtk_open(const fmbModel* m, const char* dir, fmbDiag* diag) {
     v->pts = calloc(3 * np, sizeof *v->pts);
     v->deform = calloc(3 * np, sizeof *v->deform);
     v->rot = calloc(np, sizeof *v->rot);
+    v->frame = calloc(9 * np, sizeof *v->frame);
     v->i32 = calloc(nc, sizeof *v->i32);
     v->i64 = calloc(nint, sizeof *v->i64);
     v->u8 = calloc(nc, sizeof *v->u8);
   }
-  if (!v->stem || !v->dir || !v->pts || !v->deform || !v->rot || !v->i32 || !v->i64 || !v->u8) {
+  if (!v->stem || !v->dir || !v->pts || !v->deform || !v->rot || !v->frame || !v->i32 || !v->i64 || !v->u8) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the VTK output");
     fmb_vtk_close(v);
     return NULL;
@@ -130,12 +136,19 @@ static const ArraySpec array_spec[NARR] = {
     {"Int32", "owner", 1, 4},         {"Float64", "Points", 3, 8},   {"Int64", "connectivity", 1, 8},
     {"Int64", "offsets", 1, 8},       {"UInt8", "types", 1, 1},
 };
+/* a spatial scene's point data, in place of deformation and rotation (the other arrays as above);
+   three vectors take the room of the two planar arrays, so the spatial offsets are computed with
+   this table in front */
+enum { ARR3_FRAME_X, ARR3_FRAME_Y, ARR3_FRAME_Z, NARR3 };
+static const ArraySpec array3_spec[NARR3] = {
+    {"Float64", "frame_x", 3, 8}, {"Float64", "frame_y", 3, 8}, {"Float64", "frame_z", 3, 8}};
 
-static void array_tag(FILE* f, int k, const uint64_t* offset) {
+static void tag_of(FILE* f, const ArraySpec* a, uint64_t offset) {
   fprintf(
       f, "        <DataArray type=\"%s\" Name=\"%s\" NumberOfComponents=\"%d\" format=\"appended\" offset=\"%llu\"/>\n",
-      array_spec[k].type, array_spec[k].name, array_spec[k].ncomp, (unsigned long long)offset[k]);
+      a->type, a->name, a->ncomp, (unsigned long long)offset);
 }
+static void array_tag(FILE* f, int k, const uint64_t* offset) { tag_of(f, &array_spec[k], offset[k]); }
 
 static void block(FILE* f, const void* data, uint64_t bytes) {
   fwrite(&bytes, sizeof bytes, 1, f);
@@ -158,9 +171,22 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   char name[600], path[1400];
   snprintf(name, sizeof name, "%s_%06ld.vtu", v->stem, v->step);
   snprintf(path, sizeof path, "%s/%s", v->dir, name);
-  /* positions, and for centreline stations the deformation in the body frame,
+  const int spatial = d->dimension == 3;
+  /* spatial: positions and the frame's axes at each point (marker3's R by columns) */
+  for (int i = 0; spatial && i < np; ++i) {
+    const fmbDrawPoint* p = &d->point[i];
+    double* pt = v->pts + 3 * i;
+    double R[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+    if (p->body == FMB_WORLD)
+      for (int k = 0; k < 3; ++k) pt[k] = d->local3[3 * i + k];
+    else if (fmb_body_point3(m, w, p->body, q, d->local3 + 3 * i, pt, R))
+      pt[0] = pt[1] = pt[2] = NAN;
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < 3; ++k) v->frame[3 * (size_t)np * c + 3 * i + k] = R[3 * k + c];
+  }
+  /* planar: positions, and for centreline stations the deformation in the body frame,
      u = A(theta)^T (r - r0) - local, and the cross-section's rotation angle - theta */
-  for (int i = 0; i < np; ++i) {
+  for (int i = 0; !spatial && i < np; ++i) {
     const fmbDrawPoint* p = &d->point[i];
     double* pt = v->pts + 3 * i;
     double* u = v->deform + 3 * i;
@@ -185,9 +211,14 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   }
   const uint64_t count[NARR] = {3 * (uint64_t)np, (uint64_t)np,    (uint64_t)nc, (uint64_t)nc,
                                 3 * (uint64_t)np, (uint64_t)nconn, (uint64_t)nc, (uint64_t)nc};
-  uint64_t offset[NARR], at = 0;
+  uint64_t offset[NARR], offset3[NARR3], at = 0;
+  for (int k = 0; spatial && k < NARR3; ++k) {
+    offset3[k] = at;
+    at += sizeof(uint64_t) + 3 * (uint64_t)np * array3_spec[k].size;
+  }
   for (int k = 0; k < NARR; ++k) {
     offset[k] = at;
+    if (spatial && (k == ARR_DEFORMATION || k == ARR_ROTATION)) continue; /* not written */
     at += sizeof(uint64_t) + count[k] * array_spec[k].size;
   }
   fmbSafeFile* sf = fmb_safe_open_guarded(path, m->inputs, NULL, 0);
@@ -204,10 +235,14 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
       "header_type=\"UInt64\">\n  <UnstructuredGrid>\n    <FieldData>\n"
       "      <DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"ascii\">%.12g</DataArray>\n"
       "    </FieldData>\n    <Piece NumberOfPoints=\"%d\" NumberOfCells=\"%d\">\n"
-      "      <PointData Vectors=\"deformation\" Scalars=\"rotation\">\n",
-      little ? "LittleEndian" : "BigEndian", t, np, nc);
-  array_tag(f, ARR_DEFORMATION, offset);
-  array_tag(f, ARR_ROTATION, offset);
+      "      <PointData %s>\n",
+      little ? "LittleEndian" : "BigEndian", t, np, nc,
+      spatial ? "Vectors=\"frame_x\"" : "Vectors=\"deformation\" Scalars=\"rotation\"");
+  for (int k = 0; spatial && k < NARR3; ++k) tag_of(f, &array3_spec[k], offset3[k]);
+  if (!spatial) {
+    array_tag(f, ARR_DEFORMATION, offset);
+    array_tag(f, ARR_ROTATION, offset);
+  }
   fprintf(f, "      </PointData>\n      <CellData Scalars=\"part\">\n");
   array_tag(f, ARR_PART, offset);
   array_tag(f, ARR_OWNER, offset);
@@ -218,8 +253,11 @@ int fmb_vtk_step(fmbVtk* v, const fmbModel* m, fmbWorkspace* w, double t, const 
   array_tag(f, ARR_OFFSETS, offset);
   array_tag(f, ARR_TYPES, offset);
   fprintf(f, "      </Cells>\n    </Piece>\n  </UnstructuredGrid>\n  <AppendedData encoding=\"raw\">\n   _");
-  block(f, v->deform, count[ARR_DEFORMATION] * 8);
-  block(f, v->rot, count[ARR_ROTATION] * 8);
+  for (int k = 0; spatial && k < NARR3; ++k) block(f, v->frame + 3 * (size_t)np * k, 3 * (uint64_t)np * 8);
+  if (!spatial) {
+    block(f, v->deform, count[ARR_DEFORMATION] * 8);
+    block(f, v->rot, count[ARR_ROTATION] * 8);
+  }
   for (int c = 0; c < nc; ++c) v->i32[c] = d->cell[c].part;
   block(f, v->i32, count[ARR_PART] * 4);
   for (int c = 0; c < nc; ++c) v->i32[c] = d->cell[c].owner;

@@ -12,6 +12,9 @@
  *   - a beam's centreline station K: BODY.shapeK_x, BODY.shapeK_y (`BODY.shape` or `shape_N`);
  *     with the frame columns too, a deformation scale s draws u + s (r - u), u the station's
  *     undeformed place in the frame; a joint on a beam lies between the two stations about its x.
+ * In a spatial scene (dimension 3) the same with 3D points, drawn by the page's own projection
+ * (orbit with the mouse, wheel zoom): a body's frame is BODY.x, y, z, qw, qx, qy, qz (r0 + R(q)
+ * local), a centreline station K BODY.shapeK_x, _y, _z.
  * What the CSV lacks is said, with the `--set outputs=[...]` that adds it to the run; a body
  * without its columns is left out of the drawing; nothing to draw at all is refused (exit 2). */
 #include <math.h>
@@ -26,16 +29,28 @@
 
 #define VIEW_MAX_TRACES 8
 
+enum { VIEW_FRAME_MAX = 7 };
 typedef struct {
   const char* name;
-  int frame[3];    /* table columns of x, y, theta; 0 = absent */
-  int nshape;      /* stations found in the CSV (BODY.shapeK_x/_y, K = 0 .. nshape - 1) */
-  int* shape;      /* 2 table columns per station */
-  int drawn;       /* has a point in the drawing */
-  int centreline;  /* its drawing has centreline stations */
-  int nstation;    /* how many (the drawing's) */
-  double* station; /* their body-frame coordinates, 2 each: the drawing's, or resampled to nshape */
+  int dim;                   /* 2, or 3 in a spatial scene: the components of a point */
+  int frame[VIEW_FRAME_MAX]; /* table columns of x, y, theta (x, y, z, qw, qx, qy, qz); 0 = absent */
+  int nshape;                /* stations found in the CSV (BODY.shapeK_x/_y(/_z), K = 0 .. nshape - 1) */
+  int* shape;                /* dim table columns per station */
+  int drawn;                 /* has a point in the drawing */
+  int centreline;            /* its drawing has centreline stations */
+  int nstation;              /* how many (the drawing's) */
+  double* station;           /* their body-frame coordinates, dim each: the drawing's, or resampled to nshape */
 } ViewBody;
+
+/* a body's frame columns: planar x, y, theta; spatial x, y, z and the Euler parameters */
+static const char* const frame_planar[] = {"x", "y", "theta", NULL};
+static const char* const frame_spatial[] = {"x", "y", "z", "qw", "qx", "qy", "qz", NULL};
+static const char* const* frame_names(int dim) { return dim == 3 ? frame_spatial : frame_planar; }
+static int frame_count(int dim) { return dim == 3 ? 7 : 3; }
+/* drawing point i's body-frame coordinates (dim of them) */
+static const double* point_local(const fmbDrawing* d, int i) {
+  return d->dimension == 3 ? d->local3 + 3 * (size_t)i : d->point[i].local;
+}
 
 static void json_string(FILE* f, const char* s) {
   fputc('"', f);
@@ -111,7 +126,7 @@ static int default_column(const fmbTable* tb, const ViewBody* vb, int nb) {
     for (int c = 1; c < n; ++c) {
       int drawing = is_shape_column(tb->name[c]);
       for (int b = 0; b < nb && !drawing; ++b)
-        for (int k = 0; k < 3; ++k) drawing |= vb[b].frame[k] == c;
+        for (int k = 0; k < VIEW_FRAME_MAX; ++k) drawing |= vb[b].frame[k] == c;
       if (drawing != pass) continue; /* first the plot's own columns, then the drawing's */
       const double sc = scale[group[c]];
       /* a range below 1e-9 of its scale is round-off, not motion */
@@ -151,20 +166,28 @@ static void write_bodies(FILE* f, const ViewBody* vb, int nb) {
     const ViewBody* v = &vb[b];
     fputs(b ? ",\n{\"name\":" : "\n{\"name\":", f);
     json_string(f, v->name);
-    if (v->frame[0])
-      fprintf(f, ",\"frame\":[%d,%d,%d]", v->frame[0] - 1, v->frame[1] - 1, v->frame[2] - 1);
-    else
+    const int dim = v->dim;
+    if (v->frame[0]) {
+      fputs(",\"frame\":[", f);
+      for (int k = 0; k < frame_count(dim); ++k) fprintf(f, "%s%d", k ? "," : "", v->frame[k] - 1);
+      fputc(']', f);
+    } else {
       fputs(",\"frame\":null", f);
+    }
     if (v->centreline && v->nshape >= 2) {
       fputs(",\"shape\":[", f);
-      for (int k = 0; k < v->nshape; ++k)
-        fprintf(f, "%s[%d,%d]", k ? "," : "", v->shape[2 * k] - 1, v->shape[2 * k + 1] - 1);
+      for (int k = 0; k < v->nshape; ++k) {
+        fputs(k ? ",[" : "[", f);
+        for (int c = 0; c < dim; ++c) fprintf(f, "%s%d", c ? "," : "", v->shape[dim * k + c] - 1);
+        fputc(']', f);
+      }
       fputs("],\"stations\":[", f);
       for (int k = 0; k < v->nshape; ++k) {
         fputs(k ? ",[" : "[", f);
-        json_number(f, v->station[2 * k]);
-        fputc(',', f);
-        json_number(f, v->station[2 * k + 1]);
+        for (int c = 0; c < dim; ++c) {
+          if (c) fputc(',', f);
+          json_number(f, v->station[dim * k + c]);
+        }
         fputc(']', f);
       }
       fputc(']', f);
@@ -189,9 +212,10 @@ static void write_points(FILE* f, const ViewBody* vb, const fmbDrawing* d, const
       first_station[p->body - 1] = npoint;
       for (int k = 0; k < v->nshape; ++k, ++npoint) {
         fprintf(f, "%s{\"body\":%d,\"local\":[", npoint ? ",\n" : "\n", p->body - 1);
-        json_number(f, v->station[2 * k]);
-        fputc(',', f);
-        json_number(f, v->station[2 * k + 1]);
+        for (int c = 0; c < v->dim; ++c) {
+          if (c) fputc(',', f);
+          json_number(f, v->station[v->dim * k + c]);
+        }
         fprintf(f, "],\"station\":%d,\"joint\":null}", k);
       }
       index[i] = first_station[p->body - 1];
@@ -203,9 +227,11 @@ static void write_points(FILE* f, const ViewBody* vb, const fmbDrawing* d, const
         for (int k = 0; k < d->cell[c].count; ++k)
           if (d->conn[d->cell[c].first + k] == i) fmb_model_joint(m, d->cell[c].owner, &joint, NULL);
     fprintf(f, "%s{\"body\":%d,\"local\":[", npoint ? ",\n" : "\n", p->body - 1);
-    json_number(f, p->local[0]);
-    fputc(',', f);
-    json_number(f, p->local[1]);
+    const double* local = point_local(d, i);
+    for (int c = 0; c < (d->dimension == 3 ? 3 : 2); ++c) {
+      if (c) fputc(',', f);
+      json_number(f, local[c]);
+    }
     fprintf(f, "],\"station\":%d,\"joint\":", v && v->centreline && v->nshape >= 2 ? p->station : -1);
     if (joint)
       json_string(f, joint);
@@ -249,6 +275,7 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
   fwrite(page, 1, (size_t)(at - page), f);
   fputs("{\"title\":", f);
   json_string(f, title);
+  if (d->dimension == 3) fputs(",\"dimension\":3", f); /* the page's 3D view (planar data as before) */
   fputs(",\"scale\":", f);
   json_number(f, scale);
   fputs(",\"t\":[", f);
@@ -311,51 +338,51 @@ static int write_page(FILE* f, const char* title, const fmbTable* tb, const View
 /* body b's columns in the CSV: its frame, its centreline stations (BODY.shapeK_x/_y) and where
    those stations are in its frame */
 static void find_columns(ViewBody* v, int b, const fmbTable* tb, const fmbDrawing* d) {
-  const char* q[3] = {"x", "y", "theta"};
+  const int dim = v->dim = d->dimension == 3 ? 3 : 2, nq = frame_count(dim);
+  const char* const* q = frame_names(dim);
   int nframe = 0;
-  for (int k = 0; k < 3; ++k) nframe += (v->frame[k] = column_of(tb, v->name, q[k])) > 0;
-  if (nframe < 3) v->frame[0] = v->frame[1] = v->frame[2] = 0;
+  for (int k = 0; k < nq; ++k) nframe += (v->frame[k] = column_of(tb, v->name, q[k])) > 0;
+  if (nframe < nq) memset(v->frame, 0, sizeof v->frame);
   for (int i = 0; i < d->npoint; ++i)
     if (d->point[i].body == b + 1) {
       v->drawn = 1;
       if (d->point[i].station >= 0) v->centreline = 1, v->nstation++;
     }
-  while (v->centreline) { /* BODY.shapeK_x, BODY.shapeK_y for K = 0, 1, ... */
-    char qx[64], qy[64];
-    snprintf(qx, sizeof qx, "shape%d_x", v->nshape);
-    snprintf(qy, sizeof qy, "shape%d_y", v->nshape);
-    const int cx = column_of(tb, v->name, qx), cy = column_of(tb, v->name, qy);
-    if (!cx || !cy) break;
-    int* grown = realloc(v->shape, 2 * ((size_t)v->nshape + 1) * sizeof *grown);
+  while (v->centreline) { /* BODY.shapeK_x, BODY.shapeK_y (, BODY.shapeK_z) for K = 0, 1, ... */
+    int col[3], found = 0;
+    for (int c = 0; c < dim; ++c) {
+      char qc[64];
+      snprintf(qc, sizeof qc, "shape%d_%c", v->nshape, "xyz"[c]);
+      found += (col[c] = column_of(tb, v->name, qc)) > 0;
+    }
+    if (found < dim) break;
+    int* grown = realloc(v->shape, (size_t)dim * ((size_t)v->nshape + 1) * sizeof *grown);
     if (!grown) break;
     v->shape = grown;
-    v->shape[2 * v->nshape] = cx;
-    v->shape[2 * v->nshape + 1] = cy;
+    for (int c = 0; c < dim; ++c) v->shape[dim * v->nshape + c] = col[c];
     v->nshape++;
   }
   if (v->centreline && v->nshape >= 2) {
     /* the CSV's stations: the drawing's when as many (BODY.shape: the nodes), else equally spaced
        from root to tip (BODY.shape_N) */
-    v->station = calloc(2 * (size_t)v->nshape, sizeof *v->station);
+    v->station = calloc((size_t)dim * (size_t)v->nshape, sizeof *v->station);
     const double* st0 = NULL;
     const double* st1 = NULL;
     for (int i = 0; i < d->npoint; ++i)
       if (d->point[i].body == b + 1 && d->point[i].station >= 0) {
-        if (d->point[i].station == 0) st0 = d->point[i].local;
-        if (d->point[i].station == v->nstation - 1) st1 = d->point[i].local;
+        if (d->point[i].station == 0) st0 = point_local(d, i);
+        if (d->point[i].station == v->nstation - 1) st1 = point_local(d, i);
       }
     for (int k = 0; v->station && st0 && st1 && k < v->nshape; ++k) {
       int found = 0;
       for (int i = 0; i < d->npoint && v->nshape == v->nstation && !found; ++i)
         if (d->point[i].body == b + 1 && d->point[i].station == k) {
-          v->station[2 * k] = d->point[i].local[0];
-          v->station[2 * k + 1] = d->point[i].local[1];
+          for (int c = 0; c < dim; ++c) v->station[dim * k + c] = point_local(d, i)[c];
           found = 1;
         }
       if (!found) {
         const double w = (double)k / (v->nshape - 1);
-        v->station[2 * k] = st0[0] + w * (st1[0] - st0[0]);
-        v->station[2 * k + 1] = st0[1] + w * (st1[1] - st0[1]);
+        for (int c = 0; c < dim; ++c) v->station[dim * k + c] = st0[c] + w * (st1[c] - st0[c]);
       }
     }
   }
@@ -363,12 +390,12 @@ static void find_columns(ViewBody* v, int b, const fmbTable* tb, const fmbDrawin
 
 /* what body v lacks, as a note (NULL: nothing) and appended to *missing (", A.x, B.shape") */
 static char* lacking(const ViewBody* v, const fmbTable* tb, char** missing, size_t* missing_len) {
-  const char* q[3] = {"x", "y", "theta"};
+  const char* const* q = frame_names(v->dim);
   const int has_shape = v->centreline && v->nshape >= 2;
   /* the columns it lacks, each named once, and what their absence costs */
   char lack[700] = "";
   size_t used = 0;
-  for (int k = 0; k < 3 && !v->frame[0]; ++k)
+  for (int k = 0; q[k] && !v->frame[0]; ++k)
     if (!column_of(tb, v->name, q[k]))
       used += (size_t)snprintf(lack + used, sizeof lack - used, ", %s.%s", v->name, q[k]);
   if (v->centreline && !has_shape && used < sizeof lack)
@@ -421,13 +448,6 @@ static void say_missing(const char* csv, const fmbTable* tb, const ViewBody* vb,
 
 /* the page of the run (a->csv, its table tb) drawn with the scene's model m into a->out */
 static int view_write(const fmbViewArgs* a, const fmbTable* tb, const fmbModel* m, const fmbDrawing* d) {
-  if (fmb_model_dimension(m) == 3) {
-    fprintf(stderr,
-            "flexmbd view: %s is spatial (dimension: 3); the viewer draws planar scenes for now "
-            "(docs/spatial.md): plot its columns with flexmbd plot\n",
-            a->s.scene);
-    return FMB_EXIT_BAD_INPUT;
-  }
   const int nb = fmb_model_nbody(m);
   ViewBody* vb = calloc((size_t)nb + 1, sizeof *vb);
   char** notes = calloc((size_t)nb + 2, sizeof *notes);

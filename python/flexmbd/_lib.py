@@ -189,6 +189,8 @@ _PROTOTYPES = {
     "fmb_advance": (ctypes.c_int, [_P, _P, ctypes.c_double, _D]),
     "fmb_data_time": (ctypes.c_double, [_P]),
     "fmb_data_state": (ctypes.c_int, [_P, ctypes.POINTER(ctypes.c_double), ctypes.POINTER(ctypes.c_double)]),
+    "fmb_data_set_state": (ctypes.c_int, [_P, _P, ctypes.c_double, ctypes.POINTER(ctypes.c_double),
+                                          ctypes.POINTER(ctypes.c_double), _D]),
     "fmb_noutput": (ctypes.c_int, [_P]),
     "fmb_output_name": (ctypes.c_char_p, [_P, ctypes.c_int]),
     "fmb_outputs": (ctypes.c_int, [_P, _P, ctypes.POINTER(ctypes.c_double)]),

@@ -539,6 +539,32 @@ class Simulation(_Owned):
                                           yp.ctypes.data_as(ctypes.POINTER(ctypes.c_double)))
         return y, yp
 
+    def set_state(self, y, yp=None, t: Optional[float] = None) -> None:
+        """Set the state (fmb_data_set_state): y (and y', None = zeros) as state() gives them, at time
+        t (None: the current time; t0 ≤ t ≤ t_end). The next advance first makes it consistent (the
+        constraints, then the accelerations and multipliers) and starts without step history. A
+        spatial body's coordinates are [r, p], Euler parameters p of any nonzero length
+        (docs/spatial.md). Raises ValueError for a wrong length, a value that is not finite or t
+        outside the run; nothing is changed then."""
+        n = self.model.state_size
+        arrays = []
+        for name, a in (("y", y), ("yp", yp)):
+            if a is None:
+                arrays.append(None)
+                continue
+            a = np.ascontiguousarray(a, dtype=np.float64)
+            if a.shape != (n,):
+                raise _lib.ArgumentError(f"Simulation.set_state: {name} has shape {a.shape}, the state has {n} values "
+                                         "(model.state_size)")
+            arrays.append(a)
+        t = self.t if t is None else float(t)
+        ptr = [None if a is None else a.ctypes.data_as(ctypes.POINTER(ctypes.c_double)) for a in arrays]
+        diag = _lib.Diag()
+        with self._use() as d:
+            rc = _lib.library().fmb_data_set_state(self._mptr, d, t, ptr[0], ptr[1], ctypes.byref(diag))
+        if rc:
+            raise _lib.ArgumentError("Simulation." + diag.msg.decode("utf-8", "replace").replace("fmb_data_", ""))
+
     @property
     def inputs(self) -> List[str]:
         """The names of the inputs set_load can change (joints with profile/law: input)."""

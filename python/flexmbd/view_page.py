@@ -6,7 +6,8 @@ flexmbd/_data/view.html, or the checkout's tools/view.html), and the data put wh
 stands is what tools/cmd_view.c writes for the same run and scene (byte for byte with the same
 title; tests/python/test_view.py checks it): the library's drawing of the scene (fmb_drawing_new)
 and the run's columns, BODY.x/y/theta for a body's frame and BODY.shapeK_x/_y for a beam's
-centreline. What the run lacks for the drawing is said in the page's notes."""
+centreline; in a spatial scene (dimension 3) BODY.x/y/z/qw/qx/qy/qz and BODY.shapeK_x/_y/_z, drawn by
+the page's 3D view. What the run lacks for the drawing is said in the page's notes."""
 from __future__ import annotations
 
 import ctypes
@@ -38,7 +39,11 @@ class _Drawing(ctypes.Structure):
     """fmbDrawing"""
     _fields_ = [("npoint", ctypes.c_int), ("ncell", ctypes.c_int), ("nconn", ctypes.c_int),
                 ("point", ctypes.POINTER(_DrawPoint)), ("cell", ctypes.POINTER(_DrawCell)),
-                ("conn", ctypes.POINTER(ctypes.c_int))]
+                ("conn", ctypes.POINTER(ctypes.c_int)),
+                ("dimension", ctypes.c_int), ("local3", ctypes.POINTER(ctypes.c_double))]  # appended (issue 34)
+
+
+FRAME_COLUMNS = {2: ("x", "y", "theta"), 3: ("x", "y", "z", "qw", "qx", "qy", "qz")}  # cmd_view.c frame_names
 
 
 def _library() -> ctypes.CDLL:
@@ -79,10 +84,11 @@ def _numbers(values) -> str:
 
 
 class _Body:
-    def __init__(self, name: str) -> None:
+    def __init__(self, name: str, dim: int = 2) -> None:
         self.name = name
-        self.frame = [0, 0, 0]  # result columns of x, y, theta; 0 = absent
-        self.shape: List[int] = []  # 2 result columns per station found
+        self.dim = dim  # components of a point: 2, or 3 in a spatial scene
+        self.frame = [0] * len(FRAME_COLUMNS[dim])  # result columns of FRAME_COLUMNS[dim]; 0 = absent
+        self.shape: List[int] = []  # dim result columns per station found
         self.drawn = False
         self.centreline = False
         self.nstation = 0
@@ -90,7 +96,7 @@ class _Body:
 
     @property
     def nshape(self) -> int:
-        return len(self.shape) // 2
+        return len(self.shape) // self.dim
 
 
 def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float = 1.0,
@@ -124,8 +130,9 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
         raise MemoryError("flexmbd view: fmb_drawing_new failed")
     try:
         d = d_ptr.contents
-        points = [(d.point[i].body, (d.point[i].local[0], d.point[i].local[1]), d.point[i].station)
-                  for i in range(d.npoint)]
+        dim = 3 if d.dimension == 3 else 2
+        points = [(d.point[i].body, tuple(d.local3[3 * i + k] for k in range(3)) if dim == 3
+                   else (d.point[i].local[0], d.point[i].local[1]), d.point[i].station) for i in range(d.npoint)]
         cells = [(d.cell[c].first, d.cell[c].count, d.cell[c].part, d.cell[c].owner) for c in range(d.ncell)]
         conn = [d.conn[k] for k in range(d.nconn)]
     finally:
@@ -136,22 +143,23 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
         lib.fmb_model_joint(model.handle, j, ctypes.byref(jname), ctypes.byref(jtype))
         joint_names.append(jname.value.decode())
 
-    bodies = [_Body(n) for n in model.bodies]
+    bodies = [_Body(n, dim) for n in model.bodies]
+    frame_q = FRAME_COLUMNS[dim]
     notes: List[str] = []
     drawable = 0
     for b, v in enumerate(bodies):
-        v.frame = [column_of(v.name, q) for q in ("x", "y", "theta")]
-        if sum(c > 0 for c in v.frame) < 3:
-            v.frame = [0, 0, 0]
+        v.frame = [column_of(v.name, q) for q in frame_q]
+        if sum(c > 0 for c in v.frame) < len(frame_q):
+            v.frame = [0] * len(frame_q)
         mine = [p for p in points if p[0] == b + 1]
         v.drawn = bool(mine)
         v.nstation = sum(p[2] >= 0 for p in mine)
         v.centreline = v.nstation > 0
-        while v.centreline:  # BODY.shapeK_x, BODY.shapeK_y for K = 0, 1, ...
-            cx, cy = column_of(v.name, f"shape{v.nshape}_x"), column_of(v.name, f"shape{v.nshape}_y")
-            if not cx or not cy:
+        while v.centreline:  # BODY.shapeK_x, BODY.shapeK_y (, BODY.shapeK_z) for K = 0, 1, ...
+            cols = [column_of(v.name, f"shape{v.nshape}_{c}") for c in "xyz"[:dim]]
+            if not all(cols):
                 break
-            v.shape += [cx, cy]
+            v.shape += cols
         if v.centreline and v.nshape >= 2:
             # the run's stations: the drawing's when as many (BODY.shape: the nodes), else equally
             # spaced from root to tip (BODY.shape_N)
@@ -161,14 +169,14 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
                     st0 = p[1]
                 if p[2] == v.nstation - 1:
                     st1 = p[1]
-            v.station = [[0.0, 0.0] for _ in range(v.nshape)]
+            v.station = [[0.0] * dim for _ in range(v.nshape)]
             for k in range(v.nshape if st0 is not None and st1 is not None else 0):
                 same = [p[1] for p in mine if p[2] == k] if v.nshape == v.nstation else []
                 if same:
-                    v.station[k] = [same[0][0], same[0][1]]
+                    v.station[k] = list(same[0][:dim])
                 else:
                     w = k / (v.nshape - 1)
-                    v.station[k] = [st0[0] + w * (st1[0] - st0[0]), st0[1] + w * (st1[1] - st0[1])]
+                    v.station[k] = [st0[c] + w * (st1[c] - st0[c]) for c in range(dim)]
         if not v.drawn:
             continue
         has_shape = v.centreline and v.nshape >= 2
@@ -176,7 +184,7 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
             drawable += 1
         lack = []
         if not v.frame[0]:
-            lack += [f"{v.name}.{q}" for q in ("x", "y", "theta") if not column_of(v.name, q)]
+            lack += [f"{v.name}.{q}" for q in frame_q if not column_of(v.name, q)]
         if v.centreline and not has_shape:
             lack.append(f"{v.name}.shape")
         if not lack:
@@ -217,7 +225,8 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
         title = f"{model.path or getattr(model, '_shown_path', 'scene')}, run"
     values = np.asarray(result.values, dtype=np.float64)
 
-    out = [template[:at], '{"title":', _json_string(title), ',"scale":', _json_number(scale)]
+    out = [template[:at], '{"title":', _json_string(title), ',"dimension":3' if dim == 3 else "", ',"scale":',
+           _json_number(scale)]
     out += [',"t":[', _numbers(values[:, 0]), '],"columns":[', ",".join(_json_string(n) for n in names[1:])]
     units = []
     for n in names[1:]:
@@ -229,11 +238,12 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
     out.append('],\n"bodies":[')
     for b, v in enumerate(bodies):
         out += [",\n{\"name\":" if b else "\n{\"name\":", _json_string(v.name)]
-        out.append(',"frame":[%d,%d,%d]' % tuple(c - 1 for c in v.frame) if v.frame[0] else ',"frame":null')
+        out.append(',"frame":[' + ",".join(str(c - 1) for c in v.frame) + "]" if v.frame[0] else ',"frame":null')
         if v.centreline and v.nshape >= 2:
-            out.append(',"shape":[' + ",".join(f"[{v.shape[2 * k] - 1},{v.shape[2 * k + 1] - 1}]"
+            out.append(',"shape":[' + ",".join("[" + ",".join(str(c - 1) for c in v.shape[dim * k:dim * (k + 1)]) + "]"
                                                for k in range(v.nshape)))
-            out.append('],"stations":[' + ",".join(f"[{_json_number(x)},{_json_number(y)}]" for x, y in v.station))
+            out.append('],"stations":[' + ",".join("[" + ",".join(_json_number(x) for x in st) + "]"
+                                                   for st in v.station))
             out.append("]")
         else:
             out.append(',"shape":null')
@@ -252,8 +262,8 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
             first_station[pb - 1] = npoint
             for k in range(v.nshape):
                 out.append(",\n" if npoint else "\n")
-                out.append(f'{{"body":{pb - 1},"local":[{_json_number(v.station[k][0])},'
-                           f'{_json_number(v.station[k][1])}],"station":{k},"joint":null}}')
+                out.append(f'{{"body":{pb - 1},"local":[{",".join(_json_number(x) for x in v.station[k])}],'
+                           f'"station":{k},"joint":null}}')
                 npoint += 1
             point_index[i] = first_station[pb - 1]
             continue
@@ -263,7 +273,7 @@ def page(result, model, *, columns: Optional[Sequence[str]] = None, scale: float
                 joint = joint_names[owner] if owner < len(joint_names) else None
                 break
         out.append(",\n" if npoint else "\n")
-        out.append(f'{{"body":{pb - 1},"local":[{_json_number(local[0])},{_json_number(local[1])}],'
+        out.append(f'{{"body":{pb - 1},"local":[{",".join(_json_number(x) for x in local)}],'
                    f'"station":{station if on_centreline else -1},"joint":'
                    f'{_json_string(joint) if joint is not None else "null"}}}')
         point_index[i] = npoint

@@ -13,6 +13,7 @@ from conftest import SRC, cli
 
 SPIN = os.path.join(SRC, "scenes", "paper", "spinup_w4.yaml")
 MECHANISM = os.path.join(SRC, "tests", "ux", "scenes", "vtk_mechanism.yaml")
+SPATIAL = os.path.join(SRC, "tests", "ux", "scenes", "spatial_view.yaml")  # a top and a spherical pendulum
 BEAM_OUTPUTS = {"solver.t_end": 1, "outputs": "[beam.x, beam.y, beam.theta, beam.shape, beam.tip_v, energy.total]"}
 
 
@@ -33,6 +34,8 @@ def cli_page(out, scene, sets, *extra):
     (SPIN, dict(BEAM_OUTPUTS, outputs="[beam.x, beam.y, beam.theta, beam.shape_5]"), None, 1.0),  # resampled stations
     (SPIN, dict(BEAM_OUTPUTS, outputs="[beam.shape, beam.tip_v]"), None, 1.0),  # no frame: a note
     (MECHANISM, {}, None, 1.0),  # joints, a spring, a body not drawn
+    (SPATIAL, {}, None, 1.0),  # dimension 3: frames from x, y, z, qw..qz, the 3D view
+    (SPATIAL, {"outputs": "[top.x, top.y, top.z, top.qw, top.qx, top.qy, top.qz, bob.x]"}, None, 1.0),  # a note
 ])
 def test_page_is_the_commands(out, scene, sets, columns, scale):
     extra = (["--columns", ",".join(columns)] if columns else []) + (["--scale", repr(scale)] if scale != 1 else [])
