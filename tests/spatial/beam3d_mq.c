@@ -8,7 +8,9 @@
  * that gives it (r0'' = R (v0' + omega x v0), e'' = 1/2 L^T (omega' + (2 e.e'/|e|^2) omega)
  * - (|e'|^2/|e|^2) e, which also zeroes the gauge e.e'' + e'.e'), maps the rows back to the
  * quasi-velocity equations (R^T on the r0 rows, 1/2 L(e) on the e rows) and prints
- * M[:, k] = (F(u E_k) - F(0)) / u (u = 1e6), then Q = -F(0): (6 + n) lines of M, then one line of Q. */
+ * M[:, k] = (F(u E_k) - F(0)) / u (u = 1e6), then Q = -F(0): (6 + n) lines of M, one line of Q, then
+ * "marker ERR_POS SCALE_POS ERR_ROT SCALE_ROT": marker3's derivatives against central differences. */
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -73,6 +75,37 @@ int main(int argc, char** argv) {
     for (int i = 0; i < nq; ++i) printf("%.17g%c", (F[i] - F0[i]) / UNIT, i + 1 < nq ? ' ' : '\n');
   }
   for (int i = 0; i < nq; ++i) printf("%.17g%c", -F0[i], i + 1 < nq ? ' ' : '\n');
+  /* the marker at a section point off the axis inside an element: dpos/dq and the virtual rotation
+     G (d(R u)/dq_k = G_k x R u) against central differences of marker3's position and R */
+  {
+    const double local[3] = {0.37 * 1.8, 0.004, -0.003};
+    double* dp = calloc(3 * (size_t)nc, sizeof *dp);
+    double* G = calloc(3 * (size_t)nc, sizeof *G);
+    double pos[3], Rm[9], pp[3], pm[3], Rp[9], Rmm[9], err_p = 0.0, err_r = 0.0, scale_p = 0.0, scale_r = 0.0;
+    if (!dp || !G || b->marker3(b->self, q, local, pos, Rm, dp, G, nc, work)) return fprintf(stderr, "marker3\n"), 3;
+    for (int k = 0; k < nc; ++k) {
+      const double h = 1e-6, qk = q[k];
+      q[k] = qk + h;
+      b->marker3(b->self, q, local, pp, Rp, NULL, NULL, nc, work);
+      q[k] = qk - h;
+      b->marker3(b->self, q, local, pm, Rmm, NULL, NULL, nc, work);
+      q[k] = qk;
+      for (int i = 0; i < 3; ++i) {
+        const double fd = (pp[i] - pm[i]) / (2 * h);
+        err_p = fmax(err_p, fabs(fd - dp[i * nc + k])), scale_p = fmax(scale_p, fabs(fd));
+      }
+      for (int c = 0; c < 3; ++c) { /* column c of R: dR/dq_k u = G_k x (R u) */
+        const double g[3] = {G[k], G[nc + k], G[2 * nc + k]}, u[3] = {Rm[c], Rm[3 + c], Rm[6 + c]};
+        const double gx[3] = {g[1] * u[2] - g[2] * u[1], g[2] * u[0] - g[0] * u[2], g[0] * u[1] - g[1] * u[0]};
+        for (int i = 0; i < 3; ++i) {
+          const double fd = (Rp[3 * i + c] - Rmm[3 * i + c]) / (2 * h);
+          err_r = fmax(err_r, fabs(fd - gx[i])), scale_r = fmax(scale_r, fabs(fd));
+        }
+      }
+    }
+    printf("marker %.3e %.3e %.3e %.3e\n", err_p, scale_p, err_r, scale_r);
+    free(dp), free(G);
+  }
   free(q), free(v), free(a), free(Res), free(F0), free(F), free(work);
   fmb_free(m);
   return 0;

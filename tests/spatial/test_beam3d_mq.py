@@ -8,7 +8,8 @@ nonzero p and p', a spinning and translating frame, gravity; for complete, FOAC 
 
 beam3d_mq reads M's columns off the C residual (R(a = e_k) - R(a = 0), mapped to the
 quasi-velocities) and Q = -R(a = 0); Q is compared without its elastic part K p (the same linear
-K in both, and 1e5 times the rest at this state). Tolerance 1e-10 of each block's largest entry: a dropped or
+K in both, and 1e5 times the rest at this state). And marker3's derivatives (dpos/dq, the virtual rotation G)
+at an off-axis section point against central differences of its position and rotation matrix. Tolerance 1e-10 of each block's largest entry: a dropped or
 wrong term (a coupling product, a Coriolis factor 2, gravity on u_C) is orders of magnitude above it.
 """
 import json
@@ -63,7 +64,14 @@ bodies:
         print(f"FAIL {model}: beam3d_mq exit {res.returncode}: {res.stderr}")
         fails += 1
         continue
-    rows = [list(map(float, line.split())) for line in res.stdout.strip().splitlines()]
+    lines = res.stdout.strip().splitlines()
+    mk = [float(c) for c in lines.pop().split()[1:]]
+    # marker3 at (0.37 L, 4 mm, -3 mm): dpos/dq and G against central differences (step 1e-6: error ~1e-10)
+    okm = mk[0] < 1e-7 * mk[1] and mk[2] < 1e-7 * mk[3]
+    print(f"{'ok  ' if okm else 'FAIL'} {model}: marker3 dpos/dq off differences by {mk[0]:.2e} of {mk[1]:.3g}, "
+          f"G by {mk[2]:.2e} of {mk[3]:.3g} (limit 1e-7 relative)")
+    fails += 0 if okm else 1
+    rows = [list(map(float, line.split())) for line in lines]
     Mc, Qc = np.array(rows[:-1]).T, np.array(rows[-1])  # each line of M is a column
     st = {"L": L, "rho": rho, "A": A, "Iy": Iy, "Iz": Iz, "E": E, "GJ": G * J, "ne": ne, "model": model,
           "R": R.flatten().tolist(), "p": p.tolist(), "nu": np.concatenate([v0, om, pd]).tolist(), "gravity": grav}
