@@ -1646,6 +1646,27 @@ extern const fmbBodyType fmb_body_beam_exact;
 static const fmbBodyType beam_fd;
 static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   extern const fmbBodyType fmb_body_beam;
+  /* `dimension: 3`: the spatial beam (bodies/beam3d.c); exact and the modal reduction are planar */
+  extern const fmbBodyType fmb_body_beam3d;
+  if (fmb_scene_dimension(p) == 3) {
+    const char* const planar_only[] = {"reduction", "jacobian"};
+    int model = BEAM_COMPLETE;
+    if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model)) return NULL;
+    if (model == 3) {
+      fmb_parse_error(p, fmb_find_key(p, item, "model"),
+                      "model: exact is planar only for now; a spatial beam (dimension: 3) is complete, foac or zoac");
+      return NULL;
+    }
+    for (int k = 0; k < 2; ++k)
+      if (fmb_find_key(p, item, planar_only[k]) >= 0) {
+        fmb_parse_error(p, fmb_find_key(p, item, planar_only[k]),
+                        "'%s' is planar only for now (a spatial beam, dimension: 3, is the full mesh with the "
+                        "engine's differenced Jacobian)",
+                        planar_only[k]);
+        return NULL;
+      }
+    return &fmb_body_beam3d;
+  }
   int model = BEAM_COMPLETE, differences = 0;
   if (fmb_get_choice(p, item, "model", FMB_OPTIONAL, all_models, &model) ||
       fmb_get_choice(p, item, "jacobian", FMB_OPTIONAL, jacobian_names, &differences))
@@ -1663,6 +1684,9 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   return differences ? &beam_fd : &fmb_body_beam;
 }
 
+/* a spatial item is always beam3d.c's (beam_variant), so the table's marker3 is its */
+int fmb_beam3d_marker3(const void* self, const double* q, const double local[3], double pos[3], double R[9],
+                       double* dpos, double* rot, int ld, double* work);
 /* the ops of both tables below (fmb_body_beam and beam_fd) */
 #define BEAM_OPS                                                                                                     \
   .name = "beam", .abi = FMB_ABI_VERSION, .parse = beam_parse, .destroy = beam_destroy, .ncoord = beam_ncoord,       \
@@ -1675,7 +1699,7 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
              "angular_velocity: 3\nvelocity: [0.2, 0.5]\n",                                                          \
   .example_damped = "damping: 0.05\n", .centreline = beam_centreline, .variant = beam_variant, .naux = beam_naux,    \
   .residual_aux = beam_residual_aux, .aux_initial = beam_aux_initial, .pattern = beam_pattern,                       \
-  .model_range = beam_model_range
+  .model_range = beam_model_range, .dimensions = FMB_DIM_PLANAR | FMB_DIM_SPATIAL, .marker3 = fmb_beam3d_marker3
 
 const fmbBodyType fmb_body_beam = {BEAM_OPS, .jacobian = beam_jacobian, .pattern_jacobian = beam_pattern_jacobian};
 static const fmbBodyType beam_fd = {BEAM_OPS};

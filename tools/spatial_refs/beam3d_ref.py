@@ -19,6 +19,7 @@ Independent of the C code: written from docs/formulation-3d.md alone. What it ho
 
     /usr/bin/python3 tools/spatial_refs/beam3d_ref.py --write   # (re)makes tests/spatial/ref/rotating_cantilever*.csv
     /usr/bin/python3 tools/spatial_refs/beam3d_ref.py --check   # the self-checks and the published values (exit 1 on failure)
+    /usr/bin/python3 tools/spatial_refs/beam3d_ref.py --mq STATE.json   # M, Q at one state as JSON (mass_forces_at)
 
 Nondimensional: lambda = Omega sqrt(rho A L^4 / EI), mu = omega sqrt(rho A L^4 / EI).
 """
@@ -523,7 +524,26 @@ def seed_rows():
     return rows
 
 
+def mass_forces_at(state_path):
+    """--mq STATE.json: M and Q of mass_forces at the state a JSON file gives, as JSON on stdout
+    {"M": [[...]], "Q": [...], "Kp": [...]} (Kp: the elastic part of -Q's deformation rows). The file holds the beam (L, rho, A, Iy, Iz, E, GJ, ne), the model,
+    the frame's rotation matrix R (row-major, 9), p (6 ne), nu = [R^T r0', omega (body), p'] and
+    gravity (global): the quantities of Eqs. 3D.20-3D.24, nothing of any other implementation."""
+    import json
+    with open(state_path) as f:
+        st = json.load(f)
+    beam = Beam(st["L"], st["rho"], st["A"], st["Iy"], st["Iz"], st["E"], st["GJ"], int(st["ne"]))
+    Rm = np.array(st["R"], dtype=float).reshape(3, 3)
+    M, Q = mass_forces(beam, st["model"], Rm, np.array(st["p"], dtype=float), np.array(st["nu"], dtype=float),
+                       np.array(st["gravity"], dtype=float))
+    Kp = beam.K() @ np.array(st["p"], dtype=float)
+    json.dump({"M": M.tolist(), "Q": Q.tolist(), "Kp": Kp.tolist()}, sys.stdout)
+    return 0
+
+
 def main(argv):
+    if len(argv) == 2 and argv[0] == "--mq":
+        return mass_forces_at(argv[1])
     write = "--write" in argv
     if write:
         rows = table()
