@@ -479,7 +479,12 @@ typedef struct fmbCampbell {
   /* internal: the last speed's modes and which of them each followed mode is */
   fmbModes* last;
   int* track;
+  /* appended: nspeed x count, each followed mode's FMB_FAMILY_* at each speed (spatial scenes;
+     FMB_FAMILY_NONE for planar ones) */
+  int* family;
 } fmbCampbell;
+/* the family a followed mode k has at most of the speeds done (FMB_FAMILY_NONE: planar) */
+FMB_API int fmb_campbell_family(const fmbCampbell* c, int k);
 
 /* The diagram at speeds[0 .. nspeed). Returns 0, or an exit code with *diag (the scene, a speed
    whose steady state or modes fail, fewer modes than opt->count); *out (free it with

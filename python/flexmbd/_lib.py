@@ -144,7 +144,8 @@ class Campbell(ctypes.Structure):
     """fmbCampbell (`last` and `track` are the library's own)"""
     _fields_ = [("nspeed", ctypes.c_int), ("done", ctypes.c_int), ("count", ctypes.c_int),
                 ("speed", ctypes.POINTER(ctypes.c_double)), ("frequency", ctypes.POINTER(ctypes.c_double)),
-                ("mac", ctypes.POINTER(ctypes.c_double)), ("last", ctypes.c_void_p), ("track", ctypes.c_void_p)]
+                ("mac", ctypes.POINTER(ctypes.c_double)), ("last", ctypes.c_void_p), ("track", ctypes.c_void_p),
+                ("family", ctypes.POINTER(ctypes.c_int))]
 
 
 class SceneSource(ctypes.Structure):
