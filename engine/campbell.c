@@ -203,7 +203,8 @@ int fmb_campbell_add(fmbCampbell* c, fmbModes* cur, fmbDiag* diag) {
     memcpy(c->track, next, sizeof(int) * (size_t)count);
   }
   for (int k = 0; k < count; ++k) freq[k] = cur->frequency[c->track[k]];
-  for (int k = 0; k < count && c->family; ++k) c->family[(size_t)i * count + k] = cur->family ? cur->family[c->track[k]] : 0;
+  for (int k = 0; k < count && c->family; ++k)
+    c->family[(size_t)i * count + k] = cur->family ? cur->family[c->track[k]] : 0;
   fmb_modes_free(c->last);
   c->last = cur;
   c->done = i + 1;

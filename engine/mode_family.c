@@ -127,8 +127,9 @@ int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* m
         }
         for (int i = 0; i < 3; ++i) body_e[i] = d[i] / dn;
       }
-      const double span = sqrt((last[0] - first[0]) * (last[0] - first[0]) +
-                               (last[1] - first[1]) * (last[1] - first[1]) + (last[2] - first[2]) * (last[2] - first[2]));
+      const double span =
+          sqrt((last[0] - first[0]) * (last[0] - first[0]) + (last[1] - first[1]) * (last[1] - first[1]) +
+               (last[2] - first[2]) * (last[2] - first[2]));
       double rad[3] = {first[0] - center[0], first[1] - center[1], first[2] - center[2]};
       const double along = dot3(rad, a);
       for (int i = 0; i < 3; ++i) rad[i] -= along * a[i];

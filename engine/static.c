@@ -265,10 +265,10 @@ typedef struct {
   const fmbModel* m;
   fmbWorkspace* w;
   double t, speed, center[2];
-  int n;           /* nq + nc + ng */
-  int ng;          /* gauge rows (S3); spatial scenes only */
-  fmbRotation3 rot; /* a spatial scene's rotation (speed == rot.speed) */
-  double *D, *E;   /* gauge directions (nq x ng), the rotation's generator (nq x nq) */
+  int n;               /* nq + nc + ng */
+  int ng;              /* gauge rows (S3); spatial scenes only */
+  fmbRotation3 rot;    /* a spatial scene's rotation (speed == rot.speed) */
+  double *D, *E;       /* gauge directions (nq x ng), the rotation's generator (nq x nq) */
   double *U, *VT, *sv; /* spatial: the SVD of A (S4) */
   double load;         /* the out-of-balance load at the start (S4's test) */
   double *y, *yp, *F, *ewt, *J0, *J1, *A;
@@ -552,8 +552,9 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
       bi->type->initial(bi->self, x + bi->qadr, v0 + bi->qadr);
     }
   const int ng = m->dimension == 3 && x ? fmb_gauge_count(m, x) : 0, n = nq + nc + ng;
-  Newton s = {m, w, opt.t, 0.0, {0.0, 0.0}, n, ng, {0.0, {0.0, 0.0, 1.0}, {0.0, 0.0, 0.0}, 0.0}, NULL, NULL,
-              NULL, NULL, NULL, 0.0, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  Newton s = {m,    w,    opt.t, 0.0,  {0.0, 0.0}, n,   ng,   {0.0, {0.0, 0.0, 1.0}, {0.0, 0.0, 0.0}, 0.0},
+              NULL, NULL, NULL,  NULL, NULL,       0.0, NULL, NULL,
+              NULL, NULL, NULL,  NULL, NULL,       NULL};
   if (x) x = realloc(x, (size_t)n * sizeof(double) + 1);
   if (x) memset(x + nq + nc, 0, (size_t)ng * sizeof(double));
   s.D = calloc((size_t)nq * ng + 1, sizeof(double));
