@@ -433,6 +433,10 @@ int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y
 int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag);
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
+/* a steady rotation refused (static.c in the plane, rotation3.c in space): the drives are not one
+   rigid rotation, or they accelerate; sets *diag, returns FMB_EXIT_BAD_INPUT */
+enum { FMB_STEADY_NOT_RIGID, FMB_STEADY_ACCELERATING };
+int fmb_steady_refusal(const fmbModel* m, int why, double t, double value, fmbDiag* diag);
 /* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
 void fmb_rigid_rotation(const fmbModel* m, double speed, const double center[2], const double* q, double* v, double* a);
 /* rotating-frame terms of a steady rotation: K += W C E + W^2 M E^2, Cg += 2 W M E (if not NULL);

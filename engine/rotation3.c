@@ -361,22 +361,13 @@ int fmb_fit_rotation3(const fmbModel* m, fmbWorkspace* w, double t, const double
   rotation_of(z, rot);
   if (res > 1e-8 * bnorm || rot->speed == 0.0 ||
       fabs(rot->screw) > 1e-8 * (1.0 + fabs(rot->center[0]) + fabs(rot->center[1]) + fabs(rot->center[2]))) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "at t = %g the drives do not turn the whole system as one rigid rotation (velocity constraints left "
-                 "unsatisfied by %.3g): a steady state exists only for constant-speed rotation of everything about one "
-                 "axis (drive a hub on a revolute3d to the ground)",
-                 t, res);
-    rc = FMB_EXIT_BAD_INPUT;
+    rc = fmb_steady_refusal(m, FMB_STEADY_NOT_RIGID, t, res, diag);
     goto done;
   }
   double tt = 0.0;
   for (int r = 0; r < nc; ++r) tt += phitt[r] * phitt[r];
   if (sqrt(tt) > 1e-9 * bnorm * (1.0 + fabs(rot->speed))) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "at t = %g the drives are accelerating (Phi_tt = %.3g): no steady state; take a time after the ramp "
-                 "(--at T) or a constant-speed drive",
-                 t, sqrt(tt));
-    rc = FMB_EXIT_BAD_INPUT;
+    rc = fmb_steady_refusal(m, FMB_STEADY_ACCELERATING, t, sqrt(tt), diag);
     goto done;
   }
   /* gravity along the spin axis turns with nothing; any other component turns against the system */
