@@ -617,7 +617,11 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
      one of 1e-16 ("no equilibrium found"), both answers wrong: say what holds. The test is on the
      pivots of the equilibrium Jacobian (smallest / largest below 1e-12: a roundoff-level pivot
      against the stiffest entry; a 1.8 m aluminium blade's softest pivot is 1e-8 of its stiffest). */
-  if (s.speed == 0.0 && res->residual_start <= FMB_STATIC_NO_LOAD) {
+  /* In space gravity (the only load there yet) can balance at the start while a free motion it
+     never meets remains (a body hanging on a ball joint spins freely about the vertical): that
+     start is an equilibrium, its free motion left where it is as (S4) leaves it. */
+  const int loaded_in_space = m->dimension == 3 && m->env.has_gravity;
+  if (s.speed == 0.0 && res->residual_start <= FMB_STATIC_NO_LOAD && !loaded_in_space) {
     const int free_motions = singular_stiffness(&s, x);
     if (free_motions < 0) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equilibrium equations cannot be evaluated (t = %g)",

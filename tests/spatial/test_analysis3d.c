@@ -55,6 +55,21 @@ int main(void) {
     }
     analysis_free(&a);
   }
+  { /* the ball joint started hanging: gravity balanced, the spin free; that start is the equilibrium */
+    const char* ov[] = {"bodies.bob.orientation=[1, 0, 0, 0]", "bodies.bob.position=[0, 0, -0.4]"};
+    Analysis a;
+    ENSURE(analyse(&a, "tests/spatial/scenes/hanging.yaml", ov, 2, 0, 0.0, 10) == 0);
+    if (a.modes) {
+      const double w = sqrt(m * g * l / (0.02 + m * l * l));
+      printf("ball joint started hanging: %d Newton iterations, modes %.3g %.10g %.10g rad/s\n", a.st.iterations,
+             a.modes->frequency[0], a.modes->frequency[1], a.modes->count > 2 ? a.modes->frequency[2] : NAN);
+      ENSURE(hang_error(&a, l) < 1e-15 && a.modes->count == 3);
+      ENSURE(fabs(a.modes->frequency[0]) < 1e-6 * w);
+      ENSURE_REL(a.modes->frequency[1], w, 1e-10);
+      ENSURE_REL(a.modes->frequency[2], w, 1e-10);
+    }
+    analysis_free(&a);
+  }
   { /* Cardan joint: one swing per pin, about x with I1 = 0.02, about y with I2 = 0.03 */
     Analysis a;
     ENSURE(analyse(&a, "tests/spatial/scenes/hanging_cardan.yaml", NULL, 0, 0, 0.0, 10) == 0);
