@@ -433,7 +433,7 @@ int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y
 int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag);
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
-/* a steady rotation refused (static.c in the plane, rotation3.c in space): the drives are not one
+/* a steady rotation refused (rotation3.c; static.c's planar fit uses it too): the drives are not one
    rigid rotation, or they accelerate; sets *diag, returns FMB_EXIT_BAD_INPUT */
 enum { FMB_STEADY_NOT_RIGID, FMB_STEADY_ACCELERATING };
 int fmb_steady_refusal(const fmbModel* m, int why, double t, double value, fmbDiag* diag);

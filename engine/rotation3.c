@@ -22,6 +22,25 @@
 
 #include "internal.h"
 
+/* the refusals of a steady rotation, shared with the plane's fit (static.c; here so that the
+   two files call in one direction) */
+int fmb_steady_refusal(const fmbModel* m, int why, double t, double value, fmbDiag* diag) {
+  if (why == FMB_STEADY_NOT_RIGID)
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "at t = %g the drives do not turn the whole system as one rigid rotation (velocity constraints left "
+                 "unsatisfied by %.3g): a steady state exists only for constant-speed rotation of everything about one "
+                 "%s",
+                 t, value,
+                 m->dimension == 3 ? "axis (drive a hub on a revolute3d to the ground)"
+                                   : "center (drive a hub pinned to the ground)");
+  else
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "at t = %g the drives are accelerating (Phi_tt = %.3g): no steady state; take a time after the ramp "
+                 "(--at T) or a constant-speed drive",
+                 t, value);
+  return FMB_EXIT_BAD_INPUT;
+}
+
 /* gauge directions of one body (at most 8, a body's frame has one) */
 #define GAUGE_MAX 8
 
