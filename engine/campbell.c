@@ -7,7 +7,11 @@
  * modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) against k's shape at the speed before is
  * assigned first, then the next largest among the rest (greedy), so two modes that cross in
  * frequency keep their own curves. More modes than followed are computed (EXTRA) so that a mode
- * coming down from above can take over a curve. */
+ * coming down from above can take over a curve.
+ *
+ * A spatial scene's modes carry their family (flap, lag, axial, torsion: fmb_modes_classify)
+ * about the spin axis; at speed 0, where the state does not turn, the axis is the one the drives
+ * give at a unit speed (the scene loaded once more with `speed_key=1`). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -51,6 +55,35 @@ int fmb_load_steady(const fmbSceneSource* scene, const char* extra, const fmbSta
 
 static int campbell_count(const fmbCampbellOptions* opt) { return opt && opt->count > 0 ? opt->count : 4; }
 
+/* the spin axis of the sweep (the drives' rotation at speed 1, time t) for a state at rest */
+static int sweep_axis(const fmbSceneSource* scene, const fmbCampbellOptions* opt, double t, fmbRotation3* rot,
+                      fmbDiag* diag) {
+  char set[600];
+  snprintf(set, sizeof set, "%s=1", opt->speed_key);
+  const int n = scene->noverrides + 1;
+  const char** ov = malloc(sizeof(char*) * (size_t)(n + 1));
+  if (!ov) return FMB_EXIT_SOLVER;
+  for (int i = 0; i < scene->noverrides; ++i) ov[i] = scene->overrides[i];
+  ov[n - 1] = set;
+  fmbModel* m = fmb_load(scene->path, ov, n, scene->reg, diag);
+  free(ov);
+  if (!m) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
+  fmbWorkspace* w = fmb_workspace_new(m);
+  double* q = calloc((size_t)m->nq + 1, sizeof(double));
+  double* v = calloc((size_t)m->nq + 1, sizeof(double));
+  int rc = w && q && v ? 0 : FMB_EXIT_SOLVER;
+  for (int b = 1; !rc && b < m->nbody; ++b) {
+    const fmbBodyInst* bi = &m->body[b];
+    bi->type->initial(bi->self, q + bi->qadr, v + bi->qadr);
+  }
+  if (!rc) rc = fmb_fit_rotation3(m, w, t, q, rot, diag);
+  free(q);
+  free(v);
+  fmb_workspace_free(w);
+  fmb_free(m);
+  return rc;
+}
+
 int fmb_campbell_modes_at(const fmbSceneSource* scene, const fmbCampbellOptions* opt, double speed, fmbModes** modes,
                           fmbDiag* diag) {
   fmbDiag local;
@@ -72,6 +105,13 @@ int fmb_campbell_modes_at(const fmbSceneSource* scene, const fmbCampbellOptions*
   fmbStaticResult res;
   int rc = fmb_load_steady(scene, set, &opt->steady, &m, &y, &yp, &res, diag);
   if (!rc) rc = fmb_modes(m, res.t, y, yp, campbell_count(opt) + FMB_CAMPBELL_EXTRA_MODES, opt->method, modes, diag);
+  if (!rc && m->dimension == 3 && !(*modes)->family) { /* at rest: the sweep's axis */
+    fmbRotation3 rot;
+    fmbDiag ad;
+    memset(&ad, 0, sizeof ad);
+    if (!sweep_axis(scene, opt, res.t, &rot, &ad) && rot.speed != 0.0)
+      fmb_modes_classify(m, res.t, y, *modes, rot.axis, rot.center, NULL);
+  }
   free(y);
   free(yp);
   fmb_free(m);
@@ -88,7 +128,8 @@ fmbCampbell* fmb_campbell_new(const double* speeds, int nspeed, int count) {
   c->frequency = calloc((size_t)nspeed * (size_t)count, sizeof(double));
   c->mac = calloc((size_t)nspeed * (size_t)count, sizeof(double));
   c->track = calloc((size_t)count, sizeof(int));
-  if (!c->speed || !c->frequency || !c->mac || !c->track) {
+  c->family = calloc((size_t)nspeed * (size_t)count, sizeof(int));
+  if (!c->speed || !c->frequency || !c->mac || !c->track || !c->family) {
     fmb_campbell_free(c);
     return NULL;
   }
@@ -103,6 +144,7 @@ void fmb_campbell_free(fmbCampbell* c) {
   free(c->frequency);
   free(c->mac);
   free(c->track);
+  free(c->family);
   free(c);
 }
 
@@ -161,6 +203,8 @@ int fmb_campbell_add(fmbCampbell* c, fmbModes* cur, fmbDiag* diag) {
     memcpy(c->track, next, sizeof(int) * (size_t)count);
   }
   for (int k = 0; k < count; ++k) freq[k] = cur->frequency[c->track[k]];
+  for (int k = 0; k < count && c->family; ++k)
+    c->family[(size_t)i * count + k] = cur->family ? cur->family[c->track[k]] : 0;
   fmb_modes_free(c->last);
   c->last = cur;
   c->done = i + 1;
@@ -197,4 +241,16 @@ int fmb_campbell(const fmbSceneSource* scene, const fmbCampbellOptions* opt, con
       snprintf(diag->file, sizeof diag->file, "%s", scene->path ? scene->path : "");
   }
   return rc;
+}
+
+int fmb_campbell_family(const fmbCampbell* c, int k) {
+  if (!c || !c->family || k < 0 || k >= c->count) return FMB_FAMILY_NONE;
+  int votes[FMB_FAMILY_TORSION + 1] = {0}, best = FMB_FAMILY_NONE;
+  for (int i = 0; i < c->done; ++i) {
+    const int f = c->family[(size_t)i * c->count + k];
+    if (f > FMB_FAMILY_NONE && f <= FMB_FAMILY_TORSION) ++votes[f];
+  }
+  for (int f = FMB_FAMILY_FLAP; f <= FMB_FAMILY_TORSION; ++f)
+    if (votes[f] > votes[best]) best = f;
+  return best;
 }

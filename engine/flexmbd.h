@@ -400,7 +400,21 @@ typedef struct fmbModes {
   double* damping_ratio; /* -Re(s)/|s|; -1 for a divergent mode */
   double* shape_re;      /* count x nq, mode k at k * nq: the generalized coordinates' motion, */
   double* shape_im;      /* scaled so the largest component is 1 (real) */
+  /* spatial scenes (dimension 3; appended): each mode's FMB_FAMILY_* (count of them; NULL when not
+     classified: a planar scene, a state without rotation unless fmb_modes_classify was called),
+     and the spin axis and a point on it of the steady rotation (speed 0: axis [0, 0, 1]) */
+  int* family;
+  double axis[3], center[3];
 } fmbModes;
+
+/* a mode's family relative to a spin axis (fmb_modes_classify, docs/analysis.md): where the
+   motion of the bodies' centreline stations (or frame origins) points — along the axis, out of
+   the plane of rotation (flap, flapwise); in that plane across the radius (lag, lead-lag or
+   chordwise); along the radius (axial); or a turn about the radius with the stations at rest
+   (torsion) */
+enum { FMB_FAMILY_NONE = 0, FMB_FAMILY_FLAP = 1, FMB_FAMILY_LAG = 2, FMB_FAMILY_AXIAL = 3, FMB_FAMILY_TORSION = 4 };
+/* "flap", "lag", "axial", "torsion", or "mode" for FMB_FAMILY_NONE and anything else */
+FMB_API const char* fmb_family_name(int family);
 
 /* eigen-solvers: dense LAPACK on the constraint-reduced problem (all modes), or shift-invert
    Arnoldi (ARPACK) with KLU on the saddle-point system (a few modes of a large system; falls
@@ -414,6 +428,13 @@ enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
 FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
                       fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
+/* Classify the modes of a spatial scene's state y (those fmb_modes computed there) against the
+   spin axis `axis` (unit) through `center`: fills modes->family (allocated here, freed by
+   fmb_modes_free) and modes->axis, ->center. fmb_modes calls it itself about a steady rotation;
+   a caller with a static state (a Campbell diagram's speed 0) gives the axis of the sweep.
+   Returns 0, FMB_EXIT_BAD_INPUT (a planar scene, mismatched modes) or FMB_EXIT_SOLVER. */
+FMB_API int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* modes, const double axis[3],
+                               const double center[3], fmbDiag* diag);
 /* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
    NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);
@@ -478,7 +499,12 @@ typedef struct fmbCampbell {
   /* internal: the last speed's modes and which of them each followed mode is */
   fmbModes* last;
   int* track;
+  /* appended: nspeed x count, each followed mode's FMB_FAMILY_* at each speed (spatial scenes;
+     FMB_FAMILY_NONE for planar ones) */
+  int* family;
 } fmbCampbell;
+/* the family a followed mode k has at most of the speeds done (FMB_FAMILY_NONE: planar) */
+FMB_API int fmb_campbell_family(const fmbCampbell* c, int k);
 
 /* The diagram at speeds[0 .. nspeed). Returns 0, or an exit code with *diag (the scene, a speed
    whose steady state or modes fail, fewer modes than opt->count); *out (free it with

@@ -434,12 +434,47 @@ int fmb_consistent_state(const fmbModel* m, fmbWorkspace* w, double t, double* y
 int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbDiag* diag);
 int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
                      fmbStaticResult* res, fmbDiag* diag);
+/* a steady rotation refused (rotation3.c; static.c's planar fit uses it too): the drives are not one
+   rigid rotation, or they accelerate; sets *diag, returns FMB_EXIT_BAD_INPUT */
+enum { FMB_STEADY_NOT_RIGID, FMB_STEADY_ACCELERATING };
+int fmb_steady_refusal(const fmbModel* m, int why, double t, double value, fmbDiag* diag);
 /* v and a (nq each) of every body's frame turning rigidly at `speed` about `center` */
 void fmb_rigid_rotation(const fmbModel* m, double speed, const double center[2], const double* q, double* v, double* a);
 /* rotating-frame terms of a steady rotation: K += W C E + W^2 M E^2, Cg += 2 W M E (if not NULL);
    nq x nq column-major with leading dimension ld */
 void fmb_rotation_terms(const fmbModel* m, double speed, const double* C, const double* M, int ld, double* K,
                         double* Cg);
+
+/* ---- rotation3.c: statics and modes of spatial scenes (docs/analysis.md) ---- */
+/* a rigid rotation in space: `speed` (rad/s) about the unit `axis` through `center` */
+typedef struct {
+  double speed, axis[3], center[3];
+  double screw; /* internal: the fit's translation along the axis (0 for a rotation) */
+} fmbRotation3;
+/* the bodies' gauge directions (fmbBodyType.gauge): their count; into D (nq x ng column-major,
+   leading dimension ld) the directions over all coordinates, returning ng (-1: a body gives too many) */
+int fmb_gauge_count(const fmbModel* m, const double* q);
+int fmb_gauge_rows(const fmbModel* m, const double* q, double* D, int ld);
+/* the coordinate velocities of every body's rigid motion z = [Omega; s] (origin velocity
+   Omega x r0 - s): V nq x 6 column-major; -1 when a body has no marker3 */
+int fmb_rotation3_basis(const fmbModel* m, fmbWorkspace* w, const double* q, double* V);
+/* v and a (nq each) of the steady rotation rot at q */
+int fmb_rigid_rotation3(const fmbModel* m, fmbWorkspace* w, const fmbRotation3* rot, const double* q, double* v,
+                        double* a);
+/* E (nq x nq, leading dimension ld): the generator of the unit-speed rotation about rot's axis */
+int fmb_rotation3_generator(const fmbModel* m, fmbWorkspace* w, const fmbRotation3* rot, const double* q, double* E,
+                            int ld);
+/* K += W C E + W^2 M E^2, Cg += 2 W M E (if not NULL) with E nq x nq (leading dimension nq) and
+   C, M, K, Cg at leading dimension ld */
+void fmb_rotation3_terms(int nq, double speed, const double* E, const double* C, const double* M, int ld, double* K,
+                         double* Cg);
+/* the rotation the drives prescribe at t (static.c's fit_rotation in space): 0 (speed 0: static)
+   or FMB_EXIT_BAD_INPUT with *diag */
+int fmb_fit_rotation3(const fmbModel* m, fmbWorkspace* w, double t, const double* q, fmbRotation3* rot, fmbDiag* diag);
+/* the rigid rotation a state's velocities v describe (speed 0 when they are not one) */
+int fmb_state_rotation3(const fmbModel* m, fmbWorkspace* w, const double* q, const double* v, fmbRotation3* rot);
+/* the largest turn (rad) of a body's frame when its coordinates move by dq */
+double fmb_turn3(const fmbModel* m, fmbWorkspace* w, const double* q, const double* dq);
 
 /* ---- output.c ---- */
 int fmb_outputs_resolve(fmbParser* p, fmbModel* m, fmbNode list);

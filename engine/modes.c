@@ -19,7 +19,12 @@
  * system the sparse path (M4, below) skips N: Arnoldi on one KLU factorization of the
  * saddle-point matrix. A mode reports |s| as its frequency and -Re(s)/|s| as its damping ratio; a
  * real positive s (divergence: ZOAC spun above w1, where w^2 = w1^2 - W^2 < 0) is reported as
- * frequency -|s|, so a Campbell curve passes continuously through zero. Dense: O(n^3). */
+ * frequency -|s|, so a Campbell curve passes continuously through zero. Dense: O(n^3).
+ * A spatial scene (engine/rotation3.c): E is the generator of the rigid rotation on every body's
+ * coordinates (G3), the rotation is read from v* with its axis, and the bodies' gauge directions
+ * D join Phi_q in the null-space basis, N spanning {Phi_q dq = 0, D^T dq = 0} (G1): no
+ * zero-frequency mode of an Euler parameter's length. Its modes are then classified into
+ * families by where they move relative to the spin axis (engine/mode_family.c). */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -307,6 +312,7 @@ void fmb_modes_free(fmbModes* md) {
   free(md->damping_ratio);
   free(md->shape_re);
   free(md->shape_im);
+  free(md->family);
   free(md);
 }
 
@@ -323,6 +329,7 @@ static int out_of_memory(const fmbModel* m, fmbDiag* diag) {
 /* (M1) about the state: nq x nq column-major blocks, and J0 (ny x ny) for the constraint rows */
 typedef struct {
   double speed;            /* the rigid rotation the state has */
+  fmbRotation3 rot;        /* with its axis (spatial scenes) */
   double *J0, *K, *Cg, *M; /* dF/dy at cj = 0; stiffness, damping + gyroscopic, mass (rotating frame) */
 } Linearized;
 
@@ -337,8 +344,14 @@ static void linearized_free(Linearized* L) {
 static int linearize(const fmbModel* m, double t, const double* y, const double* yp, Linearized* L, fmbDiag* diag) {
   const int nq = m->nq, ny = m->ny;
   memset(L, 0, sizeof *L);
-  L->speed = state_speed(m, y, y + nq);
   fmbWorkspace* w = fmb_workspace_new(m);
+  L->rot = (fmbRotation3){0.0, {0.0, 0.0, 1.0}, {0.0, 0.0, 0.0}, 0.0};
+  if (m->dimension == 3) {
+    if (w) fmb_state_rotation3(m, w, y, y + nq, &L->rot);
+    L->speed = L->rot.speed;
+  } else {
+    L->speed = state_speed(m, y, y + nq);
+  }
   double* J1 = calloc((size_t)ny * ny, sizeof(double));
   double* ewt = calloc((size_t)ny, sizeof(double));
   double* C = calloc((size_t)nq * nq, sizeof(double));
@@ -371,7 +384,18 @@ static int linearize(const fmbModel* m, double t, const double* y, const double*
         L->M[k] = J1[(size_t)(nq + j) * ny + nq + i] - C[k];
         L->Cg[k] = C[k];
       }
-    fmb_rotation_terms(m, L->speed, C, L->M, nq, L->K, L->Cg); /* (M1) */
+    if (m->dimension != 3) {
+      fmb_rotation_terms(m, L->speed, C, L->M, nq, L->K, L->Cg); /* (M1) */
+    } else if (L->speed != 0.0) {
+      double* E = calloc((size_t)nq * nq, sizeof(double));
+      if (!E || fmb_rotation3_generator(m, w, &L->rot, y, E, nq)) {
+        fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the rigid rotation of the bodies cannot be formed");
+        rc = FMB_EXIT_SOLVER;
+      } else {
+        fmb_rotation3_terms(nq, L->speed, E, C, L->M, nq, L->K, L->Cg); /* (M1) */
+      }
+      free(E);
+    }
   }
   fmb_workspace_free(w);
   free(J1);
@@ -431,9 +455,11 @@ static void reduced_free(Reduced* R) {
   memset(R, 0, sizeof *R);
 }
 
-/* the right singular vectors of Phi_q (nc x nq, from J0's rows) into VT, its rank into *rank */
-static int constraint_svd(const fmbModel* m, const double* J0, double* VT, int* rank, fmbDiag* diag) {
-  const int nq = m->nq, nc = m->nc, ny = m->ny;
+/* the right singular vectors of [Phi_q; D^T] (nc + ng rows, from J0's rows and the gauge
+   directions D, nq x ng) into VT, its rank into *rank */
+static int constraint_svd(const fmbModel* m, const double* J0, const double* D, int ng, double* VT, int* rank,
+                          fmbDiag* diag) {
+  const int nq = m->nq, nc = m->nc + ng, ny = m->ny;
   *rank = 0;
   if (nc == 0) return 0;
   double* P = calloc((size_t)nc * nq, sizeof(double));
@@ -444,7 +470,8 @@ static int constraint_svd(const fmbModel* m, const double* J0, double* VT, int* 
     rc = out_of_memory(m, diag);
   } else {
     for (int j = 0; j < nq; ++j)
-      for (int r = 0; r < nc; ++r) P[(size_t)j * nc + r] = J0[(size_t)j * ny + 2 * nq + r];
+      for (int r = 0; r < nc; ++r)
+        P[(size_t)j * nc + r] = r < m->nc ? J0[(size_t)j * ny + 2 * nq + r] : D[(size_t)(r - m->nc) * nq + j];
     int lwork = -1, one = 1;
     double q1 = 0.0, u1 = 0.0;
     dgesvd_("N", "A", &nc, &nq, P, &nc, sv, &u1, &one, VT, &nq, &q1, &lwork, &info);
@@ -468,13 +495,20 @@ static int constraint_svd(const fmbModel* m, const double* J0, double* VT, int* 
   return rc;
 }
 
-static int reduce_constraints(const fmbModel* m, const Linearized* L, Reduced* R, fmbDiag* diag) {
-  const int nq = m->nq, nc = m->nc;
+static int reduce_constraints(const fmbModel* m, const double* y, const Linearized* L, Reduced* R, fmbDiag* diag) {
+  const int nq = m->nq, ng = m->dimension == 3 ? fmb_gauge_count(m, y) : 0, nc = m->nc + ng;
   memset(R, 0, sizeof *R);
   double* VT = calloc((size_t)nq * nq, sizeof(double));
+  double* D = calloc((size_t)nq * ng + 1, sizeof(double));
   double* tmp = NULL;
   int rank = 0;
-  int rc = VT ? constraint_svd(m, L->J0, VT, &rank, diag) : out_of_memory(m, diag);
+  int rc = VT && D ? 0 : out_of_memory(m, diag);
+  if (!rc && ng > 0 && fmb_gauge_rows(m, y, D, nq) != ng) {
+    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "a body's gauge directions cannot be formed");
+    rc = FMB_EXIT_SOLVER;
+  }
+  if (!rc) rc = constraint_svd(m, L->J0, D, ng, VT, &rank, diag);
+  free(D);
   const int nr = nq - rank;
   if (!rc && nr == 0) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "the joints leave no motion: there are no modes");
@@ -756,11 +790,6 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
     return FMB_EXIT_BAD_INPUT;
   }
   *out = NULL;
-  if (m->dimension == 3) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "modes of spatial scenes (dimension: 3) are not implemented yet (docs/spatial.md)");
-    return FMB_EXIT_BAD_INPUT;
-  }
   /* an unknown method once ran the dense path silently; a time of nan linearized at nan */
   if (method != FMB_EIGEN_AUTO && method != FMB_EIGEN_DENSE && method != FMB_EIGEN_SPARSE) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
@@ -791,12 +820,18 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
      does not apply (a singular saddle-point matrix: rigid motions; no convergence), dense */
   const int use_sparse = count > 0 && 4 * count < m->nq &&
                          (method == FMB_EIGEN_SPARSE || (method == FMB_EIGEN_AUTO && m->nq >= FMB_SPARSE_MIN_COORDS));
-  rc = use_sparse ? solve_sparse(m, &L, count, &E, diag) : 1;
+  /* the sparse path's saddle-point matrix has no gauge rows: spatial scenes are solved dense */
+  rc = use_sparse && m->dimension != 3 ? solve_sparse(m, &L, count, &E, diag) : 1;
   if (rc == 1) {
-    rc = reduce_constraints(m, &L, &R, diag);
+    rc = reduce_constraints(m, y, &L, &R, diag);
     if (!rc) rc = solve_dense(m, t, &R, &E, diag);
   }
   if (!rc) rc = pack_modes(m, &E, &R, L.speed, count, out, diag);
+  if (!rc && m->dimension == 3) { /* families about the spin axis (a static state: none, family 0) */
+    memcpy((*out)->axis, L.rot.axis, sizeof L.rot.axis);
+    memcpy((*out)->center, L.rot.center, sizeof L.rot.center);
+    if (L.speed != 0.0) (void)fmb_modes_classify(m, t, y, *out, L.rot.axis, L.rot.center, NULL); /* else none */
+  }
   linearized_free(&L);
   reduced_free(&R);
   eigen_free(&E);

@@ -490,8 +490,8 @@ static int parse_scene(fmbParser* p, fmbModel* m) {
   }
   if (m->initial_static && m->dimension == 3)
     return fmb_parse_error(p, fmb_find_key(p, root, "initial"),
-                           "'initial: static' is planar for now: statics of spatial scenes (dimension: 3) are not "
-                           "implemented yet");
+                           "'initial: static' is planar for now: a run of a spatial scene (dimension: 3) does not "
+                           "start from its static or steady state yet (`flexmbd static` computes it)");
   if (vtk >= 0 && m->dimension == 3)
     return fmb_parse_error(p, vtk,
                            "'vtk' is planar for now: a spatial scene (dimension: 3) has no ParaView output yet");

@@ -20,6 +20,13 @@
  *     G(x, s) = F(x) - (1 - s) F(x0),   s = 0 -> 1                                (S2)
  * which applies the out-of-balance load of the starting point (gravity, loads, centrifugal
  * forces, a drive's offset) in increments, halving an increment whenever Newton fails on it.
+ * A spatial scene (dimension 3, engine/rotation3.c): the rotation has an axis as well, fitted the
+ * same way (G2), E is the generator (G3) of its rigid motion on every body's coordinates, and the
+ * bodies' gauge directions d (the length of Euler parameters, which nothing physical sees) are
+ * held by rows d^T dq = 0 with multipliers mu beside the constraint rows (G1): x = [q, lambda, mu],
+ *     [dF_v/dq  Phi_q^T  D; Phi_q 0 0; D^T 0 0]                                        (S3)
+ * is regular where the 2D one is. The body's own equation along d is identically 0 at rest and
+ * in a steady rotation, so mu stays 0.
  * Setup-time code: it allocates. */
 #include <math.h>
 #include <stdio.h>
@@ -155,12 +162,7 @@ static int fit_rotation(const fmbModel* m, fmbWorkspace* w, double t, const doub
   }
   res = sqrt(res);
   if (res > 1e-8 * bnorm || z[0] == 0.0) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "at t = %g the drives do not turn the whole system as one rigid rotation (velocity constraints left "
-                 "unsatisfied by %.3g): a steady state exists only for constant-speed rotation of everything about one "
-                 "center (drive a hub pinned to the ground)",
-                 t, res);
-    rc = FMB_EXIT_BAD_INPUT;
+    rc = fmb_steady_refusal(m, FMB_STEADY_NOT_RIGID, t, res, diag);
     goto done;
   }
   if (frameless) {
@@ -170,11 +172,7 @@ static int fit_rotation(const fmbModel* m, fmbWorkspace* w, double t, const doub
     goto done;
   }
   if (norm2(phitt, nc) > 1e-9 * bnorm * (1.0 + fabs(z[0]))) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "at t = %g the drives are accelerating (Phi_tt = %.3g): no steady state; take a time after the ramp "
-                 "(--at T) or a constant-speed drive",
-                 t, norm2(phitt, nc));
-    rc = FMB_EXIT_BAD_INPUT;
+    rc = fmb_steady_refusal(m, FMB_STEADY_ACCELERATING, t, norm2(phitt, nc), diag);
     goto done;
   }
   if (m->env.has_gravity) {
@@ -258,7 +256,12 @@ typedef struct {
   const fmbModel* m;
   fmbWorkspace* w;
   double t, speed, center[2];
-  int n; /* nq + nc */
+  int n;               /* nq + nc + ng */
+  int ng;              /* gauge rows (S3); spatial scenes only */
+  fmbRotation3 rot;    /* a spatial scene's rotation (speed == rot.speed) */
+  double *D, *E;       /* gauge directions (nq x ng), the rotation's generator (nq x nq) */
+  double *U, *VT, *sv; /* spatial: the SVD of A (S4) */
+  double load;         /* the out-of-balance load at the start (S4's test) */
   double *y, *yp, *F, *ewt, *J0, *J1, *A;
   int* piv;
 } Newton;
@@ -271,7 +274,10 @@ static void make_state(Newton* s, const double* x) {
   memset(s->yp, 0, (size_t)m->ny * sizeof(double));
   memcpy(s->y, x, (size_t)nq * sizeof(double));
   memcpy(s->y + 2 * nq, x + nq, (size_t)nc * sizeof(double));
-  fmb_rigid_rotation(m, s->speed, s->center, x, s->y + nq, s->yp + nq);
+  if (m->dimension == 3)
+    fmb_rigid_rotation3(m, s->w, &s->rot, x, s->y + nq, s->yp + nq);
+  else
+    fmb_rigid_rotation(m, s->speed, s->center, x, s->y + nq, s->yp + nq);
   memcpy(s->yp, s->y + nq, (size_t)nq * sizeof(double));
   fmb_aux_iterated_consistent(m, s->w, s->y, s->yp); /* the mixed forms' z: their displacement form */
 }
@@ -283,7 +289,64 @@ static int eval_F(Newton* s, const double* x, double* Fx) {
   int rc = fmb_system_residual(m, s->w, s->t, s->y, s->yp, s->F);
   if (rc) return rc;
   memcpy(Fx, s->F + m->nq, (size_t)(m->nq + m->nc) * sizeof(double));
+  if (s->ng > 0) { /* (S3): + D mu in the force rows, 0 in the gauge rows */
+    const int nq = m->nq, at = nq + m->nc;
+    if (fmb_gauge_rows(m, x, s->D, nq) != s->ng) return -1;
+    for (int g = 0; g < s->ng; ++g) {
+      for (int i = 0; i < nq; ++i) Fx[i] += s->D[(size_t)g * nq + i] * x[at + g];
+      Fx[at + g] = 0.0;
+    }
+  }
   return 0;
+}
+
+/* LAPACK (as modes.c): the SVD of a spatial scene's Newton matrix */
+extern void dgesvd_(const char* jobu, const char* jobvt, const int* m, const int* n, double* a, const int* lda,
+                    double* s, double* u, const int* ldu, double* vt, const int* ldvt, double* work, const int* lwork,
+                    int* info);
+
+/* Space has free motions that a load never meets: a body on a ball joint under gravity turns
+   freely about the vertical through the pivot, at every pose, so the Newton matrix is singular
+   along a motion that every equilibrium of the family shares. Its step is then the least-norm
+   one, from the SVD A = U S V^T with singular values below 1e-12 of the largest dropped:
+       dx = V S^+ U^T G                                                                   (S4)
+   (the free motion stays where it started), and a residual outside the range of A beyond
+   roundoff (a load that nothing holds: a free body under gravity) is a singular system as the
+   planar LU's zero pivot is. 0, or 2 when the SVD fails. */
+static int svd_factor(Newton* s) {
+  const int n = s->n;
+  int lwork = -1, info = 0;
+  double q1 = 0.0;
+  dgesvd_("A", "A", &n, &n, s->A, &n, s->sv, s->U, &n, s->VT, &n, &q1, &lwork, &info);
+  lwork = (int)q1 + 1;
+  double* work = malloc((size_t)lwork * sizeof(double));
+  if (!work) return -1;
+  dgesvd_("A", "A", &n, &n, s->A, &n, s->sv, s->U, &n, s->VT, &n, work, &lwork, &info);
+  free(work);
+  return info ? 2 : 0;
+}
+
+/* (S4) in place on g; 1 when g has a part outside the range of A beyond roundoff */
+static int svd_solve(Newton* s, double* g) {
+  const int n = s->n;
+  double* c = calloc((size_t)n, sizeof(double));
+  if (!c) return 1;
+  double dropped = 0.0;
+  for (int k = 0; k < n; ++k) {
+    double d = 0.0;
+    for (int i = 0; i < n; ++i) d += s->U[(size_t)k * n + i] * g[i];
+    if (s->sv[k] > 1e-12 * s->sv[0])
+      c[k] = d / s->sv[k];
+    else
+      dropped += d * d;
+  }
+  for (int i = 0; i < n; ++i) {
+    double x = 0.0;
+    for (int k = 0; k < n; ++k) x += s->VT[(size_t)i * n + k] * c[k];
+    g[i] = x;
+  }
+  free(c);
+  return sqrt(dropped) > 1e-9 * (1.0 + s->load);
 }
 
 /* dense [dF_v/dq (S1), Phi_q^T; Phi_q, 0] at x, LU-factored into s->A; 0, 2 when the LU meets an
@@ -302,6 +365,14 @@ static int factor_jacobian(Newton* s, const double* x) {
     for (int i = 0; i < nq + nc; ++i) s->A[(size_t)j * n + i] = s->J0[(size_t)j * ny + nq + i];
   for (int k = 0; k < nc; ++k)
     for (int i = 0; i < nq; ++i) s->A[(size_t)(nq + k) * n + i] = s->J0[(size_t)(2 * nq + k) * ny + nq + i];
+  if (s->ng > 0) { /* (S3) */
+    if (fmb_gauge_rows(m, x, s->D, nq) != s->ng) return -1;
+    for (int g = 0; g < s->ng; ++g)
+      for (int i = 0; i < nq; ++i) {
+        s->A[(size_t)(nq + nc + g) * n + i] = s->D[(size_t)g * nq + i];
+        s->A[(size_t)i * n + nq + nc + g] = s->D[(size_t)g * nq + i];
+      }
+  }
   if (s->speed != 0.0) {
     /* C = J0's (F_v, v) block, M = J1's minus C; both nq x nq with leading dimension ny */
     for (int j = 0; j < nq; ++j)
@@ -327,13 +398,24 @@ static int factor_jacobian(Newton* s, const double* x) {
         Mc[(size_t)j * nq + i] = Mtmp[(size_t)j * ny + i];
         K[(size_t)j * nq + i] = 0.0;
       }
-    fmb_rotation_terms(m, s->speed, Cc, Mc, nq, K, NULL);
+    if (m->dimension == 3) {
+      if (fmb_rotation3_generator(m, s->w, &s->rot, x, s->E, nq)) {
+        free(K);
+        free(Cc);
+        free(Mc);
+        return -1;
+      }
+      fmb_rotation3_terms(nq, s->speed, s->E, Cc, Mc, nq, K, NULL);
+    } else {
+      fmb_rotation_terms(m, s->speed, Cc, Mc, nq, K, NULL);
+    }
     for (int j = 0; j < nq; ++j)
       for (int i = 0; i < nq; ++i) s->A[(size_t)j * n + i] += K[(size_t)j * nq + i];
     free(K);
     free(Cc);
     free(Mc);
   }
+  if (m->dimension == 3) return svd_factor(s);
   return fmb_lu_factor(n, s->A, s->piv) ? 2 : 0; /* 2: an exactly zero pivot */
 }
 
@@ -389,6 +471,7 @@ static int singular_stiffness(Newton* s, const double* x) {
   const int rc = factor_jacobian(s, x);
   if (rc == 2) return 1; /* an exactly zero pivot */
   if (rc) return -1;
+  if (s->m->dimension == 3) return s->sv[s->n - 1] <= 1e-12 * s->sv[0] ? 1 : 0;
   double lo = INFINITY, hi = 0.0;
   for (int i = 0; i < s->n; ++i) {
     const double d = fabs(s->A[(size_t)i * s->n + i]);
@@ -408,7 +491,7 @@ static int initial_multipliers(Newton* s, double* x, fmbDiag* diag) {
   const fmbModel* m = s->m;
   const int nq = m->nq, nc = m->nc;
   if (nc == 0) return 0;
-  double* Fx = malloc((size_t)(nq + nc) * sizeof(double));
+  double* Fx = malloc((size_t)s->n * sizeof(double));
   double* PhiQ = calloc((size_t)nc * nq, sizeof(double));
   double* G = calloc((size_t)nc * nc, sizeof(double));
   double* r = calloc((size_t)nc, sizeof(double));
@@ -449,10 +532,29 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
   if (opt.max_iter <= 0) opt.max_iter = 30;
   if (opt.max_halvings <= 0) opt.max_halvings = 12;
   if (!(opt.tol > 0.0)) opt.tol = 1e-10;
-  const int nq = m->nq, nc = m->nc, n = nq + nc, ny = m->ny;
+  const int nq = m->nq, nc = m->nc, ny = m->ny;
   memset(res, 0, sizeof *res);
   res->t = opt.t;
-  Newton s = {m, w, opt.t, 0.0, {0.0, 0.0}, n, NULL, NULL, NULL, NULL, NULL, NULL, NULL, NULL};
+  double* x = calloc((size_t)nq + nc + 1, sizeof(double));
+  double* v0 = calloc((size_t)nq + 1, sizeof(double));
+  if (x && v0)
+    for (int b = 1; b < m->nbody; ++b) {
+      const fmbBodyInst* bi = &m->body[b];
+      bi->type->initial(bi->self, x + bi->qadr, v0 + bi->qadr);
+    }
+  const int ng = m->dimension == 3 && x ? fmb_gauge_count(m, x) : 0, n = nq + nc + ng;
+  Newton s = {m,    w,    opt.t, 0.0,  {0.0, 0.0}, n,   ng,   {0.0, {0.0, 0.0, 1.0}, {0.0, 0.0, 0.0}, 0.0},
+              NULL, NULL, NULL,  NULL, NULL,       0.0, NULL, NULL,
+              NULL, NULL, NULL,  NULL, NULL,       NULL};
+  if (x) x = realloc(x, (size_t)n * sizeof(double) + 1);
+  if (x) memset(x + nq + nc, 0, (size_t)ng * sizeof(double));
+  s.D = calloc((size_t)nq * ng + 1, sizeof(double));
+  s.E = m->dimension == 3 ? calloc((size_t)nq * nq + 1, sizeof(double)) : NULL;
+  if (m->dimension == 3) {
+    s.U = calloc((size_t)n * n, sizeof(double));
+    s.VT = calloc((size_t)n * n, sizeof(double));
+    s.sv = calloc((size_t)n, sizeof(double));
+  }
   s.y = calloc((size_t)ny, sizeof(double));
   s.yp = calloc((size_t)ny, sizeof(double));
   s.F = calloc((size_t)ny, sizeof(double));
@@ -461,26 +563,28 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
   s.J1 = calloc((size_t)ny * ny, sizeof(double));
   s.A = calloc((size_t)n * n, sizeof(double));
   s.piv = calloc((size_t)n, sizeof(int));
-  double* x = calloc((size_t)n, sizeof(double));
   double* xt = calloc((size_t)n, sizeof(double));
   double* F0 = calloc((size_t)n, sizeof(double));
   double* G = calloc((size_t)n, sizeof(double));
-  double* v0 = calloc((size_t)nq, sizeof(double));
   int rc = 0;
-  if (!s.y || !s.yp || !s.F || !s.ewt || !s.J0 || !s.J1 || !s.A || !s.piv || !x || !xt || !F0 || !G || !v0) {
+  if (!s.y || !s.yp || !s.F || !s.ewt || !s.J0 || !s.J1 || !s.A || !s.piv || !x || !xt || !F0 || !G || !v0 || !s.D ||
+      (m->dimension == 3 && (!s.E || !s.U || !s.VT || !s.sv))) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory for the static solution (%d unknowns)", n);
     rc = FMB_EXIT_SOLVER;
     goto done;
   }
-  for (int b = 1; b < m->nbody; ++b) {
-    const fmbBodyInst* bi = &m->body[b];
-    bi->type->initial(bi->self, x + bi->qadr, v0 + bi->qadr);
+  if (m->dimension == 3) {
+    if ((rc = fmb_fit_rotation3(m, w, opt.t, x, &s.rot, diag))) goto done;
+    s.speed = s.rot.speed;
+    s.center[0] = s.rot.center[0];
+    s.center[1] = s.rot.center[1];
+  } else if ((rc = fit_rotation(m, w, opt.t, x, &s.speed, s.center, diag))) {
+    goto done;
   }
-  if ((rc = fit_rotation(m, w, opt.t, x, &s.speed, s.center, diag))) goto done;
   res->speed = s.speed;
   res->center[0] = s.center[0];
   res->center[1] = s.center[1];
-  if (s.speed != 0.0) turn_to_drives(&s, x);
+  if (s.speed != 0.0 && m->dimension != 3) turn_to_drives(&s, x);
   if ((rc = initial_multipliers(&s, x, diag))) goto done;
   if (eval_F(&s, x, F0)) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equations are not finite at the starting point (t = %g)",
@@ -489,13 +593,18 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
     goto done;
   }
   res->residual_start = norm2(F0, n);
+  s.load = res->residual_start;
   /* No load (a mechanism without gravity, springs or applied forces: the out-of-balance load is
      roundoff, 2e-15 on a pendulum without gravity) and a singular stiffness: every pose along the
      free motion is an equilibrium. Newton then succeeded on a residual of exactly 0 and failed on
      one of 1e-16 ("no equilibrium found"), both answers wrong: say what holds. The test is on the
      pivots of the equilibrium Jacobian (smallest / largest below 1e-12: a roundoff-level pivot
      against the stiffest entry; a 1.8 m aluminium blade's softest pivot is 1e-8 of its stiffest). */
-  if (s.speed == 0.0 && res->residual_start <= FMB_STATIC_NO_LOAD) {
+  /* In space gravity (the only load there yet) can balance at the start while a free motion it
+     never meets remains (a body hanging on a ball joint spins freely about the vertical): that
+     start is an equilibrium, its free motion left where it is as (S4) leaves it. */
+  const int loaded_in_space = m->dimension == 3 && m->env.has_gravity;
+  if (s.speed == 0.0 && res->residual_start <= FMB_STATIC_NO_LOAD && !loaded_in_space) {
     const int free_motions = singular_stiffness(&s, x);
     if (free_motions < 0) {
       fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "the equilibrium equations cannot be evaluated (t = %g)",
@@ -531,13 +640,21 @@ int fmb_static_solve(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions*
         singular = 1;
         break;
       }
-      fmb_lu_solve(n, s.A, s.piv, G);
+      if (m->dimension != 3) {
+        fmb_lu_solve(n, s.A, s.piv, G);
+      } else if (svd_solve(&s, G)) { /* (S4): a load that nothing holds */
+        singular = 1;
+        break;
+      }
       /* a frame turns at most MAX_TURN per iteration: near a mechanism's dead point (a
          pendulum at the horizontal has no stiffness in its angle) the full step would spin it
          through many turns */
       double turn = 0.0;
-      for (int b = 1; b < m->nbody; ++b)
-        if (has_frame(&m->body[b])) turn = fmax(turn, fabs(G[m->body[b].qadr + 2]));
+      if (m->dimension == 3)
+        turn = fmb_turn3(m, w, xt, G);
+      else
+        for (int b = 1; b < m->nbody; ++b)
+          if (has_frame(&m->body[b])) turn = fmax(turn, fabs(G[m->body[b].qadr + 2]));
       const double scale = turn > MAX_TURN ? MAX_TURN / turn : 1.0;
       int finite = 1, small = scale == 1.0;
       for (int i = 0; i < n; ++i) {
@@ -605,5 +722,10 @@ done:
   free(F0);
   free(G);
   free(v0);
+  free(s.D);
+  free(s.E);
+  free(s.U);
+  free(s.VT);
+  free(s.sv);
   return rc;
 }

@@ -19,12 +19,6 @@ int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double
     return FMB_EXIT_BAD_INPUT;
   }
   memset(res, 0, sizeof *res);
-  if (m->dimension == 3) { /* a spatial body's Euler-parameter gauge is fixed by its dynamics only */
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "statics, steady states and modes of spatial scenes (dimension: 3) are not implemented yet "
-                 "(docs/spatial.md); run the scene instead");
-    return FMB_EXIT_BAD_INPUT;
-  }
   if (opt && opt->has_t && !isfinite(opt->t)) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0, "fmb_static: the time (fmbStaticOptions.t) is %g, not finite",
                  opt->t);

@@ -34,9 +34,22 @@ static int parse_speeds(const char* text, double* out) {
   return *p ? -1 : n;
 }
 
+/* the CSV's name of followed mode k: `modeK` (planar, as always), or in a spatial scene its family
+   and its rank in the family, `flap1`, `lag1`, `flap2`, `torsion1` ... (fmb_campbell_family) */
+static void curve_name(const fmbCampbell* c, int k, char* name, size_t len) {
+  const int f = fmb_campbell_family(c, k);
+  if (f == FMB_FAMILY_NONE) {
+    snprintf(name, len, "mode%d", k + 1);
+    return;
+  }
+  int rank = 1;
+  for (int j = 0; j < k; ++j) rank += fmb_campbell_family(c, j) == f;
+  snprintf(name, len, "%s%d", fmb_family_name(f), rank);
+}
+
 /* gnuplot: one curve per tracked mode; a failure here is a warning, the CSV stands. (Not through
    `flexmbd plot`: its CSV reader takes run outputs, whose first column is t.) */
-static void plot(const char* csv, const char* png, int count, const char* title) {
+static void plot(const char* csv, const char* png, const fmbCampbell* c, int count, const char* title) {
   /* gnuplot writes beside the figure; the figure is replaced only by a finished plot */
   fmbSafeFile* fig = fmb_cli_safe_open(png, NULL, 0);
   const char* fig_path = fmb_safe_write_path(fig);
@@ -56,7 +69,14 @@ static void plot(const char* csv, const char* png, int count, const char* title)
   for (int k = 0; k < count && !bad; ++k) {
     fprintf(g, "%s", k ? ", " : "");
     bad |= fmb_cli_gnuplot_string(g, csv);
-    fprintf(g, " using 1:%d with linespoints pt 7 ps 0.5 title 'mode %d'", k + 2, k + 1);
+    const int f = fmb_campbell_family(c, k);
+    if (f == FMB_FAMILY_NONE) {
+      fprintf(g, " using 1:%d with linespoints pt 7 ps 0.5 title 'mode %d'", k + 2, k + 1);
+    } else { /* a spatial scene: the family names the curve, one point type per family */
+      char name[32];
+      curve_name(c, k, name, sizeof name);
+      fprintf(g, " using 1:%d with linespoints pt %d ps 0.6 title '%s'", k + 2, 5 + 2 * f, name);
+    }
   }
   if (bad) fprintf(stderr, "flexmbd campbell: a file name holds a control character, no plot\n");
   fprintf(g, bad ? "\nexit status 1\n" : ", x with lines dt 2 lc rgb 'gray' title '1x speed'\n");
@@ -77,7 +97,7 @@ static int write_csv(const char* out, const fmbCampbell* c) {
     names[0] = "speed";
     for (int k = 0; k < c->count; ++k) {
       names[k + 1] = text + 16 * (size_t)(k + 1);
-      snprintf(names[k + 1], 16, "mode%d", k + 1);
+      curve_name(c, k, names[k + 1], 16);
     }
     for (int i = 0; i < c->done; ++i) {
       rows[(size_t)i * ncol] = c->speed[i];
@@ -185,7 +205,7 @@ static int report(const fmbCliCampbell* a, const fmbCampbell* c, const double* s
   if (!wrc && done > 0 && png && out && strcmp(out, "-") != 0) {
     char title[700];
     snprintf(title, sizeof title, "Campbell diagram: %s", a->s.scene);
-    plot(out, png, count, title);
+    plot(out, png, c, count, title);
   }
   fprintf(stderr, "stats: status=%s speeds=%d of %d modes=%d\n",
           rc == FMB_EXIT_INTERRUPTED ? "interrupted"

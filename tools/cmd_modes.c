@@ -17,17 +17,23 @@
 
 #include "cli.h"
 
+/* a spatial scene's modes classified about a spin axis (fmb_modes_classify) get the columns flap,
+   lag, axial, torsion: 1 in the mode's family, 0 in the others */
 static int modes_csv(const fmbModes* md, const char* path, fmbDiag* diag) {
-  static const char* const names[] = {"mode", "frequency", "frequency_hz", "damping_ratio"};
-  double* rows = malloc((size_t)md->count * 4 * sizeof(double) + 1);
+  static const char* const names[] = {"mode", "frequency", "frequency_hz", "damping_ratio",
+                                      "flap", "lag",       "axial",        "torsion"};
+  const int nc = md->family ? 8 : 4;
+  double* rows = malloc((size_t)md->count * nc * sizeof(double) + 1);
   if (!rows) return FMB_EXIT_SOLVER;
   for (int k = 0; k < md->count; ++k) {
-    rows[4 * k] = k + 1;
-    rows[4 * k + 1] = md->frequency[k];
-    rows[4 * k + 2] = md->frequency[k] / (2.0 * M_PI);
-    rows[4 * k + 3] = md->damping_ratio[k];
+    double* r = rows + (size_t)nc * k;
+    r[0] = k + 1;
+    r[1] = md->frequency[k];
+    r[2] = md->frequency[k] / (2.0 * M_PI);
+    r[3] = md->damping_ratio[k];
+    for (int f = FMB_FAMILY_FLAP; nc > 4 && f <= FMB_FAMILY_TORSION; ++f) r[3 + f] = md->family[k] == f;
   }
-  int rc = fmb_write_table(path, 4, names, md->count, rows, diag);
+  int rc = fmb_write_table(path, nc, names, md->count, rows, diag);
   free(rows);
   return rc;
 }
@@ -117,12 +123,17 @@ int fmb_cmd_modes(int argc, char** argv) {
     fprintf(stderr, "modes about the %s at t = %g (%d degrees of freedom after the constraints, %s eigen-solver):\n",
             res.speed != 0.0 ? "steady rotation" : "static equilibrium", res.t, md->nreduced,
             md->sparse ? "sparse shift-invert" : "dense");
-    if (res.speed != 0.0)
+    if (res.speed != 0.0 && !md->family)
       fprintf(stderr, "  speed %.8g rad/s about (%g, %g)\n", res.speed, res.center[0], res.center[1]);
-    fprintf(stderr, "  %4s %16s %14s %14s\n", "mode", "frequency rad/s", "Hz", "damping ratio");
+    if (md->family) /* a spatial scene's steady rotation: its axis, the families about it */
+      fprintf(stderr, "  speed %.8g rad/s about the axis [%g, %g, %g] through (%g, %g, %g)\n", res.speed, md->axis[0],
+              md->axis[1], md->axis[2], md->center[0], md->center[1], md->center[2]);
+    fprintf(stderr, "  %4s %16s %14s %14s%s\n", "mode", "frequency rad/s", "Hz", "damping ratio",
+            md->family ? "  family" : "");
     for (int k = 0; k < md->count; ++k)
-      fprintf(stderr, "  %4d %16.8g %14.8g %14.6g%s\n", k + 1, md->frequency[k], md->frequency[k] / (2.0 * M_PI),
-              md->damping_ratio[k], md->frequency[k] < 0 ? "   divergent (unstable)" : "");
+      fprintf(stderr, "  %4d %16.8g %14.8g %14.6g%s%s%s\n", k + 1, md->frequency[k], md->frequency[k] / (2.0 * M_PI),
+              md->damping_ratio[k], md->family ? "  " : "", md->family ? fmb_family_name(md->family[k]) : "",
+              md->frequency[k] < 0 ? "   divergent (unstable)" : "");
   }
   if (rc != FMB_EXIT_BAD_INPUT) fmb_cli_print_static(&res, rc == 0, (double)(clock() - c0) / CLOCKS_PER_SEC, stderr);
   fmb_modes_free(md);

@@ -51,7 +51,8 @@ int fmb_cli_modes_save(const char* path, int rc, const fmbDiag* diag, const fmbM
     ok = fwrite(m, sizeof *m, 1, f) == 1 && fwrite(m->frequency, sizeof(double), n, f) == n &&
          fwrite(m->damping_ratio, sizeof(double), n, f) == n &&
          fwrite(m->shape_re, sizeof(double), n * nq, f) == n * nq &&
-         fwrite(m->shape_im, sizeof(double), n * nq, f) == n * nq;
+         fwrite(m->shape_im, sizeof(double), n * nq, f) == n * nq &&
+         (!m->family || fwrite(m->family, sizeof(int), n, f) == n);
   }
   ok = fflush(f) == 0 && ok;
   return fmb_safe_close(sf, ok) == 0 && ok ? 0 : -1;
@@ -68,6 +69,8 @@ static fmbModes* read_back(FILE* f, int* rc, fmbDiag* diag) {
     m = calloc(1, sizeof *m);
     if (m && fread(m, sizeof *m, 1, f) == 1) {
       const size_t n = (size_t)m->count, nq = (size_t)m->nq;
+      const int classified = m->family != NULL; /* the writer's pointer: only whether it wrote them */
+      m->family = classified ? malloc(n * sizeof(int) + 1) : NULL;
       m->frequency = malloc(n * sizeof(double) + 1);
       m->damping_ratio = malloc(n * sizeof(double) + 1);
       m->shape_re = malloc(n * nq * sizeof(double) + 1);
@@ -75,7 +78,8 @@ static fmbModes* read_back(FILE* f, int* rc, fmbDiag* diag) {
       if (!m->frequency || !m->damping_ratio || !m->shape_re || !m->shape_im ||
           fread(m->frequency, sizeof(double), n, f) != n || fread(m->damping_ratio, sizeof(double), n, f) != n ||
           fread(m->shape_re, sizeof(double), n * nq, f) != n * nq ||
-          fread(m->shape_im, sizeof(double), n * nq, f) != n * nq) {
+          fread(m->shape_im, sizeof(double), n * nq, f) != n * nq || (classified && !m->family) ||
+          (classified && fread(m->family, sizeof(int), n, f) != n)) {
         fmb_modes_free(m);
         m = NULL;
       }

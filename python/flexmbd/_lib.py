@@ -130,7 +130,8 @@ class Modes(ctypes.Structure):
     _fields_ = [("count", ctypes.c_int), ("nq", ctypes.c_int), ("nreduced", ctypes.c_int), ("sparse", ctypes.c_int),
                 ("speed", ctypes.c_double), ("frequency", ctypes.POINTER(ctypes.c_double)),
                 ("damping_ratio", ctypes.POINTER(ctypes.c_double)), ("shape_re", ctypes.POINTER(ctypes.c_double)),
-                ("shape_im", ctypes.POINTER(ctypes.c_double))]
+                ("shape_im", ctypes.POINTER(ctypes.c_double)), ("family", ctypes.POINTER(ctypes.c_int)),
+                ("axis", ctypes.c_double * 3), ("center", ctypes.c_double * 3)]
 
 
 class CampbellOptions(ctypes.Structure):
@@ -143,7 +144,8 @@ class Campbell(ctypes.Structure):
     """fmbCampbell (`last` and `track` are the library's own)"""
     _fields_ = [("nspeed", ctypes.c_int), ("done", ctypes.c_int), ("count", ctypes.c_int),
                 ("speed", ctypes.POINTER(ctypes.c_double)), ("frequency", ctypes.POINTER(ctypes.c_double)),
-                ("mac", ctypes.POINTER(ctypes.c_double)), ("last", ctypes.c_void_p), ("track", ctypes.c_void_p)]
+                ("mac", ctypes.POINTER(ctypes.c_double)), ("last", ctypes.c_void_p), ("track", ctypes.c_void_p),
+                ("family", ctypes.POINTER(ctypes.c_int))]
 
 
 class SceneSource(ctypes.Structure):
