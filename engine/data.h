@@ -46,6 +46,8 @@ struct fmbData {
   fmbStats ic;                       /* the initial projection's corrections */
   unsigned char* range_warned;       /* nbody: the body's model_range warning was given (once per run) */
   int interrupted;
+  /* the state is fmb_static_data's, not a run's: fmb_advance needs fmb_init */
+  int analysis_state;
   int failed;   /* the last init or advance failed (fmb_data_stats' status) */
   double cpu_s; /* CPU time of this thread in init and advance */
   int untimed;  /* fmb_run's: it times the whole run itself, so init and advance read no CPU clock
@@ -59,7 +61,12 @@ int fmb_data_misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDia
 double fmb_thread_cpu_seconds(void);
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
-/* free a data object that never left the engine (fmb_run's) at once, without the quarantine */
+/* free a data object that never left the engine (fmb_run's, an analysis wrapper's) at once,
+   without the quarantine; NULL or not live: nothing */
 void fmb_data_destroy(fmbData* d);
+/* an analysis's state (fmb_static_data: the equilibrium at t) becomes d's: readable by
+   fmb_data_state, fmb_outputs and fmb_modes_data; the run's integrator is dropped and
+   fmb_advance asks for fmb_init (a run starts from the scene's initial conditions) */
+void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp);
 
 #endif

@@ -394,6 +394,22 @@ enum { FMB_EIGEN_AUTO = 0, FMB_EIGEN_DENSE = 1, FMB_EIGEN_SPARSE = 2 };
 FMB_API int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method,
                       fmbModes** out, fmbDiag* diag);
 FMB_API void fmb_modes_free(fmbModes* modes);
+
+/* The same analyses on a data object (fmb_data_new): they take their scratch from it, so a program
+   holding one runs statics and modes without the engine making a workspace per call (fmb_static
+   and fmb_modes make a data object for the call). The model's inputs are as d holds them
+   (fmb_set_input) and the bodies' blocks a run's next Jacobian may reuse are left alone: advancing
+   after an analysis gives the bytes advancing without it gives.
+   fmb_static_data: fmb_static's equilibrium (from the scene's poses, at opt->t); on success it
+   becomes d's state at res->t (fmb_data_state, fmb_outputs, fmb_modes_data read it) and d's run
+   ends there: fmb_advance asks for fmb_init (`initial: static` runs from the equilibrium). On
+   failure d's state is unchanged.
+   fmb_modes_data: fmb_modes about d's state (fmb_data_time, fmb_data_state: a run's between
+   advances, or fmb_static_data's); d is only read. FMB_EXIT_BAD_INPUT with *diag for misuse (a
+   NULL, freed or other model's d, no state yet) as the stepping calls. */
+FMB_API int fmb_static_data(const fmbModel* m, fmbData* d, const fmbStaticOptions* opt, fmbStaticResult* res,
+                            fmbDiag* diag);
+FMB_API int fmb_modes_data(const fmbModel* m, fmbData* d, int count, int method, fmbModes** out, fmbDiag* diag);
 /* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
    NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);

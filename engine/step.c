@@ -174,6 +174,20 @@ void fmb_data_destroy(fmbData* d) {
   free(d);
 }
 
+void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp) {
+  if (!live(d)) return;
+  if (d->integ) d->ops->destroy(d->integ);
+  d->integ = NULL;
+  d->restart = d->reinit_pending = 0;
+  if (y != d->y) memcpy(d->y, y, sizeof(double) * (size_t)d->m->ny);
+  if (yp != d->yp) memcpy(d->yp, yp, sizeof(double) * (size_t)d->m->ny);
+  d->t = t;
+  d->ic_done = 1;
+  d->initialised = 0;
+  d->failed = 0;
+  d->analysis_state = 1;
+}
+
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop) {
   if (live(d)) d->stop = stop ? stop : &d->cancel;
 }
@@ -245,7 +259,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   d->integ = NULL;
   d->ops = fmb_integrator_for(m);
   d->restart = d->reinit_pending = 0;
-  d->initialised = d->ic_done = d->interrupted = 0;
+  d->initialised = d->ic_done = d->interrupted = d->analysis_state = 0;
   fmb_stop_set(&d->cancel, 0);
   d->cpu_s = 0.0;
   memset(&d->before, 0, sizeof d->before);
@@ -467,7 +481,10 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   if (misused(m, d, "fmb_advance", diag)) return FMB_EXIT_BAD_INPUT;
   if (!d->initialised) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "fmb_advance: the data object has no state yet: call fmb_init first (or it failed)");
+                 d->analysis_state
+                     ? "fmb_advance: the data object holds fmb_static_data's equilibrium, not a run's state: call "
+                       "fmb_init to start a run (`initial: static` starts one from the equilibrium)"
+                     : "fmb_advance: the data object has no state yet: call fmb_init first (or it failed)");
     return FMB_EXIT_BAD_INPUT;
   }
   if (isnan(t_out) || t_out < d->t) {
