@@ -188,6 +188,10 @@ void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const d
   d->analysis_state = 1;
 }
 
+void fmb_data_set_timing(fmbData* d, int on) {
+  if (live(d)) d->untimed = !on;
+}
+
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop) {
   if (live(d)) d->stop = stop ? stop : &d->cancel;
 }

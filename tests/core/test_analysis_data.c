@@ -13,7 +13,9 @@
  *    counters at the end are those of the same run without it (with the blocks' cache not held
  *    during the analysis they are not); and its modes are fmb_modes' at the run's state.
  * 4. After fmb_static_data the data holds the equilibrium: fmb_data_time is its time, fmb_advance
- *    asks for fmb_init; misuse (NULL, no state yet) is refused with FMB_EXIT_BAD_INPUT. */
+ *    asks for fmb_init; misuse (NULL, no state yet) is refused with FMB_EXIT_BAD_INPUT.
+ * 5. fmb_data_set_timing(d, 0) (no thread CPU clock read per advance: bench/inputs.sh) leaves
+ *    st.cpu_s at 0 and the run's bytes as they are with the clock. */
 #include <stdlib.h>
 #include <string.h>
 
@@ -21,15 +23,15 @@
 #include "testlib.h"
 
 /* ENSURE with a message saying which case and what differed */
-#define ENSURE_MSG(cond, ...)                                         \
-  do {                                                                \
-    ++fmbt_checks;                                                    \
-    if (!(cond)) {                                                    \
+#define ENSURE_MSG(cond, ...)                                       \
+  do {                                                              \
+    ++fmbt_checks;                                                  \
+    if (!(cond)) {                                                  \
       fprintf(stderr, "%s:%d: check failed: ", __FILE__, __LINE__); \
-      fprintf(stderr, __VA_ARGS__);                                   \
-      fputc('\n', stderr);                                            \
-      ++fmbt_failures;                                                \
-    }                                                                 \
+      fprintf(stderr, __VA_ARGS__);                                 \
+      fputc('\n', stderr);                                          \
+      ++fmbt_failures;                                              \
+    }                                                               \
   } while (0)
 
 static int same_bytes(const double* a, const double* b, size_t n) { return memcmp(a, b, n * sizeof(double)) == 0; }
@@ -102,8 +104,9 @@ static void static_and_modes(const char* rel, int count, int method, int expect_
   } else
     ENSURE_MSG(same_modes(md_new, md_old), "%s: fmb_modes_data's modes differ from fmb_modes'", rel);
   ENSURE(md_new && md_new->count == count && md_new->sparse == expect_sparse);
-  if (md_new) printf("%s: speed %g rad/s, first frequency %.9g rad/s (%s)\n", rel, md_new->speed,
-                     md_new->frequency[0], md_new->sparse ? "sparse" : "dense");
+  if (md_new)
+    printf("%s: speed %g rad/s, first frequency %.9g rad/s (%s)\n", rel, md_new->speed, md_new->frequency[0],
+           md_new->sparse ? "sparse" : "dense");
   ENSURE(fmb_data_time(d) == r_new.t);
   ENSURE(fmb_advance(m, d, r_new.t + 1e-3, &diag) == FMB_EXIT_BAD_INPUT && strstr(diag.msg, "fmb_init"));
   /* a run starts from the scene's initial conditions again */
@@ -146,8 +149,8 @@ static void modes_between_advances(void) {
   char path[1024];
   fmbDiag diag;
   const char* sets[] = {"solver.integrator=ida", "solver.t_end=0.06"};
-  fmbModel* m = fmb_load(fmbt_path("scenes/paper/pendulum.yaml", path, sizeof path), sets, 2, fmb_builtin_registry(),
-                         &diag);
+  fmbModel* m =
+      fmb_load(fmbt_path("scenes/paper/pendulum.yaml", path, sizeof path), sets, 2, fmb_builtin_registry(), &diag);
   ENSURE_MSG(m != NULL, "%s", diag.msg);
   if (!m) return;
   const int n = fmb_state_size(m);
@@ -160,8 +163,7 @@ static void modes_between_advances(void) {
   ENSURE(run_pendulum(m, every, t_end, 0, y_plain, &st_plain, NULL) == 0);
   ENSURE(run_pendulum(m, every, t_end, 1, y_modes, &st_modes, &md) == 0);
   ENSURE(st_plain.jacobians_reused > 0); /* else the cache the analysis must leave alone is never used */
-  ENSURE_MSG(same_bytes(y_modes, y_plain, (size_t)n), "modes every %g s moved the run's state at t = %g", every,
-             t_end);
+  ENSURE_MSG(same_bytes(y_modes, y_plain, (size_t)n), "modes every %g s moved the run's state at t = %g", every, t_end);
   ENSURE_MSG(st_modes.steps == st_plain.steps && st_modes.jacobians == st_plain.jacobians &&
                  st_modes.residuals == st_plain.residuals && st_modes.newton_iters == st_plain.newton_iters,
              "modes every %g s changed the run: steps %ld/%ld, jacobians %ld/%ld", every, st_modes.steps,
@@ -185,9 +187,36 @@ static void modes_between_advances(void) {
   fmb_free(m);
 }
 
+/* fmb_data_set_timing(d, 0): no CPU clock read, st.cpu_s 0, the run itself the same bytes */
+static void timing_switch(void) {
+  char path[1024];
+  fmbDiag diag;
+  const char* sets[] = {"solver.t_end=0.2"};
+  fmbModel* m = fmb_load(fmbt_path("scenes/pendulum.yaml", path, sizeof path), sets, 1, fmb_builtin_registry(), &diag);
+  ENSURE(m != NULL);
+  if (!m) return;
+  const int n = fmb_state_size(m);
+  double* y[2] = {calloc((size_t)n, sizeof(double)), calloc((size_t)n, sizeof(double))};
+  fmbStats st[2];
+  for (int timed = 0; timed < 2; ++timed) {
+    fmbData* d = fmb_data_new(m, &diag);
+    fmb_data_set_timing(d, timed);
+    ENSURE(fmb_init(m, d, &diag) == 0);
+    for (long k = 1; k < fmb_row_count(m); ++k) ENSURE(fmb_advance(m, d, fmb_row_time(m, k), &diag) == 0);
+    ENSURE(fmb_data_state(d, y[timed], NULL) == 0 && fmb_data_stats(d, &st[timed]) == 0);
+    fmb_data_free(d);
+  }
+  ENSURE(st[0].cpu_s == 0.0 && st[1].cpu_s > 0.0);
+  ENSURE(st[0].steps == st[1].steps && st[0].steps > 0 && same_bytes(y[0], y[1], (size_t)n));
+  fmb_data_set_timing(NULL, 0); /* nothing */
+  free(y[0]), free(y[1]);
+  fmb_free(m);
+}
+
 int main(void) {
   static_and_modes("scenes/campbell_beam.yaml", 4, FMB_EIGEN_AUTO, 1);
   static_and_modes("scenes/paper/pendulum.yaml", 3, FMB_EIGEN_DENSE, 0);
   modes_between_advances();
+  timing_switch();
   return fmbt_finish("test_analysis_data");
 }
