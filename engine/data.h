@@ -1,5 +1,6 @@
-/* data.h — the state of one run of one model (fmbData, engine/step.c), private to the engine: the
- * stepping functions and the run loop (run.c) that writes files on top of them. Everything a run
+/* data.h — the state of one run of one model (fmbData; made in data.c, run in step.c), private
+ * to the engine: the stepping functions, the run loop (run.c) that writes files on top of them,
+ * and the analyses and checks that take their scratch from a data object. Everything a run
  * changes lives here or in its workspace; the model is only read. */
 #ifndef FMB_DATA_H
 #define FMB_DATA_H
@@ -7,6 +8,9 @@
 #include <signal.h>
 
 #include "integrator.h"
+
+#define FMB_DATA_LIVE 0x44424d46u  /* "FMBD" */
+#define FMB_DATA_FREED 0x45455246u /* "FREE" */
 
 struct fmbData {
   unsigned magic; /* FMB_DATA_LIVE while usable; FMB_DATA_FREED in quarantine (step.c) */
@@ -61,6 +65,8 @@ int fmb_data_misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDia
 double fmb_thread_cpu_seconds(void);
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
+/* everything fmb_data_new allocated in d, not d itself (data.c; fmb_data_free quarantines d) */
+void fmb_data_release(fmbData* d);
 /* free a data object that never left the engine (fmb_run's, an analysis wrapper's) at once,
    without the quarantine; NULL or not live: nothing */
 void fmb_data_destroy(fmbData* d);

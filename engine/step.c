@@ -25,9 +25,6 @@
 
 #include "data.h"
 
-#define FMB_DATA_LIVE 0x44424d46u  /* "FMBD" */
-#define FMB_DATA_FREED 0x45455246u /* "FREE" */
-
 /* how close to rank-deficient Phi_q must be where IDA failed for `formulation: auto` to switch to
    the projected formulation: a row whose part independent of the others is below 1e-2 of the
    largest row (a parallelogram within about half a degree of flat; IDA on the GGL system gave up
@@ -83,58 +80,6 @@ static void add_stats(fmbStats* to, const fmbStats* from) {
 
 /* ------------------------------------------------------------------------------------------ */
 
-static void release(fmbData* d) {
-  if (d->integ) d->ops->destroy(d->integ);
-  d->integ = NULL;
-  double* bufs[] = {d->y,       d->yp,       d->atol,      d->row, d->work_before, d->redundant_phi,
-                    d->start.y, d->start.yp, d->start.work};
-  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
-  free(d->range_warned);
-  fmb_workspace_free(d->w);
-  d->w = NULL;
-}
-
-fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
-  fmbDiag local;
-  if (!diag) diag = &local;
-  memset(diag, 0, sizeof *diag);
-  if (!m) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_data_new: no model (NULL)");
-    return NULL;
-  }
-  fmbData* d = calloc(1, sizeof *d);
-  if (!d) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up a run");
-    return NULL;
-  }
-  const size_t ny = (size_t)m->ny + 1;
-  d->m = m;
-  d->w = fmb_workspace_new(m);
-  d->y = calloc(ny, sizeof(double));
-  d->yp = calloc(ny, sizeof(double));
-  d->atol = calloc(ny, sizeof(double));
-  d->row = calloc((size_t)m->noutput + 1, sizeof(double));
-  d->work_before = calloc((size_t)m->njoint + 1, sizeof(double));
-  d->redundant_phi = calloc((size_t)m->nc + 1, sizeof(double));
-  d->range_warned = calloc((size_t)m->nbody + 1, 1);
-  d->may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
-  d->start.y = calloc(ny, sizeof(double));
-  d->start.yp = calloc(ny, sizeof(double));
-  d->start.work = calloc((size_t)m->njoint + 1, sizeof(double));
-  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi || !d->range_warned ||
-      !d->start.y || !d->start.yp || !d->start.work) {
-    release(d);
-    free(d);
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
-    return NULL;
-  }
-  fmb_absolute_tolerances(m, d->atol);
-  d->stop = &d->cancel;
-  d->t = NAN;
-  d->magic = FMB_DATA_LIVE;
-  return d;
-}
-
 void fmb_data_free(fmbData* d) {
   if (!d) return;
   pthread_mutex_lock(&quarantine_lock);
@@ -142,7 +87,7 @@ void fmb_data_free(fmbData* d) {
     pthread_mutex_unlock(&quarantine_lock);
     return;
   }
-  release(d);
+  fmb_data_release(d);
   d->magic = FMB_DATA_FREED;
   fmbData* evicted = quarantine[quarantine_next];
   quarantine[quarantine_next] = d;
@@ -165,13 +110,6 @@ quarantine_release(void) {
     quarantine[i] = NULL;
   }
   pthread_mutex_unlock(&quarantine_lock);
-}
-
-void fmb_data_destroy(fmbData* d) {
-  if (!live(d)) return;
-  release(d);
-  d->magic = 0;
-  free(d);
 }
 
 void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp) {
