@@ -62,7 +62,6 @@ fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
   return d;
 }
 
-
 void fmb_data_destroy(fmbData* d) {
   if (!d || d->magic != FMB_DATA_LIVE) return;
   fmb_data_release(d);

@@ -112,20 +112,6 @@ quarantine_release(void) {
   pthread_mutex_unlock(&quarantine_lock);
 }
 
-void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp) {
-  if (!live(d)) return;
-  if (d->integ) d->ops->destroy(d->integ);
-  d->integ = NULL;
-  d->restart = d->reinit_pending = 0;
-  if (y != d->y) memcpy(d->y, y, sizeof(double) * (size_t)d->m->ny);
-  if (yp != d->yp) memcpy(d->yp, yp, sizeof(double) * (size_t)d->m->ny);
-  d->t = t;
-  d->ic_done = 1;
-  d->initialised = 0;
-  d->failed = 0;
-  d->analysis_state = 1;
-}
-
 void fmb_data_set_timing(fmbData* d, int on) {
   if (live(d)) d->untimed = !on;
 }
@@ -179,6 +165,19 @@ static void restart_backend(fmbData* d) {
     memcpy(d->work_before, fmb_workspace_work(d->w), sizeof(double) * (size_t)m->njoint);
   d->reinit_pending = 1;
   d->restart = 1;
+}
+
+void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp) {
+  if (!live(d)) return;
+  retire_backend(d, 0); /* its counters stay the run's (fmb_data_stats) */
+  d->restart = 0;
+  if (y != d->y) memcpy(d->y, y, sizeof(double) * (size_t)d->m->ny);
+  if (yp != d->yp) memcpy(d->yp, yp, sizeof(double) * (size_t)d->m->ny);
+  d->t = t;
+  d->ic_done = 1;
+  d->initialised = 0;
+  d->failed = 0;
+  d->analysis_state = 1;
 }
 
 static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
