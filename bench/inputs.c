@@ -12,11 +12,12 @@
  * output column from the continuous run (motion: the restarts' own error; hold: plus the hold's
  * O(PERIOD) lag).
  *
- *   inputs LAW.yaml INPUT.yaml -l LOAD -f FREQUENCY_RAD_S [-p PERIOD] [-r REPEATS] [-H]
- * (INPUT.yaml: LAW.yaml with the load's `law: input, value: 0` instead of `law: harmonic`)
+ *   inputs LAW.yaml INPUT.yaml -l LOAD -f FREQUENCY_RAD_S [-p PERIOD] [-r REPEATS] [-H] [-U]
+ * (INPUT.yaml: LAW.yaml with the load's `law: input, value: 0` instead of `law: harmonic`;
+ * -U: the data objects do not read the thread's CPU clock around each advance, fmb_data_set_timing)
  * prints one CSV line (header with -H):
  *   scene,period_s,settings,steps_law,steps_hold,steps_motion,cpu_law_s,cpu_hold_s,cpu_motion_s,
- *   ratio_hold,ratio_motion,diff_hold,diff_motion
+ *   ratio_hold,ratio_motion,diff_hold,diff_motion,library_clock
  * Only the public API (flexmbd.h): bench/inputs.sh builds it against another tree's library too.
  * Exit 2 on bad arguments or input, 3 when a run fails. */
 #include <math.h>
@@ -34,6 +35,7 @@ enum { WAY_LAW, WAY_HOLD, WAY_MOTION, NWAY };
 typedef struct {
   const char* load;
   double omega, period;
+  int clock; /* the data objects read the thread's CPU clock around each advance (the default) */
 } Controller;
 
 /* one run: the outputs' first column at every row into col0 (rows), the steps into *steps */
@@ -45,6 +47,7 @@ static int run(const fmbModel* m, int way, const Controller* c, double* col0, lo
   double* out = calloc((size_t)fmb_noutput(m) + 1, sizeof(double));
   const double c0 = cpu_now();
   fmbData* d = fmb_data_new(m, &diag);
+  if (!c->clock) fmb_data_set_timing(d, 0); /* this program times the run itself */
   int rc = !out || !d || fmb_init(m, d, &diag);
   long setting = 0;
   for (long k = 0; !rc && k < rows; ++k) {
@@ -74,7 +77,7 @@ static int run(const fmbModel* m, int way, const Controller* c, double* col0, lo
 
 int main(int argc, char** argv) {
   const char *scene = NULL, *scene_input = NULL;
-  Controller c = {NULL, NAN, 1e-3};
+  Controller c = {NULL, NAN, 1e-3, 1};
   int repeats = 5, header = 0;
   for (int i = 1; i < argc; ++i) {
     const int more = i + 1 < argc;
@@ -88,6 +91,8 @@ int main(int argc, char** argv) {
       repeats = atoi(argv[++i]);
     else if (strcmp(argv[i], "-H") == 0)
       header = 1;
+    else if (strcmp(argv[i], "-U") == 0)
+      c.clock = 0;
     else if (argv[i][0] != '-' && !scene)
       scene = argv[i];
     else if (argv[i][0] != '-' && !scene_input)
@@ -96,7 +101,8 @@ int main(int argc, char** argv) {
       scene = NULL, i = argc;
   }
   if (!scene || !scene_input || !c.load || !(c.omega > 0) || !(c.period > 0) || repeats < 1) {
-    fprintf(stderr, "usage: inputs LAW.yaml INPUT.yaml -l LOAD -f FREQUENCY_RAD_S [-p PERIOD] [-r REPEATS] [-H]\n");
+    fprintf(stderr,
+            "usage: inputs LAW.yaml INPUT.yaml -l LOAD -f FREQUENCY_RAD_S [-p PERIOD] [-r REPEATS] [-H] [-U]\n");
     return 2;
   }
   fmb_set_warn(NULL, NULL); /* the hold's first jump is warned about: not the bench's business */
@@ -128,11 +134,11 @@ int main(int argc, char** argv) {
   fmb_model_solver(law, &si);
   if (header)
     printf("scene,period_s,settings,steps_law,steps_hold,steps_motion,cpu_law_s,cpu_hold_s,cpu_motion_s,ratio_hold,"
-           "ratio_motion,diff_hold,diff_motion\n");
-  printf("%s,%g,%ld,%ld,%ld,%ld,%.4f,%.4f,%.4f,%.2f,%.2f,%.3e,%.3e\n", scene, c.period,
+           "ratio_motion,diff_hold,diff_motion,library_clock\n");
+  printf("%s,%g,%ld,%ld,%ld,%ld,%.4f,%.4f,%.4f,%.2f,%.2f,%.3e,%.3e,%d\n", scene, c.period,
          (long)floor((si.t_end - si.t0) / c.period + 1e-9) + 1, steps[WAY_LAW], steps[WAY_HOLD], steps[WAY_MOTION],
          med[WAY_LAW], med[WAY_HOLD], med[WAY_MOTION], med[WAY_HOLD] / med[WAY_LAW], med[WAY_MOTION] / med[WAY_LAW],
-         diff[WAY_HOLD], diff[WAY_MOTION]);
+         diff[WAY_HOLD], diff[WAY_MOTION], c.clock);
   for (int w = 0; w < NWAY; ++w) {
     free(col[w]);
     free(cpu[w]);

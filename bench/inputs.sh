@@ -10,16 +10,19 @@
 #           within the solver's tolerance of where the last one led keeps the step history
 # and again with settings every 10 ms (100 Hz). diff_*: the largest difference of hub.omega (rad/s)
 # from the continuous run (hold: the hold's lag; motion: the restarts' and the steps' own error).
+# Each period twice: library_clock 1, the data objects as made (each advance reads the thread's CPU
+# clock for fmb_data_stats: two system calls, ~19 % of the 1 kHz motion run on a virtual machine,
+# perf at 66117f6), and 0, turned off by fmb_data_set_timing as a program that times itself would.
 #
-#   bash bench/inputs.sh [REPS]        (default 9; ~30 s)
+#   bash bench/inputs.sh [REPS]        (default 9; ~45 s)
 #
 # Results: bench/results/inputs.csv
 #   scene,period_s,settings,steps_law,steps_hold,steps_motion,cpu_law_s,cpu_hold_s,cpu_motion_s,
-#   ratio_hold,ratio_motion,diff_hold,diff_motion
+#   ratio_hold,ratio_motion,diff_hold,diff_motion,library_clock
 set -euo pipefail
 REPS=${1:-9}
 case $REPS in
-  -h | --help) sed -n 2,19p "$0"; exit 0 ;;
+  -h | --help) sed -n 2,21p "$0"; exit 0 ;;
   *[!0-9]* | '' | 0) echo "inputs.sh: expected a number of repeats, got '$REPS'" >&2; exit 2 ;;
 esac
 cd "$(dirname "$0")/.."
@@ -32,7 +35,9 @@ trap 'rm -f "$TMP"' EXIT
 R="$B/bench_inputs bench/scenes/input_rotor.yaml bench/scenes/input_rotor_input.yaml -l motor -f 6.283185307179586 -r $REPS"
 {
   $R -H -p 0.001
+  $R -p 0.001 -U
   $R -p 0.01
+  $R -p 0.01 -U
 } > "$TMP"
 mv "$TMP" "$OUT"
 cat "$OUT"

@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "data.h"
 #include "internal.h"
 
 int fmb_load_steady(const fmbSceneSource* scene, const char* extra, const fmbStaticOptions* opt, fmbModel** m,
@@ -68,7 +69,8 @@ static int sweep_axis(const fmbSceneSource* scene, const fmbCampbellOptions* opt
   fmbModel* m = fmb_load(scene->path, ov, n, scene->reg, diag);
   free(ov);
   if (!m) return diag->code ? diag->code : FMB_EXIT_BAD_INPUT;
-  fmbWorkspace* w = fmb_workspace_new(m);
+  fmbData* own = fmb_data_new(m, NULL); /* the run's scratch lives in a data object (issue 35) */
+  fmbWorkspace* w = own ? own->w : NULL;
   double* q = calloc((size_t)m->nq + 1, sizeof(double));
   double* v = calloc((size_t)m->nq + 1, sizeof(double));
   int rc = w && q && v ? 0 : FMB_EXIT_SOLVER;
@@ -79,7 +81,7 @@ static int sweep_axis(const fmbSceneSource* scene, const fmbCampbellOptions* opt
   if (!rc) rc = fmb_fit_rotation3(m, w, t, q, rot, diag);
   free(q);
   free(v);
-  fmb_workspace_free(w);
+  fmb_data_destroy(own);
   fmb_free(m);
   return rc;
 }

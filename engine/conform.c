@@ -29,7 +29,7 @@
 
 #include <unistd.h>
 
-#include "internal.h"
+#include "data.h"
 
 #define CONFORM_T_END 1.0
 #define ENERGY_TOL 1e-5 /* relative to the largest energy component along the run (rtol 1e-10) */
@@ -799,7 +799,8 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   }
   /* a variant (beam:model=exact) is its own ops table: check that one's outputs and damping */
   if (bt && m->nbody > 1 && m->body[m->nbody - 1].type) bt = m->body[m->nbody - 1].type;
-  fmbWorkspace* w = fmb_workspace_new(m);
+  fmbData* run = fmb_data_new(m, NULL); /* the scratch of the checks below */
+  fmbWorkspace* w = run ? run->w : NULL;
   double* y = calloc((size_t)m->ny, sizeof(double));
   double* yp = calloc((size_t)m->ny, sizeof(double));
   fmbStats st;
@@ -827,7 +828,7 @@ int fmb_conform(fmbRegistry* reg, const char* type_name, const char* work_dir, F
   if (!joint && !spatial && m->body[m->nbody - 1].nq >= 3)
     strncat(outputs, ", probe.x, probe.omega", sizeof outputs - strlen(outputs) - 1);
   free(y), free(yp);
-  fmb_workspace_free(w);
+  fmb_data_destroy(run);
   fmb_free(m);
   if (ic == 0)
     check_energy(&r, base, type_name, &ex, joint ? jt->example_damped : bt->example_damped,

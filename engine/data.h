@@ -1,5 +1,6 @@
-/* data.h — the state of one run of one model (fmbData, engine/step.c), private to the engine: the
- * stepping functions and the run loop (run.c) that writes files on top of them. Everything a run
+/* data.h — the state of one run of one model (fmbData; made in data.c, run in step.c), private
+ * to the engine: the stepping functions, the run loop (run.c) that writes files on top of them,
+ * and the analyses and checks that take their scratch from a data object. Everything a run
  * changes lives here or in its workspace; the model is only read. */
 #ifndef FMB_DATA_H
 #define FMB_DATA_H
@@ -7,6 +8,9 @@
 #include <signal.h>
 
 #include "integrator.h"
+
+#define FMB_DATA_LIVE 0x44424d46u  /* "FMBD" */
+#define FMB_DATA_FREED 0x45455246u /* "FREE" */
 
 struct fmbData {
   unsigned magic; /* FMB_DATA_LIVE while usable; FMB_DATA_FREED in quarantine (step.c) */
@@ -46,6 +50,8 @@ struct fmbData {
   fmbStats ic;                       /* the initial projection's corrections */
   unsigned char* range_warned;       /* nbody: the body's model_range warning was given (once per run) */
   int interrupted;
+  /* the state is fmb_static_data's, not a run's: fmb_advance needs fmb_init */
+  int analysis_state;
   int failed;   /* the last init or advance failed (fmb_data_stats' status) */
   double cpu_s; /* CPU time of this thread in init and advance */
   int untimed;  /* fmb_run's: it times the whole run itself, so init and advance read no CPU clock
@@ -59,7 +65,14 @@ int fmb_data_misused(const fmbModel* m, const fmbData* d, const char* fn, fmbDia
 double fmb_thread_cpu_seconds(void);
 /* fmb_run's SIGINT flag instead of the data's own cancel flag (NULL: the data's) */
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop);
-/* free a data object that never left the engine (fmb_run's) at once, without the quarantine */
+/* everything fmb_data_new allocated in d, not d itself (data.c; fmb_data_free quarantines d) */
+void fmb_data_release(fmbData* d);
+/* free a data object that never left the engine (fmb_run's, an analysis wrapper's) at once,
+   without the quarantine; NULL or not live: nothing */
 void fmb_data_destroy(fmbData* d);
+/* an analysis's state (fmb_static_data: the equilibrium at t) becomes d's: readable by
+   fmb_data_state, fmb_outputs and fmb_modes_data; the run's integrator is dropped and
+   fmb_advance asks for fmb_init (a run starts from the scene's initial conditions) */
+void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp);
 
 #endif

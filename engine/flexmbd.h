@@ -314,6 +314,11 @@ FMB_API int fmb_run_rows(const fmbModel* m, fmbData* d, fmbRowFn row, void* user
 /* the integrator's counters so far (all backends of this run), t_reached = time(), the CPU time
    spent in fmb_init and fmb_advance, the warnings given since fmb_init: 0, or FMB_EXIT_BAD_INPUT */
 FMB_API int fmb_data_stats(const fmbData* d, fmbStats* st);
+/* on (the default): fmb_init, fmb_advance and fmb_run_rows read the thread's CPU clock, for
+   st.cpu_s; 0: they do not, and st.cpu_s stays as it was. The clock is a system call, two an
+   advance: a program stepping in small advances that times itself turns it off (bench/inputs.sh:
+   a controller setting an input at 1 kHz, docs/api.md "Inputs"). NULL or a freed d: nothing. */
+FMB_API void fmb_data_set_timing(fmbData* d, int on);
 /* ask the advance in progress, or the next one, to stop: it returns FMB_EXIT_INTERRUPTED with the
    state at the last good step, and the request is used up (a later advance goes on from there).
    Only sets a flag: safe from another thread or a signal handler. */
@@ -435,6 +440,22 @@ FMB_API void fmb_modes_free(fmbModes* modes);
    Returns 0, FMB_EXIT_BAD_INPUT (a planar scene, mismatched modes) or FMB_EXIT_SOLVER. */
 FMB_API int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* modes, const double axis[3],
                                const double center[3], fmbDiag* diag);
+
+/* The same analyses on a data object (fmb_data_new): they take their scratch from it, so a program
+   holding one runs statics and modes without the engine making a workspace per call (fmb_static
+   and fmb_modes make a data object for the call). The model's inputs are as d holds them
+   (fmb_set_input) and the bodies' blocks a run's next Jacobian may reuse are left alone: advancing
+   after an analysis gives the bytes advancing without it gives.
+   fmb_static_data: fmb_static's equilibrium (from the scene's poses, at opt->t); on success it
+   becomes d's state at res->t (fmb_data_state, fmb_outputs, fmb_modes_data read it) and d's run
+   ends there: fmb_advance asks for fmb_init (`initial: static` runs from the equilibrium). On
+   failure d's state is unchanged.
+   fmb_modes_data: fmb_modes about d's state (fmb_data_time, fmb_data_state: a run's between
+   advances, or fmb_static_data's); d is only read. FMB_EXIT_BAD_INPUT with *diag for misuse (a
+   NULL, freed or other model's d, no state yet) as the stepping calls. */
+FMB_API int fmb_static_data(const fmbModel* m, fmbData* d, const fmbStaticOptions* opt, fmbStaticResult* res,
+                            fmbDiag* diag);
+FMB_API int fmb_modes_data(const fmbModel* m, fmbData* d, int count, int method, fmbModes** out, fmbDiag* diag);
 /* modal assurance criterion |a^H b|^2 / (|a|^2 |b|^2) of mode i of a and mode k of b, in [0, 1];
    NaN for NULL sets, shapes of different lengths or i, k out of range (0 would read "orthogonal") */
 FMB_API double fmb_modes_mac(const fmbModes* a, int i, const fmbModes* b, int k);

@@ -18,8 +18,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "data.h"
 #include "fd.h"
-#include "internal.h"
 #include "klu_policy.h"
 
 #define FMB_ASSEMBLY_TOL 1e-6 /* m or rad: a larger initial correction changes the mechanism */
@@ -308,6 +308,7 @@ int fmb_pose_check(const fmbModel* m, fmbWorkspace* w, double t, double* q, fmbD
 /* The constraints at the scene's initial state, projected: what fmb_count_redundant and
    fmb_check_constraints both report. */
 typedef struct {
+  fmbData* data; /* the scratch (its workspace: w) */
   fmbWorkspace* w;
   double *q, *v, *PhiQ, *phi, *phit, *phitt, *G, *rhs;
   int* piv;
@@ -319,7 +320,8 @@ typedef struct {
 static int analyze_start(const fmbModel* m, Start* s) {
   const int nq = m->nq, nc = m->nc;
   memset(s, 0, sizeof *s);
-  s->w = fmb_workspace_new(m);
+  s->data = fmb_data_new(m, NULL);
+  s->w = s->data ? s->data->w : NULL;
   s->q = calloc((size_t)nq + 1, sizeof(double));
   s->v = calloc((size_t)nq + 1, sizeof(double));
   s->PhiQ = calloc((size_t)(nc ? nc : 1) * nq, sizeof(double));
@@ -343,7 +345,7 @@ static int analyze_start(const fmbModel* m, Start* s) {
 }
 
 static void start_free(Start* s) {
-  fmb_workspace_free(s->w);
+  fmb_data_destroy(s->data);
   double* bufs[] = {s->q, s->v, s->PhiQ, s->phi, s->phit, s->phitt, s->G, s->rhs};
   for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
   free(s->piv);

@@ -282,8 +282,17 @@ void fmbp_warning_at(fmbParser* p, fmbNode node, const char* fmt, ...)
 
 /* ---- system.c: DAE residual and iteration matrix ---- */
 typedef struct fmbWorkspace fmbWorkspace;
+/* made by fmb_data_new only (step.c): every run, analysis and check gets its scratch from a data
+   object, the caller's or one its public wrapper makes (docs/api.md "Analyses on a data object") */
 fmbWorkspace* fmb_workspace_new(const fmbModel* m);
+/* mode_family.c: fmb_modes_classify on the caller's scratch (fmb_modes' data object) */
+int fmb_modes_classify_with(const fmbModel* m, fmbWorkspace* w, double t, const double* y, fmbModes* md,
+                            const double axis[3], const double center[3], fmbDiag* diag);
 void fmb_workspace_free(fmbWorkspace* w);
+long fmb_workspace_count(void); /* workspaces made so far in this process (a test's check) */
+/* hold = 1: fmb_system_jacobian neither reads nor writes the bodies' block cache, which stays the
+   run's (an analysis between advances must not change what the run's next Jacobian reuses) */
+void fmb_workspace_hold_cache(fmbWorkspace* w, int hold);
 double* fmb_workspace_plugin(fmbWorkspace* w);
 /* the inputs' settings (m->ninput; the scene's `value:` at rest when the workspace is made, and
    again after fmb_workspace_inputs_reset) */

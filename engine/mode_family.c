@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "data.h"
 #include "internal.h"
 
 const char* fmb_family_name(int family) {
@@ -50,8 +51,8 @@ static int radial(const double axis[3], const double center[3], const double pos
   return 1;
 }
 
-int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* md, const double axis[3],
-                       const double center[3], fmbDiag* diag) {
+int fmb_modes_classify_with(const fmbModel* m, fmbWorkspace* w, double t, const double* y, fmbModes* md,
+                            const double axis[3], const double center[3], fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag);
@@ -68,7 +69,6 @@ int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* m
     return FMB_EXIT_BAD_INPUT;
   }
   const double a[3] = {axis[0] / an, axis[1] / an, axis[2] / an};
-  fmbWorkspace* w = fmb_workspace_new(m);
   int nst = 0, cap = 0, rc = w ? 0 : FMB_EXIT_SOLVER;
   Station* st = NULL;
   for (int b = 1; !rc && b < m->nbody; ++b) {
@@ -190,6 +190,15 @@ int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* m
     free(st[j].G);
   }
   free(st);
-  fmb_workspace_free(w);
+  return rc;
+}
+
+/* the public entry: its scratch from a data object made for the call (issue 35: a run's scratch
+   lives in fmbData; fmb_modes passes its own) */
+int fmb_modes_classify(const fmbModel* m, double t, const double* y, fmbModes* md, const double axis[3],
+                       const double center[3], fmbDiag* diag) {
+  fmbData* own = m ? fmb_data_new(m, NULL) : NULL;
+  const int rc = fmb_modes_classify_with(m, own ? own->w : NULL, t, y, md, axis, center, diag);
+  fmb_data_destroy(own);
   return rc;
 }

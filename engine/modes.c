@@ -29,7 +29,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "data.h"
 #include "klu_policy.h"
 
 #include <arpack/arpack.h>
@@ -341,10 +341,10 @@ static void linearized_free(Linearized* L) {
   memset(L, 0, sizeof *L);
 }
 
-static int linearize(const fmbModel* m, double t, const double* y, const double* yp, Linearized* L, fmbDiag* diag) {
+static int linearize(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, Linearized* L,
+                     fmbDiag* diag) {
   const int nq = m->nq, ny = m->ny;
   memset(L, 0, sizeof *L);
-  fmbWorkspace* w = fmb_workspace_new(m);
   L->rot = (fmbRotation3){0.0, {0.0, 0.0, 1.0}, {0.0, 0.0, 0.0}, 0.0};
   if (m->dimension == 3) {
     if (w) fmb_state_rotation3(m, w, y, y + nq, &L->rot);
@@ -397,7 +397,6 @@ static int linearize(const fmbModel* m, double t, const double* y, const double*
       free(E);
     }
   }
-  fmb_workspace_free(w);
   free(J1);
   free(ewt);
   free(C);
@@ -780,8 +779,9 @@ void xerbla_(const char* name, const int* info, int len) {
   (void)len;
 }
 
-int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method, fmbModes** out,
-              fmbDiag* diag) {
+/* fmb_modes on the scratch of a data object (w: its workspace, NULL when none could be made) */
+static int modes_with(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, int count,
+                      int method, fmbModes** out, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag);
@@ -814,7 +814,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   Eigen E;
   memset(&R, 0, sizeof R);
   memset(&E, 0, sizeof E);
-  int rc = linearize(m, t, y, yp, &L, diag);
+  int rc = linearize(m, w, t, y, yp, &L, diag);
   if (rc) return rc;
   /* a few modes of a large system: shift-invert Arnoldi (bench/modes.sh: the crossover); when it
      does not apply (a singular saddle-point matrix: rigid motions; no convergence), dense */
@@ -830,7 +830,7 @@ int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, in
   if (!rc && m->dimension == 3) { /* families about the spin axis (a static state: none, family 0) */
     memcpy((*out)->axis, L.rot.axis, sizeof L.rot.axis);
     memcpy((*out)->center, L.rot.center, sizeof L.rot.center);
-    if (L.speed != 0.0) (void)fmb_modes_classify(m, t, y, *out, L.rot.axis, L.rot.center, NULL); /* else none */
+    if (L.speed != 0.0) (void)fmb_modes_classify_with(m, w, t, y, *out, L.rot.axis, L.rot.center, NULL); /* else none */
   }
   linearized_free(&L);
   reduced_free(&R);
@@ -910,7 +910,8 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_write_state_row: NULL model or state");
     return FMB_EXIT_BAD_INPUT;
   }
-  fmbWorkspace* w = fmb_workspace_new(m);
+  fmbData* own = fmb_data_new(m, NULL);
+  fmbWorkspace* w = own ? own->w : NULL;
   fmbCsv* c = w ? fmb_csv_open_guarded(path, m->inputs, diag) : NULL;
   int rc = 0;
   if (!c) {
@@ -929,7 +930,7 @@ int fmb_write_state_row(const fmbModel* m, const char* path, double t, const dou
     }
   }
   fmb_csv_close(c);
-  fmb_workspace_free(w);
+  fmb_data_destroy(own);
   return rc;
 }
 
@@ -943,7 +944,8 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
     return FMB_EXIT_BAD_INPUT;
   }
   const int nout = m->noutput, nq = m->nq;
-  fmbWorkspace* w = fmb_workspace_new(m);
+  fmbData* own = fmb_data_new(m, NULL);
+  fmbWorkspace* w = own ? own->w : NULL;
   double* yy = malloc((size_t)m->ny * sizeof(double));
   double* plus = malloc((size_t)nout * sizeof(double));
   double* minus = malloc((size_t)nout * sizeof(double));
@@ -976,7 +978,7 @@ int fmb_write_mode_shapes(const fmbModel* m, double t, const double* y, const do
   }
   if (!rc) rc = fmb_write_table(path, nout, names, md->count, rows, diag);
 done:
-  fmb_workspace_free(w);
+  fmb_data_destroy(own);
   free(yy);
   free(plus);
   free(minus);
@@ -1004,7 +1006,8 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
   const int nq = m->nq;
   const double w = md->frequency[k];
   const int periodic = w > 0.0;
-  fmbWorkspace* ws = fmb_workspace_new(m);
+  fmbData* own = fmb_data_new(m, NULL);
+  fmbWorkspace* ws = own ? own->w : NULL;
   double* yy = malloc((size_t)m->ny * sizeof(double));
   fmbVtk* v = ws && yy ? fmb_vtk_open(m, dir, diag) : NULL;
   int rc = 0;
@@ -1024,7 +1027,36 @@ int fmb_write_mode_animation(const fmbModel* m, double t, const double* y, const
     }
   }
   fmb_vtk_close(v);
-  fmb_workspace_free(ws);
+  fmb_data_destroy(own);
   free(yy);
+  return rc;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * the public modes entries: on the caller's data object, or on one made for the call (docs/api.md
+ * "Analyses on a data object") */
+
+int fmb_modes(const fmbModel* m, double t, const double* y, const double* yp, int count, int method, fmbModes** out,
+              fmbDiag* diag) {
+  fmbData* own = m ? fmb_data_new(m, NULL) : NULL;
+  const int rc = modes_with(m, own ? own->w : NULL, t, y, yp, count, method, out, diag);
+  fmb_data_destroy(own);
+  return rc;
+}
+
+int fmb_modes_data(const fmbModel* m, fmbData* d, int count, int method, fmbModes** out, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (out) *out = NULL;
+  if (fmb_data_misused(m, d, "fmb_modes_data", diag)) return FMB_EXIT_BAD_INPUT;
+  if (!d->ic_done) {
+    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
+                 "fmb_modes_data: the data object holds no state yet (fmb_init, or fmb_static_data, first)");
+    return FMB_EXIT_BAD_INPUT;
+  }
+  fmb_workspace_hold_cache(d->w, 1); /* the run's next Jacobian may reuse its cached blocks */
+  const int rc = modes_with(m, d->w, d->t, d->y, d->yp, count, method, out, diag);
+  fmb_workspace_hold_cache(d->w, 0);
   return rc;
 }

@@ -13,7 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "data.h"
 #include "pattern.h"
 
 typedef struct {
@@ -234,19 +234,19 @@ int fmb_pattern_build(fmbModel* m) {
   const int nq = m->nq;
   for (int b = 1; b < m->nbody; ++b)
     if (body_pattern(&m->body[b])) return -1;
-  /* which columns each joint can touch: by evaluating it (system.c), which needs a workspace */
-  fmbWorkspace* w = fmb_workspace_new(m);
-  if (!w) return -1;
+  /* which columns each joint can touch: by evaluating it (system.c), on a data object's scratch */
+  fmbData* scratch = fmb_data_new(m, NULL);
+  if (!scratch) return -1;
   for (int j = 0; j < m->njoint; ++j) {
     fmbJointInst* ji = &m->joint[j];
     ji->sup = malloc(sizeof(int) * (size_t)(ji->ncol + 1));
     if (!ji->sup) {
-      fmb_workspace_free(w);
+      fmb_data_destroy(scratch);
       return -1;
     }
-    ji->nsup = fmb_joint_support(m, w, j, ji->sup);
+    ji->nsup = fmb_joint_support(m, scratch->w, j, ji->sup);
   }
-  fmb_workspace_free(w);
+  fmb_data_destroy(scratch);
 
   Runs rs = {NULL, 0, 0};
   int* S = malloc(sizeof(int) * (size_t)(3 * (m->max_joint_cols + 1)));

@@ -30,7 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "integrator.h"
+#include "data.h"
 
 /* largest change of any coordinate per step of the walk (m, rad): the sample nearest a flat
    position lies within half of it, where the relative singular value of Phi_q is ~ SCAN_STEP / 2 */
@@ -121,7 +121,8 @@ int fmb_needs_singular_method(const fmbModel* m) {
   if (m->nc == 0 || m->nz > 0 || 2 * m->nq > SCAN_MAX_UNKNOWNS || !rigid_bodies_only(m) || !has_closed_loop(m))
     return 0;
   const int nq = m->nq, nc = m->nc;
-  fmbWorkspace* w = fmb_workspace_new(m);
+  fmbData* scratch = fmb_data_new(m, NULL);
+  fmbWorkspace* w = scratch ? scratch->w : NULL;
   fmbAugmented* g = fmb_augmented_new(m);
   double* y = calloc((size_t)m->ny + 1, sizeof(double));
   double* yp = calloc((size_t)m->ny + 1, sizeof(double));
@@ -181,6 +182,6 @@ int fmb_needs_singular_method(const fmbModel* m) {
   free(yp);
   free(y);
   fmb_augmented_free(g);
-  fmb_workspace_free(w);
+  fmb_data_destroy(scratch);
   return singular;
 }

@@ -7,10 +7,11 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "internal.h"
+#include "data.h"
 
-int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
-               fmbDiag* diag) {
+/* fmb_static on the scratch of a data object (w: its workspace, NULL when none could be made) */
+static int static_with(const fmbModel* m, fmbWorkspace* w, const fmbStaticOptions* opt, double* y, double* yp,
+                       fmbStaticResult* res, fmbDiag* diag) {
   fmbDiag local;
   if (!diag) diag = &local;
   memset(diag, 0, sizeof *diag);
@@ -29,7 +30,6 @@ int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double
                  "fmb_static: options out of range (a negative or NaN tol, max_iter or max_halvings)");
     return FMB_EXIT_BAD_INPUT;
   }
-  fmbWorkspace* w = fmb_workspace_new(m);
   double* q = calloc((size_t)m->nq + 1, sizeof(double));
   double* v = calloc((size_t)m->nq + 1, sizeof(double));
   int rc = 0;
@@ -47,6 +47,31 @@ int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double
   }
   free(q);
   free(v);
-  fmb_workspace_free(w);
+  return rc;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * the public entries: on the caller's data object, or on one made for the call (docs/api.md
+ * "Analyses on a data object") */
+
+int fmb_static(const fmbModel* m, const fmbStaticOptions* opt, double* y, double* yp, fmbStaticResult* res,
+               fmbDiag* diag) {
+  fmbData* own = m ? fmb_data_new(m, NULL) : NULL;
+  const int rc = static_with(m, own ? own->w : NULL, opt, y, yp, res, diag);
+  fmb_data_destroy(own);
+  return rc;
+}
+
+int fmb_static_data(const fmbModel* m, fmbData* d, const fmbStaticOptions* opt, fmbStaticResult* res, fmbDiag* diag) {
+  fmbDiag local;
+  if (!diag) diag = &local;
+  memset(diag, 0, sizeof *diag);
+  if (fmb_data_misused(m, d, "fmb_static_data", diag)) return FMB_EXIT_BAD_INPUT;
+  /* solved into the data's scratch state (step.c: free between advances): d's state stays the
+     run's when there is no equilibrium */
+  fmb_workspace_hold_cache(d->w, 1);
+  const int rc = static_with(m, d->w, opt, d->start.y, d->start.yp, res, diag);
+  fmb_workspace_hold_cache(d->w, 0);
+  if (!rc) fmb_data_hold_analysis_state(d, res->t, d->start.y, d->start.yp);
   return rc;
 }

@@ -25,9 +25,6 @@
 
 #include "data.h"
 
-#define FMB_DATA_LIVE 0x44424d46u  /* "FMBD" */
-#define FMB_DATA_FREED 0x45455246u /* "FREE" */
-
 /* how close to rank-deficient Phi_q must be where IDA failed for `formulation: auto` to switch to
    the projected formulation: a row whose part independent of the others is below 1e-2 of the
    largest row (a parallelogram within about half a degree of flat; IDA on the GGL system gave up
@@ -83,58 +80,6 @@ static void add_stats(fmbStats* to, const fmbStats* from) {
 
 /* ------------------------------------------------------------------------------------------ */
 
-static void release(fmbData* d) {
-  if (d->integ) d->ops->destroy(d->integ);
-  d->integ = NULL;
-  double* bufs[] = {d->y,       d->yp,       d->atol,      d->row, d->work_before, d->redundant_phi,
-                    d->start.y, d->start.yp, d->start.work};
-  for (size_t i = 0; i < sizeof bufs / sizeof bufs[0]; ++i) free(bufs[i]);
-  free(d->range_warned);
-  fmb_workspace_free(d->w);
-  d->w = NULL;
-}
-
-fmbData* fmb_data_new(const fmbModel* m, fmbDiag* diag) {
-  fmbDiag local;
-  if (!diag) diag = &local;
-  memset(diag, 0, sizeof *diag);
-  if (!m) {
-    fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, "", 0, 0, "fmb_data_new: no model (NULL)");
-    return NULL;
-  }
-  fmbData* d = calloc(1, sizeof *d);
-  if (!d) {
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up a run");
-    return NULL;
-  }
-  const size_t ny = (size_t)m->ny + 1;
-  d->m = m;
-  d->w = fmb_workspace_new(m);
-  d->y = calloc(ny, sizeof(double));
-  d->yp = calloc(ny, sizeof(double));
-  d->atol = calloc(ny, sizeof(double));
-  d->row = calloc((size_t)m->noutput + 1, sizeof(double));
-  d->work_before = calloc((size_t)m->njoint + 1, sizeof(double));
-  d->redundant_phi = calloc((size_t)m->nc + 1, sizeof(double));
-  d->range_warned = calloc((size_t)m->nbody + 1, 1);
-  d->may_switch = m->solver.formulation == FMB_FORM_AUTO && m->nc > 0 && m->nz == 0;
-  d->start.y = calloc(ny, sizeof(double));
-  d->start.yp = calloc(ny, sizeof(double));
-  d->start.work = calloc((size_t)m->njoint + 1, sizeof(double));
-  if (!d->w || !d->y || !d->yp || !d->atol || !d->row || !d->work_before || !d->redundant_phi || !d->range_warned ||
-      !d->start.y || !d->start.yp || !d->start.work) {
-    release(d);
-    free(d);
-    fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "out of memory setting up the integrator");
-    return NULL;
-  }
-  fmb_absolute_tolerances(m, d->atol);
-  d->stop = &d->cancel;
-  d->t = NAN;
-  d->magic = FMB_DATA_LIVE;
-  return d;
-}
-
 void fmb_data_free(fmbData* d) {
   if (!d) return;
   pthread_mutex_lock(&quarantine_lock);
@@ -142,7 +87,7 @@ void fmb_data_free(fmbData* d) {
     pthread_mutex_unlock(&quarantine_lock);
     return;
   }
-  release(d);
+  fmb_data_release(d);
   d->magic = FMB_DATA_FREED;
   fmbData* evicted = quarantine[quarantine_next];
   quarantine[quarantine_next] = d;
@@ -167,11 +112,8 @@ quarantine_release(void) {
   pthread_mutex_unlock(&quarantine_lock);
 }
 
-void fmb_data_destroy(fmbData* d) {
-  if (!live(d)) return;
-  release(d);
-  d->magic = 0;
-  free(d);
+void fmb_data_set_timing(fmbData* d, int on) {
+  if (live(d)) d->untimed = !on;
 }
 
 void fmb_data_watch(fmbData* d, const volatile sig_atomic_t* stop) {
@@ -225,6 +167,19 @@ static void restart_backend(fmbData* d) {
   d->restart = 1;
 }
 
+void fmb_data_hold_analysis_state(fmbData* d, double t, const double* y, const double* yp) {
+  if (!live(d)) return;
+  retire_backend(d, 0); /* its counters stay the run's (fmb_data_stats) */
+  d->restart = 0;
+  if (y != d->y) memcpy(d->y, y, sizeof(double) * (size_t)d->m->ny);
+  if (yp != d->yp) memcpy(d->yp, yp, sizeof(double) * (size_t)d->m->ny);
+  d->t = t;
+  d->ic_done = 1;
+  d->initialised = 0;
+  d->failed = 0;
+  d->analysis_state = 1;
+}
+
 static void mass_failure(const fmbModel* m, int bad, double t, fmbDiag* diag) {
   const fmbBodyInst* b = &m->body[bad - 1];
   const char* hint = (b->type && b->type->indefinite_mass) ? b->type->indefinite_mass(b->self) : NULL;
@@ -245,7 +200,7 @@ int fmb_init(const fmbModel* m, fmbData* d, fmbDiag* diag) {
   d->integ = NULL;
   d->ops = fmb_integrator_for(m);
   d->restart = d->reinit_pending = 0;
-  d->initialised = d->ic_done = d->interrupted = 0;
+  d->initialised = d->ic_done = d->interrupted = d->analysis_state = 0;
   fmb_stop_set(&d->cancel, 0);
   d->cpu_s = 0.0;
   memset(&d->before, 0, sizeof d->before);
@@ -467,7 +422,10 @@ int fmb_advance(const fmbModel* m, fmbData* d, double t_out, fmbDiag* diag) {
   if (misused(m, d, "fmb_advance", diag)) return FMB_EXIT_BAD_INPUT;
   if (!d->initialised) {
     fmb_diag_set(diag, FMB_EXIT_BAD_INPUT, m->path, 0, 0,
-                 "fmb_advance: the data object has no state yet: call fmb_init first (or it failed)");
+                 d->analysis_state
+                     ? "fmb_advance: the data object holds fmb_static_data's equilibrium, not a run's state: call "
+                       "fmb_init to start a run (`initial: static` starts one from the equilibrium)"
+                     : "fmb_advance: the data object has no state yet: call fmb_init first (or it failed)");
     return FMB_EXIT_BAD_INPUT;
   }
   if (isnan(t_out) || t_out < d->t) {

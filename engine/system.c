@@ -18,6 +18,7 @@
  * independent rows still fix the same motion (docs/mechanisms.md). Their share of the reactions
  * is restored in the outputs by the minimum-norm rule (output.c, with augmented.c's minimum-norm solve). */
 #include <math.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -42,6 +43,7 @@ struct fmbWorkspace {
   double* cache;
   size_t* cache_adr;
   int cache_valid;
+  int cache_held;           /* an analysis on a run's workspace: the cache is the run's (fmb_workspace_hold_cache) */
   double* work_done;        /* njoint: accumulated work of each joint (step.c fills it) */
   unsigned char* redundant; /* nc: 1 = a redundant row, out of the equations (ic.c decides) */
   int nredundant_cap;       /* nc */
@@ -68,7 +70,13 @@ static size_t block_size(const fmbBodyInst* b) {
   return b->pnnz >= 0 ? (size_t)b->pnnz : (size_t)b->nq * (size_t)b->nq;
 }
 
+/* workspaces made so far in this process, for the test that an analysis given a data object
+   makes none (tests/core/test_analysis_data.c); atomic: runs in threads each make theirs */
+static atomic_long workspaces_made;
+long fmb_workspace_count(void) { return atomic_load(&workspaces_made); }
+
 fmbWorkspace* fmb_workspace_new(const fmbModel* m) {
+  atomic_fetch_add(&workspaces_made, 1);
   fmbWorkspace* w = calloc(1, sizeof *w);
   if (!w) return NULL;
   int mr = 1;
@@ -197,6 +205,7 @@ unsigned char* fmb_workspace_redundant(fmbWorkspace* w, int* count) {
 }
 
 double* fmb_workspace_spring_energy0(fmbWorkspace* w) { return &w->spring_energy0; }
+void fmb_workspace_hold_cache(fmbWorkspace* w, int hold) { w->cache_held = hold; }
 void** fmb_workspace_attached(fmbWorkspace* w, void (*free_fn)(void*)) {
   if (free_fn) w->attached_free = free_fn;
   return &w->attached;
@@ -528,14 +537,17 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     sink_add(&s, Fq + i, Yq + i, cj);
     sink_add(&s, Fq + i, Yv + i, -1.0);
   }
-  const int reuse = reuse_blocks && w->cache && w->cache_valid;
+  /* held (an analysis between a run's advances): the blocks are evaluated anew into the scratch
+     and the cache keeps the run's last fresh ones, which its next Jacobian may reuse */
+  double* cache = w->cache_held ? NULL : w->cache;
+  const int reuse = reuse_blocks && cache && w->cache_valid;
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
     const int n = bi->nq, a0 = bi->qadr;
     const size_t nn = block_size(bi);
     double *K = w->K, *C = w->C, *M = w->M;
-    if (w->cache) {
-      K = w->cache + w->cache_adr[b];
+    if (cache) {
+      K = cache + w->cache_adr[b];
       C = K + nn;
       M = C + nn;
     }
@@ -544,7 +556,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
                                                       ewt + a0, ewt + nq + a0, K, C, M, w->plugin + bi->workadr, w->fd)
                              : fmb_body_blocks(m, w, b, q + a0, v + a0, vp + a0, ewt + a0, K, C, M);
       if (rc) {
-        w->cache_valid = 0;
+        if (cache) w->cache_valid = 0;
         return rc;
       }
     }
@@ -568,7 +580,7 @@ int fmb_system_jacobian(const fmbModel* m, fmbWorkspace* w, double t, double cj,
     sink_block(&s, Fv + a0, n, Yq + a0, n, K, n, 1.0);
     sink_block(&s, Fv + a0, n, Yv + a0, n, w->fdcol, n, 1.0);
   }
-  if (w->cache) w->cache_valid = 1;
+  if (cache) w->cache_valid = 1;
 
   memcpy(w->qpert, q, (size_t)nq * sizeof(double));
   memcpy(w->vpert, v, (size_t)nq * sizeof(double));
