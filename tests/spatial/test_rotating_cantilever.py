@@ -9,8 +9,10 @@ hub of radius 0 turned about z by revolute3d's constant profile. `flexmbd campbe
 Checks, each failing when the physics is wrong:
   1. families: at every speed the first flapwise and the first chordwise mode are found (flap1, lag1), the two
      differ above 1 rad/s (flapwise stiffens by Omega^2 more);
-  2. Southwell at low speed (Omega <= omega_0): omega^2 = omega_0^2 + K Omega^2 with the continuum's K (flapwise
-     1.193 from mu_flap_series, chordwise K - 1), within 1 %;
+  2. Southwell at low speed: omega^2 = omega_0^2 + K Omega^2 with the continuum's K (flapwise 1.193 from
+     mu_flap_series, chordwise K - 1) within 1 % where the continuum itself follows the linear law that closely
+     (flapwise to 0.5 omega_0, chordwise to 0.25 omega_0), and the flapwise secant against the continuum's own
+     secant to 1e-3 up to lambda = 3 (0.85 omega_0);
   3. the continuum up to lambda = 12 (Omega = 12 sqrt(EI / rho A L^4) = 13.3 rad/s, 3.4 omega_0): the flapwise
      eigenvalue against the Frobenius series to 1e-4 (16 elements: the element's own error is 6e-6), the chordwise
      against the inextensible continuum to 5e-3 (the beam keeps its axial motion, whose Coriolis coupling the
@@ -20,12 +22,7 @@ Checks, each failing when the physics is wrong:
   5. ZOAC misses the stiffening: its flapwise mode stays at omega_0 (1e-4) while complete's rises, and its
      chordwise mode softens as sqrt(omega_0^2 - Omega^2).
 
-Not registered in ctest until bodies/beam3d.c (`type: beam` with `dimension: 3`) is merged; then add to
-tests/spatial/CMakeLists.txt:
-  add_test(NAME spatial_rotating_cantilever COMMAND ${FLEXMBD_SPATIAL_PYTHON3}
-           ${CMAKE_CURRENT_SOURCE_DIR}/test_rotating_cantilever.py $<TARGET_FILE:flexmbd> ${PROJECT_SOURCE_DIR}
-           ${CMAKE_CURRENT_BINARY_DIR}/rotating_cantilever)
-  set_tests_properties(spatial_rotating_cantilever PROPERTIES LABELS "spatial;analysis" TIMEOUT 600)
+ctest: spatial_rotating_cantilever (tests/spatial/CMakeLists.txt).
 """
 import math
 import os
@@ -77,7 +74,12 @@ seed = table(os.path.join(src, "tests", "spatial", "ref", "rotating_cantilever_s
 omega0 = ref["mu_flap_series"][0] * SCALE
 lam = ref["lambda"]
 K_flap = (ref["mu_flap_series"][1] ** 2 - ref["mu_flap_series"][0] ** 2) / lam[1] ** 2  # lambda = 0.5: 1.193
-low = np.array([0.0, 0.25, 0.5, 1.0]) * omega0
+# The linear law is the low-speed limit: the continuum's own secant (mu^2 - mu_0^2) / lambda^2 falls 0.27 % below
+# K at 0.5 omega_0 and 1.1 % at omega_0 (docs/formulation-3d.md section 8), an absolute drift that is 1.7 % of the
+# chordwise K - 1 already at 0.5 omega_0. So the law is asked to 1 % where the continuum obeys it (flapwise to
+# 0.5 omega_0, chordwise to 0.25 omega_0), and beyond, up to lambda = 3 (0.85 omega_0), the beam's flapwise
+# secant is asked to follow the continuum's own secant (Frobenius series) to 1e-3.
+low = np.array([0.0, 0.1, 0.25, 0.5]) * omega0
 c = campbell("southwell", low)
 check("flap1" in c and "lag1" in c, f"families named: columns {sorted(k for k in c if k != 'speed')}")
 if "flap1" in c and "lag1" in c:
@@ -89,8 +91,17 @@ if "flap1" in c and "lag1" in c:
         kf = (c["flap1"][i] ** 2 - w0f ** 2) / W ** 2
         kc = (c["lag1"][i] ** 2 - w0c ** 2) / W ** 2
         check(abs(kf / K_flap - 1) < 0.01, f"Southwell flapwise at {W:.4g} rad/s: K = {kf:.5f} (continuum {K_flap:.5f})")
-        check(abs(kc / (K_flap - 1) - 1) < 0.01,
-              f"Southwell chordwise at {W:.4g} rad/s: K - 1 = {kc:.5f} (continuum {K_flap - 1:.5f})")
+        if W <= 0.25 * omega0 * (1 + 1e-9):
+            check(abs(kc / (K_flap - 1) - 1) < 0.01,
+                  f"Southwell chordwise at {W:.4g} rad/s: K - 1 = {kc:.5f} (continuum {K_flap - 1:.5f})")
+    mid = (lam >= 1) & (lam <= 3)
+    cm = campbell("secant", np.concatenate(([0.0], lam[mid] * SCALE)))
+    if "flap1" in cm:
+        sec_fe = (cm["flap1"][1:] ** 2 - cm["flap1"][0] ** 2) / (lam[mid] * SCALE) ** 2
+        sec_ct = (ref["mu_flap_series"][mid] ** 2 - ref["mu_flap_series"][0] ** 2) / lam[mid] ** 2
+        e = np.max(np.abs(sec_fe / sec_ct - 1))
+        check(e < 1e-3, f"flapwise secant against the continuum's at lambda 1..3 (to 0.85 omega_0): {e:.2e} relative "
+                        f"(continuum secant {sec_ct.min():.5f}..{sec_ct.max():.5f}, K {K_flap:.5f})")
     check(c["flap1"][-1] > c["lag1"][-1] * 1.05, "flapwise stiffens more than chordwise")
 
 # 3: the continuum up to lambda = 12
