@@ -63,8 +63,10 @@ static const char* const reaction3_names[] = {
 static const char* const constraint_names[] = {"position", "velocity", NULL};
 /* in space: the pose of a body's origin (its marker3 at [0, 0, 0]) and its frame as unit Euler
    parameters (w >= 0), for a spatial body whose type gives no such output of its own (rigid3d
-   gives its own, from its coordinates) */
-static const char* const pose3_names[] = {"x", "y", "z", "qw", "qx", "qy", "qz", NULL};
+   gives its own, from its coordinates); on request also the frame's Euler angles z-y-x, R = Rz(yaw)
+   Ry(pitch) Rx(roll), rigid3d's convention. The default columns are the first POSE3_DEFAULT. */
+static const char* const pose3_names[] = {"x", "y", "z", "qw", "qx", "qy", "qz", "roll", "pitch", "yaw", NULL};
+enum { POSE3_DEFAULT = 7 };
 /* the units of the quantities above, in their order (constraint norms mix m and rad: none) */
 static const char* const frame_units[] = {"m", "m", "rad", "rad/s", "m/s", "m/s"};
 static const char* const power_units[] = {"W", "J"};
@@ -351,6 +353,10 @@ static double pose3_value(const fmbModel* m, fmbWorkspace* w, int b, int id, con
   double pos[3], R[9], p[4];
   if (fmb_body_point3(m, w, b, q, origin, pos, R)) return NAN;
   if (id < 3) return pos[id];
+  if (id >= POSE3_DEFAULT) { /* roll, pitch, yaw (rigid3d's formula, R row-major) */
+    const double euler[3] = {atan2(R[7], R[8]), asin(fmax(-1.0, fmin(1.0, -R[6]))), atan2(R[3], R[0])};
+    return euler[id - POSE3_DEFAULT];
+  }
   fmb_matrix_quat(R, p);
   return p[id - 3];
 }
@@ -391,7 +397,7 @@ static void outputs_default_spatial(fmbModel* m) {
   const char* const* pose = pose3_names;
   for (int b = 1; b < m->nbody; ++b) {
     const fmbBodyInst* bi = &m->body[b];
-    for (int k = 0; pose[k] && bi->nq > 0; ++k) {
+    for (int k = 0; k < POSE3_DEFAULT && bi->nq > 0; ++k) {
       const int id = fmb_type_output_id(bi->type->output_lookup, bi->self, bi->type->output_names, pose[k]);
       if (id < 0 && !bi->marker3) continue;
       fmbOutput* o = &m->output[m->noutput++];

@@ -157,6 +157,21 @@ elif case == "free":
         d = np.max(np.abs(E - E[0])) / E[0]
         expect(d < 1e-7, f"free {model}: energy {E[0]:.6g} J held to {d:.2e} relative (limit 1e-7) with "
                f"tip_w up to {np.max(np.abs(r['beam.tip_w'])):.3g} m")
+    # the frame's Euler angles on request (the engine's, from marker3 at the root: beam3d gives none of its own)
+    # against the beam's own Euler parameters turned into z-y-x angles here
+    r, _ = run(ROT3, "free_euler", "joints=[]", "solver.t_end=0.5", "solver.rtol=1e-9", "solver.output_step=0.01",
+               "bodies.beam.angular_velocity=[0.3, 0.2, 2]", "bodies.beam.elements=4",
+               "outputs=[beam.qw, beam.qx, beam.qy, beam.qz, beam.roll, beam.pitch, beam.yaw]")
+    if r is not None:
+        w, x, y, z = (r[f"beam.q{c}"] for c in "wxyz")
+        roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+        pitch = np.arcsin(np.clip(2 * (w * y - z * x), -1, 1))
+        yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        d = max(np.max(np.abs(np.angle(np.exp(1j * (r[f"beam.{k}"] - v))))) for k, v in
+                (("roll", roll), ("pitch", pitch), ("yaw", yaw)))
+        expect(d < 1e-9 and np.ptp(yaw) > 0.5 and np.ptp(roll) > 0.01,
+               f"free: roll, pitch, yaw equal the Euler parameters' z-y-x angles to {d:.2e} rad (limit 1e-9), "
+               f"yaw spanning {np.ptp(yaw):.3g} rad")
 else:
     sys.exit(f"unknown case {case}")
 
