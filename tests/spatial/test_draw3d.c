@@ -20,19 +20,9 @@
 
 #include "testlib.h"
 
-static int rod_centreline(const void* self, int n, double* local) {
-  (void)self;
-  if (n <= 0) return 5;
-  for (int i = 0; i < n; ++i) {
-    local[2 * i] = -0.5 + (double)i / (n - 1);
-    local[2 * i + 1] = 0.0;
-  }
-  return n;
-}
-
-static fmbBodyType rod_type;
-static const fmbBodyType* rod_types[] = {&rod_type, NULL};
-static const fmbPlugin rod_plugin = {.abi = FMB_ABI_VERSION, .name = "rod3d", .version = "1", .bodies = rod_types};
+/* the test type itself: the plugin tests/ux/test_view3d.py loads with --plugin, compiled in (one
+   definition of rod3d for both tests) */
+#include "../ux/rod3d_plugin.c"
 
 #define SCENE(TYPE)                                                                                         \
   "dimension: 3\ngravity: [0, 0, -9.81]\nsolver: {t_end: 0.5, rtol: 1e-9, output_step: 0.05}\n"             \
@@ -70,18 +60,11 @@ static int vtu_array(const char* text, size_t len, const char* name, double* out
 
 int main(void) {
   fmbDiag diag;
-  const fmbRegistry* builtin = fmb_builtin_registry();
-  for (int i = 0; i < fmb_registry_nbodies(builtin); ++i)
-    if (strcmp(fmb_registry_body(builtin, i)->name, "rigid3d") == 0) rod_type = *fmb_registry_body(builtin, i);
-  ENSURE(rod_type.name != NULL);
-  rod_type.name = "rod3d";
-  rod_type.centreline = rod_centreline;
-  rod_type.output_names = NULL; /* the engine's pose columns, not rigid3d's */
-  rod_type.output_lookup = NULL;
-  rod_type.output_units = NULL;
+  const fmbPlugin* rod3d = fmb_plugin_descriptor(); /* rigid3d's ops, a centreline, no outputs of its own */
+  ENSURE(rod3d != NULL);
   fmbRegistry* reg = fmb_registry_new();
   ENSURE(reg && fmb_registry_add(reg, fmb_builtin_plugin(), "built-in", &diag) == 0);
-  ENSURE(fmb_registry_add(reg, &rod_plugin, "test", &diag) == 0);
+  ENSURE(fmb_registry_add(reg, rod3d, "test", &diag) == 0);
   if (fmbt_failures) return fmbt_finish("test_draw3d");
 
   /* the twin: rigid3d's own columns */
