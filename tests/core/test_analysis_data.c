@@ -115,7 +115,8 @@ static void static_and_modes(const char* rel, int count, int method, int expect_
   ENSURE(fmb_static_data(NULL, d, NULL, &r_new, &diag) == FMB_EXIT_BAD_INPUT);
   ENSURE(fmb_static_data(m, NULL, NULL, &r_new, &diag) == FMB_EXIT_BAD_INPUT);
   ENSURE(fmb_static_data(m, d, NULL, NULL, &diag) == FMB_EXIT_BAD_INPUT);
-  ENSURE(fmb_modes_data(m, NULL, count, method, &md_new, &diag) == FMB_EXIT_BAD_INPUT);
+  fmbModes* md_bad = NULL; /* a refused call sets its *out to NULL: not md_new, which still holds modes */
+  ENSURE(fmb_modes_data(m, NULL, count, method, &md_bad, &diag) == FMB_EXIT_BAD_INPUT && md_bad == NULL);
   fmb_modes_free(md_old);
   fmb_modes_free(md_new);
   fmb_data_free(d);
