@@ -14,10 +14,13 @@
  *    during the analysis they are not); and its modes are fmb_modes' at the run's state.
  * 4. After fmb_static_data the data holds the equilibrium: fmb_data_time is its time, fmb_advance
  *    asks for fmb_init; misuse (NULL, no state yet) is refused with FMB_EXIT_BAD_INPUT.
- * 5. fmb_data_set_timing(d, 0) (no thread CPU clock read per advance: bench/inputs.sh) leaves
- *    st.cpu_s at 0 and the run's bytes as they are with the clock. */
+ * 5. fmb_data_set_timing(d, 0) (no clock read per advance: bench/inputs.sh) leaves st.cpu_s at 0
+ *    and the run's bytes as they are with the clock. With the clock, st.cpu_s counts the calls,
+ *    not the caller's own work between them (0.1 s of CPU spent between the advances: st.cpu_s
+ *    stays below half of it), and never exceeds the thread's CPU time since fmb_init. */
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 #include "internal.h" /* fmb_workspace_count: the engine's, exposed to tests only */
 #include "testlib.h"
@@ -174,7 +177,14 @@ static void modes_between_advances(void) {
   fmb_free(m);
 }
 
-/* fmb_data_set_timing(d, 0): no CPU clock read, st.cpu_s 0, the run itself the same bytes */
+static double thread_cpu(void) {
+  struct timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* fmb_data_set_timing(d, 0): no clock read, st.cpu_s 0, the run itself the same bytes; with it,
+   st.cpu_s is the calls' time, not the caller's */
 static void timing_switch(void) {
   char path[1024];
   fmbDiag diag;
@@ -196,6 +206,32 @@ static void timing_switch(void) {
   ENSURE(st[0].cpu_s == 0.0 && st[1].cpu_s > 0.0);
   ENSURE(st[0].steps == st[1].steps && st[0].steps > 0 && same_bytes(y[0], y[1], (size_t)n));
   fmb_data_set_timing(NULL, 0); /* nothing */
+
+  /* the caller's work between the advances is not the library's: 0.1 s of it in all (the run
+     itself takes a few ms) */
+  const long rows = fmb_row_count(m);
+  const double busy_each = 0.1 / (double)rows;
+  double busy = 0.0, sink = 0.0;
+  fmbStats st_busy;
+  const double cpu_start = thread_cpu();
+  fmbData* d = fmb_data_new(m, &diag);
+  ENSURE(fmb_init(m, d, &diag) == 0);
+  for (long k = 1; k < rows; ++k) {
+    ENSURE(fmb_advance(m, d, fmb_row_time(m, k), &diag) == 0);
+    const double c0 = thread_cpu();
+    for (double c = c0; c - c0 < busy_each; c = thread_cpu())
+      for (int i = 0; i < 1000; ++i) sink += 1e-9 * (double)i;
+    busy += thread_cpu() - c0;
+  }
+  ENSURE(fmb_data_stats(d, &st_busy) == 0);
+  const double cpu_total = thread_cpu() - cpu_start;
+  fmb_data_free(d);
+  ENSURE_MSG(st_busy.cpu_s > 0.0 && st_busy.cpu_s < 0.5 * busy && st_busy.cpu_s <= cpu_total,
+             "st.cpu_s = %.4f s with %.4f s of the caller's work between the advances (thread: %.4f s; the run "
+             "alone: %.4f s)%s",
+             st_busy.cpu_s, busy, cpu_total, st[1].cpu_s, sink < 0 ? "" : "");
+  printf("timing: st.cpu_s %.4f s alone, %.4f s with %.3f s of the caller's work between the advances\n", st[1].cpu_s,
+         st_busy.cpu_s, busy);
   free(y[0]), free(y[1]);
   fmb_free(m);
 }
