@@ -337,7 +337,8 @@ static int radau_start(RadauRun* c, double t0, const double* y0, const double* y
    every restart then failed, 965 times in docs/python.md's 1000 settings, +17 % CPU. With the step
    kept, bench/scenes/input_rotor.yaml's load set every 10 ms with fmb_set_input_motion took 427
    steps (1176 before, 181 with the continuous law), every 1 ms by value 2003 (8168), and
-   docs/python.md's speed controller 5370 steps with 220 Jacobians (8981 with 999), -18 % CPU. */
+   docs/python.md's speed controller 5370 steps with 220 Jacobians (8105 with 999 keeping the step
+   alone, -18 % CPU; 8981 before either). */
 static int radau_reinit(void* self, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
   RadauRun* c = self;
   const double h_before = c->h; /* the step the controller proposed next */

@@ -67,7 +67,7 @@ double fmb_thread_cpu_seconds(void) {
   return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
-/* How fmb_data_stats' cpu_s is kept (docs/api.md "Stepping"). The thread's CPU clock is a system
+/* How fmb_data_stats' cpu_s is kept (docs/api.md "What a controller in the loop costs"). The thread's CPU clock is a system
    call, and on a virtual machine a slow one (1-10 us on the KVM of docs/performance.md): read
    before and after every advance it was 19 % of a controller's run that sets an input every
    millisecond (bench/inputs.sh). So each fmb_init and fmb_advance is timed on the monotonic clock,
