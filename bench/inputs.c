@@ -14,7 +14,7 @@
  *
  *   inputs LAW.yaml INPUT.yaml -l LOAD -f FREQUENCY_RAD_S [-p PERIOD] [-r REPEATS] [-H] [-U]
  * (INPUT.yaml: LAW.yaml with the load's `law: input, value: 0` instead of `law: harmonic`;
- * -U: the data objects do not read the thread's CPU clock around each advance, fmb_data_set_timing)
+ * -U: the data objects do not time each advance (the monotonic clock), fmb_data_set_timing)
  * prints one CSV line (header with -H):
  *   scene,period_s,settings,steps_law,steps_hold,steps_motion,cpu_law_s,cpu_hold_s,cpu_motion_s,
  *   ratio_hold,ratio_motion,diff_hold,diff_motion,library_clock
@@ -35,7 +35,7 @@ enum { WAY_LAW, WAY_HOLD, WAY_MOTION, NWAY };
 typedef struct {
   const char* load;
   double omega, period;
-  int clock; /* the data objects read the thread's CPU clock around each advance (the default) */
+  int clock; /* the data objects time each advance for fmb_data_stats (the default) */
 } Controller;
 
 /* one run: the outputs' first column at every row into col0 (rows), the steps into *steps */

@@ -10,9 +10,10 @@
 #           within the solver's tolerance of where the last one led keeps the step history
 # and again with settings every 10 ms (100 Hz). diff_*: the largest difference of hub.omega (rad/s)
 # from the continuous run (hold: the hold's lag; motion: the restarts' and the steps' own error).
-# Each period twice: library_clock 1, the data objects as made (each advance reads the thread's CPU
-# clock for fmb_data_stats: two system calls, ~19 % of the 1 kHz motion run on a virtual machine,
-# perf at 66117f6), and 0, turned off by fmb_data_set_timing as a program that times itself would.
+# Each period twice: library_clock 1, the data objects as made (each advance reads the monotonic
+# clock for fmb_data_stats, no system call; until e855c8a it read the thread's CPU clock twice, two
+# system calls, ~19 % of the 1 kHz motion run on a virtual machine, perf at 66117f6), and 0, turned
+# off by fmb_data_set_timing as a program that times itself would.
 #
 #   bash bench/inputs.sh [REPS]        (default 9; ~45 s)
 #
@@ -22,7 +23,7 @@
 set -euo pipefail
 REPS=${1:-9}
 case $REPS in
-  -h | --help) sed -n 2,21p "$0"; exit 0 ;;
+  -h | --help) sed -n 2,22p "$0"; exit 0 ;;
   *[!0-9]* | '' | 0) echo "inputs.sh: expected a number of repeats, got '$REPS'" >&2; exit 2 ;;
 esac
 cd "$(dirname "$0")/.."

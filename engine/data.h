@@ -5,6 +5,7 @@
 #ifndef FMB_DATA_H
 #define FMB_DATA_H
 
+#include <pthread.h>
 #include <signal.h>
 
 #include "integrator.h"
@@ -52,10 +53,15 @@ struct fmbData {
   int interrupted;
   /* the state is fmb_static_data's, not a run's: fmb_advance needs fmb_init */
   int analysis_state;
-  int failed;   /* the last init or advance failed (fmb_data_stats' status) */
-  double cpu_s; /* CPU time of this thread in init and advance */
-  int untimed;  /* fmb_run's: it times the whole run itself, so init and advance read no CPU clock
-                   (two system calls an output row, ~5 % of the w15 spin-up) */
+  int failed; /* the last init or advance failed (fmb_data_stats' status) */
+  /* the time spent in init and advance (fmb_data_stats bounds it by cpu_at_init, step.c) */
+  double cpu_s;
+  int untimed; /* fmb_run's: it times the whole run itself, so init and advance read no clock */
+  /* the calling thread's CPU clock at fmb_init and that thread; one_thread: every timed call since
+     ran in it (the bound of fmb_data_stats holds only then) */
+  double cpu_at_init;
+  pthread_t init_thread;
+  int one_thread;
 };
 
 /* the misuse every call on (m, d) refuses (NULL, freed, another model's): FMB_EXIT_BAD_INPUT with

@@ -311,13 +311,17 @@ typedef int (*fmbRowFn)(void* user, double t, const double* values, int nvalues)
    (that row is not delivered); FMB_EXIT_BAD_INPUT for misuse. The rows delivered before stay
    delivered; fmb_data_stats tells where the run got to. */
 FMB_API int fmb_run_rows(const fmbModel* m, fmbData* d, fmbRowFn row, void* user, fmbDiag* diag);
-/* the integrator's counters so far (all backends of this run), t_reached = time(), the CPU time
-   spent in fmb_init and fmb_advance, the warnings given since fmb_init: 0, or FMB_EXIT_BAD_INPUT */
+/* the integrator's counters so far (all backends of this run), t_reached = time(), the time
+   spent in fmb_init and fmb_advance (cpu_s: each call timed on the monotonic clock, the sum
+   bounded by the calling thread's CPU time since fmb_init, read here: the thread's CPU time in
+   those calls while it keeps its core; docs/api.md), the warnings given since fmb_init: 0, or
+   FMB_EXIT_BAD_INPUT */
 FMB_API int fmb_data_stats(const fmbData* d, fmbStats* st);
-/* on (the default): fmb_init, fmb_advance and fmb_run_rows read the thread's CPU clock, for
-   st.cpu_s; 0: they do not, and st.cpu_s stays as it was. The clock is a system call, two an
-   advance: a program stepping in small advances that times itself turns it off (bench/inputs.sh:
-   a controller setting an input at 1 kHz, docs/api.md "Inputs"). NULL or a freed d: nothing. */
+/* on (the default): fmb_init and fmb_advance read the monotonic clock (no system call on Linux:
+   vDSO) and fmb_run_rows the thread's CPU clock once at its start and end, for st.cpu_s; 0: they
+   do not, and st.cpu_s stays as it was (a program that times itself; bench/inputs.sh measures
+   both for a controller setting an input at 1 kHz, docs/api.md "Inputs"). NULL or a freed d:
+   nothing. */
 FMB_API void fmb_data_set_timing(fmbData* d, int on);
 /* ask the advance in progress, or the next one, to stop: it returns FMB_EXIT_INTERRUPTED with the
    state at the last good step, and the request is used up (a later advance goes on from there).

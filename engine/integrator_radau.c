@@ -325,11 +325,33 @@ static int radau_start(RadauRun* c, double t0, const double* y0, const double* y
   return 0;
 }
 
-/* fmb_set_input's restart: the start's step history and a new Jacobian (keeping the last one was
-   tried: its first Newton iteration after every restart then failed to converge, 965 times in the
-   docs/python.md speed controller's 1000 settings, +17 % CPU) */
+/* fmb_set_input's restart: the start's step history, but neither the start's small first step
+   nor a new Jacobian. Radau IIA is a one-step method, so nothing of the jump at t0 lies inside a
+   step that starts there, and the step the controller had chosen for the dynamics before the
+   setting fits them after it (a jump that excites faster motion is met by the first step's
+   rejection, h / 10): from 1e-3 output_step every restart climbed back by the growth bound (8x a
+   step). The Jacobian and, while h stays, its LU are kept too, with the Jacobian marked as not
+   fresh (caljac 0), so a Newton iteration that fails on it evaluates a new one, as between any two
+   steps; an input seldom enters the Jacobian (a load is additive, a drive's row is theta - u(t)).
+   Keeping only the Jacobian was tried with the small first step: its first Newton iteration after
+   every restart then failed, 965 times in docs/python.md's 1000 settings, +17 % CPU. With the step
+   kept, bench/scenes/input_rotor.yaml's load set every 10 ms with fmb_set_input_motion took 427
+   steps (1176 before, 181 with the continuous law), every 1 ms by value 2003 (8168), and
+   docs/python.md's speed controller 5370 steps with 220 Jacobians (8105 with 999 keeping the step
+   alone, -18 % CPU; 8981 before either). */
 static int radau_reinit(void* self, double t0, const double* y0, const double* yp0, fmbDiag* diag) {
-  return radau_start(self, t0, y0, yp0, diag);
+  RadauRun* c = self;
+  const double h_before = c->h; /* the step the controller proposed next */
+  const double h_lu = c->h_lu;
+  const int have_jacobian = !c->need_jac;
+  const int rc = radau_start(c, t0, y0, yp0, diag);
+  if (rc) return rc;
+  if (h_before > c->h) c->h = fmin(h_before, c->hmax);
+  if (have_jacobian) {
+    c->need_jac = 0;
+    c->h_lu = h_lu; /* decompose again only for another h (radau_step) */
+  }
+  return 0;
 }
 
 static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup* s, double t0, const double* y0,

@@ -26,6 +26,7 @@
  * zero-frequency mode of an Euler parameter's length. Its modes are then classified into
  * families by where they move relative to the spin axis (engine/mode_family.c). */
 #include <math.h>
+#include <pthread.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -49,6 +50,7 @@ extern void dgeev_(const char* jobvl, const char* jobvr, const int* n, double* a
                    int* info);
 extern void dgesv_(const int* n, const int* nrhs, double* a, const int* lda, int* ipiv, double* b, const int* ldb,
                    int* info);
+extern void dlarnv_(const int* idist, int* iseed, const int* n, double* x);
 extern void dgemm_(const char* ta, const char* tb, const int* m, const int* n, const int* k, const double* alpha,
                    const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
                    const int* ldc);
@@ -224,6 +226,28 @@ static void csc_matvec_add(const Csc* a, const double* x, double* y) {
   }
 }
 
+/* ARPACK's reverse-communication routines (dnaupd, dnaup2, dnaitr, dgetv0, dneupd) keep their
+   state between the calls of one computation in Fortran SAVE variables, and its timing and debug
+   common blocks are global: two computations in two threads at once would run on each other's
+   state. So one computation at a time in the process, from the first dnaupd to the dneupd. The
+   mutex is initialised statically and holds no data: it is the one piece of process-wide state
+   here, and it is immutable synchronisation, not state a run could see (issue 35 item 3). */
+static pthread_mutex_t arpack_lock = PTHREAD_MUTEX_INITIALIZER;
+
+/* The Arnoldi start vector, given to dnaupd (info = 1) rather than drawn by ARPACK: dgetv0 draws it
+   with dlarnv from a seed it SAVEs and advances, so a second computation in the same process (the
+   speeds of a Campbell diagram, fmb_modes called twice) started elsewhere and agreed only to
+   roundoff, and threads shared the seed. This is the vector dgetv0 draws on its first call in a
+   process (dlarnv, uniform on (-1, 1), seed 1, 3, 5, 7: dgetv0.f), drawn from a fresh seed every
+   time: every computation repeats the first one's bytes, so results of a process that computed
+   sparse modes once (every `flexmbd modes` run) are unchanged. A pseudo-random vector has a part
+   along every mode almost surely; a regular one (all ones, say) could be orthogonal to a
+   symmetric structure's antisymmetric modes. */
+static void arpack_start_vector(int n, double* resid) {
+  int seed[4] = {1, 3, 5, 7}, uniform_pm1 = 2;
+  dlarnv_(&uniform_pm1, seed, &n, resid);
+}
+
 /* 0 with the converged Ritz values mapped to s = 1/mu (*wr_out, *wi_out, *nconv) and vectors
    (*V_out, 2 nq rows); 1 when the path does not apply (a singular saddle-point matrix: rigid
    motions; no convergence); -1 out of memory */
@@ -251,10 +275,12 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
   rc = 1;
   lu = fmb_klu_new(ns, S.p, S.i, 0);
   if (!lu || fmb_klu_factor(lu, S.x) != FMB_KLU_OK) goto done;
-  int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 0;
-  iparam[0] = 1;    /* exact shifts */
-  iparam[2] = 3000; /* restarts */
-  iparam[6] = 1;    /* regular mode on the operator (M4) */
+  int iparam[11] = {0}, ipntr[14] = {0}, ido = 0, info = 1; /* info = 1: resid is the start vector */
+  iparam[0] = 1;                                            /* exact shifts */
+  iparam[2] = 3000;                                         /* restarts */
+  iparam[6] = 1;                                            /* regular mode on the operator (M4) */
+  arpack_start_vector(n2, resid);
+  pthread_mutex_lock(&arpack_lock);
   do {
     dnaupd_c(&ido, "I", n2, "LM", nev, 0.0, resid, ncv, V, n2, iparam, ipntr, workd, workl, lworkl, &info);
     if (ido != 1 && ido != -1) break;
@@ -268,9 +294,12 @@ static int sparse_modes(int nq, int nc, int ny, const double* J0, const double* 
     memcpy(yv, rhs, (size_t)nq * sizeof(double));
     memcpy(yv + nq, x, (size_t)nq * sizeof(double));
   } while (1);
-  if (info < 0 || iparam[4] < 1) goto done;
-  dneupd_c(1, "A", select, dr, di, Z, n2, 0.0, 0.0, workev, "I", n2, "LM", nev, 0.0, resid, ncv, V, n2, iparam, ipntr,
-           workd, workl, lworkl, &info);
+  if (info >= 0 && iparam[4] >= 1)
+    dneupd_c(1, "A", select, dr, di, Z, n2, 0.0, 0.0, workev, "I", n2, "LM", nev, 0.0, resid, ncv, V, n2, iparam, ipntr,
+             workd, workl, lworkl, &info);
+  else if (info >= 0)
+    info = -1; /* no Ritz value converged */
+  pthread_mutex_unlock(&arpack_lock);
   if (info != 0 || iparam[4] < 1) goto done;
   *nconv = iparam[4] < nev + 1 ? iparam[4] : nev + 1;
   for (int k = 0; k < *nconv; ++k) { /* s = 1/mu */

@@ -2,7 +2,8 @@
 # tools/tsan.sh [BUILD_DIR] — the library from many threads under ThreadSanitizer (issue 35 item 3):
 # configures BUILD_DIR (default build-tsan) with -DFLEXMBD_TSAN=ON (clang when installed, as
 # Debian's gcc 12 TSan needs the same runtime), builds only tests/core/test_threads (8 threads
-# loading, running and stepping 8 scenes at once against one thread's bytes) and runs it.
+# loading, running and stepping 8 scenes at once against one thread's bytes; 4 computing sparse
+# modes at once) and runs it.
 # Any report fails it: halt_on_error=1 and a non-zero exit code (TSAN_OPTIONS exitcode=66).
 set -eu
 src=$(cd "$(dirname "$0")/.." && pwd)
@@ -28,4 +29,8 @@ if [ "$n" != 8 ]; then
   echo "tsan.sh: expected 8 identical comparisons, got $n" >&2
   exit 1
 fi
-echo "tsan.sh: clean (ThreadSanitizer, test_threads: 8 threads)"
+if ! echo "$out" | grep -q "sparse modes, 4 threads x 2 vs 1: 8 of 8 identical"; then
+  echo "tsan.sh: the sparse modes from 4 threads did not all match one thread's" >&2
+  exit 1
+fi
+echo "tsan.sh: clean (ThreadSanitizer, test_threads: 8 threads; sparse modes from 4)"

@@ -12,7 +12,14 @@
  * On the tree before this test, the load path noted every file read in one unlocked process-wide
  * list (engine/safe_file.c) and made the built-in registry lazily without a lock: four threads
  * loading new scene files aborted or crashed 7 runs in 8. tools/tsan.sh runs this test under
- * ThreadSanitizer (CI's robustness step), which reports any such race even when the run survives. */
+ * ThreadSanitizer (CI's robustness step), which reports any such race even when the run survives.
+ *
+ * Then NMODES threads compute the sparse modes (ARPACK) of one rotating beam's steady state at
+ * once, twice each, and every result must hold the bytes one thread computed first. ARPACK keeps
+ * the state of a computation in Fortran SAVE variables and drew its start vector from a seed it
+ * kept between calls: on the tree before, a second computation in one process differed at
+ * roundoff, and threads ran on each other's state (engine/modes.c now gives the start vector and
+ * serialises the computation). */
 #include <errno.h>
 #include <pthread.h>
 #include <stdlib.h>
@@ -138,6 +145,76 @@ static void* job_main(void* arg) {
   return NULL;
 }
 
+/* ---- sparse modes from NMODES threads at once ---- */
+#define NMODES 4
+#define MODES_COUNT 4
+
+typedef struct {
+  const fmbModel* m;
+  double t;
+  const double *y, *yp;
+  pthread_barrier_t* start;
+  fmbModes* md[2];
+} ModesJob;
+
+static void* modes_main(void* arg) {
+  ModesJob* j = arg;
+  fmbDiag diag;
+  pthread_barrier_wait(j->start);
+  for (int k = 0; k < 2; ++k)
+    if (fmb_modes(j->m, j->t, j->y, j->yp, MODES_COUNT, FMB_EIGEN_SPARSE, &j->md[k], &diag)) j->md[k] = NULL;
+  return NULL;
+}
+
+static int same_doubles(const double* a, const double* b, size_t n) {
+  return (!n || (a && b)) && memcmp(a, b, n * sizeof(double)) == 0;
+}
+
+static int same_modes(const fmbModes* a, const fmbModes* b) {
+  if (!a || !b || a->count != b->count || a->nq != b->nq || !a->sparse || !b->sparse || a->count < 1) return 0;
+  const size_t n = (size_t)a->count, nshape = n * (size_t)a->nq;
+  return same_doubles(a->frequency, b->frequency, n) && same_doubles(a->damping_ratio, b->damping_ratio, n) &&
+         same_doubles(a->shape_re, b->shape_re, nshape) && same_doubles(a->shape_im, b->shape_im, nshape);
+}
+
+static void sparse_modes_together(void) {
+  char path[1200];
+  snprintf(path, sizeof path, "%s/scenes/campbell_beam.yaml", FLEXMBD_SOURCE_DIR);
+  fmbDiag diag;
+  fmbModel* m = fmb_load(path, NULL, 0, fmb_builtin_registry(), &diag);
+  ENSURE(m != NULL);
+  if (!m) return;
+  const int n = fmb_state_size(m);
+  double *y = calloc((size_t)n, sizeof(double)), *yp = calloc((size_t)n, sizeof(double));
+  fmbStaticResult r;
+  fmbModes* alone = NULL;
+  ENSURE(y && yp && fmb_static(m, NULL, y, yp, &r, &diag) == 0);
+  ENSURE(fmb_modes(m, r.t, y, yp, MODES_COUNT, FMB_EIGEN_SPARSE, &alone, &diag) == 0);
+  ModesJob jobs[NMODES];
+  pthread_t tid[NMODES];
+  pthread_barrier_t start;
+  pthread_barrier_init(&start, NULL, NMODES);
+  for (int i = 0; i < NMODES; ++i) {
+    jobs[i] = (ModesJob){.m = m, .t = r.t, .y = y, .yp = yp, .start = &start};
+    ENSURE(pthread_create(&tid[i], NULL, modes_main, &jobs[i]) == 0);
+  }
+  for (int i = 0; i < NMODES; ++i) pthread_join(tid[i], NULL);
+  pthread_barrier_destroy(&start);
+  int same = 0;
+  for (int i = 0; i < NMODES; ++i)
+    for (int k = 0; k < 2; ++k) {
+      same += same_modes(jobs[i].md[k], alone);
+      fmb_modes_free(jobs[i].md[k]);
+    }
+  ENSURE(same == 2 * NMODES);
+  printf("campbell_beam.yaml    sparse modes, %d threads x 2 vs 1: %d of %d identical (%d modes, first %.9g rad/s)\n",
+         NMODES, same, 2 * NMODES, alone ? alone->count : 0, alone && alone->count ? alone->frequency[0] : 0.0);
+  fmb_modes_free(alone);
+  free(y);
+  free(yp);
+  fmb_free(m);
+}
+
 static void make_dir(const char* dir) {
   if (mkdir(dir, 0777) && errno != EEXIST) fprintf(stderr, "cannot make %s: %s\n", dir, strerror(errno));
 }
@@ -200,5 +277,6 @@ int main(void) {
            a->refused && b->refused ? "yes" : "no", a->why[0] ? " together: " : "", a->why, b->why[0] ? " alone: " : "",
            b->why);
   }
+  sparse_modes_together();
   return fmbt_finish("test_threads");
 }
