@@ -14,6 +14,17 @@
 S=scenes/paper/spinup_w4.yaml
 set_exact="--set bodies.beam.model=exact --set bodies.beam.elements=8"
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+# side_by_side COMPLETE.err EXACT.err: the two stats lines (cst, st) and the exact run's steps,
+# jac, cf, it and the complete run's cjac
+side_by_side() {
+  cst=$(tail -1 "$1")
+  st=$(tail -1 "$2")
+  steps=$(echo "$st" | field steps)
+  jac=$(echo "$st" | field jacobians)
+  cf=$(echo "$st" | field conv_fails)
+  it=$(echo "$st" | field newton_iters)
+  cjac=$(echo "$cst" | field jacobians)
+}
 for integ in radau9 radau5 ida; do
   for r in 1e-4 1e-5 1e-6 1e-7 1e-8; do
     # shellcheck disable=SC2086
@@ -49,12 +60,7 @@ for r in 1e-4 1e-5 1e-6; do
   for model in complete exact; do
     "$F" run $S15 -o "$OUT/w15-$model-$r.csv" --set bodies.beam.model=$model --set solver.rtol=$r 2>"$OUT/w15-$model-$r.err"
   done
-  cst=$(tail -1 "$OUT/w15-complete-$r.err")
-  st=$(tail -1 "$OUT/w15-exact-$r.err")
-  steps=$(echo "$st" | field steps)
-  jac=$(echo "$st" | field jacobians)
-  cf=$(echo "$st" | field conv_fails)
-  cjac=$(echo "$cst" | field jacobians)
+  side_by_side "$OUT/w15-complete-$r.err" "$OUT/w15-exact-$r.err"
   echo "w15 auto rtol $r: exact steps $steps, Jacobians $jac, conv_fails $cf; complete steps $(echo "$cst" | field steps), Jacobians $cjac, conv_fails $(echo "$cst" | field conv_fails)"
   check "w15 auto rtol $r: at most 5 convergence failures ($cf)" "[ '$cf' -le 5 ]"
   check "w15 auto rtol $r: Jacobians ($jac) at most 2x the complete model's ($cjac) + 2" "[ '$jac' -le $((2 * cjac + 2)) ]"
@@ -87,13 +93,7 @@ P=scenes/paper/pendulum.yaml
 for model in complete exact; do
   "$F" run "$P" -o "$OUT/pend-$model.csv" --set bodies.beam.model=$model --set solver.t_end=0.2 2>"$OUT/pend-$model.err"
 done
-cst=$(tail -1 "$OUT/pend-complete.err")
-st=$(tail -1 "$OUT/pend-exact.err")
-steps=$(echo "$st" | field steps)
-jac=$(echo "$st" | field jacobians)
-cf=$(echo "$st" | field conv_fails)
-it=$(echo "$st" | field newton_iters)
-cjac=$(echo "$cst" | field jacobians)
+side_by_side "$OUT/pend-complete.err" "$OUT/pend-exact.err"
 echo "pendulum 0.2 s auto: exact steps $steps, Jacobians $jac, conv_fails $cf, Newton iterations $it; complete steps $(echo "$cst" | field steps), Jacobians $cjac, conv_fails $(echo "$cst" | field conv_fails), Newton iterations $(echo "$cst" | field newton_iters)"
 echo "pendulum: the goal, Jacobians at most 2x the complete model's + 2 ($((2 * cjac + 2))): $([ "$jac" -le $((2 * cjac + 2)) ] && echo met || echo NOT met, not asserted)"
 check "pendulum exact: convergence failures ($cf) at most 5 % of the steps ($steps)" "[ $((cf * 100)) -le $((5 * steps)) ]"
