@@ -14,8 +14,17 @@
 # (default 3): steps, Jacobians, conv_fails, Newton iterations and the median CPU, into
 # bench/results/exact_rtol.csv, and per scene/backend whether the exact beam's CPU falls as rtol is
 # loosened. FLEXMBD_BEFORE=path uses that binary instead of building BEFORE (bench/lib.sh).
+# --probe instead: why the exact beam's Newton is slow on the pendulum (docs/performance.md, "The
+# exact beam's Newton"): the pendulum's first T_PEND s (default 0.2) as shipped and with one thing
+# changed at a time (gravity, stiffness, EA alone at the same mass and EI, the axial form, the
+# linear solver, the mesh, the step, the backend), and the omega0 = 4 spin-up and a clamped
+# clamped cantilever with and without gravity (their first 0.2 s: the complete model leaves its
+# range under gravity there after 0.22 s, its deflection 19 % of the length), complete and exact side by side: steps, Jacobians,
+# conv_fails, Newton iterations per step (counts: one run each) and the median CPU of REPS
+# (default 3), into bench/results/exact_probe.csv and a table on stdout.
 #   bash bench/exact_ratio.sh [--reps N] [--integrators "auto radau5 ida"] [--t-pend T]
 #   bash bench/exact_ratio.sh --sweep [--reps N] [--before COMMIT] [--rtols "1e-4 1e-6"] [--t-pend T]
+#   bash bench/exact_ratio.sh --probe [--reps N] [--t-pend T]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -26,6 +35,7 @@ REPS=
 INTEGRATORS="auto"
 TPEND=
 SWEEP=0
+PROBE=0
 BEFORE=cf68845
 RTOLS="1e-4 1e-5 1e-6 1e-7 1e-8"
 while [ $# -gt 0 ]; do
@@ -34,9 +44,10 @@ while [ $# -gt 0 ]; do
     --integrators) INTEGRATORS=$2; shift ;;
     --t-pend) TPEND=$2; shift ;;
     --sweep) SWEEP=1 ;;
+    --probe) PROBE=1 ;;
     --before) BEFORE=$2; shift ;;
     --rtols) RTOLS=$2; shift ;;
-    -h|--help) sed -n 2,20p "$0"; exit 0 ;;
+    -h|--help) sed -n 2,28p "$0"; exit 0 ;;
     *) echo "exact_ratio.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
   shift
@@ -44,6 +55,57 @@ done
 mkdir -p "$RES"
 WORK=$(mktemp -d)
 trap 'rm -rf "$WORK"' EXIT
+if [ "$PROBE" = 1 ]; then
+  REPS=${REPS:-3}
+  TPEND=${TPEND:-0.2}
+  CSV=$RES/exact_probe.csv
+  echo "case,model,steps,jacobians,conv_fails,newton_iters,cpu_s_median" > "$CSV"
+  P=scenes/paper/pendulum.yaml
+  W=scenes/paper/spinup_w4.yaml
+  # case|scene|settings (one --set each, space-separated)
+  cases=(
+    "pendulum as shipped|$P|solver.t_end=$TPEND"
+    "gravity x0.01|$P|solver.t_end=$TPEND gravity=[0,-0.0981]"
+    "gravity x0.1|$P|solver.t_end=$TPEND gravity=[0,-0.981]"
+    "gravity x10|$P|solver.t_end=$TPEND gravity=[0,-98.1]"
+    "no gravity; swinging at 3 rad/s|$P|solver.t_end=$TPEND gravity=[0,0] bodies.beam.angular_velocity=3"
+    "E x100 (sag / 100)|$P|solver.t_end=$TPEND bodies.beam.youngs_modulus=68.95e11"
+    "EA x0.01 (same mass and EI)|$P|solver.t_end=$TPEND bodies.beam.area=2.5e-6 bodies.beam.density=276700"
+    "EA x10 (same mass and EI)|$P|solver.t_end=$TPEND bodies.beam.area=2.5e-3 bodies.beam.density=276.7"
+    "axial_form displacement|$P|solver.t_end=$TPEND bodies.beam.axial_form=displacement"
+    "linear_solver klu_full|$P|solver.t_end=$TPEND solver.linear_solver=klu_full"
+    "1 element|$P|solver.t_end=$TPEND bodies.beam.elements=1"
+    "4 elements|$P|solver.t_end=$TPEND bodies.beam.elements=4"
+    "max_step 3e-5|$P|solver.t_end=$TPEND solver.max_step=3e-5"
+    "radau5|$P|solver.t_end=$TPEND solver.integrator=radau5"
+    "ida|$P|solver.t_end=$TPEND solver.integrator=ida"
+    "hanging at rest (angle -90 deg)|$P|solver.t_end=$TPEND bodies.beam.angle=-1.5707963"
+    "spin-up w4; first 0.2 s|$W|solver.error_control=positions solver.t_end=0.2"
+    "spin-up w4 + gravity; first 0.2 s|$W|solver.error_control=positions solver.t_end=0.2 gravity=[0,-9.81]"
+    "cantilever held; transverse gravity 0.2 s|$W|solver.error_control=positions joints.spin.omega0=0 solver.t_end=0.2 gravity=[0,-9.81]"
+    "cantilever held; axial gravity 0.2 s|$W|solver.error_control=positions joints.spin.omega0=0 solver.t_end=0.2 gravity=[-9.81,0]"
+  )
+  for c in "${cases[@]}"; do
+    name=${c%%|*}
+    rest=${c#*|}
+    scene=${rest%%|*}
+    sets=()
+    for kv in ${rest#*|}; do sets+=(--set "$kv"); done
+    for m in complete exact; do
+      : > "$WORK/cpu"
+      for ((k = 0; k < REPS; ++k)); do
+        line=$("$F" run "$scene" -o "$WORK/out.csv" --quiet --set "bodies.beam.model=$m" "${sets[@]}" 2>&1 | tail -1 || true)
+        echo "$line" | stat_field cpu_s >> "$WORK/cpu"
+      done
+      echo "$name,$m,$(echo "$line" | stat_field steps),$(echo "$line" | stat_field jacobians),$(echo "$line" | stat_field conv_fails),$(echo "$line" | stat_field newton_iters),$(median < "$WORK/cpu")" >> "$CSV"
+    done
+  done
+  echo "case: complete / exact  steps, Jacobians, conv_fails, Newton iterations per step, CPU s"
+  awk -F, 'NR > 1 { k = $1; if (!(k in seen)) { seen[k] = 1; order[++n] = k }
+      r[k, $2] = sprintf("%s, %s, %s, %.2f, %.4f", $3, $4, $5, $6 / ($3 > 0 ? $3 : 1), $7) }
+    END { for (m = 1; m <= n; ++m) printf "%-42s %s  /  %s\n", order[m], r[order[m], "complete"], r[order[m], "exact"] }' "$CSV"
+  exit 0
+fi
 if [ "$SWEEP" = 1 ]; then
   REPS=${REPS:-3}
   TPEND=${TPEND:-0.2}

@@ -14,6 +14,17 @@
 S=scenes/paper/spinup_w4.yaml
 set_exact="--set bodies.beam.model=exact --set bodies.beam.elements=8"
 field() { sed -n "s/.* $1=\([^ ]*\).*/\1/p"; }
+# side_by_side COMPLETE.err EXACT.err: the two stats lines (cst, st) and the exact run's steps,
+# jac, cf, it and the complete run's cjac
+side_by_side() {
+  cst=$(tail -1 "$1")
+  st=$(tail -1 "$2")
+  steps=$(echo "$st" | field steps)
+  jac=$(echo "$st" | field jacobians)
+  cf=$(echo "$st" | field conv_fails)
+  it=$(echo "$st" | field newton_iters)
+  cjac=$(echo "$cst" | field jacobians)
+}
 for integ in radau9 radau5 ida; do
   for r in 1e-4 1e-5 1e-6 1e-7 1e-8; do
     # shellcheck disable=SC2086
@@ -49,12 +60,7 @@ for r in 1e-4 1e-5 1e-6; do
   for model in complete exact; do
     "$F" run $S15 -o "$OUT/w15-$model-$r.csv" --set bodies.beam.model=$model --set solver.rtol=$r 2>"$OUT/w15-$model-$r.err"
   done
-  cst=$(tail -1 "$OUT/w15-complete-$r.err")
-  st=$(tail -1 "$OUT/w15-exact-$r.err")
-  steps=$(echo "$st" | field steps)
-  jac=$(echo "$st" | field jacobians)
-  cf=$(echo "$st" | field conv_fails)
-  cjac=$(echo "$cst" | field jacobians)
+  side_by_side "$OUT/w15-complete-$r.err" "$OUT/w15-exact-$r.err"
   echo "w15 auto rtol $r: exact steps $steps, Jacobians $jac, conv_fails $cf; complete steps $(echo "$cst" | field steps), Jacobians $cjac, conv_fails $(echo "$cst" | field conv_fails)"
   check "w15 auto rtol $r: at most 5 convergence failures ($cf)" "[ '$cf' -le 5 ]"
   check "w15 auto rtol $r: Jacobians ($jac) at most 2x the complete model's ($cjac) + 2" "[ '$jac' -le $((2 * cjac + 2)) ]"
@@ -75,6 +81,24 @@ check "w4 (16 elements) radau9: steps at rtol 1e-4 ($steps_w4_1e4) no more than 
 jac=$(tail -1 "$OUT/disp.err" | field jacobians)
 echo "displacement form, radau9 rtol 1e-6: Jacobians $jac"
 check "the displacement form breaks the 10-Jacobian bound (the test can fail)" "[ '$jac' -gt 10 ]"
+# The flexible pendulum (scenes/paper/pendulum.yaml, 16 elements, radau9 under auto), its first
+# 0.2 s, exact beside complete. NOT healthy yet (issue 32 item 4, docs/performance.md "The exact
+# beam's Newton"): measured 679 steps, 227 Jacobians, 0 failures, 4.5 Newton iterations per step
+# against the complete model's 699, 13, 0, 2.6; the goal (Jacobians like the complete model's) is
+# printed, not asserted. Asserted, as a guard against it getting worse: failures at most 5 % of
+# the steps, Jacobians at most half the steps, Newton iterations at most 6 per step (gravity x10
+# breaks all three: 1,450 steps, 1,396 Jacobians, 679 failures, 9.8 per step;
+# bash bench/exact_ratio.sh --probe).
+P=scenes/paper/pendulum.yaml
+for model in complete exact; do
+  "$F" run "$P" -o "$OUT/pend-$model.csv" --set bodies.beam.model=$model --set solver.t_end=0.2 2>"$OUT/pend-$model.err"
+done
+side_by_side "$OUT/pend-complete.err" "$OUT/pend-exact.err"
+echo "pendulum 0.2 s auto: exact steps $steps, Jacobians $jac, conv_fails $cf, Newton iterations $it; complete steps $(echo "$cst" | field steps), Jacobians $cjac, conv_fails $(echo "$cst" | field conv_fails), Newton iterations $(echo "$cst" | field newton_iters)"
+echo "pendulum: the goal, Jacobians at most 2x the complete model's + 2 ($((2 * cjac + 2))): $([ "$jac" -le $((2 * cjac + 2)) ] && echo met || echo NOT met, not asserted)"
+check "pendulum exact: convergence failures ($cf) at most 5 % of the steps ($steps)" "[ $((cf * 100)) -le $((5 * steps)) ]"
+check "pendulum exact: Jacobians ($jac) at most half the steps ($steps)" "[ $((jac * 2)) -le '$steps' ]"
+check "pendulum exact: at most 6 Newton iterations per step ($it in $steps)" "[ '$it' -le $((6 * steps)) ]"
 # shellcheck disable=SC2086
 "$F" run $S -o "$OUT/ref.csv" $set_exact --set solver.rtol=1e-11 --set solver.integrator=radau5 --quiet 2>/dev/null
 err=$("$F" compare "$OUT/radau9-1e-8.csv" "$OUT/ref.csv" --columns beam.tip_v 2>&1 | field max_abs)
