@@ -955,9 +955,13 @@ static void add_global_row(const double* g, double s, int nq, double* rq, double
 }
 
 /* beam_nwork's part for the dense Jacobian beyond the residual's: the z of residual_serial
-   (7 ne), element_derivs' dprefix per element (3 NL ne) and the gradients of the prefix (3) and
+   (7 ne), element_derivs' results per element (the coupled models need them twice: the prefix
+   gradients first, then the outboard-to-inboard sweep) and the gradients of the prefix (3) and
    the tail (1) over q, v, a (12 nq) */
-static size_t jacobian_nwork(const Beam* b) { return (size_t)b->ne * (7 + 3 * NL) + (size_t)12 * (size_t)(3 + b->n); }
+enum { DERIVS_DOUBLES = (sizeof(ElementDerivs) + sizeof(double) - 1) / sizeof(double) };
+static size_t jacobian_nwork(const Beam* b) {
+  return (size_t)b->ne * (7 + DERIVS_DOUBLES) + (size_t)12 * (size_t)(3 + b->n);
+}
 
 /* Dense K, C, M (column-major nq x nq; NULL blocks are skipped only all together) of the residual
    with the sums eliminated (residual_serial). Element e's rows read the prefix P_e (the sums of
@@ -973,10 +977,10 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
   if (!K || !C || !M) return -1;
   const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
   const size_t st = (size_t)nq;
-  double* R = work + 5 * (size_t)ne; /* residual_serial's scratch, then R, z, dprefix gradients, dP, dT */
+  double* R = work + 5 * (size_t)ne; /* residual_serial's scratch, then R, z, element_derivs per element, dP, dT */
   double* z = R + nq;
-  double* Dp = z + 7 * (size_t)ne;
-  double* dP = Dp + 3 * NL * (size_t)ne;
+  ElementDerivs* Dall = (ElementDerivs*)(z + 7 * (size_t)ne);
+  double* dP = z + (7 + DERIVS_DOUBLES) * (size_t)ne;
   double* dT = dP + 9 * st;
   if (residual_serial(b, env, q, v, a, R, work, z)) return 1;
   memset(K, 0, sizeof(double) * st * st);
@@ -986,7 +990,6 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
   FrameMotion fm;
   frame_motion(env, q, v, a, &fm);
   const double zero[3] = {0.0, 0.0, 0.0};
-  ElementDerivs D;
   /* the frame rows R_xy = A(theta) S: theta turns them (d/dtheta = (-R_y, R_x)), S_k moves them */
   K[2 * st + 0] += -R[1];
   K[2 * st + 1] += R[0];
@@ -994,41 +997,42 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
   if (coupled) {
     /* dP_(ne-1): the dprefix gradients of every element but the last */
     for (int e = 0; e < ne; ++e) {
-      element_derivs(b, &fm, e, q + 3, v + 3, a + 3, z + zP(b, e), &D);
-      memcpy(Dp + 3 * NL * (size_t)e, D.dprefix, sizeof D.dprefix);
+      element_derivs(b, &fm, e, q + 3, v + 3, a + 3, z + zP(b, e), &Dall[e]);
       if (e < ne - 1)
         for (int k = 0; k < 3; ++k)
-          add_local_row(e, D.dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
+          add_local_row(e, Dall[e].dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
     }
   }
   for (int e = ne - 1; e >= 0; --e) {
-    element_derivs(b, &fm, e, q + 3, v + 3, a + 3, coupled ? z + zP(b, e) : zero, &D);
+    ElementDerivs Dz;
+    if (!coupled) element_derivs(b, &fm, e, q + 3, v + 3, a + 3, zero, &Dz);
+    const ElementDerivs* D = coupled ? &Dall[e] : &Dz;
     /* the rows of its dofs: local, through P_e, and the tail -F_e T_e */
     for (int l = 0; l < 6; ++l) {
       const int i = ldof(e, l);
       if (i < 0) continue;
       double *rq = K + 3 + i, *rv = C + 3 + i, *ra = M + 3 + i;
-      add_local_row(e, D.rp[l], 1.0, rq, rv, ra, st);
+      add_local_row(e, D->rp[l], 1.0, rq, rv, ra, st);
       if (!coupled) continue;
-      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D.rp[l][LP + k], nq, rq, rv, ra, st);
+      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D->rp[l][LP + k], nq, rq, rv, ra, st);
       if (l < 2) continue; /* the tail acts on the transverse dofs (h) */
-      add_local_row(e, D.F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
-      add_global_row(dT, -D.Fv[l - 2], nq, rq, rv, ra, st);
+      add_local_row(e, D->F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
+      add_global_row(dT, -D->Fv[l - 2], nq, rq, rv, ra, st);
     }
     /* the frame rows: S_k gathers frame_k of every element */
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) {
         if (W[i][k] == 0.0) continue;
-        add_local_row(e, D.frame[k], W[i][k], K + i, C + i, M + i, st);
+        add_local_row(e, D->frame[k], W[i][k], K + i, C + i, M + i, st);
         if (coupled)
           for (int m = 0; m < 3; ++m)
-            add_global_row(dP + 3 * st * m, W[i][k] * D.frame[k][LP + m], nq, K + i, C + i, M + i, st);
+            add_global_row(dP + 3 * st * m, W[i][k] * D->frame[k][LP + m], nq, K + i, C + i, M + i, st);
       }
     if (!coupled) continue;
     /* dT_(e-1) = dT_e + dcsum_e */
-    add_local_row(e, D.csum, 1.0, dT, dT + st, dT + 2 * st, 1);
+    add_local_row(e, D->csum, 1.0, dT, dT + st, dT + 2 * st, 1);
     for (int m = 0; m < 3; ++m)
-      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D.csum[LP + m] * dP[3 * st * m + c];
+      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D->csum[LP + m] * dP[3 * st * m + c];
     /* dP_(e-1): element e-1's dofs drop out; its left node keeps element e-2's part */
     if (e == 0) break;
     for (int k = 0; k < 3; ++k) {
@@ -1038,7 +1042,7 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
         if (i >= 0) g[3 + i] = g[st + 3 + i] = g[2 * st + 3 + i] = 0.0;
       }
       if (e >= 2) {
-        const double* T = Dp + 3 * NL * (size_t)(e - 2) + NL * k;
+        const double* T = Dall[e - 2].dprefix[k];
         for (int l = 1; l < 6; l += (l == 1 ? 3 : 1)) { /* e-2's right node: ua[1], d[2], d[3] */
           const int i = ldof(e - 2, l);
           g[3 + i] += T[LQ + l];
