@@ -496,17 +496,25 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
     for (int i = 0; i < 2; ++i) FR1[i][k] = r[i], FD1[i][k] = d[i], FC1[i][k] = c[i];
   }
   (void)FC1;
-  double mFR0x, mFR0y[2], mFR1x, mFD0x[4], mFD0y[4], mFD1x[3], mFD1y[3], mFC0x[6] = {0.0}, mFC0y[6] = {0.0};
-  poly_moments(mu, FR0[0], 6, 1, &mFR0x);
-  poly_moments(mu, FR0[1], 6, 2, mFR0y);
+  double mFR0x, mFR0y[2], mFR1x, mFD0x[6], mFD0y[6], mFD1x[3], mFD1y[3], mFC0x[6] = {0.0}, mFC0y[6] = {0.0};
   poly_moments(mu, FR1[0], 3, 1, &mFR1x);
-  poly_moments(mu, FD0[0], 6, 4, mFD0x);
-  poly_moments(mu, FD0[1], 6, 4, mFD0y);
   poly_moments(mu, FD1[0], 3, 3, mFD1x);
   poly_moments(mu, FD1[1], 3, 3, mFD1y);
-  if (coupled) {
-    poly_moments(mu, FC0[0], 6, 6, mFC0x);
-    poly_moments(mu, FC0[1], 6, 6, mFC0y);
+  if (model == BEAM_COMPLETE) { /* F_R = F_D = F_C (point_forces): one set of moments */
+    poly_moments(mu, FD0[0], 6, 6, mFD0x);
+    poly_moments(mu, FD0[1], 6, 6, mFD0y);
+    memcpy(mFC0x, mFD0x, sizeof mFC0x);
+    memcpy(mFC0y, mFD0y, sizeof mFC0y);
+    mFR0x = mFD0x[0], mFR0y[0] = mFD0y[0], mFR0y[1] = mFD0y[1];
+  } else {
+    poly_moments(mu, FR0[0], 6, 1, &mFR0x);
+    poly_moments(mu, FR0[1], 6, 2, mFR0y);
+    poly_moments(mu, FD0[0], 6, 4, mFD0x);
+    poly_moments(mu, FD0[1], 6, 4, mFD0y);
+    if (coupled) {
+      poly_moments(mu, FC0[0], 6, 6, mFC0x);
+      poly_moments(mu, FC0[1], 6, 6, mFC0y);
+    }
   }
   out->frame[0] = me * mFR0x;
   out->frame[1] = me * mFR0y[0];
