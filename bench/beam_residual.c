@@ -5,11 +5,15 @@
  * built from two commits' beam.c times the two evaluations side by side (bench/beam_residual.sh).
  *
  *   beam_residual [-n "8 16 ..."] [-r REPEATS] [-t SECONDS]
+ *   beam_residual -g
  *
  * Per mesh and per evaluation (residual: the dense residual, residual_aux: the banded assembly's,
  * jacobian: the dense K, C, M, pattern_jacobian: the banded blocks), one line
  *   n=.. what=.. per_s=.. (median of REPEATS timings, each as many calls as fill SECONDS of CPU)
- *   checksum=.. (the sum of |R|: the two builds evaluate the same thing) */
+ *   checksum=.. (the sum of |R|: the two builds evaluate the same thing)
+ * -g instead prints, per model (8 elements, a random state with gravity), how much the residual
+ * moves when evaluated with 3...9 Gauss points instead of 10, over the largest inertial row (the
+ * elastic rows K p are exact at any count): which quadrature each model's integrands need. */
 #ifndef BEAM_SOURCE
 #define BEAM_SOURCE "../bodies/beam.c"
 #endif
@@ -56,7 +60,49 @@ static double run_once(Case* c) {
   return c->R[3 + c->b->n - 1];
 }
 
+static Beam* model_beam(int model, int ne, int ng) {
+  Beam* b = seed_beam(ne, 0);
+  b->model = model;
+  b->ng = ng;
+  beam_setup(b);
+  return b;
+}
+
+static int gauss_table(void) {
+  const char* const names[] = {"zoac", "foac", "complete"};
+  enum { NE = 8, NC = 3 + 3 * NE };
+  const fmbEnv env = {.gravity = {0.3, -9.81}, .has_gravity = 1}, still = {.has_gravity = 0};
+  for (int model = BEAM_ZOAC; model <= BEAM_COMPLETE; ++model) {
+    double q[NC], v[NC], a[NC], none[NC] = {0.0}, Rel[NC], R10[NC], R[NC];
+    for (int i = 0; i < NC; ++i) {
+      q[i] = i < 3 ? urand() : 0.05 * urand();
+      v[i] = 5.0 * urand();
+      a[i] = 100.0 * urand();
+    }
+    Beam* b10 = model_beam(model, NE, 10);
+    double* work = calloc(beam_nwork(b10) + 1, sizeof(double));
+    beam_residual(b10, &env, q, v, a, R10, work);
+    beam_residual(b10, &still, q, none, none, Rel, work); /* K p alone */
+    double scale = 0.0;
+    for (int i = 0; i < NC; ++i) scale = fmax(scale, fabs(R10[i] - Rel[i]));
+    printf("%s:", names[model]);
+    for (int ng = 3; ng <= 9; ++ng) {
+      Beam* b = model_beam(model, NE, ng);
+      beam_residual(b, &env, q, v, a, R, work);
+      double d = 0.0;
+      for (int i = 0; i < NC; ++i) d = fmax(d, fabs(R[i] - R10[i]));
+      printf(" %d:%.2e", ng, d / scale);
+      free(b);
+    }
+    printf("\n");
+    free(work);
+    free(b10);
+  }
+  return 0;
+}
+
 int main(int argc, char** argv) {
+  if (argc == 2 && strcmp(argv[1], "-g") == 0) return gauss_table();
   const char* ns = "8 16 32 64 128 256 512 1024";
   int repeats = 7;
   double span = 0.2;
