@@ -13,7 +13,10 @@
  *     J_R^T F_R + J_D^T F_D + J_C^T F_C
  * with three force vectors (per model, see point_forces). J_C's p-columns are -e1 h^T with the
  * dense h(x) = H(x) p; its products are accumulated with prefix sums (scalars h^T(.)) and tail
- * sums (the vector sum over points of c h), so a residual costs O(ne * points).
+ * sums (the vector sum over points of c h), so a residual costs O(ne). Every integrand is a
+ * polynomial in the element coordinate, so the residual integrates each element exactly from
+ * coefficient vectors and moments (element_terms); the Jacobian differentiates the same sums at
+ * the Gauss points (point_terms, element_derivs), exact for the same degrees.
  *
  * Those sums couple every element to all others, so the Jacobian of `residual` is dense. The
  * banded assembly (`assembly: banded`, the default from 64 elements) carries them as auxiliary
@@ -172,8 +175,9 @@ static void beam_setup(Beam* b) {
   for (int k = 0; k < 12; ++k) b->mu[k] = 1.0 / (k + 1);
 }
 
-/* default Gauss points per element: the highest polynomial degree in xi of the model's
-   integrands is 10 for complete (h h^T, h of degree 5), 6 for FOAC and ZOAC */
+/* default Gauss points per element (the Jacobian's; the residual integrates exactly): the
+   highest polynomial degree in xi of the model's integrands is 10 for complete (h h^T, h of
+   degree 5), 6 for FOAC and ZOAC */
 static int default_points(int model) { return model == BEAM_COMPLETE ? 6 : 4; }
 
 static int beam_parse(fmbParser* p, fmbNode item, void** self) {
@@ -350,8 +354,8 @@ static void element_state(const Beam* b, int e, const double* p, const double* p
 }
 
 /* One quadrature point g of element e: its deformation, coupling and the force vectors of the
-   cross-section pair (point_forces), F = F0 + y F1. Shared by the residual (element_terms) and
-   its derivatives (element_derivs). */
+   cross-section pair (point_forces), F = F0 + y F1: what element_derivs differentiates, point
+   by point (element_terms integrates the same quantities exactly, by moments). */
 typedef struct {
   double x, n1[2], w1, w2, w2s, w1d, w2d, w2sd, wc, wcd, M2;
   double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
