@@ -13,7 +13,10 @@
  *     J_R^T F_R + J_D^T F_D + J_C^T F_C
  * with three force vectors (per model, see point_forces). J_C's p-columns are -e1 h^T with the
  * dense h(x) = H(x) p; its products are accumulated with prefix sums (scalars h^T(.)) and tail
- * sums (the vector sum over points of c h), so a residual costs O(ne * points).
+ * sums (the vector sum over points of c h), so a residual costs O(ne). Every integrand is a
+ * polynomial in the element coordinate, so the residual integrates each element exactly from
+ * coefficient vectors and moments (element_terms); the Jacobian differentiates the same sums at
+ * the Gauss points (point_terms, element_derivs), exact for the same degrees.
  *
  * Those sums couple every element to all others, so the Jacobian of `residual` is dense. The
  * banded assembly (`assembly: banded`, the default from 64 elements) carries them as auxiliary
@@ -53,6 +56,9 @@ typedef struct Beam {
      H[j][l] = int_0^x N2j' N2l' (dh_j/dd_l) at each point and over a whole element */
   double G_out[FMB_GAUSS_MAX][4][3], H_out[FMB_GAUSS_MAX][4][4], H_full[4][4];
   double kb[4][4], ka; /* element bending stiffness, axial stiffness EA/le */
+  /* for the residual's exact integration (element_terms): the coefficients of xi^0..3 in the
+     shape functions N2j (ncubic) and the moments mu_k = int_0^1 xi^k (k = 0..11) */
+  double ncubic[4][4], mu[12];
 } Beam;
 
 /* ---------------------------------------------------------------------------------------------
@@ -92,6 +98,7 @@ static int adof(int e, int j) {
 }
 
 static double dot4(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]; }
+static double dot2(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1]; }
 static double dot3(const double* a, const double* b) { return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]; }
 static double dot5(const double* a, const double* b) {
   return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4];
@@ -162,10 +169,15 @@ static void beam_setup(Beam* b) {
   for (int i = 0; i < 4; ++i)
     for (int j = 0; j < 4; ++j) b->kb[i][j] = ei * kb[i][j];
   b->ka = b->Emod * b->A / le;
+  /* N2 = [1 - 3 xi^2 + 2 xi^3, le (xi - 2 xi^2 + xi^3), 3 xi^2 - 2 xi^3, le (xi^3 - xi^2)] (hermite) */
+  const double nc[4][4] = {{1.0, 0.0, -3.0, 2.0}, {0.0, le, -2.0 * le, le}, {0.0, 0.0, 3.0, -2.0}, {0.0, 0.0, -le, le}};
+  memcpy(b->ncubic, nc, sizeof nc);
+  for (int k = 0; k < 12; ++k) b->mu[k] = 1.0 / (k + 1);
 }
 
-/* default Gauss points per element: the highest polynomial degree in xi of the model's
-   integrands is 10 for complete (h h^T, h of degree 5), 6 for FOAC and ZOAC */
+/* default Gauss points per element (the Jacobian's; the residual integrates exactly): the
+   highest polynomial degree in xi of the model's integrands is 10 for complete (h h^T, h of
+   degree 5), 6 for FOAC and ZOAC */
 static int default_points(int model) { return model == BEAM_COMPLETE ? 6 : 4; }
 
 static int beam_parse(fmbParser* p, fmbNode item, void** self) {
@@ -328,10 +340,13 @@ static void element_state(const Beam* b, int e, const double* p, const double* p
   gather(p, e, es->ua, es->d);
   gather(pd, e, es->uda, es->dd);
   gather(pdd, e, es->udda, es->ddd);
+  slope_poly(b, es->d, es->cp);
+  slope_poly(b, es->dd, es->cv);
+  slope_poly(b, es->ddd, es->ca);
   if (b->model != BEAM_ZOAC) {
     double vv[5];
-    slope_products(b, es->d, es->dd, es->cp, es->cv, es->pp, es->pv5);
-    slope_poly(b, es->ddd, es->ca);
+    poly_mul(es->cp, es->cp, es->pp);
+    poly_mul(es->cp, es->cv, es->pv5);
     poly_mul(es->cp, es->ca, es->ha);
     poly_mul(es->cv, es->cv, vv);
     for (int k = 0; k < 5; ++k) es->ha[k] += vv[k];
@@ -339,8 +354,8 @@ static void element_state(const Beam* b, int e, const double* p, const double* p
 }
 
 /* One quadrature point g of element e: its deformation, coupling and the force vectors of the
-   cross-section pair (point_forces), F = F0 + y F1. Shared by the residual (element_terms) and
-   its derivatives (element_derivs). */
+   cross-section pair (point_forces), F = F0 + y F1: what element_derivs differentiates, point
+   by point (element_terms integrates the same quantities exactly, by moments). */
 typedef struct {
   double x, n1[2], w1, w2, w2s, w1d, w2d, w2sd, wc, wcd, M2;
   double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
@@ -388,46 +403,149 @@ static void point_terms(const Beam* b, const FrameMotion* fm, int e, int g, cons
   pt->wc = wc, pt->wcd = wcd, pt->M2 = M2;
 }
 
+/* The moments int_0^1 xi^k F(xi) for k = 0..nk-1 of a polynomial F with nc coefficients */
+static inline void poly_moments(const double* mu, const double* F, int nc, int nk, double* m) {
+  for (int k = 0; k < nk; ++k) {
+    double s = 0.0;
+    for (int i = 0; i < nc; ++i) s += F[i] * mu[i + k];
+    m[k] = s;
+  }
+}
+
+/* One element's contribution, integrated exactly. Every integrand is a polynomial in xi: with
+   w1 linear, w2 cubic, the slopes quadratic and the coupling terms w_c, dw_c/dt and h^T pdd +
+   pd^T H pd quintic (int_0^x of quartics), the accelerations of point_terms are quintics (the
+   y-parts, a_RD1, quadratics), and the products element_terms sums reach degree 10 (w_c F_C in
+   the theta row, the coupling tail's h F_C[0]). So instead of evaluating point_terms at the
+   Gauss points, the accelerations are built once per element as coefficient vectors, the
+   forces from them by point_forces (linear: coefficient by coefficient, f in the constant one),
+   and each integral is a dot product of coefficients with moments mu_k = 1/(k+1): the same
+   numbers as the Gauss sums (exact to degree 2 ng - 1 >= 10, test_beam_residual) at about half
+   the flops (bench/beam_residual.c). */
 static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
                           const double* pdd, const double prefix[3], ElementTerms* out) {
-  const int coupled = b->model != BEAM_ZOAC;
-  const double r2 = b->r * b->r;
+  const int model = b->model, coupled = model != BEAM_ZOAC;
+  const double le = b->le, r2 = b->r * b->r, om = fm->om, om2 = fm->om2, al = fm->al;
+  const double* mu = b->mu;
+  const double me = b->rho * b->A * le; /* the element's mass: int rho A dx = me int_0^1 dxi */
   ElementState es;
   element_state(b, e, p, pd, pdd, &es);
-  memset(out, 0, sizeof *out);
-  double fc_moment[5] = {0.0, 0.0, 0.0, 0.0, 0.0};
-  for (int g = 0; g < b->ng; ++g) {
-    const double* ns = b->ns_out[g];
-    const double* nd = b->nd_out[g];
-    PointTerms pt;
-    point_terms(b, fm, e, g, &es, prefix, &pt);
-    const double *FR0 = pt.FR0, *FD0 = pt.FD0, *FC0 = pt.FC0, *FR1 = pt.FR1, *FD1 = pt.FD1;
-    out->frame[0] += FR0[0];
-    out->frame[1] += FR0[1];
-    /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
-    out->frame[2] +=
-        pt.x * FR0[1] - r2 * FR1[0] + pt.w1 * FD0[1] - r2 * pt.w2s * FD1[1] - pt.w2 * FD0[0] + pt.wc * FC0[1];
-    /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
-    out->rp_a[0] += pt.n1[0] * FD0[0];
-    out->rp_a[1] += pt.n1[1] * FD0[0];
-    for (int j = 0; j < 4; ++j) out->rp_t[j] += ns[j] * FD0[1] - r2 * nd[j] * FD1[0];
-    if (coupled) {
-      /* p rows: -h F_C[0]; h's own element part through the F_C-weighted moments of the
-         partial-integral weights, the inboard part by the tail */
-      out->csum += FC0[0];
-      for (int k = 0; k < 5; ++k) fc_moment[k] += FC0[0] * b->pw_out[g][k];
+  /* the fields as coefficients of xi^k: x, w1 (and rates) linear, w2 (and rates) cubic, the
+     slopes w2' = cp, cv, ca quadratic (element_state), the coupling terms quintic */
+  const double x[2] = {e * le, le};
+  const double w1[2] = {es.ua[0], es.ua[1] - es.ua[0]}, w1d[2] = {es.uda[0], es.uda[1] - es.uda[0]},
+               w1dd[2] = {es.udda[0], es.udda[1] - es.udda[0]};
+  double w2[4], w2d[4], w2dd[4];
+  for (int k = 0; k < 4; ++k) {
+    w2[k] = w2d[k] = w2dd[k] = 0.0;
+    for (int j = 0; j < 4; ++j) {
+      w2[k] += b->ncubic[j][k] * es.d[j];
+      w2d[k] += b->ncubic[j][k] * es.dd[j];
+      w2dd[k] += b->ncubic[j][k] * es.ddd[j];
     }
   }
+  double wc[6] = {0.0}, wcd[6] = {0.0}, hacc[6] = {0.0};
   if (coupled) {
-    double Gm[4][3]; /* sum over points of F_C[0] G(xi_g) */
+    /* w_c = -1/2 (P0 + int_0^xi pp), dw_c/dt = -(P1 + int pv), hacc = P2 + int ha (point_terms) */
+    wc[0] = -0.5 * prefix[0];
+    wcd[0] = -prefix[1];
+    hacc[0] = prefix[2];
+    for (int k = 0; k < 5; ++k) {
+      const double w = le * mu[k];
+      wc[k + 1] = -0.5 * w * es.pp[k];
+      wcd[k + 1] = -w * es.pv5[k];
+      hacc[k + 1] = w * es.ha[k];
+    }
+  }
+  /* point_terms' accelerations, F = F0 + y F1, as coefficient vectors */
+  double aRD0[2][6] = {{0.0}}, aC[2][6] = {{0.0}}, aRD1[2][3], aR0[2][6] = {{0.0}};
+  for (int k = 0; k < 4; ++k) {
+    aRD0[0][k] += -al * w2[k] - 2.0 * om * w2d[k];
+    aRD0[1][k] += -om2 * w2[k] + w2dd[k];
+  }
+  for (int k = 0; k < 2; ++k) {
+    aRD0[0][k] += -om2 * (x[k] + w1[k]) + w1dd[k];
+    aRD0[1][k] += al * (x[k] + w1[k]) + 2.0 * om * w1d[k];
+    aR0[0][k] = -om2 * x[k];
+    aR0[1][k] = al * x[k];
+  }
+  for (int i = 0; i < 2; ++i) {
+    aRD0[i][0] += fm->a0[i];
+    aR0[i][0] += fm->a0[i];
+  }
+  for (int k = 0; k < 3; ++k) {
+    aRD1[0][k] = om2 * es.cp[k] - es.ca[k];
+    aRD1[1][k] = -al * es.cp[k] - 2.0 * om * es.cv[k];
+  }
+  aRD1[0][0] -= al;
+  aRD1[1][0] -= om2;
+  if (coupled)
+    for (int k = 0; k < 6; ++k) {
+      aC[0][k] = -om2 * wc[k] - hacc[k];
+      aC[1][k] = al * wc[k] + 2.0 * om * wcd[k];
+    }
+  /* the forces per unit mass, coefficient by coefficient; then their moments */
+  double FR0[2][6], FD0[2][6], FC0[2][6], FR1[2][3], FD1[2][3], FC1[2][3];
+  const double zero[2] = {0.0, 0.0}, aR1[2] = {-al, -om2};
+  for (int k = 0; k < 6; ++k) {
+    double r[2], d[2], c[2];
+    const double aRDk[2] = {aRD0[0][k], aRD0[1][k]}, aRk[2] = {aR0[0][k], aR0[1][k]}, aCk[2] = {aC[0][k], aC[1][k]};
+    point_forces(model, 1.0, aRDk, aRk, aCk, k == 0 ? fm->f : zero, r, d, c);
+    for (int i = 0; i < 2; ++i) FR0[i][k] = r[i], FD0[i][k] = d[i], FC0[i][k] = c[i];
+  }
+  for (int k = 0; k < 3; ++k) {
+    double r[2], d[2], c[2];
+    const double aRDk[2] = {aRD1[0][k], aRD1[1][k]};
+    point_forces(model, 1.0, aRDk, k == 0 ? aR1 : zero, zero, zero, r, d, c);
+    for (int i = 0; i < 2; ++i) FR1[i][k] = r[i], FD1[i][k] = d[i], FC1[i][k] = c[i];
+  }
+  (void)FC1;
+  double mFR0x, mFR0y[2], mFR1x, mFD0x[6], mFD0y[6], mFD1x[3], mFD1y[3], mFC0x[6] = {0.0}, mFC0y[6] = {0.0};
+  poly_moments(mu, FR1[0], 3, 1, &mFR1x);
+  poly_moments(mu, FD1[0], 3, 3, mFD1x);
+  poly_moments(mu, FD1[1], 3, 3, mFD1y);
+  if (model == BEAM_COMPLETE) { /* F_R = F_D = F_C (point_forces): one set of moments */
+    poly_moments(mu, FD0[0], 6, 6, mFD0x);
+    poly_moments(mu, FD0[1], 6, 6, mFD0y);
+    memcpy(mFC0x, mFD0x, sizeof mFC0x);
+    memcpy(mFC0y, mFD0y, sizeof mFC0y);
+    mFR0x = mFD0x[0], mFR0y[0] = mFD0y[0], mFR0y[1] = mFD0y[1];
+  } else {
+    poly_moments(mu, FR0[0], 6, 1, &mFR0x);
+    poly_moments(mu, FR0[1], 6, 2, mFR0y);
+    poly_moments(mu, FD0[0], 6, 4, mFD0x);
+    poly_moments(mu, FD0[1], 6, 4, mFD0y);
+    if (coupled) {
+      poly_moments(mu, FC0[0], 6, 6, mFC0x);
+      poly_moments(mu, FC0[1], 6, 6, mFC0y);
+    }
+  }
+  out->frame[0] = me * mFR0x;
+  out->frame[1] = me * mFR0y[0];
+  /* theta row: rho0 x F_R + u_D x F_D + (e1 w_c) x F_C, u_D = [w1 - y w2', w2] */
+  out->frame[2] = me * (dot2(x, mFR0y) - r2 * mFR1x + dot2(w1, mFD0y) - r2 * dot3(es.cp, mFD1y) - dot4(w2, mFD0x) +
+                        dot3(wc, mFC0y) + dot3(wc + 3, mFC0y + 3));
+  /* p rows: S_D^T F_D (local), S_D = [N1 - y N2'; N2] */
+  out->rp_a[0] = me * (mFD0x[0] - mFD0x[1]);
+  out->rp_a[1] = me * mFD0x[1];
+  for (int j = 0; j < 4; ++j) out->rp_t[j] = me * (dot4(b->ncubic[j], mFD0y) - r2 * dot3(b->nslope[j], mFD1x));
+  if (coupled) {
+    /* p rows: -h F_C[0]; h's own element part through the F_C-weighted moments of the partial-
+       integral weights pw_k(xi) = le xi^(k+1) / (k+1), the inboard part by the tail */
+    double fc_moment[5], Gm[4][3]; /* int F_C[0] pw_k, and int F_C[0] G(xi) */
+    for (int k = 0; k < 5; ++k) fc_moment[k] = me * le * mu[k] * mFC0x[k + 1];
     h_weights(b, fc_moment, Gm);
     for (int j = 0; j < 4; ++j) {
       out->F[j] = dot3(b->G_full[j], es.cp);
       out->rp_t[j] -= dot3(Gm[j], es.cp);
     }
+    out->csum = me * mFC0x[0];
     out->dprefix[0] = dot5(es.pp, b->pw_full);
     out->dprefix[1] = dot5(es.pv5, b->pw_full);
     out->dprefix[2] = dot5(es.ha, b->pw_full);
+  } else {
+    for (int j = 0; j < 4; ++j) out->F[j] = 0.0;
+    out->csum = out->dprefix[0] = out->dprefix[1] = out->dprefix[2] = 0.0;
   }
 }
 
@@ -849,9 +967,13 @@ static void add_global_row(const double* g, double s, int nq, double* rq, double
 }
 
 /* beam_nwork's part for the dense Jacobian beyond the residual's: the z of residual_serial
-   (7 ne), element_derivs' dprefix per element (3 NL ne) and the gradients of the prefix (3) and
+   (7 ne), element_derivs' results per element (the coupled models need them twice: the prefix
+   gradients first, then the outboard-to-inboard sweep) and the gradients of the prefix (3) and
    the tail (1) over q, v, a (12 nq) */
-static size_t jacobian_nwork(const Beam* b) { return (size_t)b->ne * (7 + 3 * NL) + (size_t)12 * (size_t)(3 + b->n); }
+enum { DERIVS_DOUBLES = (sizeof(ElementDerivs) + sizeof(double) - 1) / sizeof(double) };
+static size_t jacobian_nwork(const Beam* b) {
+  return (size_t)b->ne * (7 + DERIVS_DOUBLES) + (size_t)12 * (size_t)(3 + b->n);
+}
 
 /* Dense K, C, M (column-major nq x nq; NULL blocks are skipped only all together) of the residual
    with the sums eliminated (residual_serial). Element e's rows read the prefix P_e (the sums of
@@ -867,10 +989,10 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
   if (!K || !C || !M) return -1;
   const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
   const size_t st = (size_t)nq;
-  double* R = work + 5 * (size_t)ne; /* residual_serial's scratch, then R, z, dprefix gradients, dP, dT */
+  double* R = work + 5 * (size_t)ne; /* residual_serial's scratch, then R, z, element_derivs per element, dP, dT */
   double* z = R + nq;
-  double* Dp = z + 7 * (size_t)ne;
-  double* dP = Dp + 3 * NL * (size_t)ne;
+  ElementDerivs* Dall = (ElementDerivs*)(z + 7 * (size_t)ne);
+  double* dP = z + (7 + DERIVS_DOUBLES) * (size_t)ne;
   double* dT = dP + 9 * st;
   if (residual_serial(b, env, q, v, a, R, work, z)) return 1;
   memset(K, 0, sizeof(double) * st * st);
@@ -880,7 +1002,6 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
   FrameMotion fm;
   frame_motion(env, q, v, a, &fm);
   const double zero[3] = {0.0, 0.0, 0.0};
-  ElementDerivs D;
   /* the frame rows R_xy = A(theta) S: theta turns them (d/dtheta = (-R_y, R_x)), S_k moves them */
   K[2 * st + 0] += -R[1];
   K[2 * st + 1] += R[0];
@@ -888,41 +1009,42 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
   if (coupled) {
     /* dP_(ne-1): the dprefix gradients of every element but the last */
     for (int e = 0; e < ne; ++e) {
-      element_derivs(b, &fm, e, q + 3, v + 3, a + 3, z + zP(b, e), &D);
-      memcpy(Dp + 3 * NL * (size_t)e, D.dprefix, sizeof D.dprefix);
+      element_derivs(b, &fm, e, q + 3, v + 3, a + 3, z + zP(b, e), &Dall[e]);
       if (e < ne - 1)
         for (int k = 0; k < 3; ++k)
-          add_local_row(e, D.dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
+          add_local_row(e, Dall[e].dprefix[k], 1.0, dP + 3 * st * k, dP + 3 * st * k + st, dP + 3 * st * k + 2 * st, 1);
     }
   }
   for (int e = ne - 1; e >= 0; --e) {
-    element_derivs(b, &fm, e, q + 3, v + 3, a + 3, coupled ? z + zP(b, e) : zero, &D);
+    ElementDerivs Dz;
+    if (!coupled) element_derivs(b, &fm, e, q + 3, v + 3, a + 3, zero, &Dz);
+    const ElementDerivs* D = coupled ? &Dall[e] : &Dz;
     /* the rows of its dofs: local, through P_e, and the tail -F_e T_e */
     for (int l = 0; l < 6; ++l) {
       const int i = ldof(e, l);
       if (i < 0) continue;
       double *rq = K + 3 + i, *rv = C + 3 + i, *ra = M + 3 + i;
-      add_local_row(e, D.rp[l], 1.0, rq, rv, ra, st);
+      add_local_row(e, D->rp[l], 1.0, rq, rv, ra, st);
       if (!coupled) continue;
-      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D.rp[l][LP + k], nq, rq, rv, ra, st);
+      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D->rp[l][LP + k], nq, rq, rv, ra, st);
       if (l < 2) continue; /* the tail acts on the transverse dofs (h) */
-      add_local_row(e, D.F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
-      add_global_row(dT, -D.Fv[l - 2], nq, rq, rv, ra, st);
+      add_local_row(e, D->F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
+      add_global_row(dT, -D->Fv[l - 2], nq, rq, rv, ra, st);
     }
     /* the frame rows: S_k gathers frame_k of every element */
     for (int i = 0; i < 3; ++i)
       for (int k = 0; k < 3; ++k) {
         if (W[i][k] == 0.0) continue;
-        add_local_row(e, D.frame[k], W[i][k], K + i, C + i, M + i, st);
+        add_local_row(e, D->frame[k], W[i][k], K + i, C + i, M + i, st);
         if (coupled)
           for (int m = 0; m < 3; ++m)
-            add_global_row(dP + 3 * st * m, W[i][k] * D.frame[k][LP + m], nq, K + i, C + i, M + i, st);
+            add_global_row(dP + 3 * st * m, W[i][k] * D->frame[k][LP + m], nq, K + i, C + i, M + i, st);
       }
     if (!coupled) continue;
     /* dT_(e-1) = dT_e + dcsum_e */
-    add_local_row(e, D.csum, 1.0, dT, dT + st, dT + 2 * st, 1);
+    add_local_row(e, D->csum, 1.0, dT, dT + st, dT + 2 * st, 1);
     for (int m = 0; m < 3; ++m)
-      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D.csum[LP + m] * dP[3 * st * m + c];
+      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D->csum[LP + m] * dP[3 * st * m + c];
     /* dP_(e-1): element e-1's dofs drop out; its left node keeps element e-2's part */
     if (e == 0) break;
     for (int k = 0; k < 3; ++k) {
@@ -932,7 +1054,7 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
         if (i >= 0) g[3 + i] = g[st + 3 + i] = g[2 * st + 3 + i] = 0.0;
       }
       if (e >= 2) {
-        const double* T = Dp + 3 * NL * (size_t)(e - 2) + NL * k;
+        const double* T = Dall[e - 2].dprefix[k];
         for (int l = 1; l < 6; l += (l == 1 ? 3 : 1)) { /* e-2's right node: ua[1], d[2], d[3] */
           const int i = ldof(e - 2, l);
           g[3 + i] += T[LQ + l];

@@ -494,6 +494,7 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
       rc = FMB_EXIT_SOLVER, why = "the auxiliary unknowns are not finite";
   }
   int converged = 0;
+  double dmax_prev = INFINITY;
   for (int it = 0; it < 20 && !rc && !converged; ++it) {
     /* G(x) */
     for (int b = 1; b < m->nbody && !rc; ++b) {
@@ -600,7 +601,13 @@ static int sparse_accelerations(const fmbModel* m, fmbWorkspace* w, double t0, d
       rc = FMB_EXIT_SOLVER;
       why = "initial accelerations are not finite";
     }
-    converged = dmax <= 1e-13 * (1.0 + xmax);
+    /* G is linear in a, z and lambda, so one step solves it and the next ones only refine at the
+       roundoff of G. That floor grows with the unknowns: a 200-element banded beam sits at
+       1.3-2.8e-9 against xmax 1e4 (1.3-1.7e-13 relative), just above the 1e-13 asked, where
+       whether an iteration lands below it is luck. So an iteration that no longer halves the
+       correction, within 1e-10, has converged as far as the residual can tell. */
+    converged = dmax <= 1e-13 * (1.0 + xmax) || (dmax <= 1e-10 * (1.0 + xmax) && dmax >= 0.5 * dmax_prev);
+    dmax_prev = dmax;
   }
   if (!rc && !converged) rc = FMB_EXIT_SOLVER, why = "Newton's method did not converge on the initial accelerations";
   if (rc) {
