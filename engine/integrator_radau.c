@@ -554,7 +554,8 @@ static void jyp_times(const RadauRun* c, const double* x, double* y) {
 }
 
 /* out = sum_j a[j] v[j] over the s stages, summed from j = 0; by whole vectors (they vectorize) */
-static void stage_combination(const RadauRun* c, const double* a, double* const* v, double* restrict out) {
+FMB_VECTOR_CLONES static void stage_combination(const RadauRun* c, const double* a, double* const* v,
+                                                double* restrict out) {
   const int ny = c->ny;
   const double a0 = a[0], *restrict v0 = v[0];
   for (int k = 0; k < ny; ++k) out[k] = a0 * v0[k];

@@ -70,16 +70,8 @@ struct fmbSchur {
   long factorizations, fail_from;
 };
 
-/* The solves and the dense LU (schur_kernels.h) in two versions, picked once at load time by the
-   CPU (GCC's target_clones, an ifunc): SSE2, x86-64's baseline the build targets, and AVX2, whose
-   vectors hold twice the values. Their loops are element-wise axpys, so the wider vectors do the
-   same operations on each value in the same order: results are bit for bit the same (no FMA:
-   "avx2" does not enable it, and -std=c11 keeps contraction off). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define SCHUR_WIDE __attribute__((target_clones("avx2", "default")))
-#else
-#define SCHUR_WIDE
-#endif
+/* the solves and the dense LU (schur_kernels.h) as AVX2 clones too (internal.h) */
+#define SCHUR_WIDE FMB_VECTOR_CLONES
 
 #define SCHUR_CAT_(a, b) a##b
 #define SCHUR_CAT(a, b) SCHUR_CAT_(a, b)
