@@ -31,18 +31,11 @@ while [ $# -gt 0 ]; do
     *) echo "bench/shipped.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
-. "$ROOT/bench/lib.sh" # median, stat_field, build_landed
+. "$ROOT/bench/lib.sh" # median, stat_field, tip_err (the references have the scenes' rows), build_landed
 build_landed "$OLD" "/tmp/fmb-$OLD"
 OUT=$RES/shipped$TAG.csv
 mkdir -p "$RES"
 
-# max |beam.tip_v(run) - ref| over the rows whose t both have
-tip_err_t() {
-  awk -F, 'FNR == 1 { for (i = 1; i <= NF; ++i) if ($i == "beam.tip_v") c = i; next }
-    NR == FNR { ref[$1] = $c; next }
-    ($1 in ref) { n++; d = $c - ref[$1]; if (d < 0) d = -d; if (d > m) m = d }
-    END { if (n < 10) print "nan"; else printf "%.3g", m }' "$1" "$2"
-}
 "$F" run scenes/paper/spinup_w15.yaml -o "$WORK/spin_ref.csv" --quiet --set solver.integrator=ida \
   --set solver.rtol=1e-12 --set solver.atol=auto 2> /dev/null
 PEND_REF=$ROOT/tests/beam/data/pendulum_converged_16.csv
@@ -69,7 +62,7 @@ for scene in pendulum spinup_w15; do
     steps=$(stat_field steps < "$e")
     label=$b
     [ "$b" = new ] && label="this tree ($(git rev-parse --short HEAD))"
-    echo "$scene,$label,$steps,$(stat_field residuals < "$e"),$(stat_field newton_iters < "$e"),$(stat_field jacobians < "$e"),$cpu,$REPS,$(awk -v c="$cpu" -v s="$steps" 'BEGIN { printf "%.1f", 1e6 * c / s }'),$(tip_err_t "$ref" "$WORK/$b.$scene.csv")" >> "$OUT"
+    echo "$scene,$label,$steps,$(stat_field residuals < "$e"),$(stat_field newton_iters < "$e"),$(stat_field jacobians < "$e"),$cpu,$REPS,$(awk -v c="$cpu" -v s="$steps" 'BEGIN { printf "%.1f", 1e6 * c / s }'),$(tip_err "$ref" "$WORK/$b.$scene.csv")" >> "$OUT"
   done
 done
 column -s, -t < "$OUT"
