@@ -70,6 +70,9 @@ struct fmbSchur {
   long factorizations, fail_from;
 };
 
+/* the solves and the dense LU (schur_kernels.h) as AVX2 clones too (internal.h) */
+#define SCHUR_WIDE FMB_VECTOR_CLONES
+
 #define SCHUR_CAT_(a, b) a##b
 #define SCHUR_CAT(a, b) SCHUR_CAT_(a, b)
 

@@ -71,7 +71,7 @@ static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
    and vectorizes (reference BLAS' zgemm/ztrsm spend ~20 instructions per complex multiply-add;
    these loops about a third of that, schur.c's schur_use_dense). The pivot is the largest
    |re| + |im| (izamax's measure). 0, or 1 when a pivot is zero or not finite (S singular). */
-static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restrict ipiv) {
+SCHUR_WIDE static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restrict ipiv) {
   for (int k = 0; k < n; ++k) {
     SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
     int p = k;
@@ -103,7 +103,8 @@ static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restrict ipiv) {
 
 /* b = (P L U)^-1 b with dense_lu's factors: the row swaps, then L and U by columns (axpy form,
    contiguous again) */
-static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* restrict ipiv, SCHUR_T* restrict b) {
+SCHUR_WIDE static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* restrict ipiv,
+                                             SCHUR_T* restrict b) {
   for (int k = 0; k < n; ++k)
     if (ipiv[k] != k) {
       const SCHUR_T t = b[k];
@@ -142,7 +143,7 @@ static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
 
 /* x = J^-1 x in place with the last factorization: dR from S dR = b_R - J_Rq D^-1 b_q, then
    dq = D^-1 (b_q - J_qR dR) (schur.c's head comment). 0 ok, 1 when the LU's solve failed. */
-static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
+SCHUR_WIDE static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
   const int nq = s->nq, nr = s->nr;
   SCHUR_T* x = (SCHUR_T*)xd;
   SCHUR_T* rhs = (SCHUR_T*)s->acc;
