@@ -485,7 +485,8 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
       aC[1][k] = al * wc[k] + 2.0 * om * wcd[k];
     }
   /* the forces per unit mass, coefficient by coefficient; then their moments */
-  double FR0[2][6], FD0[2][6], FC0[2][6], FR1[2][3], FD1[2][3], FC1[2][3];
+  double FR0[2][6], FD0[2][6], FC0[2][6], FR1[2][3],
+      FD1[2][3]; /* F_C1 enters no row (theta: w_c F_C0[1]; p: F_C0[0]) */
   const double zero[2] = {0.0, 0.0}, aR1[2] = {-al, -om2};
   for (int k = 0; k < 6; ++k) {
     double r[2], d[2], c[2];
@@ -497,9 +498,8 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
     double r[2], d[2], c[2];
     const double aRDk[2] = {aRD1[0][k], aRD1[1][k]};
     point_forces(model, 1.0, aRDk, k == 0 ? aR1 : zero, zero, zero, r, d, c);
-    for (int i = 0; i < 2; ++i) FR1[i][k] = r[i], FD1[i][k] = d[i], FC1[i][k] = c[i];
+    for (int i = 0; i < 2; ++i) FR1[i][k] = r[i], FD1[i][k] = d[i];
   }
-  (void)FC1;
   double mFR0x, mFR0y[2], mFR1x, mFD0x[6], mFD0y[6], mFD1x[3], mFD1y[3], mFC0x[6] = {0.0}, mFC0y[6] = {0.0};
   poly_moments(mu, FR1[0], 3, 1, &mFR1x);
   poly_moments(mu, FD1[0], 3, 3, mFD1x);

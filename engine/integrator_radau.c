@@ -825,25 +825,31 @@ static void store_dense_output(RadauRun* c) {
   c->have_cont = 1;
 }
 
-/* the polynomial's part after cont[0] at x, and its x-derivative: Horner on the Newton form */
-static void dense_terms(const RadauRun* c, int k, double x, double* p_out, double* dp_out) {
-  double p = c->cont[c->s][k], dp = 0.0;
+/* the polynomial's part after cont[0] at x for every component (p), and its x-derivative (dp,
+   unless NULL): Horner on the Newton form, by whole vectors (the recurrences of all components run
+   together; per component the same operations as one at a time). The one
+   evaluation of the step's polynomial: dense output and the Newton start. */
+static void dense_poly(const RadauRun* c, double x, double* restrict p, double* restrict dp) {
+  const int ny = c->ny;
+  memcpy(p, c->cont[c->s], sizeof(double) * (size_t)ny);
+  if (dp) memset(dp, 0, sizeof(double) * (size_t)ny);
   for (int l = c->s - 1; l >= 1; --l) {
-    dp = p + (x - c->xnode[l]) * dp;
-    p = c->cont[l][k] + (x - c->xnode[l]) * p;
+    const double dx = x - c->xnode[l];
+    const double* restrict cl = c->cont[l];
+    if (dp)
+      for (int k = 0; k < ny; ++k) dp[k] = p[k] + dx * dp[k];
+    for (int k = 0; k < ny; ++k) p[k] = cl[k] + dx * p[k];
   }
-  *p_out = p;
-  *dp_out = dp;
 }
 
-/* y and y' of the last step's polynomial at t (within it) */
-static void dense_output(const RadauRun* c, double t, double* y, double* yp) {
+/* y and y' of the last step's polynomial at t (within it): p in y and dp in yp, then combined */
+static void dense_output(const RadauRun* c, double t, double* restrict y, double* restrict yp) {
   const double x = (t - c->t) / c->hold;
+  dense_poly(c, x, y, yp);
   for (int k = 0; k < c->ny; ++k) {
-    double p, dp;
-    dense_terms(c, k, x, &p, &dp);
+    const double p = y[k];
+    yp[k] = (p + x * yp[k]) / c->hold;
     y[k] = c->cont[0][k] + x * p;
-    yp[k] = (p + x * dp) / c->hold;
   }
 }
 
@@ -855,19 +861,12 @@ static void starting_values(RadauRun* c, int zero) {
     for (int i = 0; i < c->s; ++i) memset(c->z[i], 0, sizeof(double) * (size_t)c->ny);
     return;
   }
-  /* dense_terms' Horner scheme (its p) by whole vectors: the same operations per component */
   const double ratio = c->h / c->hold;
-  const int ny = c->ny;
   for (int i = 0; i < c->s; ++i) {
     const double xq = c->tab->c[i] * ratio;
-    double* restrict zi = c->z[i];
-    memcpy(zi, c->cont[c->s], sizeof(double) * (size_t)ny);
-    for (int l = c->s - 1; l >= 1; --l) {
-      const double dx = xq - c->xnode[l];
-      const double* restrict cl = c->cont[l];
-      for (int k = 0; k < ny; ++k) zi[k] = cl[k] + dx * zi[k];
-    }
-    for (int k = 0; k < ny; ++k) zi[k] *= xq;
+    double* zi = c->z[i];
+    dense_poly(c, xq, zi, NULL);
+    for (int k = 0; k < c->ny; ++k) zi[k] *= xq;
   }
 }
 
