@@ -8,13 +8,21 @@
  * SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
  * SCHUR_IS_COMPLEX (0 or 1); undefines them at its end. */
 
-/* S = J_RR - J_Rq D^-1 J_qR, column by column through a dense scratch column (schur.c's head
-   comment); also the compact J_Rq (complex: real, D^-1 applied in the solve; real: J_Rq D^-1)
-   and D^-1 J_qR copies the solves use. 0, or 1 when D has a
-   zero or non-finite entry. */
-static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
+/* S = J_RR - J_Rq D^-1 J_qR, column by column (schur.c's head comment); also the compact J_Rq
+   (complex: real, D^-1 applied in the solve; real: J_Rq D^-1) and D^-1 J_qR copies the solves use.
+   Column c of S is accumulated in place: in S's dense storage when S is dense, else in the zeroed
+   scratch column acc, gathered into KLU's values after. Per entry the operations of the
+   column-wise product in their order: for each q row i of J's column (ascending) S_rc -= (J_Rq)_ri
+   (D^-1 J_qR)_ic, with (D^-1 J_qR)_ic the qr_val just stored (the same product J_ic / J_ii), then
+   S_rc += (J_RR)_rc. J_Rq's columns are runs of consecutive rows (schur_blocks), so the update is
+   a contiguous axpy that vectorizes; a zero (D^-1 J_qR)_ic is skipped: the beam's mu columns hold
+   all of its q rows in the pattern (Phi_q^T, a joint's block), a few of them nonzero. Skipping
+   leaves every value as it was: the column starts at +0, and subtracting a zero product from a
+   value that is +0 or nonzero changes nothing (-0 never arises: x - x is +0 when rounding to
+   nearest). 0, or 1 when D has a zero or non-finite entry. */
+SCHUR_WIDE static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
   const fmbModel* m = s->m;
-  const int nq = s->nq;
+  const int nq = s->nq, nr = s->nr;
   const SCHUR_T* J = (const SCHUR_T*)Jd;
   SCHUR_T* dinv = (SCHUR_T*)s->dinv;
   SCHUR_T* acc = (SCHUR_T*)s->acc;
@@ -33,31 +41,36 @@ static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
     for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = J[k] * dinv[i];
 #endif
   }
-  for (int c = 0; c < s->nr; ++c) {
+  for (int c = 0; c < nr; ++c) {
     SCHUR_T* val = (SCHUR_T*)s->qr_val + s->qr_ptr[c];
     for (long k = m->colptr[nq + c]; k < s->first_kept[nq + c]; ++k) *val++ = J[k] * dinv[m->rowind[k]];
   }
-  for (int c = 0; c < s->nr; ++c) {
+  const SCHUR_T* qr_val = (const SCHUR_T*)s->qr_val;
+  for (int c = 0; c < nr; ++c) {
     const int jc = nq + c;
-    for (long k = m->colptr[jc]; k < m->colptr[jc + 1]; ++k) {
-      const long i = m->rowind[k];
-      if (i >= nq) {
-        acc[i - nq] += J[k];
-        continue;
-      }
-      const SCHUR_T coef = J[k] * dinv[i]; /* (D^-1 J_qR)_ic */
+    SCHUR_T* restrict col = acc;
+    if (s->lu) { /* dense: the whole column, zeros included */
+      col = (SCHUR_T*)s->lu + (size_t)c * (size_t)nr;
+      memset(col, 0, sizeof(SCHUR_T) * (size_t)nr);
+    }
+    for (int t = s->qr_ptr[c]; t < s->qr_ptr[c + 1]; ++t) {
+      const SCHUR_T coef = qr_val[t]; /* (D^-1 J_qR)_ic */
+      if (coef == 0.0) continue;
+      const int i = s->qr_row[t];
 #if SCHUR_IS_COMPLEX
-      const double* rq = s->rq_val + s->rq_ptr[i] - s->first_kept[i]; /* J_Rq's column i, real */
+      const double* restrict rq = s->rq_val + s->rq_ptr[i]; /* J_Rq's column i, real */
 #else
-      const double* rq = J;
+      const double* restrict rq = Jd + s->first_kept[i];
 #endif
-      for (long kk = s->first_kept[i]; kk < m->colptr[i + 1]; ++kk) acc[m->rowind[kk] - nq] -= rq[kk] * coef;
+      for (int r = s->rq_run_ptr[i]; r < s->rq_run_ptr[i + 1]; ++r) {
+        SCHUR_T* restrict dst = col + s->run_row[r];
+        const int len = s->run_len[r];
+        for (int j = 0; j < len; ++j) dst[j] -= rq[j] * coef;
+        rq += len;
+      }
     }
-    if (s->lu) { /* dense: the whole column, zeros included, then acc cleared */
-      memcpy((SCHUR_T*)s->lu + (size_t)c * (size_t)s->nr, acc, sizeof(SCHUR_T) * (size_t)s->nr);
-      memset(acc, 0, sizeof(SCHUR_T) * (size_t)s->nr);
-      continue;
-    }
+    for (long k = s->first_kept[jc]; k < m->colptr[jc + 1]; ++k) col[m->rowind[k] - nq] += J[k];
+    if (s->lu) continue;
     for (SuiteSparse_long k = s->colptr[c]; k < s->colptr[c + 1]; ++k) {
       data[k] = acc[s->rowind[k]];
       acc[s->rowind[k]] = 0.0;
