@@ -79,43 +79,97 @@ SCHUR_WIDE static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
   return 0;
 }
 
-/* Dense LU with partial pivoting of the n x n column-major a, in place (L unit lower, U upper),
-   LAPACK's getf2 written out: right-looking, so every inner loop runs down a contiguous column
-   and vectorizes (reference BLAS' zgemm/ztrsm spend ~20 instructions per complex multiply-add;
-   these loops about a third of that, schur.c's schur_use_dense). The pivot is the largest
-   |re| + |im| (izamax's measure). 0, or 1 when a pivot is zero or not finite (S singular). */
+/* x[lo..hi) -= col_m[i] u_m for the members m < cnt of a group, in the members' order: per value
+   the subtractions of one axpy per member, in the same order; four members in one pass keep the
+   value in a register between them (a load and a store per four products instead of per one) */
+static inline void SCHUR_FN(group_update)(SCHUR_T* restrict x, int lo, int hi, const SCHUR_T* const* col,
+                                          const SCHUR_T* u, int cnt) {
+  if (cnt == 4) {
+    const SCHUR_T* restrict c0 = col[0], * restrict c1 = col[1], * restrict c2 = col[2], * restrict c3 = col[3];
+    const SCHUR_T u0 = u[0], u1 = u[1], u2 = u[2], u3 = u[3];
+    for (int i = lo; i < hi; ++i) {
+      SCHUR_T t = x[i];
+      t -= c0[i] * u0;
+      t -= c1[i] * u1;
+      t -= c2[i] * u2;
+      t -= c3[i] * u3;
+      x[i] = t;
+    }
+    return;
+  }
+  for (int m = 0; m < cnt; ++m) {
+    const SCHUR_T* restrict cm = col[m];
+    const SCHUR_T um = u[m];
+    for (int i = lo; i < hi; ++i) x[i] -= cm[i] * um;
+  }
+}
+
+/* x = L^-1 x by L's first kend columns (unit lower, column-major a, n x n): for k < kend in turn,
+   u = x[k] and, unless u is zero, x[i] -= L_ik u below k. The nonzero u's are taken in groups of
+   four (group_update): a row k inside a group gets the group's earlier members when it is reached
+   (it needs them for its own u), the rows below the group all four together when it is full */
+static inline void SCHUR_FN(lower_eliminate)(const SCHUR_T* a, int n, int kend, SCHUR_T* restrict x) {
+  const SCHUR_T* col[4];
+  SCHUR_T u[4];
+  int cnt = 0;
+  for (int k = 0; k < kend; ++k) {
+    SCHUR_T xk = x[k];
+    for (int m = 0; m < cnt; ++m) xk -= col[m][k] * u[m];
+    x[k] = xk;
+    if (xk == 0.0) continue; /* S's zeros outside the beam core stay zero */
+    col[cnt] = a + (size_t)k * (size_t)n;
+    u[cnt++] = xk;
+    if (cnt == 4) {
+      SCHUR_FN(group_update)(x, k + 1, n, col, u, 4);
+      cnt = 0;
+    }
+  }
+  SCHUR_FN(group_update)(x, kend, n, col, u, cnt);
+}
+
+/* Dense LU with partial pivoting of the n x n column-major a, in place (L unit lower, U upper):
+   LAPACK's getf2, the pivot the largest |re| + |im| (izamax's measure). Left-looking, column by
+   column: column j gets the earlier row swaps, then L's updates (lower_eliminate), then its pivot.
+   Each value gets the same operations in the same order as in the right-looking form (every
+   update of column j by column k after the swaps up to k, k ascending, none where the multiplier
+   u = a_kj is zero; a swap moves a row and its values alike, and the rows at k and above are
+   fixed once swap k is done), so the factors and pivots are bit for bit those of the
+   right-looking loop, while column j stays in cache and four updates go in one pass (reference
+   BLAS' zgemm/ztrsm spend ~20 instructions per complex multiply-add: schur.c's schur_use_dense).
+   0, or 1 when a pivot is zero or not finite (S singular). */
 SCHUR_WIDE static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restrict ipiv) {
-  for (int k = 0; k < n; ++k) {
-    SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
-    int p = k;
+  for (int j = 0; j < n; ++j) {
+    SCHUR_T* restrict aj = a + (size_t)j * (size_t)n;
+    for (int k = 0; k < j; ++k)
+      if (ipiv[k] != k) {
+        const SCHUR_T t = aj[k];
+        aj[k] = aj[ipiv[k]];
+        aj[ipiv[k]] = t;
+      }
+    SCHUR_FN(lower_eliminate)(a, n, j, aj);
+    int p = j;
     double best = -1.0;
-    for (int i = k; i < n; ++i) {
-      const double v = SCHUR_ABS1(ak[i]);
+    for (int i = j; i < n; ++i) {
+      const double v = SCHUR_ABS1(aj[i]);
       if (v > best) best = v, p = i;
     }
-    ipiv[k] = p;
+    ipiv[j] = p;
     if (best == 0.0 || !isfinite(best)) return 1;
-    if (p != k)
-      for (int j = 0; j < n; ++j) {
-        SCHUR_T* col = a + (size_t)j * (size_t)n;
-        const SCHUR_T t = col[k];
-        col[k] = col[p];
+    if (p != j)
+      for (int c = 0; c <= j; ++c) {
+        SCHUR_T* col = a + (size_t)c * (size_t)n;
+        const SCHUR_T t = col[j];
+        col[j] = col[p];
         col[p] = t;
       }
-    const SCHUR_T r = 1.0 / ak[k];
-    for (int i = k + 1; i < n; ++i) ak[i] *= r;
-    for (int j = k + 1; j < n; ++j) {
-      SCHUR_T* restrict aj = a + (size_t)j * (size_t)n;
-      const SCHUR_T u = aj[k];
-      if (u == 0.0) continue; /* S's zeros outside the beam core stay zero */
-      for (int i = k + 1; i < n; ++i) aj[i] -= ak[i] * u;
-    }
+    const SCHUR_T r = 1.0 / aj[j];
+    for (int i = j + 1; i < n; ++i) aj[i] *= r;
   }
   return 0;
 }
 
 /* b = (P L U)^-1 b with dense_lu's factors: the row swaps, then L and U by columns (axpy form,
-   contiguous again) */
+   contiguous again; the nonzero b_k's four at a time, as in lower_eliminate) */
 SCHUR_WIDE static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* restrict ipiv,
                                              SCHUR_T* restrict b) {
   for (int k = 0; k < n; ++k)
@@ -124,18 +178,25 @@ SCHUR_WIDE static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, c
       b[k] = b[ipiv[k]];
       b[ipiv[k]] = t;
     }
-  for (int k = 0; k < n; ++k) {
-    const SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
-    const SCHUR_T bk = b[k];
-    if (bk == 0.0) continue;
-    for (int i = k + 1; i < n; ++i) b[i] -= ak[i] * bk;
-  }
+  SCHUR_FN(lower_eliminate)(a, n, n, b);
+  /* U from the last row up: b_k = (b_k - the group's pending products) / U_kk, then U's column k
+     above k times b_k, four columns together */
+  const SCHUR_T* col[4];
+  SCHUR_T u[4];
+  int cnt = 0;
   for (int k = n - 1; k >= 0; --k) {
-    const SCHUR_T* restrict ak = a + (size_t)k * (size_t)n;
-    const SCHUR_T bk = b[k] / ak[k];
+    const SCHUR_T* ak = a + (size_t)k * (size_t)n;
+    SCHUR_T bk = b[k];
+    for (int m = 0; m < cnt; ++m) bk -= col[m][k] * u[m];
+    bk = bk / ak[k];
     b[k] = bk;
     if (bk == 0.0) continue;
-    for (int i = 0; i < k; ++i) b[i] -= ak[i] * bk;
+    col[cnt] = ak;
+    u[cnt++] = bk;
+    if (cnt == 4) {
+      SCHUR_FN(group_update)(b, 0, k, col, u, 4);
+      cnt = 0;
+    }
   }
 }
 
