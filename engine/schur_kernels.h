@@ -223,23 +223,54 @@ SCHUR_WIDE static int SCHUR_FN(schur_solve)(fmbSchur* s, double* xd) {
   SCHUR_T* rhs = (SCHUR_T*)s->acc;
   SCHUR_T* dq = (SCHUR_T*)s->dq;
   const SCHUR_T* dinv = (const SCHUR_T*)s->dinv;
-  /* b_R - J_Rq D^-1 b_q */
+  /* b_R - J_Rq D^-1 b_q, column i of J_Rq after column i - 1 for every value; columns whose rows
+     are one and the same run (a beam's are all of S's rows) four per pass, each value kept in a
+     register between them */
   memcpy(rhs, x + nq, sizeof(SCHUR_T) * (size_t)nr);
-  for (int i = 0; i < nq; ++i) {
+  SCHUR_T bq[4];
+  for (int i = 0; i < nq;) {
+    int g = 1; /* columns i.. in this pass */
+    const int r0 = s->rq_run_ptr[i];
+    if (s->rq_run_ptr[i + 1] == r0 + 1)
+      while (g < 4 && i + g < nq && s->rq_run_ptr[i + g + 1] == r0 + g + 1 && s->run_row[r0 + g] == s->run_row[r0] &&
+             s->run_len[r0 + g] == s->run_len[r0])
+        ++g;
+    for (int l = 0; l < g; ++l) {
 #if SCHUR_IS_COMPLEX
-    const SCHUR_T bi = x[i] * dinv[i]; /* (D^-1 b_q)_i, then J_Rq (real) times it */
-    dq[i] = bi;
+      bq[l] = x[i + l] * dinv[i + l]; /* (D^-1 b_q)_i, then J_Rq (real) times it */
+      dq[i + l] = bq[l];
 #else
-    const SCHUR_T bi = x[i]; /* rq_val holds J_Rq D^-1 */
-    dq[i] = bi * dinv[i];
+      bq[l] = x[i + l]; /* rq_val holds J_Rq D^-1 */
+      dq[i + l] = bq[l] * dinv[i + l];
 #endif
-    const double* val = s->rq_val + s->rq_ptr[i];
-    for (int r = s->rq_run_ptr[i]; r < s->rq_run_ptr[i + 1]; ++r) {
-      SCHUR_T* restrict dst = rhs + s->run_row[r];
-      const int len = s->run_len[r];
-      for (int j = 0; j < len; ++j) dst[j] -= val[j] * bi;
-      val += len;
     }
+    if (g == 4) {
+      SCHUR_T* restrict dst = rhs + s->run_row[r0];
+      const int len = s->run_len[r0];
+      const double* restrict v0 = s->rq_val + s->rq_ptr[i], * restrict v1 = s->rq_val + s->rq_ptr[i + 1], * restrict v2 = s->rq_val + s->rq_ptr[i + 2], * restrict v3 = s->rq_val + s->rq_ptr[i + 3];
+      const SCHUR_T b0 = bq[0], b1 = bq[1], b2 = bq[2], b3 = bq[3];
+      for (int j = 0; j < len; ++j) {
+        SCHUR_T t = dst[j];
+        t -= v0[j] * b0;
+        t -= v1[j] * b1;
+        t -= v2[j] * b2;
+        t -= v3[j] * b3;
+        dst[j] = t;
+      }
+      i += 4;
+      continue;
+    }
+    for (int l = 0; l < g; ++l) {
+      const SCHUR_T bi = bq[l];
+      const double* val = s->rq_val + s->rq_ptr[i + l];
+      for (int r = s->rq_run_ptr[i + l]; r < s->rq_run_ptr[i + l + 1]; ++r) {
+        SCHUR_T* restrict dst = rhs + s->run_row[r];
+        const int len = s->run_len[r];
+        for (int j = 0; j < len; ++j) dst[j] -= val[j] * bi;
+        val += len;
+      }
+    }
+    i += g;
   }
   int ok = 1;
   if (s->lu) {
