@@ -79,14 +79,14 @@ SCHUR_WIDE static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
   return 0;
 }
 
-/* x[lo..hi) -= col_m[i] u_m for the members m < cnt of a group, in the members' order: per value
-   the subtractions of one axpy per member, in the same order; four members in one pass keep the
-   value in a register between them (a load and a store per four products instead of per one) */
-static inline void SCHUR_FN(group_update)(SCHUR_T* restrict x, int lo, int hi, const SCHUR_T* const* col,
-                                          const SCHUR_T* u, int cnt) {
+/* x[lo..hi) -= c_m[i] u_m for the members m < cnt (<= 4) of a group, in the members' order: per
+   value the subtractions of one axpy per member, in the same order; four members in one pass keep
+   the value in a register between them (a load and a store per four products instead of per one) */
+static inline void SCHUR_FN(group_update)(SCHUR_T* restrict x, int lo, int hi, int cnt, const SCHUR_T* restrict c0,
+                                          SCHUR_T u0, const SCHUR_T* restrict c1, SCHUR_T u1,
+                                          const SCHUR_T* restrict c2, SCHUR_T u2, const SCHUR_T* restrict c3,
+                                          SCHUR_T u3) {
   if (cnt == 4) {
-    const SCHUR_T* restrict c0 = col[0], * restrict c1 = col[1], * restrict c2 = col[2], * restrict c3 = col[3];
-    const SCHUR_T u0 = u[0], u1 = u[1], u2 = u[2], u3 = u[3];
     for (int i = lo; i < hi; ++i) {
       SCHUR_T t = x[i];
       t -= c0[i] * u0;
@@ -97,11 +97,12 @@ static inline void SCHUR_FN(group_update)(SCHUR_T* restrict x, int lo, int hi, c
     }
     return;
   }
-  for (int m = 0; m < cnt; ++m) {
-    const SCHUR_T* restrict cm = col[m];
-    const SCHUR_T um = u[m];
-    for (int i = lo; i < hi; ++i) x[i] -= cm[i] * um;
-  }
+  if (cnt > 0)
+    for (int i = lo; i < hi; ++i) x[i] -= c0[i] * u0;
+  if (cnt > 1)
+    for (int i = lo; i < hi; ++i) x[i] -= c1[i] * u1;
+  if (cnt > 2)
+    for (int i = lo; i < hi; ++i) x[i] -= c2[i] * u2;
 }
 
 /* x = L^-1 x by L's first kend columns (unit lower, column-major a, n x n): for k < kend in turn,
@@ -109,22 +110,32 @@ static inline void SCHUR_FN(group_update)(SCHUR_T* restrict x, int lo, int hi, c
    four (group_update): a row k inside a group gets the group's earlier members when it is reached
    (it needs them for its own u), the rows below the group all four together when it is full */
 static inline void SCHUR_FN(lower_eliminate)(const SCHUR_T* a, int n, int kend, SCHUR_T* restrict x) {
-  const SCHUR_T* col[4];
-  SCHUR_T u[4];
+  const SCHUR_T *c0 = a, *c1 = a, *c2 = a;
+  SCHUR_T u0 = 0.0, u1 = 0.0, u2 = 0.0;
   int cnt = 0;
   for (int k = 0; k < kend; ++k) {
     SCHUR_T xk = x[k];
-    for (int m = 0; m < cnt; ++m) xk -= col[m][k] * u[m];
-    x[k] = xk;
+    if (cnt > 0) {
+      xk -= c0[k] * u0;
+      if (cnt > 1) {
+        xk -= c1[k] * u1;
+        if (cnt > 2) xk -= c2[k] * u2;
+      }
+      x[k] = xk;
+    }
     if (xk == 0.0) continue; /* S's zeros outside the beam core stay zero */
-    col[cnt] = a + (size_t)k * (size_t)n;
-    u[cnt++] = xk;
-    if (cnt == 4) {
-      SCHUR_FN(group_update)(x, k + 1, n, col, u, 4);
-      cnt = 0;
+    const SCHUR_T* ck = a + (size_t)k * (size_t)n;
+    switch (cnt) {
+      case 0: c0 = ck, u0 = xk, cnt = 1; break;
+      case 1: c1 = ck, u1 = xk, cnt = 2; break;
+      case 2: c2 = ck, u2 = xk, cnt = 3; break;
+      default:
+        SCHUR_FN(group_update)(x, k + 1, n, 4, c0, u0, c1, u1, c2, u2, ck, xk);
+        cnt = 0;
+        break;
     }
   }
-  SCHUR_FN(group_update)(x, kend, n, col, u, cnt);
+  SCHUR_FN(group_update)(x, kend, n, cnt, c0, u0, c1, u1, c2, u2, a, 0.0);
 }
 
 /* Dense LU with partial pivoting of the n x n column-major a, in place (L unit lower, U upper):
@@ -181,21 +192,30 @@ SCHUR_WIDE static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, c
   SCHUR_FN(lower_eliminate)(a, n, n, b);
   /* U from the last row up: b_k = (b_k - the group's pending products) / U_kk, then U's column k
      above k times b_k, four columns together */
-  const SCHUR_T* col[4];
-  SCHUR_T u[4];
+  const SCHUR_T *c0 = a, *c1 = a, *c2 = a;
+  SCHUR_T u0 = 0.0, u1 = 0.0, u2 = 0.0;
   int cnt = 0;
   for (int k = n - 1; k >= 0; --k) {
     const SCHUR_T* ak = a + (size_t)k * (size_t)n;
     SCHUR_T bk = b[k];
-    for (int m = 0; m < cnt; ++m) bk -= col[m][k] * u[m];
+    if (cnt > 0) {
+      bk -= c0[k] * u0;
+      if (cnt > 1) {
+        bk -= c1[k] * u1;
+        if (cnt > 2) bk -= c2[k] * u2;
+      }
+    }
     bk = bk / ak[k];
     b[k] = bk;
     if (bk == 0.0) continue;
-    col[cnt] = ak;
-    u[cnt++] = bk;
-    if (cnt == 4) {
-      SCHUR_FN(group_update)(b, 0, k, col, u, 4);
-      cnt = 0;
+    switch (cnt) {
+      case 0: c0 = ak, u0 = bk, cnt = 1; break;
+      case 1: c1 = ak, u1 = bk, cnt = 2; break;
+      case 2: c2 = ak, u2 = bk, cnt = 3; break;
+      default:
+        SCHUR_FN(group_update)(b, 0, k, 4, c0, u0, c1, u1, c2, u2, ak, bk);
+        cnt = 0;
+        break;
     }
   }
 }
