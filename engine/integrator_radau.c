@@ -540,12 +540,13 @@ FMB_VECTOR_CLONES static void iteration_matrices(RadauRun* c) {
 }
 
 static int decompose(RadauRun* c) {
-  iteration_matrices(c);
   int failed = 0;
-  if (c->red1) {
-    failed = fmb_schur_factor(c->red1, c->e1);
-    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_schur_factor(c->red2[p], c->e2[p]);
+  if (c->red1) { /* the reduced factorizations read the matrices' entries from J_y and J_y' */
+    failed = fmb_schur_factor_pencil(c->red1, c->jy, c->jyp, c->tab->gamma / c->h, 0.0);
+    for (int p = 0; p < c->npair && !failed; ++p)
+      failed = fmb_schur_factor_pencil(c->red2[p], c->jy, c->jyp, c->tab->alpha[p] / c->h, c->tab->beta[p] / c->h);
   } else {
+    iteration_matrices(c);
     failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK;
     for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_klu_factor(c->lu2[p], c->e2[p]) != FMB_KLU_OK;
   }

@@ -8,6 +8,16 @@
  * SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
  * SCHUR_IS_COMPLEX (0 or 1); undefines them at its end. */
 
+/* entry k of J from its source (SchurSource, schur.c) */
+static inline SCHUR_T SCHUR_FN(jval)(const SchurSource* src, long k) {
+  if (src->J) return ((const SCHUR_T*)src->J)[k];
+#if SCHUR_IS_COMPLEX
+  return CMPLX(src->jy[k] + src->a * src->jyp[k], src->b * src->jyp[k]);
+#else
+  return src->jy[k] + src->a * src->jyp[k];
+#endif
+}
+
 /* S = J_RR - J_Rq D^-1 J_qR, column by column (schur.c's head comment); also the compact J_Rq
    (complex: real, D^-1 applied in the solve; real: J_Rq D^-1) and D^-1 J_qR copies the solves use.
    Column c of S is accumulated in place: in S's dense storage when S is dense, else in the zeroed
@@ -20,30 +30,30 @@
    leaves every value as it was: the column starts at +0, and subtracting a zero product from a
    value that is +0 or nonzero changes nothing (-0 never arises: x - x is +0 when rounding to
    nearest). 0, or 1 when D has a zero or non-finite entry. */
-SCHUR_WIDE static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
+SCHUR_WIDE static int SCHUR_FN(schur_form)(fmbSchur* s, const SchurSource* src) {
   const fmbModel* m = s->m;
   const int nq = s->nq, nr = s->nr;
-  const SCHUR_T* J = (const SCHUR_T*)Jd;
   SCHUR_T* dinv = (SCHUR_T*)s->dinv;
   SCHUR_T* acc = (SCHUR_T*)s->acc;
   SCHUR_T* data = (SCHUR_T*)s->data;
   for (int i = 0; i < nq; ++i) {
-    const SCHUR_T d = J[s->diag_pos[i]];
+    const SCHUR_T d = SCHUR_FN(jval)(src, s->diag_pos[i]);
     if (d == 0.0 || !SCHUR_FINITE(d)) return 1;
     dinv[i] = 1.0 / d;
   }
   for (int i = 0; i < nq; ++i) {
     double* val = s->rq_val + s->rq_ptr[i];
 #if SCHUR_IS_COMPLEX /* J_Rq's real part: its imaginary part is zero (fmbSchur) */
-    for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = creal(J[k]);
+    for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = creal(SCHUR_FN(jval)(src, k));
 #else /* J_Rq D^-1, the product IDA's runs were made with: singular passages (the parallelogram's
          flat points, tests/failures' singular four-bar) are sensitive to its last bit */
-    for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = J[k] * dinv[i];
+    for (long k = s->first_kept[i]; k < m->colptr[i + 1]; ++k) *val++ = SCHUR_FN(jval)(src, k) * dinv[i];
 #endif
   }
   for (int c = 0; c < nr; ++c) {
     SCHUR_T* val = (SCHUR_T*)s->qr_val + s->qr_ptr[c];
-    for (long k = m->colptr[nq + c]; k < s->first_kept[nq + c]; ++k) *val++ = J[k] * dinv[m->rowind[k]];
+    for (long k = m->colptr[nq + c]; k < s->first_kept[nq + c]; ++k)
+      *val++ = SCHUR_FN(jval)(src, k) * dinv[m->rowind[k]];
   }
   const SCHUR_T* qr_val = (const SCHUR_T*)s->qr_val;
   for (int c = 0; c < nr; ++c) {
@@ -59,17 +69,31 @@ SCHUR_WIDE static int SCHUR_FN(schur_form)(fmbSchur* s, const double* Jd) {
       const int i = s->qr_row[t];
 #if SCHUR_IS_COMPLEX
       const double* restrict rq = s->rq_val + s->rq_ptr[i]; /* J_Rq's column i, real */
-#else
-      const double* restrict rq = Jd + s->first_kept[i];
-#endif
       for (int r = s->rq_run_ptr[i]; r < s->rq_run_ptr[i + 1]; ++r) {
         SCHUR_T* restrict dst = col + s->run_row[r];
         const int len = s->run_len[r];
         for (int j = 0; j < len; ++j) dst[j] -= rq[j] * coef;
         rq += len;
       }
+#else /* J_Rq itself (rq_val holds J_Rq D^-1): J's, or the pencil's entries as jval makes them */
+      const long k0 = s->first_kept[i];
+      const double* restrict rq = src->J ? src->J + k0 : src->jy + k0;
+      const double* restrict rqp = src->J ? NULL : src->jyp + k0;
+      const double a = src->a;
+      for (int r = s->rq_run_ptr[i]; r < s->rq_run_ptr[i + 1]; ++r) {
+        SCHUR_T* restrict dst = col + s->run_row[r];
+        const int len = s->run_len[r];
+        if (!rqp)
+          for (int j = 0; j < len; ++j) dst[j] -= rq[j] * coef;
+        else {
+          for (int j = 0; j < len; ++j) dst[j] -= (rq[j] + a * rqp[j]) * coef;
+          rqp += len;
+        }
+        rq += len;
+      }
+#endif
     }
-    for (long k = s->first_kept[jc]; k < m->colptr[jc + 1]; ++k) col[m->rowind[k] - nq] += J[k];
+    for (long k = s->first_kept[jc]; k < m->colptr[jc + 1]; ++k) col[m->rowind[k] - nq] += SCHUR_FN(jval)(src, k);
     if (s->lu) continue;
     for (SuiteSparse_long k = s->colptr[c]; k < s->colptr[c + 1]; ++k) {
       data[k] = acc[s->rowind[k]];
@@ -223,8 +247,8 @@ SCHUR_WIDE static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, c
 /* S formed from J and factorized (klu.c's policy: the old pivot order while the condition
    estimates allow). 0 ok, 1 recoverable (D singular, or a small dense S), -1 KLU could not
    factorize S, not even from scratch with new pivots. */
-static int SCHUR_FN(schur_factor)(fmbSchur* s, const double* J) {
-  if (SCHUR_FN(schur_form)(s, J)) return 1;
+static int SCHUR_FN(schur_factor)(fmbSchur* s, const SchurSource* src) {
+  if (SCHUR_FN(schur_form)(s, src)) return 1;
   if (s->lu) { /* partial pivoting afresh each time: a dense LU has no refactorization to reuse */
     s->factored = !SCHUR_FN(dense_lu)((SCHUR_T*)s->lu, s->nr, s->ipiv);
     return s->factored ? 0 : 1;
