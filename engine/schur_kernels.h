@@ -6,7 +6,7 @@
  *
  * Expects: SCHUR_T, SCHUR_FINITE(x), SCHUR_FN(name) (the name with the type's suffix),
  * SCHUR_ABS1(x) (|x|, |re| + |im| if complex) and
- * SCHUR_IS_COMPLEX (0 or 1); undefines them at its end. */
+ * SCHUR_IS_COMPLEX (0 or 1); undefines them at its end. Uses schur.c's SchurSource. */
 
 /* entry k of J from its source (SchurSource, schur.c) */
 static inline SCHUR_T SCHUR_FN(jval)(const SchurSource* src, long k) {
