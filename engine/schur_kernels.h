@@ -129,6 +129,16 @@ static inline void SCHUR_FN(group_update)(SCHUR_T* restrict x, int lo, int hi, i
     for (int i = lo; i < hi; ++i) x[i] -= c2[i] * u2;
 }
 
+/* x's rows swapped as the LU's first kend pivots swapped them, in their order */
+static inline void SCHUR_FN(apply_swaps)(const int* ipiv, int kend, SCHUR_T* x) {
+  for (int k = 0; k < kend; ++k)
+    if (ipiv[k] != k) {
+      const SCHUR_T t = x[k];
+      x[k] = x[ipiv[k]];
+      x[ipiv[k]] = t;
+    }
+}
+
 /* x = L^-1 x by L's first kend columns (unit lower, column-major a, n x n): for k < kend in turn,
    u = x[k] and, unless u is zero, x[i] -= L_ik u below k. The nonzero u's are taken in groups of
    four (group_update): a row k inside a group gets the group's earlier members when it is reached
@@ -175,12 +185,7 @@ static inline void SCHUR_FN(lower_eliminate)(const SCHUR_T* a, int n, int kend, 
 SCHUR_WIDE static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restrict ipiv) {
   for (int j = 0; j < n; ++j) {
     SCHUR_T* restrict aj = a + (size_t)j * (size_t)n;
-    for (int k = 0; k < j; ++k)
-      if (ipiv[k] != k) {
-        const SCHUR_T t = aj[k];
-        aj[k] = aj[ipiv[k]];
-        aj[ipiv[k]] = t;
-      }
+    SCHUR_FN(apply_swaps)(ipiv, j, aj);
     SCHUR_FN(lower_eliminate)(a, n, j, aj);
     int p = j;
     double best = -1.0;
@@ -207,12 +212,7 @@ SCHUR_WIDE static int SCHUR_FN(dense_lu)(SCHUR_T* restrict a, int n, int* restri
    contiguous again; the nonzero b_k's four at a time, as in lower_eliminate) */
 SCHUR_WIDE static void SCHUR_FN(dense_solve)(const SCHUR_T* restrict a, int n, const int* restrict ipiv,
                                              SCHUR_T* restrict b) {
-  for (int k = 0; k < n; ++k)
-    if (ipiv[k] != k) {
-      const SCHUR_T t = b[k];
-      b[k] = b[ipiv[k]];
-      b[ipiv[k]] = t;
-    }
+  SCHUR_FN(apply_swaps)(ipiv, n, b);
   SCHUR_FN(lower_eliminate)(a, n, n, b);
   /* U from the last row up: b_k = (b_k - the group's pending products) / U_kk, then U's column k
      above k times b_k, four columns together */
