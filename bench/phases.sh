@@ -47,13 +47,13 @@ dense_poly fmb_csv_row"
 profile() { # binary label
   valgrind --tool=callgrind --callgrind-out-file="$WORK/$2.cg" "$1" run "$ROOT/$SCENE" -o "$WORK/$2.csv" --quiet \
     2> "$WORK/$2.err" < /dev/null
-  callgrind_annotate --inclusive=yes "$WORK/$2.cg" 2> /dev/null > "$WORK/$2.txt"
+  callgrind_annotate --inclusive=yes --threshold=100 "$WORK/$2.cg" 2> /dev/null > "$WORK/$2.txt"
 }
 profile "/tmp/fmb-$OLD/build/flexmbd" old
 profile "$F" new
 count() { # label function (an ERE): its inclusive count, its AVX2 and default clones' summed
   { grep -E ":($2)(\.avx2|\.default)? \[" "$WORK/$1.txt" || true; } |
-    awk '{ gsub(",", "", $1); s += $1 } END { printf "%d", s }'
+    awk '{ gsub(",", "", $1); s += $1 } END { printf "%.0f", s }'
 }
 NEW_LABEL="this tree ($(git rev-parse --short HEAD))"
 echo "phase,$OLD,$NEW_LABEL,ratio" > "$OUT"
