@@ -2,7 +2,7 @@
 # bench/shipped.sh — the two shipped paper scenes' per-step cost, an old build beside this tree
 # (issue 32, item 3: radau's per-step cost; docs/performance.md, "The shipped pendulum").
 #
-#   bash bench/shipped.sh [--reps N] [--old COMMIT] [--tag NAME]
+#   bash bench/shipped.sh [--reps N] [--old COMMIT] [--tag NAME] [--scene pendulum|spinup_w15]
 #
 # scenes/paper/pendulum.yaml and scenes/paper/spinup_w15.yaml as shipped, run by OLD (default
 # 2a91686, built beside the tree by bench/lib.sh's build_landed, on its own copy of the scenes) and
@@ -11,7 +11,8 @@
 # Jacobians, the median CPU, CPU per step, and max |beam.tip_v - converged| at the scene's rows:
 # the pendulum against tests/beam/data/pendulum_converged_16.csv (radau9 rtol 1e-12, stored for
 # tests/beam/shipped_pendulum.sh), the spin-up against this tree's IDA at rtol 1e-12 (made here;
-# bench/hardest.sh's reference). Results: bench/results/shipped.csv (--tag: shipped_NAME.csv).
+# bench/hardest.sh's reference). --scene: that scene only (the spin-up alone takes seconds, so
+# --reps 21 is cheap). Results: bench/results/shipped.csv (--tag: shipped_NAME.csv).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$PWD
@@ -22,12 +23,14 @@ trap 'rm -rf "$WORK"' EXIT
 REPS=7
 OLD=2a91686
 TAG=
+SCENES="pendulum spinup_w15"
 while [ $# -gt 0 ]; do
   case $1 in
     --reps) REPS=$2; shift 2 ;;
     --old) OLD=$2; shift 2 ;;
     --tag) TAG=_$2; shift 2 ;;
-    -h | --help) sed -n 2,15p "$0"; exit 0 ;;
+    --scene) SCENES=$2; shift 2 ;;
+    -h | --help) sed -n 2,16p "$0"; exit 0 ;;
     *) echo "bench/shipped.sh: unknown argument '$1'" >&2; exit 2 ;;
   esac
 done
@@ -36,8 +39,10 @@ build_landed "$OLD" "/tmp/fmb-$OLD"
 OUT=$RES/shipped$TAG.csv
 mkdir -p "$RES"
 
-"$F" run scenes/paper/spinup_w15.yaml -o "$WORK/spin_ref.csv" --quiet --set solver.integrator=ida \
-  --set solver.rtol=1e-12 --set solver.atol=auto 2> /dev/null
+case " $SCENES " in *" spinup_w15 "*)
+  "$F" run scenes/paper/spinup_w15.yaml -o "$WORK/spin_ref.csv" --quiet --set solver.integrator=ida \
+    --set solver.rtol=1e-12 --set solver.atol=auto 2> /dev/null ;;
+esac
 PEND_REF=$ROOT/tests/beam/data/pendulum_converged_16.csv
 
 one() { # build scene out err
@@ -48,12 +53,12 @@ one() { # build scene out err
   fi
 }
 for rep in $(seq "$REPS"); do
-  for scene in pendulum spinup_w15; do
+  for scene in $SCENES; do
     for b in "$OLD" new; do one "$b" "scenes/paper/$scene.yaml" "$WORK/$b.$scene.csv" "$WORK/$b.$scene.$rep.err"; done
   done
 done
 echo "scene,build,steps,residuals,newton_iters,jacobians,cpu_s_median,reps,cpu_us_per_step,tip_err_m" > "$OUT"
-for scene in pendulum spinup_w15; do
+for scene in $SCENES; do
   ref=$WORK/spin_ref.csv
   [ "$scene" = pendulum ] && ref=$PEND_REF
   for b in "$OLD" new; do

@@ -522,23 +522,31 @@ static int evaluate_jacobian(RadauRun* c) {
 /* E1 = J_y + (gamma/h) J_y' and, per complex pair p, E2_p = J_y + ((alpha_p + i beta_p)/h) J_y',
    factorized: 0 ok, 1 singular, -1 a reduced factorization failed outright (KLU, or the tests'
    fault injection) */
-static int decompose(RadauRun* c) {
+/* the iteration matrices' values from J_y and J_y' (element-wise: an AVX2 clone, internal.h) */
+FMB_VECTOR_CLONES static void iteration_matrices(RadauRun* c) {
   const long nnz = c->m->nnz;
   const double g = c->tab->gamma / c->h;
-  for (long k = 0; k < nnz; ++k) c->e1[k] = c->jy[k] + g * c->jyp[k];
+  const double* restrict jy = c->jy, * restrict jyp = c->jyp;
+  double* restrict e1 = c->e1;
+  for (long k = 0; k < nnz; ++k) e1[k] = jy[k] + g * jyp[k];
   for (int p = 0; p < c->npair; ++p) {
     const double a = c->tab->alpha[p] / c->h, b = c->tab->beta[p] / c->h;
-    double* e2 = c->e2[p];
+    double* restrict e2 = c->e2[p];
     for (long k = 0; k < nnz; ++k) {
-      e2[2 * k] = c->jy[k] + a * c->jyp[k];
-      e2[2 * k + 1] = b * c->jyp[k];
+      e2[2 * k] = jy[k] + a * jyp[k];
+      e2[2 * k + 1] = b * jyp[k];
     }
   }
+}
+
+static int decompose(RadauRun* c) {
   int failed = 0;
-  if (c->red1) {
-    failed = fmb_schur_factor(c->red1, c->e1);
-    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_schur_factor(c->red2[p], c->e2[p]);
+  if (c->red1) { /* the reduced factorizations read the matrices' entries from J_y and J_y' */
+    failed = fmb_schur_factor_pencil(c->red1, c->jy, c->jyp, c->tab->gamma / c->h, 0.0);
+    for (int p = 0; p < c->npair && !failed; ++p)
+      failed = fmb_schur_factor_pencil(c->red2[p], c->jy, c->jyp, c->tab->alpha[p] / c->h, c->tab->beta[p] / c->h);
   } else {
+    iteration_matrices(c);
     failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK;
     for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_klu_factor(c->lu2[p], c->e2[p]) != FMB_KLU_OK;
   }
@@ -829,7 +837,7 @@ static void store_dense_output(RadauRun* c) {
    unless NULL): Horner on the Newton form, by whole vectors (the recurrences of all components run
    together; per component the same operations as one at a time). The one
    evaluation of the step's polynomial: dense output and the Newton start. */
-static void dense_poly(const RadauRun* c, double x, double* restrict p, double* restrict dp) {
+FMB_VECTOR_CLONES static void dense_poly(const RadauRun* c, double x, double* restrict p, double* restrict dp) {
   const int ny = c->ny;
   memcpy(p, c->cont[c->s], sizeof(double) * (size_t)ny);
   if (dp) memset(dp, 0, sizeof(double) * (size_t)ny);
@@ -843,13 +851,14 @@ static void dense_poly(const RadauRun* c, double x, double* restrict p, double* 
 }
 
 /* y and y' of the last step's polynomial at t (within it): p in y and dp in yp, then combined */
-static void dense_output(const RadauRun* c, double t, double* restrict y, double* restrict yp) {
+FMB_VECTOR_CLONES static void dense_output(const RadauRun* c, double t, double* restrict y, double* restrict yp) {
   const double x = (t - c->t) / c->hold;
   dense_poly(c, x, y, yp);
+  const double* restrict c0 = c->cont[0];
   for (int k = 0; k < c->ny; ++k) {
     const double p = y[k];
     yp[k] = (p + x * yp[k]) / c->hold;
-    y[k] = c->cont[0][k] + x * p;
+    y[k] = c0[k] + x * p;
   }
 }
 

@@ -70,6 +70,15 @@ struct fmbSchur {
   long factorizations, fail_from;
 };
 
+/* Where the factorization reads J (schur_kernels.h's jval): J itself, interleaved (re, im) when
+   complex, or, when J is NULL, the pencil J_y + (a + i b) J_y' entry by entry (b = 0 for the
+   real one) with the operations radau's iteration matrices were formed with, so that the values
+   are the same bit for bit and radau stores no matrix the factorization reads once */
+typedef struct {
+  const double *J, *jy, *jyp;
+  double a, b;
+} SchurSource;
+
 /* the solves and the dense LU (schur_kernels.h) as AVX2 clones too (internal.h) */
 #define SCHUR_WIDE FMB_VECTOR_CLONES
 
@@ -90,9 +99,19 @@ struct fmbSchur {
 #define SCHUR_IS_COMPLEX 1
 #include "schur_kernels.h"
 
-int fmb_schur_factor(fmbSchur* s, const double* J) {
+static int schur_factor_from(fmbSchur* s, const SchurSource* src) {
   if (s->fail_from && ++s->factorizations >= s->fail_from) return -1;
-  return s->nc == 2 ? schur_factor_complex(s, J) : schur_factor_real(s, J);
+  return s->nc == 2 ? schur_factor_complex(s, src) : schur_factor_real(s, src);
+}
+
+int fmb_schur_factor(fmbSchur* s, const double* J) {
+  const SchurSource src = {.J = J};
+  return schur_factor_from(s, &src);
+}
+
+int fmb_schur_factor_pencil(fmbSchur* s, const double* jy, const double* jyp, double a, double b) {
+  const SchurSource src = {.jy = jy, .jyp = jyp, .a = a, .b = s->nc == 2 ? b : 0.0};
+  return schur_factor_from(s, &src);
 }
 
 int fmb_schur_solve(fmbSchur* s, double* x) { return s->nc == 2 ? schur_solve_complex(s, x) : schur_solve_real(s, x); }

@@ -13,6 +13,10 @@
 typedef struct fmbSchur fmbSchur;
 fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values);
 int fmb_schur_factor(fmbSchur* s, const double* J);
+/* the same for J = jy + (a + i b) jyp (real: jy + a jyp, b unused) on the model's pattern, its
+   entries computed as read: jy[k] + a jyp[k] and b jyp[k], bit for bit the values of the stored
+   matrix (radau's iteration matrices) */
+int fmb_schur_factor_pencil(fmbSchur* s, const double* jy, const double* jyp, double a, double b);
 int fmb_schur_solve(fmbSchur* s, double* x);
 void fmb_schur_forget(fmbSchur* s); /* drop the factorization: the next one chooses pivots afresh */
 void fmb_schur_free(fmbSchur* s);

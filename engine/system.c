@@ -19,6 +19,7 @@
  * is restored in the outputs by the minimum-norm rule (output.c, with augmented.c's minimum-norm solve). */
 #include <math.h>
 #include <stdatomic.h>
+#include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -395,10 +396,19 @@ static void csc_add_block(const fmbModel* m, double* data, int r0, int nr, int c
 /* ---------------------------------------------------------------------------------------------
  * residual */
 
+/* 1 when every x[i] is finite. A non-finite double has all eleven exponent bits set, so adding
+   one at the exponent's lowest bit carries into the sign bit exactly then; or-ing that over the
+   vector has no early exit and no branch per value, and vectorizes (integer lanes) where
+   isfinite's test-and-return did not: three calls per residual */
 static int all_finite(const double* x, int n) {
-  for (int i = 0; i < n; ++i)
-    if (!isfinite(x[i])) return 0;
-  return 1;
+  const uint64_t exponent = 0x7ff0000000000000u, low = 0x0010000000000000u;
+  uint64_t bad = 0;
+  for (int i = 0; i < n; ++i) {
+    uint64_t bits;
+    memcpy(&bits, x + i, sizeof bits);
+    bad |= (bits & exponent) + low;
+  }
+  return (bad >> 63) == 0;
 }
 
 static int system_residual(const fmbModel* m, fmbWorkspace* w, double t, const double* y, const double* yp, double* F,
