@@ -211,6 +211,7 @@ static const char* const exact_models[] = {"zoac", "foac", "complete", "exact", 
 static const char* const exact_integrations[] = {"reduced", "full", NULL};
 static const char* const exact_assemblies[] = {"auto", "dense", "banded", NULL}; /* as beam.c's */
 static const char* const exact_axial_forms[] = {"mixed", "displacement", NULL};  /* as beam.c's */
+static const char* const exact_kinematics[] = {"cable", "intrinsic", NULL};       /* as beam.c's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on. Unlike beam.c's (whose banded form adds
    auxiliary unknowns), this pattern adds nothing: measured (bench/exact_banded.sh, the omega0 = 15
@@ -229,6 +230,8 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, exact_models, &model); /* "exact": beam.c chose this table */
   err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, exact_integrations, &b->integration);
+  int kinematics = 0; /* "intrinsic" is bodies/beam_intrinsic.c's (beam.c's variant chose): "cable" here */
+  err |= fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, exact_kinematics, &kinematics);
   int assembly = ASSEMBLY_AUTO;
   err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, exact_assemblies, &assembly);
   b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
@@ -836,6 +839,11 @@ static const fmbParam exact_params[] = {
      .choices = exact_axial_forms,
      .doc = "mixed: the axial strains at the axial points are unknowns Newton iterates on (integration: reduced, "
             "assembly not dense); displacement: the form before it, to compare (docs/models.md, \"Newton\")"},
+    {.key = "kinematics",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "cable",
+     .choices = exact_kinematics,
+     .doc = "cable here: nodal positions and slopes (intrinsic: bodies/beam_intrinsic.c)"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},

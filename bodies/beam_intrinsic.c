@@ -1,0 +1,556 @@
+/*
+ * beam_intrinsic.c — `type: beam`, `model: exact`, `kinematics: intrinsic`: the same continuum as
+ * bodies/beam_exact.c (the planar extensible elastica without shear, in the floating frame) in
+ * intrinsic coordinates: the axial strain and the tangent's angle along the beam instead of
+ * nodal positions and slopes (docs/models.md, "Intrinsic kinematics").
+ *
+ * Why: with rho'(s) = (1 + eps(s)) e(phi(s)), e(phi) = (cos phi, sin phi), one has exactly
+ *     |rho'| - 1 = eps,   rho' x rho'' / |rho'|^2 = phi',
+ * so U = 1/2 int (EA eps^2 + EI phi'^2) ds is QUADRATIC in the coordinates and the stiffness is
+ * constant, as in the complete model. In the cable's coordinates EA's stiff direction turns with
+ * the slope, and a frozen Newton matrix is wrong by ~EA dphi (issue 32 item 4, the hypothesis
+ * this file tests). All the nonlinearity moves into the inertia (positions are integrals).
+ *
+ * Coordinates q = [x, y, theta, eps_0, kappa_0, (eps_i, phi_i, kappa_i) for nodes i = 1..ne]:
+ * eps linear between nodes (C0; its energy has no derivative of eps), phi cubic Hermite from the
+ * nodal (phi_i, kappa_i = phi'_i) (C1: the curvature is continuous, as the cable's). The root is
+ * clamped to the frame: phi_0 = 0, with the root stretch eps_0 and root curvature kappa_0 free (as
+ * beam_exact.c's free root stretch a). So x, y, theta are the root's position and tangent, as in
+ * every beam model, and joints, drives and outputs see the same frame.
+ *
+ * Kinematics in the frame: rho(s) = int_0^s rho'(s') ds', its rates from
+ *     rho'_t  = epsdot e + (1 + eps) phidot e_perp,
+ *     rho'_tt = epsddot e + 2 epsdot phidot e_perp + (1 + eps)(phiddot e_perp - phidot^2 e),
+ * and a_b = A^T r0'' + theta'' I~rho - theta'^2 rho + 2 theta' I~rho_t + rho_tt (beam_exact.c's).
+ * The integrals are a rule of NESTED points: each element's increment rho(s_e+1) - rho(s_e) by
+ * nq-point Gauss on the element, and the position of a mass point at s_e + x_g le by the same
+ * nq-point rule on [s_e, s_e + x_g le]. nq = 4 (exact to degree 7 in xi; the integrand is smooth
+ * in xi, e(phi) with phi cubic); tests/exact/test_exact_intrinsic.c checks it against 8 points.
+ * The discrete positions rho_g(q) ARE the model: the residual is the exact virtual work of
+ * T = 1/2 sum_g w_g mu |v_g|^2 with these positions, so energy is conserved as for any
+ * Lagrangian discretization.
+ *
+ * Residual: R_j = sum_g w_g mu (d rho_g/d q_j) . F_g + dU/dq_j, F = a_b - f_b. Swapping the sums
+ * (d rho_g/dq_j is a sum of d rho'/dq_j over nested points), R_j = sum_p w_p (d rho'/dq_j)(s_p) .
+ * G_p with G_p = the weighted F of every mass point whose position contains p: for an element's
+ * increment points the suffix sum of F over the elements beyond it, for a mass point's own points
+ * its own F. O(ne) per residual: one forward pass (positions, F) and one backward (suffix sums).
+ * Mass points: 4 Gauss per element (as beam_exact.c); the strain energy is a quartic in xi, exact
+ * at those 4 points. The Jacobian is the engine's differences (engine/fd.c), dense.
+ */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "beam_section.h"
+#include "flexmbd_plugin.h"
+
+enum { INTRINSIC_MAX_ELEMENTS = 4096, INTRINSIC_MAX_POINTS = 8 };
+
+typedef struct BeamIntrinsic {
+  double L, rho, A, Izz, Emod;
+  int ne;
+  double pos0[2], angle0, vel0[2], omega0;
+  /* derived */
+  double le, mu, EA, EI;
+  int n;                                                 /* deformation coordinates 2 + 3 ne */
+  int nq, nm;                                            /* nested rule, mass rule (points per element) */
+  double xq[INTRINSIC_MAX_POINTS], wq[INTRINSIC_MAX_POINTS]; /* nested rule on [0, 1] */
+  double xm[INTRINSIC_MAX_POINTS], wm[INTRINSIC_MAX_POINTS]; /* mass points on [0, 1] */
+} BeamIntrinsic;
+
+static void intrinsic_setup(BeamIntrinsic* b, int nested_points) {
+  b->le = b->L / b->ne;
+  b->mu = b->rho * b->A;
+  b->EA = b->Emod * b->A;
+  b->EI = b->Emod * b->Izz;
+  b->n = 2 + 3 * b->ne;
+  b->nq = nested_points;
+  b->nm = 4;
+  fmb_gauss_legendre01(b->nq, b->xq, b->wq);
+  fmb_gauss_legendre01(b->nm, b->xm, b->wm);
+}
+
+/* Element dofs: local l = 3 k + f (k: node e or e+1; f: 0 eps, 1 phi, 2 kappa). Index in q, or -1
+   for the clamped root angle phi_0. */
+static int idof(int e, int l) {
+  const int node = e + (l >= 3), f = l % 3;
+  if (node == 0) return f == 0 ? 3 : f == 2 ? 4 : -1;
+  return 5 + 3 * (node - 1) + f;
+}
+
+/* weights of the element's six dofs at xi in their field (eps: linear; phi: Hermite with the
+   slope weights carrying le) and, for phi, their s-derivatives (phi' = kappa) */
+static void shape6(double xi, double le, double w[6], double dw[6]) {
+  double ns[4], nd[4];
+  fmb_beam_hermite(xi, le, ns, nd);
+  w[0] = 1.0 - xi, w[1] = ns[0], w[2] = ns[1], w[3] = xi, w[4] = ns[2], w[5] = ns[3];
+  if (dw) dw[0] = -1.0 / le, dw[1] = nd[0], dw[2] = nd[1], dw[3] = 1.0 / le, dw[4] = nd[2], dw[5] = nd[3];
+}
+
+static void element_dofs(const double* x, int e, double X[6]) {
+  for (int l = 0; l < 6; ++l) {
+    const int i = idof(e, l);
+    X[l] = i >= 0 ? x[i] : 0.0;
+  }
+}
+
+/* eps and phi (and phi' when asked) from the element's dof values X at weights w (dw) */
+static void fields(const double w[6], const double* dw, const double X[6], double* eps, double* phi, double* dphi) {
+  *eps = w[0] * X[0] + w[3] * X[3];
+  *phi = w[1] * X[1] + w[2] * X[2] + w[4] * X[4] + w[5] * X[5];
+  if (dphi) *dphi = dw[1] * X[1] + dw[2] * X[2] + dw[4] * X[4] + dw[5] * X[5];
+}
+
+/* rho', rho'_t, rho'_tt at one point (any may be NULL but rp) */
+static void tangent_terms(const double w[6], const double X[6], const double* Xd, const double* Xdd, double rp[2],
+                          double* rpt, double* rptt) {
+  double eps, phi, ed = 0.0, pd = 0.0, edd = 0.0, pdd = 0.0;
+  fields(w, NULL, X, &eps, &phi, NULL);
+  if (Xd) fields(w, NULL, Xd, &ed, &pd, NULL);
+  if (Xdd) fields(w, NULL, Xdd, &edd, &pdd, NULL);
+  const double c = cos(phi), s = sin(phi), st = 1.0 + eps;
+  rp[0] = st * c, rp[1] = st * s;
+  if (rpt) rpt[0] = ed * c - st * pd * s, rpt[1] = ed * s + st * pd * c;
+  if (rptt) {
+    const double along = edd - st * pd * pd, across = 2.0 * ed * pd + st * pdd;
+    rptt[0] = along * c - across * s;
+    rptt[1] = along * s + across * c;
+  }
+}
+
+/* sum over the nested rule on [0, span] of element e: the increments of rho, rho_t, rho_tt */
+static void nested_increment(const BeamIntrinsic* b, double span, const double X[6], const double* Xd,
+                             const double* Xdd, double d[2], double* dt, double* dtt) {
+  d[0] = d[1] = 0.0;
+  if (dt) dt[0] = dt[1] = 0.0;
+  if (dtt) dtt[0] = dtt[1] = 0.0;
+  for (int m = 0; m < b->nq; ++m) {
+    double w[6], rp[2], rpt[2], rptt[2];
+    shape6(span * b->xq[m], b->le, w, NULL);
+    tangent_terms(w, X, Xd, Xdd, rp, dt ? rpt : NULL, dtt ? rptt : NULL);
+    const double wl = b->wq[m] * span * b->le;
+    d[0] += wl * rp[0], d[1] += wl * rp[1];
+    if (dt) dt[0] += wl * rpt[0], dt[1] += wl * rpt[1];
+    if (dtt) dtt[0] += wl * rptt[0], dtt[1] += wl * rptt[1];
+  }
+}
+
+/* R_j += wl (d rho'/d q_j)(xi) . G over the element's dofs: d rho'/d eps-dof = N e, d rho'/d
+   phi-dof = (1 + eps) H e_perp */
+static void add_tangent_work(int e, double xi, double le, double wl, const double X[6], const double G[2],
+                             double* R) {
+  double w[6], eps, phi;
+  shape6(xi, le, w, NULL);
+  fields(w, NULL, X, &eps, &phi, NULL);
+  const double c = cos(phi), s = sin(phi);
+  const double along = wl * (c * G[0] + s * G[1]), across = wl * (1.0 + eps) * (-s * G[0] + c * G[1]);
+  for (int l = 0; l < 6; ++l) {
+    const int i = idof(e, l);
+    if (i >= 0) R[i] += w[l] * (l % 3 == 0 ? along : across);
+  }
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Parse (the keys of beam_exact.c's cable that apply; `kinematics: intrinsic` brought us here).
+ * ------------------------------------------------------------------------------------------- */
+static const char* const intrinsic_models[] = {"zoac", "foac", "complete", "exact", NULL}; /* as beam.c's */
+static const char* const intrinsic_kinematics[] = {"cable", "intrinsic", NULL};            /* as beam.c's */
+
+static int intrinsic_parse(fmbParser* p, fmbNode item, void** self) {
+  BeamIntrinsic* b = calloc(1, sizeof *b);
+  if (!b) return fmb_parse_error(p, item, "out of memory");
+  int model = 3, kinematics = 1, err = 0;
+  err |= fmb_get_double(p, item, "length", FMB_REQUIRED | FMB_POSITIVE, &b->L);
+  err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, INTRINSIC_MAX_ELEMENTS, &b->ne);
+  err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, &b->rho);
+  err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
+  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->Izz);
+  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
+  err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, intrinsic_models, &model);
+  err |= fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, intrinsic_kinematics, &kinematics);
+  err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
+  err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
+  err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
+  err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
+  const char* const refused[] = {"damping", "quadrature_points", "integration", "assembly", "axial_form"};
+  for (int k = 0; k < 5 && !err; ++k)
+    if (fmb_find_key(p, item, refused[k]) >= 0)
+      err = fmb_parse_error(p, fmb_find_key(p, item, refused[k]),
+                            "'%s' is not available with kinematics: intrinsic (undamped; its quadrature is fixed, "
+                            "its Jacobian dense by differences: docs/models.md); remove the key",
+                            refused[k]);
+  if (err) {
+    free(b);
+    return err;
+  }
+  intrinsic_setup(b, 4);
+  const double me = b->mu * b->le, k_axial = b->EA / b->le, k_bend = 12.0 * b->EI / (b->le * b->le * b->le);
+  if (!isnormal(me) || !isnormal(k_axial) || !isnormal(k_bend) || !isfinite(fmax(k_axial, k_bend) / me)) {
+    fmb_beam_refuse_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
+    free(b);
+    return -1;
+  }
+  *self = b;
+  return 0;
+}
+
+static void intrinsic_destroy(void* self) { free(self); }
+
+static int intrinsic_ncoord(const void* self) { return 3 + ((const BeamIntrinsic*)self)->n; }
+
+static void intrinsic_initial(const void* self, double* q0, double* v0) {
+  const BeamIntrinsic* b = self;
+  const int nc = 3 + b->n;
+  memset(q0, 0, sizeof(double) * (size_t)nc);
+  memset(v0, 0, sizeof(double) * (size_t)nc);
+  q0[0] = b->pos0[0], q0[1] = b->pos0[1], q0[2] = b->angle0;
+  v0[0] = b->vel0[0], v0[1] = b->vel0[1], v0[2] = b->omega0;
+}
+
+/* work: per element its mass points' weighted F (2 nm) and their sum (2) for the residual; 2 per
+   coordinate for the marker's body-frame columns */
+static size_t intrinsic_nwork(const void* self) {
+  const BeamIntrinsic* b = self;
+  const size_t residual = (size_t)b->ne * (size_t)(2 * b->nm + 2), marker = 2 * (size_t)(3 + b->n);
+  return residual > marker ? residual : marker;
+}
+
+/* A^T (r0'' - g) in the body frame */
+static void frame_load(const fmbEnv* env, const double* q, const double* a, double* c, double* s, double G0[2]) {
+  *c = cos(q[2]), *s = sin(q[2]);
+  double g[2] = {0.0, 0.0};
+  if (env && env->has_gravity) g[0] = env->gravity[0], g[1] = env->gravity[1];
+  const double d[2] = {a[0] - g[0], a[1] - g[1]};
+  G0[0] = *c * d[0] + *s * d[1];
+  G0[1] = -*s * d[0] + *c * d[1];
+}
+
+static int intrinsic_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
+                              double* R, double* work) {
+  const BeamIntrinsic* b = self;
+  const int nm = b->nm, stride = 2 * nm + 2;
+  double c, s, G0[2];
+  frame_load(env, q, a, &c, &s, G0);
+  const double om = v[2], al = a[2];
+  memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
+  /* forward: positions and rates at the nodes and mass points, the mass points' F */
+  double rho[2] = {0.0, 0.0}, rt[2] = {0.0, 0.0}, rtt[2] = {0.0, 0.0};
+  for (int e = 0; e < b->ne; ++e) {
+    double X[6], Xd[6], Xdd[6];
+    element_dofs(q, e, X), element_dofs(v, e, Xd), element_dofs(a, e, Xdd);
+    double* Fw = work + (size_t)e * (size_t)stride;
+    double* Te = Fw + 2 * nm;
+    Te[0] = Te[1] = 0.0;
+    for (int g = 0; g < nm; ++g) {
+      double d[2], dt[2], dtt[2];
+      nested_increment(b, b->xm[g], X, Xd, Xdd, d, dt, dtt);
+      const double r[2] = {rho[0] + d[0], rho[1] + d[1]}, r_t[2] = {rt[0] + dt[0], rt[1] + dt[1]};
+      const double r_tt[2] = {rtt[0] + dtt[0], rtt[1] + dtt[1]};
+      const double F[2] = {G0[0] - al * r[1] - om * om * r[0] - 2.0 * om * r_t[1] + r_tt[0],
+                           G0[1] + al * r[0] - om * om * r[1] + 2.0 * om * r_t[0] + r_tt[1]};
+      const double w = b->mu * b->wm[g] * b->le;
+      Fw[2 * g] = w * F[0], Fw[2 * g + 1] = w * F[1];
+      Te[0] += Fw[2 * g], Te[1] += Fw[2 * g + 1];
+      R[0] += Fw[2 * g] * c - Fw[2 * g + 1] * s; /* J = A^T e_x */
+      R[1] += Fw[2 * g] * s + Fw[2 * g + 1] * c; /* J = A^T e_y */
+      R[2] += -r[1] * Fw[2 * g] + r[0] * Fw[2 * g + 1]; /* J = I~rho */
+    }
+    double d[2], dt[2], dtt[2];
+    nested_increment(b, 1.0, X, Xd, Xdd, d, dt, dtt);
+    for (int k = 0; k < 2; ++k) rho[k] += d[k], rt[k] += dt[k], rtt[k] += dtt[k];
+  }
+  /* backward: the suffix sum S of F beyond each element; the deformation rows */
+  double S[2] = {0.0, 0.0};
+  for (int e = b->ne - 1; e >= 0; --e) {
+    double X[6];
+    element_dofs(q, e, X);
+    const double* Fw = work + (size_t)e * (size_t)stride;
+    for (int m = 0; m < b->nq; ++m) add_tangent_work(e, b->xq[m], b->le, b->wq[m] * b->le, X, S, R);
+    for (int g = 0; g < nm; ++g)
+      for (int m = 0; m < b->nq; ++m)
+        add_tangent_work(e, b->xm[g] * b->xq[m], b->le, b->wq[m] * b->xm[g] * b->le, X, Fw + 2 * g, R);
+    /* strain energy: dU = int EA eps N + EI phi' H' (a quartic in xi: exact at the 4 mass points) */
+    for (int g = 0; g < nm; ++g) {
+      double w[6], dw[6], eps, phi, dphi;
+      shape6(b->xm[g], b->le, w, dw);
+      fields(w, dw, X, &eps, &phi, &dphi);
+      const double wl = b->wm[g] * b->le;
+      for (int l = 0; l < 6; ++l) {
+        const int i = idof(e, l);
+        if (i >= 0) R[i] += l % 3 == 0 ? wl * b->EA * eps * w[l] : wl * b->EI * dphi * dw[l];
+      }
+    }
+    S[0] += Fw[2 * nm], S[1] += Fw[2 * nm + 1];
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Where things are: rho and rho_t at node k (the nested rule's sums up to it), the marker.
+ * ------------------------------------------------------------------------------------------- */
+static void node_state(const BeamIntrinsic* b, const double* q, const double* v, int k, double rho[2], double rt[2]) {
+  rho[0] = rho[1] = 0.0;
+  if (rt) rt[0] = rt[1] = 0.0;
+  for (int e = 0; e < k; ++e) {
+    double X[6], Xd[6], d[2], dt[2];
+    element_dofs(q, e, X);
+    if (v) element_dofs(v, e, Xd);
+    nested_increment(b, 1.0, X, v ? Xd : NULL, NULL, d, rt ? dt : NULL, NULL);
+    rho[0] += d[0], rho[1] += d[1];
+    if (rt) rt[0] += dt[0], rt[1] += dt[1];
+  }
+}
+
+/* d rho/d q of the nested points of element e over [0, span] into body-frame columns du (2 per
+   coordinate, nc of them), for the marker's derivatives */
+static void add_position_columns(const BeamIntrinsic* b, int e, double span, const double X[6], double* du) {
+  for (int m = 0; m < b->nq; ++m) {
+    double w[6], eps, phi;
+    shape6(span * b->xq[m], b->le, w, NULL);
+    fields(w, NULL, X, &eps, &phi, NULL);
+    const double wl = b->wq[m] * span * b->le, c = cos(phi), s = sin(phi);
+    for (int l = 0; l < 6; ++l) {
+      const int i = idof(e, l);
+      if (i < 0) continue;
+      if (l % 3 == 0)
+        du[2 * i] += wl * w[l] * c, du[2 * i + 1] += wl * w[l] * s;
+      else
+        du[2 * i] -= wl * w[l] * (1.0 + eps) * s, du[2 * i + 1] += wl * w[l] * (1.0 + eps) * c;
+    }
+  }
+}
+
+/* work: 2 nc doubles of body-frame columns (intrinsic_nwork) */
+static int intrinsic_marker(const void* self, const double* q, const double local[2], double pos[2], double* angle,
+                            double* dpos_dq, double* dangle_dq, double* work) {
+  const BeamIntrinsic* b = self;
+  const int nc = 3 + b->n;
+  const double x = local[0], y = local[1];
+  if (x > b->L * (1.0 + 1e-12)) return -1;
+  const double c = cos(q[2]), s = sin(q[2]);
+  if (dpos_dq) memset(dpos_dq, 0, sizeof(double) * 2 * (size_t)nc);
+  if (dangle_dq) memset(dangle_dq, 0, sizeof(double) * (size_t)nc);
+  double pb[2] = {x, y}, phi = 0.0;
+  const int onbeam = x > 0.0; /* points at x <= 0 move rigidly with the frame (the root is clamped) */
+  int e = 0;
+  double xi = 0.0, X[6], w[6];
+  if (onbeam) {
+    double rho[2], d[2], eps;
+    fmb_beam_locate(b->le, b->ne, x, &e, &xi);
+    node_state(b, q, NULL, e, rho, NULL);
+    element_dofs(q, e, X);
+    nested_increment(b, xi, X, NULL, NULL, d, NULL, NULL);
+    shape6(xi, b->le, w, NULL);
+    fields(w, NULL, X, &eps, &phi, NULL);
+    pb[0] = rho[0] + d[0] - y * sin(phi);
+    pb[1] = rho[1] + d[1] + y * cos(phi);
+  }
+  pos[0] = q[0] + c * pb[0] - s * pb[1];
+  pos[1] = q[1] + s * pb[0] + c * pb[1];
+  if (angle) *angle = q[2] + phi;
+  if (dangle_dq) dangle_dq[2] = 1.0;
+  if (dpos_dq) {
+    dpos_dq[0] = 1.0;
+    dpos_dq[nc + 1] = 1.0;
+    dpos_dq[2] = -s * pb[0] - c * pb[1];
+    dpos_dq[nc + 2] = c * pb[0] - s * pb[1];
+  }
+  if (!onbeam) return 0;
+  if (dangle_dq)
+    for (int l = 0; l < 6; ++l)
+      if (l % 3 && idof(e, l) >= 0) dangle_dq[idof(e, l)] += w[l];
+  if (!dpos_dq) return 0;
+  double* du = work; /* body-frame d pb / d q_i, 2 per coordinate */
+  memset(du, 0, sizeof(double) * 2 * (size_t)nc);
+  for (int k = 0; k < e; ++k) {
+    double Xk[6];
+    element_dofs(q, k, Xk);
+    add_position_columns(b, k, 1.0, Xk, du);
+  }
+  add_position_columns(b, e, xi, X, du);
+  for (int l = 0; l < 6; ++l) { /* y n(phi): d n/d phi = -e(phi) */
+    const int i = idof(e, l);
+    if (i >= 0 && l % 3) du[2 * i] -= y * w[l] * cos(phi), du[2 * i + 1] -= y * w[l] * sin(phi);
+  }
+  for (int i = 3; i < nc; ++i) {
+    dpos_dq[i] = c * du[2 * i] - s * du[2 * i + 1];
+    dpos_dq[nc + i] = s * du[2 * i] + c * du[2 * i + 1];
+  }
+  return 0;
+}
+
+/* ---------------------------------------------------------------------------------------------
+ * Energy and outputs.
+ * ------------------------------------------------------------------------------------------- */
+/* T, U_e, U_g and p_theta (angular momentum about the frame origin) at the mass points */
+static void intrinsic_integrals(const BeamIntrinsic* b, const fmbEnv* env, const double* q, const double* v,
+                                fmbEnergy* en, double* ptheta) {
+  const double c = cos(q[2]), s = sin(q[2]), om = v[2];
+  const double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
+  double T = 0.0, Ue = 0.0, pth = 0.0, mrho[2] = {0.0, 0.0}, rho[2] = {0.0, 0.0}, rt[2] = {0.0, 0.0};
+  for (int e = 0; e < b->ne; ++e) {
+    double X[6], Xd[6], d[2], dt[2];
+    element_dofs(q, e, X), element_dofs(v, e, Xd);
+    for (int g = 0; g < b->nm; ++g) {
+      nested_increment(b, b->xm[g], X, Xd, NULL, d, dt, NULL);
+      const double r[2] = {rho[0] + d[0], rho[1] + d[1]};
+      const double w = b->mu * b->wm[g] * b->le;
+      const double vb[2] = {v0[0] - om * r[1] + rt[0] + dt[0], v0[1] + om * r[0] + rt[1] + dt[1]};
+      T += 0.5 * w * (vb[0] * vb[0] + vb[1] * vb[1]);
+      pth += w * (-r[1] * vb[0] + r[0] * vb[1]);
+      mrho[0] += w * r[0], mrho[1] += w * r[1];
+      double sw[6], dw[6], eps, phi, dphi;
+      shape6(b->xm[g], b->le, sw, dw);
+      fields(sw, dw, X, &eps, &phi, &dphi);
+      Ue += 0.5 * b->wm[g] * b->le * (b->EA * eps * eps + b->EI * dphi * dphi);
+    }
+    nested_increment(b, 1.0, X, Xd, NULL, d, dt, NULL);
+    rho[0] += d[0], rho[1] += d[1], rt[0] += dt[0], rt[1] += dt[1];
+  }
+  double Ug = 0.0;
+  if (env && env->has_gravity) {
+    const double m = b->mu * b->L, gx = env->gravity[0], gy = env->gravity[1];
+    Ug = -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
+  }
+  en->kinetic = T;
+  en->strain = Ue;
+  en->gravity = Ug;
+  en->spring = 0.0;
+  if (ptheta) *ptheta = pth;
+}
+
+static void intrinsic_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
+                             double* work) {
+  (void)work;
+  intrinsic_integrals(self, env, q, v, en, NULL);
+}
+
+static int intrinsic_output_lookup(const void* self, const char* quantity) {
+  return fmb_beam_output_lookup(((const BeamIntrinsic*)self)->ne, quantity);
+}
+
+/* beam_exact.c's names and meanings: tip_u/tip_v the tip's displacement in the frame */
+static int intrinsic_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
+  (void)work;
+  const BeamIntrinsic* b = self;
+  if (id == FMB_BEAM_ANG_MOMENTUM) {
+    fmbEnergy en;
+    intrinsic_integrals(b, NULL, q, v, &en, value);
+    return 0;
+  }
+  if (id == FMB_BEAM_TIP_ANGLE) {
+    *value = q[5 + 3 * (b->ne - 1) + 1]; /* phi at the tip */
+    return 0;
+  }
+  int node = b->ne, comp = id;
+  if (id >= FMB_BEAM_NODE_BASE) {
+    node = (id - FMB_BEAM_NODE_BASE) / FMB_BEAM_NODE_STRIDE;
+    const int k = (id - FMB_BEAM_NODE_BASE) % FMB_BEAM_NODE_STRIDE;
+    comp = k == 0 ? FMB_BEAM_TIP_U : k == 1 ? FMB_BEAM_TIP_V : k == 2 ? FMB_BEAM_TIP_X : FMB_BEAM_TIP_Y;
+  } else if (id < 0 || id >= FMB_BEAM_NTIP) {
+    return -1;
+  }
+  double rho[2], rt[2];
+  node_state(b, q, v, node, rho, rt);
+  const double c = cos(q[2]), s = sin(q[2]);
+  switch (comp) {
+    case FMB_BEAM_TIP_U: *value = rho[0] - node * b->le; break;
+    case FMB_BEAM_TIP_V: *value = rho[1]; break;
+    case FMB_BEAM_TIP_U_RATE: *value = rt[0]; break;
+    case FMB_BEAM_TIP_V_RATE: *value = rt[1]; break;
+    case FMB_BEAM_TIP_X: *value = q[0] + c * rho[0] - s * rho[1]; break;
+    default: *value = q[1] + s * rho[0] + c * rho[1]; break;
+  }
+  return 0;
+}
+
+static void intrinsic_describe(const void* self, FILE* f) {
+  const BeamIntrinsic* b = self;
+  fprintf(f,
+          "exact model in intrinsic kinematics (strain and angle along the beam, constant stiffness), %d elements, "
+          "nested %d-point rule, dense Jacobian by differences\n",
+          b->ne, b->nq);
+}
+
+/* as the cable's (beam_exact.c): undamped axial modes */
+static int intrinsic_max_bdf_order(const void* self) {
+  (void)self;
+  return 2;
+}
+
+static int intrinsic_velocity_error_test(const void* self) {
+  (void)self;
+  return 0;
+}
+
+/* metres per unit: the frame's x, y 1; theta, a stretch or an angle L (it swings or stretches at
+   most the rest of the beam, as the cable's slopes); a node's curvature kappa_i changes phi by at
+   most 4/27 le (the Hermite slope weight's peak) near the node: L 4 le / 27 */
+static void intrinsic_length_scale(const void* self, double* mpu) {
+  const BeamIntrinsic* b = self;
+  mpu[0] = mpu[1] = 1.0;
+  mpu[2] = mpu[3] = b->L;
+  mpu[4] = b->L * 4.0 * b->le / 27.0;
+  for (int i = 0; i < b->ne; ++i) {
+    double* nd = mpu + 5 + 3 * i;
+    nd[0] = nd[1] = b->L;
+    nd[2] = b->L * 4.0 * b->le / 27.0;
+  }
+}
+
+static const char* intrinsic_invalid_state(const void* self, const double* q, const double* v) {
+  (void)v;
+  const BeamIntrinsic* b = self;
+  for (int i = 0; i <= b->ne; ++i) {
+    const double eps = q[i == 0 ? 3 : 5 + 3 * (i - 1)];
+    const double phi = i == 0 ? 0.0 : q[5 + 3 * (i - 1) + 1];
+    if (!(fabs(eps) <= 0.5 && fabs(phi) <= 100.0))
+      return "a node's axial strain exceeds 50 % or its angle 100 rad: the solution is diverging "
+             "(check the loads and parameters)";
+  }
+  return NULL;
+}
+
+static int intrinsic_centreline(const void* self, int n, double* local) {
+  const BeamIntrinsic* b = self;
+  return fmb_beam_centreline(b->L, b->ne, n, local);
+}
+
+static const fmbParam intrinsic_params[] = {
+    FMB_BEAM_SECTION_PARAMS(INTRINSIC_MAX_ELEMENTS),
+    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = intrinsic_models, .doc = "exact here"},
+    {.key = "kinematics",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "cable",
+     .choices = intrinsic_kinematics,
+     .doc = "intrinsic here: axial strain and tangent angle along the beam (constant stiffness)"},
+    FMB_BEAM_FRAME_PARAMS,
+    {.key = NULL},
+};
+
+const fmbBodyType fmb_body_beam_intrinsic = {
+    .name = "beam",
+    .abi = FMB_ABI_VERSION,
+    .parse = intrinsic_parse,
+    .destroy = intrinsic_destroy,
+    .ncoord = intrinsic_ncoord,
+    .initial = intrinsic_initial,
+    .residual = intrinsic_residual,
+    .marker = intrinsic_marker,
+    .nwork = intrinsic_nwork,
+    .energy = intrinsic_energy,
+    .output_names = fmb_beam_output_names,
+    .output_units = fmb_beam_output_units,
+    .output_lookup = intrinsic_output_lookup,
+    .output = intrinsic_output,
+    .describe = intrinsic_describe,
+    .max_bdf_order = intrinsic_max_bdf_order,
+    .velocity_error_test = intrinsic_velocity_error_test,
+    .invalid_state = intrinsic_invalid_state,
+    .length_scale = intrinsic_length_scale,
+    .centreline = intrinsic_centreline,
+    .params = intrinsic_params,
+    .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
+               "model: exact\nkinematics: intrinsic\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",
+};
