@@ -57,7 +57,12 @@ typedef struct BeamIntrinsic {
   int nq, nm;                                            /* nested rule, mass rule (points per element) */
   double xq[INTRINSIC_MAX_POINTS], wq[INTRINSIC_MAX_POINTS]; /* nested rule on [0, 1] */
   double xm[INTRINSIC_MAX_POINTS], wm[INTRINSIC_MAX_POINTS]; /* mass points on [0, 1] */
+  /* the shape weights (shape6) at the nested points, the same in every element: of the element's
+     increment, of each mass point's [0, x_g], and at the mass points with their s-derivatives */
+  double sh_full[INTRINSIC_MAX_POINTS][6], sh_sub[4][INTRINSIC_MAX_POINTS][6], sh_mass[4][6], dsh_mass[4][6];
 } BeamIntrinsic;
+
+static void shape6(double xi, double le, double w[6], double dw[6]);
 
 static void intrinsic_setup(BeamIntrinsic* b, int nested_points) {
   b->le = b->L / b->ne;
@@ -69,6 +74,11 @@ static void intrinsic_setup(BeamIntrinsic* b, int nested_points) {
   b->nm = 4;
   fmb_gauss_legendre01(b->nq, b->xq, b->wq);
   fmb_gauss_legendre01(b->nm, b->xm, b->wm);
+  for (int m = 0; m < b->nq; ++m) shape6(b->xq[m], b->le, b->sh_full[m], NULL);
+  for (int g = 0; g < b->nm; ++g) {
+    shape6(b->xm[g], b->le, b->sh_mass[g], b->dsh_mass[g]);
+    for (int m = 0; m < b->nq; ++m) shape6(b->xm[g] * b->xq[m], b->le, b->sh_sub[g][m], NULL);
+  }
 }
 
 /* Element dofs: local l = 3 k + f (k: node e or e+1; f: 0 eps, 1 phi, 2 kappa). Index in q, or -1
@@ -104,12 +114,13 @@ static void fields(const double w[6], const double* dw, const double X[6], doubl
 
 /* rho', rho'_t, rho'_tt at one point (any may be NULL but rp) */
 static void tangent_terms(const double w[6], const double X[6], const double* Xd, const double* Xdd, double rp[2],
-                          double* rpt, double* rptt) {
+                          double* rpt, double* rptt, double* cache) {
   double eps, phi, ed = 0.0, pd = 0.0, edd = 0.0, pdd = 0.0;
   fields(w, NULL, X, &eps, &phi, NULL);
   if (Xd) fields(w, NULL, Xd, &ed, &pd, NULL);
   if (Xdd) fields(w, NULL, Xdd, &edd, &pdd, NULL);
   const double c = cos(phi), s = sin(phi), st = 1.0 + eps;
+  if (cache) cache[0] = c, cache[1] = s, cache[2] = st;
   rp[0] = st * c, rp[1] = st * s;
   if (rpt) rpt[0] = ed * c - st * pd * s, rpt[1] = ed * s + st * pd * c;
   if (rptt) {
@@ -119,16 +130,20 @@ static void tangent_terms(const double w[6], const double X[6], const double* Xd
   }
 }
 
-/* sum over the nested rule on [0, span] of element e: the increments of rho, rho_t, rho_tt */
-static void nested_increment(const BeamIntrinsic* b, double span, const double X[6], const double* Xd,
-                             const double* Xdd, double d[2], double* dt, double* dtt) {
+/* sum over the nested rule on [0, span] of element e: the increments of rho, rho_t, rho_tt; sh:
+   the rule's precomputed shape weights for this span, or NULL (computed here); cache: NULL or
+   3 nq doubles for cos phi, sin phi, 1 + eps at the points (add_tangent_work reuses them) */
+static void nested_increment(const BeamIntrinsic* b, double span, const double (*sh)[6], const double X[6],
+                             const double* Xd, const double* Xdd, double d[2], double* dt, double* dtt,
+                             double* cache) {
   d[0] = d[1] = 0.0;
   if (dt) dt[0] = dt[1] = 0.0;
   if (dtt) dtt[0] = dtt[1] = 0.0;
   for (int m = 0; m < b->nq; ++m) {
-    double w[6], rp[2], rpt[2], rptt[2];
-    shape6(span * b->xq[m], b->le, w, NULL);
-    tangent_terms(w, X, Xd, Xdd, rp, dt ? rpt : NULL, dtt ? rptt : NULL);
+    double own[6], rp[2], rpt[2], rptt[2];
+    const double* w = sh ? sh[m] : own;
+    if (!sh) shape6(span * b->xq[m], b->le, own, NULL);
+    tangent_terms(w, X, Xd, Xdd, rp, dt ? rpt : NULL, dtt ? rptt : NULL, cache ? cache + 3 * m : NULL);
     const double wl = b->wq[m] * span * b->le;
     d[0] += wl * rp[0], d[1] += wl * rp[1];
     if (dt) dt[0] += wl * rpt[0], dt[1] += wl * rpt[1];
@@ -136,15 +151,11 @@ static void nested_increment(const BeamIntrinsic* b, double span, const double X
   }
 }
 
-/* R_j += wl (d rho'/d q_j)(xi) . G over the element's dofs: d rho'/d eps-dof = N e, d rho'/d
-   phi-dof = (1 + eps) H e_perp */
-static void add_tangent_work(int e, double xi, double le, double wl, const double X[6], const double G[2],
-                             double* R) {
-  double w[6], eps, phi;
-  shape6(xi, le, w, NULL);
-  fields(w, NULL, X, &eps, &phi, NULL);
-  const double c = cos(phi), s = sin(phi);
-  const double along = wl * (c * G[0] + s * G[1]), across = wl * (1.0 + eps) * (-s * G[0] + c * G[1]);
+/* R_j += wl (d rho'/d q_j) . G over the element's dofs at a point of shape weights w, where
+   cs = (cos phi, sin phi, 1 + eps): d rho'/d eps-dof = N e, d rho'/d phi-dof = (1 + eps) H e_perp */
+static void add_tangent_work(int e, const double w[6], const double cs[3], double wl, const double G[2], double* R) {
+  const double c = cs[0], s = cs[1];
+  const double along = wl * (c * G[0] + s * G[1]), across = wl * cs[2] * (-s * G[0] + c * G[1]);
   for (int l = 0; l < 6; ++l) {
     const int i = idof(e, l);
     if (i >= 0) R[i] += w[l] * (l % 3 == 0 ? along : across);
@@ -208,11 +219,13 @@ static void intrinsic_initial(const void* self, double* q0, double* v0) {
   v0[0] = b->vel0[0], v0[1] = b->vel0[1], v0[2] = b->omega0;
 }
 
-/* work: per element its mass points' weighted F (2 nm) and their sum (2) for the residual; 2 per
-   coordinate for the marker's body-frame columns */
+/* work: per element its mass points' weighted F (2 nm), their sum (2) and cos phi, sin phi,
+   1 + eps at its nested points (3 nq (nm + 1)) for the residual; 2 per coordinate for the
+   marker's body-frame columns */
+static int residual_stride(const BeamIntrinsic* b) { return 2 * b->nm + 2 + 3 * b->nq * (b->nm + 1); }
 static size_t intrinsic_nwork(const void* self) {
   const BeamIntrinsic* b = self;
-  const size_t residual = (size_t)b->ne * (size_t)(2 * b->nm + 2), marker = 2 * (size_t)(3 + b->n);
+  const size_t residual = (size_t)b->ne * (size_t)residual_stride(b), marker = 2 * (size_t)(3 + b->n);
   return residual > marker ? residual : marker;
 }
 
@@ -229,7 +242,7 @@ static void frame_load(const fmbEnv* env, const double* q, const double* a, doub
 static int intrinsic_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
                               double* R, double* work) {
   const BeamIntrinsic* b = self;
-  const int nm = b->nm, stride = 2 * nm + 2;
+  const int nm = b->nm, nq = b->nq, stride = residual_stride(b);
   double c, s, G0[2];
   frame_load(env, q, a, &c, &s, G0);
   const double om = v[2], al = a[2];
@@ -241,10 +254,11 @@ static int intrinsic_residual(const void* self, const fmbEnv* env, const double*
     element_dofs(q, e, X), element_dofs(v, e, Xd), element_dofs(a, e, Xdd);
     double* Fw = work + (size_t)e * (size_t)stride;
     double* Te = Fw + 2 * nm;
+    double* cache = Te + 2; /* the mass points' nested points, then the increment's */
     Te[0] = Te[1] = 0.0;
     for (int g = 0; g < nm; ++g) {
       double d[2], dt[2], dtt[2];
-      nested_increment(b, b->xm[g], X, Xd, Xdd, d, dt, dtt);
+      nested_increment(b, b->xm[g], b->sh_sub[g], X, Xd, Xdd, d, dt, dtt, cache + 3 * nq * g);
       const double r[2] = {rho[0] + d[0], rho[1] + d[1]}, r_t[2] = {rt[0] + dt[0], rt[1] + dt[1]};
       const double r_tt[2] = {rtt[0] + dtt[0], rtt[1] + dtt[1]};
       const double F[2] = {G0[0] - al * r[1] - om * om * r[0] - 2.0 * om * r_t[1] + r_tt[0],
@@ -257,7 +271,7 @@ static int intrinsic_residual(const void* self, const fmbEnv* env, const double*
       R[2] += -r[1] * Fw[2 * g] + r[0] * Fw[2 * g + 1]; /* J = I~rho */
     }
     double d[2], dt[2], dtt[2];
-    nested_increment(b, 1.0, X, Xd, Xdd, d, dt, dtt);
+    nested_increment(b, 1.0, b->sh_full, X, Xd, Xdd, d, dt, dtt, cache + 3 * nq * nm);
     for (int k = 0; k < 2; ++k) rho[k] += d[k], rt[k] += dt[k], rtt[k] += dtt[k];
   }
   /* backward: the suffix sum S of F beyond each element; the deformation rows */
@@ -266,14 +280,15 @@ static int intrinsic_residual(const void* self, const fmbEnv* env, const double*
     double X[6];
     element_dofs(q, e, X);
     const double* Fw = work + (size_t)e * (size_t)stride;
-    for (int m = 0; m < b->nq; ++m) add_tangent_work(e, b->xq[m], b->le, b->wq[m] * b->le, X, S, R);
+    const double* cache = Fw + 2 * nm + 2;
+    for (int m = 0; m < nq; ++m) add_tangent_work(e, b->sh_full[m], cache + 3 * (nq * nm + m), b->wq[m] * b->le, S, R);
     for (int g = 0; g < nm; ++g)
-      for (int m = 0; m < b->nq; ++m)
-        add_tangent_work(e, b->xm[g] * b->xq[m], b->le, b->wq[m] * b->xm[g] * b->le, X, Fw + 2 * g, R);
+      for (int m = 0; m < nq; ++m)
+        add_tangent_work(e, b->sh_sub[g][m], cache + 3 * (nq * g + m), b->wq[m] * b->xm[g] * b->le, Fw + 2 * g, R);
     /* strain energy: dU = int EA eps N + EI phi' H' (a quartic in xi: exact at the 4 mass points) */
     for (int g = 0; g < nm; ++g) {
-      double w[6], dw[6], eps, phi, dphi;
-      shape6(b->xm[g], b->le, w, dw);
+      const double *w = b->sh_mass[g], *dw = b->dsh_mass[g];
+      double eps, phi, dphi;
       fields(w, dw, X, &eps, &phi, &dphi);
       const double wl = b->wm[g] * b->le;
       for (int l = 0; l < 6; ++l) {
@@ -296,7 +311,7 @@ static void node_state(const BeamIntrinsic* b, const double* q, const double* v,
     double X[6], Xd[6], d[2], dt[2];
     element_dofs(q, e, X);
     if (v) element_dofs(v, e, Xd);
-    nested_increment(b, 1.0, X, v ? Xd : NULL, NULL, d, rt ? dt : NULL, NULL);
+    nested_increment(b, 1.0, b->sh_full, X, v ? Xd : NULL, NULL, d, rt ? dt : NULL, NULL, NULL);
     rho[0] += d[0], rho[1] += d[1];
     if (rt) rt[0] += dt[0], rt[1] += dt[1];
   }
@@ -340,7 +355,7 @@ static int intrinsic_marker(const void* self, const double* q, const double loca
     fmb_beam_locate(b->le, b->ne, x, &e, &xi);
     node_state(b, q, NULL, e, rho, NULL);
     element_dofs(q, e, X);
-    nested_increment(b, xi, X, NULL, NULL, d, NULL, NULL);
+    nested_increment(b, xi, NULL, X, NULL, NULL, d, NULL, NULL, NULL);
     shape6(xi, b->le, w, NULL);
     fields(w, NULL, X, &eps, &phi, NULL);
     pb[0] = rho[0] + d[0] - y * sin(phi);
@@ -393,7 +408,7 @@ static void intrinsic_integrals(const BeamIntrinsic* b, const fmbEnv* env, const
     double X[6], Xd[6], d[2], dt[2];
     element_dofs(q, e, X), element_dofs(v, e, Xd);
     for (int g = 0; g < b->nm; ++g) {
-      nested_increment(b, b->xm[g], X, Xd, NULL, d, dt, NULL);
+      nested_increment(b, b->xm[g], b->sh_sub[g], X, Xd, NULL, d, dt, NULL, NULL);
       const double r[2] = {rho[0] + d[0], rho[1] + d[1]};
       const double w = b->mu * b->wm[g] * b->le;
       const double vb[2] = {v0[0] - om * r[1] + rt[0] + dt[0], v0[1] + om * r[0] + rt[1] + dt[1]};
@@ -405,7 +420,7 @@ static void intrinsic_integrals(const BeamIntrinsic* b, const fmbEnv* env, const
       fields(sw, dw, X, &eps, &phi, &dphi);
       Ue += 0.5 * b->wm[g] * b->le * (b->EA * eps * eps + b->EI * dphi * dphi);
     }
-    nested_increment(b, 1.0, X, Xd, NULL, d, dt, NULL);
+    nested_increment(b, 1.0, b->sh_full, X, Xd, NULL, d, dt, NULL, NULL);
     rho[0] += d[0], rho[1] += d[1], rt[0] += dt[0], rt[1] += dt[1];
   }
   double Ug = 0.0;
