@@ -85,7 +85,7 @@ echo "free beam spinning at 3 rad/s: max |E - E0|, E = $de J"
 check "spinning free: energy constant to 1e-7 relative" "echo $de | awk '{ exit !(\$1 <= 1e-7 * \$2) }'"
 
 # 6. the pendulum's first 0.2 s under auto (radau9): energy conserved, and the Newton iteration
-# healthy: the cable took 227 Jacobians here, the complete model 13, the intrinsic form 2 (measured)
+# healthy: the cable took 227 Jacobians here, the complete model 13, the intrinsic form 1 (measured)
 P=scenes/paper/pendulum.yaml
 for v in "complete" "cable" "intrinsic"; do
   model=exact
