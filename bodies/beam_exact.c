@@ -211,7 +211,7 @@ static const char* const exact_models[] = {"zoac", "foac", "complete", "exact", 
 static const char* const exact_integrations[] = {"reduced", "full", NULL};
 static const char* const exact_assemblies[] = {"auto", "dense", "banded", NULL}; /* as beam.c's */
 static const char* const exact_axial_forms[] = {"mixed", "displacement", NULL};  /* as beam.c's */
-static const char* const exact_kinematics[] = {"cable", "intrinsic", NULL};       /* as beam.c's */
+static const char* const exact_kinematics[] = {"cable", "intrinsic", NULL};      /* as beam.c's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on. Unlike beam.c's (whose banded form adds
    auxiliary unknowns), this pattern adds nothing: measured (bench/exact_banded.sh, the omega0 = 15
