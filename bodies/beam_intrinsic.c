@@ -567,6 +567,10 @@ static int intrinsic_centreline(const void* self, int n, double* local) {
   return fmb_beam_centreline(b->L, b->ne, n, local);
 }
 
+/* the cable's choices (beam.c's), declared here only to be refused by name */
+static const char* const refused_integrations[] = {"reduced", "full", NULL};
+static const char* const refused_assemblies[] = {"auto", "dense", "banded", NULL};
+static const char* const refused_axial_forms[] = {"mixed", "displacement", NULL};
 static const fmbParam intrinsic_params[] = {
     FMB_BEAM_SECTION_PARAMS(INTRINSIC_MAX_ELEMENTS),
     {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = intrinsic_models, .doc = "exact here"},
@@ -576,6 +580,17 @@ static const fmbParam intrinsic_params[] = {
      .choices = intrinsic_kinematics,
      .doc = "intrinsic here: axial strain and tangent angle along the beam (constant stiffness)"},
     FMB_BEAM_FRAME_PARAMS,
+    /* keys of type beam that this form refuses, with the reason (so they are looked up) */
+    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
+    {.key = "quadrature_points",
+     .kind = FMB_PARAM_INT,
+     .unit = "1",
+     .lo = 1,
+     .hi = FMB_GAUSS_MAX,
+     .doc = "refused: its rules are fixed"},
+    {.key = "integration", .kind = FMB_PARAM_CHOICE, .choices = refused_integrations, .doc = "refused: the cable's"},
+    {.key = "assembly", .kind = FMB_PARAM_CHOICE, .choices = refused_assemblies, .doc = "refused: dense"},
+    {.key = "axial_form", .kind = FMB_PARAM_CHOICE, .choices = refused_axial_forms, .doc = "refused: the cable's"},
     {.key = NULL},
 };
 
