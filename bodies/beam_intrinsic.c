@@ -242,10 +242,14 @@ static void intrinsic_initial(const void* self, double* q0, double* v0) {
    1 + eps at its nested points (3 nq) for the residual; 2 per coordinate for the marker's
    body-frame columns */
 static int residual_stride(const BeamIntrinsic* b) { return 2 * b->nm + 2 + 3 * b->nq; }
-static size_t intrinsic_nwork(const void* self) {
-  const BeamIntrinsic* b = self;
+/* after both: the outputs' cache (sweep_state) */
+static size_t cache_at(const BeamIntrinsic* b) {
   const size_t residual = (size_t)b->ne * (size_t)residual_stride(b), marker = 2 * (size_t)(3 + b->n);
   return residual > marker ? residual : marker;
+}
+static size_t intrinsic_nwork(const void* self) {
+  const BeamIntrinsic* b = self;
+  return cache_at(b) + 1 + 2 * (size_t)(3 + b->n) + 4 * (size_t)(b->ne + 1) + 5;
 }
 
 /* A^T (r0'' - g) in the body frame */
@@ -328,19 +332,16 @@ static int intrinsic_residual(const void* self, const fmbEnv* env, const double*
 }
 
 /* ---------------------------------------------------------------------------------------------
- * Where things are: rho and rho_t at node k (the nested rule's sums up to it), the marker.
+ * Where things are: rho at node k (the elements' increments up to it), the marker.
  * ------------------------------------------------------------------------------------------- */
-static void node_state(const BeamIntrinsic* b, const double* q, const double* v, int k, double rho[2], double rt[2]) {
+static void node_position(const BeamIntrinsic* b, const double* q, int k, double rho[2]) {
   rho[0] = rho[1] = 0.0;
-  if (rt) rt[0] = rt[1] = 0.0;
   for (int e = 0; e < k; ++e) {
-    double X[6], Xd[6], d[2], rp[INTRINSIC_MAX_POINTS][2], rpt[INTRINSIC_MAX_POINTS][2];
+    double X[6], d[2], rp[INTRINSIC_MAX_POINTS][2];
     element_dofs(q, e, X);
-    if (v) element_dofs(v, e, Xd);
-    element_tangents(b, X, v ? Xd : NULL, NULL, rp, rpt, NULL, NULL);
+    element_tangents(b, X, NULL, NULL, rp, NULL, NULL, NULL);
     integrate_points(b, b->wq, (const double(*)[2])rp, d);
     rho[0] += d[0], rho[1] += d[1];
-    if (rt) integrate_points(b, b->wq, (const double(*)[2])rpt, d), rt[0] += d[0], rt[1] += d[1];
   }
 }
 
@@ -380,7 +381,7 @@ static int intrinsic_marker(const void* self, const double* q, const double loca
   if (onbeam) {
     double rho[2], d[2], eps, rp[INTRINSIC_MAX_POINTS][2];
     fmb_beam_locate(b->le, b->ne, x, &e, &xi);
-    node_state(b, q, NULL, e, rho, NULL);
+    node_position(b, q, e, rho);
     element_dofs(q, e, X);
     span_weights(b, xi, Wx);
     element_tangents(b, X, NULL, NULL, rp, NULL, NULL, NULL);
@@ -427,12 +428,24 @@ static int intrinsic_marker(const void* self, const double* q, const double loca
 /* ---------------------------------------------------------------------------------------------
  * Energy and outputs.
  * ------------------------------------------------------------------------------------------- */
-/* T, U_e, U_g and p_theta (angular momentum about the frame origin) at the mass points */
-static void intrinsic_integrals(const BeamIntrinsic* b, const fmbEnv* env, const double* q, const double* v,
-                                fmbEnergy* en, double* ptheta) {
-  const double c = cos(q[2]), s = sin(q[2]), om = v[2];
-  const double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
+/* One sweep at (q, v) for every output and the energy: the nodes' rho and rho_t (2 (ne + 1)
+   each), then T, U_e, p_theta (angular momentum about the frame origin) and sum w mu rho_g (2).
+   An output row asks for several outputs and the energy at one state: the sweep is kept in the
+   scratch with the (q, v) it was made at and made again only when they differ (bitwise). */
+enum { SWEEP_T, SWEEP_UE, SWEEP_PTHETA, SWEEP_MRHO };
+static const double* sweep_state(const BeamIntrinsic* b, const double* q, const double* v, double* work) {
+  const size_t nc = (size_t)(3 + b->n);
+  double* key = work + cache_at(b);
+  double* out = key + 1 + 2 * nc;
+  if (key[0] == 1.0 && !memcmp(key + 1, q, nc * sizeof(double)) && !memcmp(key + 1 + nc, v, nc * sizeof(double)))
+    return out;
+  double* rho_n = out;
+  double* rt_n = out + 2 * (b->ne + 1);
+  double* sums = rt_n + 2 * (b->ne + 1);
+  const double om = v[2];
+  const double c = cos(q[2]), s = sin(q[2]), v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
   double T = 0.0, Ue = 0.0, pth = 0.0, mrho[2] = {0.0, 0.0}, rho[2] = {0.0, 0.0}, rt[2] = {0.0, 0.0};
+  rho_n[0] = rho_n[1] = rt_n[0] = rt_n[1] = 0.0;
   for (int e = 0; e < b->ne; ++e) {
     double X[6], Xd[6], d[2], dt[2], rp[INTRINSIC_MAX_POINTS][2], rpt[INTRINSIC_MAX_POINTS][2];
     element_dofs(q, e, X), element_dofs(v, e, Xd);
@@ -453,23 +466,34 @@ static void intrinsic_integrals(const BeamIntrinsic* b, const fmbEnv* env, const
     integrate_points(b, b->wq, (const double(*)[2])rp, d);
     integrate_points(b, b->wq, (const double(*)[2])rpt, dt);
     rho[0] += d[0], rho[1] += d[1], rt[0] += dt[0], rt[1] += dt[1];
+    rho_n[2 * (e + 1)] = rho[0], rho_n[2 * (e + 1) + 1] = rho[1];
+    rt_n[2 * (e + 1)] = rt[0], rt_n[2 * (e + 1) + 1] = rt[1];
   }
-  double Ug = 0.0;
-  if (env && env->has_gravity) {
-    const double m = b->mu * b->L, gx = env->gravity[0], gy = env->gravity[1];
-    Ug = -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
-  }
-  en->kinetic = T;
-  en->strain = Ue;
-  en->gravity = Ug;
-  en->spring = 0.0;
-  if (ptheta) *ptheta = pth;
+  sums[SWEEP_T] = T, sums[SWEEP_UE] = Ue, sums[SWEEP_PTHETA] = pth;
+  sums[SWEEP_MRHO] = mrho[0], sums[SWEEP_MRHO + 1] = mrho[1];
+  memcpy(key + 1, q, nc * sizeof(double));
+  memcpy(key + 1 + nc, v, nc * sizeof(double));
+  key[0] = 1.0;
+  return out;
 }
+
+/* the sweep's sums (after the nodes' rho and rho_t) */
+static const double* sweep_sums(const BeamIntrinsic* b, const double* sweep) { return sweep + 4 * (b->ne + 1); }
 
 static void intrinsic_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                              double* work) {
-  (void)work;
-  intrinsic_integrals(self, env, q, v, en, NULL);
+  const BeamIntrinsic* b = self;
+  const double* sums = sweep_sums(b, sweep_state(b, q, v, work));
+  const double c = cos(q[2]), s = sin(q[2]), *mrho = sums + SWEEP_MRHO;
+  double Ug = 0.0;
+  if (env && env->has_gravity) { /* -int mu g . (r0 + A rho) */
+    const double m = b->mu * b->L, gx = env->gravity[0], gy = env->gravity[1];
+    Ug = -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
+  }
+  en->kinetic = sums[SWEEP_T];
+  en->strain = sums[SWEEP_UE];
+  en->gravity = Ug;
+  en->spring = 0.0;
 }
 
 static int intrinsic_output_lookup(const void* self, const char* quantity) {
@@ -478,11 +502,9 @@ static int intrinsic_output_lookup(const void* self, const char* quantity) {
 
 /* beam_exact.c's names and meanings: tip_u/tip_v the tip's displacement in the frame */
 static int intrinsic_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
-  (void)work;
   const BeamIntrinsic* b = self;
   if (id == FMB_BEAM_ANG_MOMENTUM) {
-    fmbEnergy en;
-    intrinsic_integrals(b, NULL, q, v, &en, value);
+    *value = sweep_sums(b, sweep_state(b, q, v, work))[SWEEP_PTHETA];
     return 0;
   }
   if (id == FMB_BEAM_TIP_ANGLE) {
@@ -497,8 +519,8 @@ static int intrinsic_output(const void* self, int id, const double* q, const dou
   } else if (id < 0 || id >= FMB_BEAM_NTIP) {
     return -1;
   }
-  double rho[2], rt[2];
-  node_state(b, q, v, node, rho, rt);
+  const double* sweep = sweep_state(b, q, v, work);
+  const double *rho = sweep + 2 * node, *rt = sweep + 2 * (b->ne + 1) + 2 * node;
   const double c = cos(q[2]), s = sin(q[2]);
   switch (comp) {
     case FMB_BEAM_TIP_U: *value = rho[0] - node * b->le; break;
