@@ -222,12 +222,7 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   BeamExact* b = calloc(1, sizeof *b);
   if (!b) return fmb_parse_error(p, item, "out of memory");
   int model = 3, err = 0;
-  err |= fmb_get_double(p, item, "length", FMB_REQUIRED | FMB_POSITIVE, &b->L);
-  err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, EXACT_MAX_ELEMENTS, &b->ne);
-  err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, &b->rho);
-  err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
-  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->Izz);
-  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
+  err |= fmb_beam_read_section(p, item, EXACT_MAX_ELEMENTS, &b->L, &b->ne, &b->rho, &b->A, &b->Izz, &b->Emod);
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, exact_models, &model); /* "exact": beam.c chose this table */
   err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, exact_integrations, &b->integration);
   int kinematics = 0; /* "intrinsic" is bodies/beam_intrinsic.c's (beam.c's variant chose): "cable" here */
@@ -241,10 +236,7 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_choice(p, item, "axial_form", FMB_OPTIONAL, exact_axial_forms, &displacement_form);
   b->mixed = !displacement_form && b->integration == INTEGRATION_REDUCED && assembly != ASSEMBLY_DENSE;
   if (b->mixed) b->banded = 1;
-  err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
-  err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
-  err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
-  err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
+  err |= fmb_beam_read_frame(p, item, b->pos0, &b->angle0, b->vel0, &b->omega0);
   if (!err && fmb_find_key(p, item, "damping") >= 0)
     err = fmb_parse_error(p, fmb_find_key(p, item, "damping"),
                           "'damping' is not available with model: exact "
@@ -275,15 +267,7 @@ static int exact_ncoord(const void* self) { return 3 + ((const BeamExact*)self)-
 
 static void exact_initial(const void* self, double* q0, double* v0) {
   const BeamExact* b = self;
-  const int nc = 3 + b->n;
-  memset(q0, 0, sizeof(double) * (size_t)nc);
-  memset(v0, 0, sizeof(double) * (size_t)nc);
-  q0[0] = b->pos0[0];
-  q0[1] = b->pos0[1];
-  q0[2] = b->angle0;
-  v0[0] = b->vel0[0];
-  v0[1] = b->vel0[1];
-  v0[2] = b->omega0;
+  fmb_beam_frame_initial(3 + b->n, b->pos0, b->angle0, b->vel0, b->omega0, q0, v0);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -351,17 +335,6 @@ static void point_frame(const Shape* sh, int e, const double X[8], const double 
   pf->ncol = nc;
 }
 
-/* frame quantities shared by the residual and the Jacobian */
-static void frame_terms(const fmbEnv* env, const double* q, const double* a, double* c, double* s, double G0[2]) {
-  *c = cos(q[2]);
-  *s = sin(q[2]);
-  double g[2] = {0.0, 0.0};
-  if (env && env->has_gravity) g[0] = env->gravity[0], g[1] = env->gravity[1];
-  const double d[2] = {a[0] - g[0], a[1] - g[1]};
-  G0[0] = *c * d[0] + *s * d[1];
-  G0[1] = -*s * d[0] + *c * d[1];
-}
-
 /* element e's nodal displacements D, positions X, rates Xd and accelerations Xdd */
 static void element_state(const BeamExact* b, const double* q, const double* v, const double* a, int e, double D[8],
                           double X[8], double Xd[8], double Xdd[8]) {
@@ -393,7 +366,7 @@ static double axial_strain(const BeamExact* b, int g, const double D[8], double 
 static int exact_eval(const BeamExact* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                       const double* z, double* R, double* Rz) {
   double c, s, G0[2];
-  frame_terms(env, q, a, &c, &s, G0);
+  fmb_beam_frame_load(env, q, a, &c, &s, G0);
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   if (Rz) memset(Rz, 0, sizeof(double) * (size_t)(2 * b->ne + 1));
   for (int e = 0; e < b->ne; ++e) {
@@ -469,7 +442,7 @@ static int exact_fill(const BeamExact* b, int banded, const fmbEnv* env, const d
                       const double* a, const double* z, double* K, double* C, double* M) {
   const size_t nc = (size_t)(3 + b->n), nv = banded ? (size_t)exact_npair_all(b) : nc * nc;
   double c, s, G0[2];
-  frame_terms(env, q, a, &c, &s, G0);
+  fmb_beam_frame_load(env, q, a, &c, &s, G0);
   const double om = v[2], al = a[2];
   if (K) memset(K, 0, sizeof(double) * nv);
   if (C) memset(C, 0, sizeof(double) * nv);
@@ -690,15 +663,9 @@ static void exact_integrals(const BeamExact* b, const fmbEnv* env, const double*
     }
     Ue += element_elastic(b, D, NULL, f, NULL);
   }
-  double Ug = 0.0;
-  if (env && env->has_gravity) {
-    /* -int mu g . (r0 + A rho) */
-    const double m = b->mu * b->L, gx = env->gravity[0], gy = env->gravity[1];
-    Ug = -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
-  }
   en->kinetic = T;
   en->strain = Ue;
-  en->gravity = Ug;
+  en->gravity = fmb_beam_gravity_potential(env, b->mu * b->L, q, c, s, mrho);
   en->spring = 0.0;
   if (ptheta) *ptheta = pth;
 }
@@ -730,28 +697,14 @@ static int exact_output(const void* self, int id, const double* q, const double*
     *value = angle - q[2];
     return 0;
   }
-  int node = b->ne, comp = id;
-  if (id >= FMB_BEAM_NODE_BASE) {
-    node = (id - FMB_BEAM_NODE_BASE) / FMB_BEAM_NODE_STRIDE;
-    const int k = (id - FMB_BEAM_NODE_BASE) % FMB_BEAM_NODE_STRIDE;
-    comp = k == 0 ? FMB_BEAM_TIP_U : k == 1 ? FMB_BEAM_TIP_V : k == 2 ? FMB_BEAM_TIP_X : FMB_BEAM_TIP_Y;
-  } else if (id < 0 || id >= FMB_BEAM_NTIP) {
-    return -1;
-  }
+  int node, comp;
+  if (fmb_beam_output_node(b->ne, id, &node, &comp)) return -1;
   /* a node's displacement and rate are coordinates (the root node is fixed in the frame) */
   const int i = 4 + 4 * (node - 1);
   const double u[2] = {node ? q[i] : 0.0, node ? q[i + 1] : 0.0};
   const double ud[2] = {node ? v[i] : 0.0, node ? v[i + 1] : 0.0};
   const double rho[2] = {node * b->le + u[0], u[1]};
-  const double c = cos(q[2]), s = sin(q[2]);
-  switch (comp) {
-    case FMB_BEAM_TIP_U: *value = u[0]; break;
-    case FMB_BEAM_TIP_V: *value = u[1]; break;
-    case FMB_BEAM_TIP_U_RATE: *value = ud[0]; break;
-    case FMB_BEAM_TIP_V_RATE: *value = ud[1]; break;
-    case FMB_BEAM_TIP_X: *value = q[0] + c * rho[0] - s * rho[1]; break;
-    default: *value = q[1] + s * rho[0] + c * rho[1]; break;
-  }
+  *value = fmb_beam_node_value(comp, q, u, ud, rho);
   return 0;
 }
 

@@ -191,18 +191,10 @@ static int intrinsic_parse(fmbParser* p, fmbNode item, void** self) {
   BeamIntrinsic* b = calloc(1, sizeof *b);
   if (!b) return fmb_parse_error(p, item, "out of memory");
   int model = 3, kinematics = 1, err = 0;
-  err |= fmb_get_double(p, item, "length", FMB_REQUIRED | FMB_POSITIVE, &b->L);
-  err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, INTRINSIC_MAX_ELEMENTS, &b->ne);
-  err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, &b->rho);
-  err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
-  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->Izz);
-  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
+  err |= fmb_beam_read_section(p, item, INTRINSIC_MAX_ELEMENTS, &b->L, &b->ne, &b->rho, &b->A, &b->Izz, &b->Emod);
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, intrinsic_models, &model);
   err |= fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, intrinsic_kinematics, &kinematics);
-  err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
-  err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
-  err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
-  err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
+  err |= fmb_beam_read_frame(p, item, b->pos0, &b->angle0, b->vel0, &b->omega0);
   const char* const refused[] = {"damping", "quadrature_points", "integration", "assembly", "axial_form"};
   for (int k = 0; k < 5 && !err; ++k)
     if (fmb_find_key(p, item, refused[k]) >= 0)
@@ -231,11 +223,7 @@ static int intrinsic_ncoord(const void* self) { return 3 + ((const BeamIntrinsic
 
 static void intrinsic_initial(const void* self, double* q0, double* v0) {
   const BeamIntrinsic* b = self;
-  const int nc = 3 + b->n;
-  memset(q0, 0, sizeof(double) * (size_t)nc);
-  memset(v0, 0, sizeof(double) * (size_t)nc);
-  q0[0] = b->pos0[0], q0[1] = b->pos0[1], q0[2] = b->angle0;
-  v0[0] = b->vel0[0], v0[1] = b->vel0[1], v0[2] = b->omega0;
+  fmb_beam_frame_initial(3 + b->n, b->pos0, b->angle0, b->vel0, b->omega0, q0, v0);
 }
 
 /* work: per element its mass points' weighted F (2 nm), their sum (2) and cos phi, sin phi,
@@ -252,22 +240,12 @@ static size_t intrinsic_nwork(const void* self) {
   return cache_at(b) + 1 + 2 * (size_t)(3 + b->n) + 4 * (size_t)(b->ne + 1) + 5;
 }
 
-/* A^T (r0'' - g) in the body frame */
-static void frame_load(const fmbEnv* env, const double* q, const double* a, double* c, double* s, double G0[2]) {
-  *c = cos(q[2]), *s = sin(q[2]);
-  double g[2] = {0.0, 0.0};
-  if (env && env->has_gravity) g[0] = env->gravity[0], g[1] = env->gravity[1];
-  const double d[2] = {a[0] - g[0], a[1] - g[1]};
-  G0[0] = *c * d[0] + *s * d[1];
-  G0[1] = -*s * d[0] + *c * d[1];
-}
-
 static int intrinsic_residual(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
                               double* R, double* work) {
   const BeamIntrinsic* b = self;
   const int nm = b->nm, nq = b->nq, stride = residual_stride(b);
   double c, s, G0[2];
-  frame_load(env, q, a, &c, &s, G0);
+  fmb_beam_frame_load(env, q, a, &c, &s, G0);
   const double om = v[2], al = a[2];
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   /* forward: positions and rates at the nodes and mass points, the mass points' F */
@@ -484,15 +462,9 @@ static void intrinsic_energy(const void* self, const fmbEnv* env, const double* 
                              double* work) {
   const BeamIntrinsic* b = self;
   const double* sums = sweep_sums(b, sweep_state(b, q, v, work));
-  const double c = cos(q[2]), s = sin(q[2]), *mrho = sums + SWEEP_MRHO;
-  double Ug = 0.0;
-  if (env && env->has_gravity) { /* -int mu g . (r0 + A rho) */
-    const double m = b->mu * b->L, gx = env->gravity[0], gy = env->gravity[1];
-    Ug = -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
-  }
   en->kinetic = sums[SWEEP_T];
   en->strain = sums[SWEEP_UE];
-  en->gravity = Ug;
+  en->gravity = fmb_beam_gravity_potential(env, b->mu * b->L, q, cos(q[2]), sin(q[2]), sums + SWEEP_MRHO);
   en->spring = 0.0;
 }
 
@@ -511,25 +483,12 @@ static int intrinsic_output(const void* self, int id, const double* q, const dou
     *value = q[5 + 3 * (b->ne - 1) + 1]; /* phi at the tip */
     return 0;
   }
-  int node = b->ne, comp = id;
-  if (id >= FMB_BEAM_NODE_BASE) {
-    node = (id - FMB_BEAM_NODE_BASE) / FMB_BEAM_NODE_STRIDE;
-    const int k = (id - FMB_BEAM_NODE_BASE) % FMB_BEAM_NODE_STRIDE;
-    comp = k == 0 ? FMB_BEAM_TIP_U : k == 1 ? FMB_BEAM_TIP_V : k == 2 ? FMB_BEAM_TIP_X : FMB_BEAM_TIP_Y;
-  } else if (id < 0 || id >= FMB_BEAM_NTIP) {
-    return -1;
-  }
+  int node, comp;
+  if (fmb_beam_output_node(b->ne, id, &node, &comp)) return -1;
   const double* sweep = sweep_state(b, q, v, work);
   const double *rho = sweep + 2 * node, *rt = sweep + 2 * (b->ne + 1) + 2 * node;
-  const double c = cos(q[2]), s = sin(q[2]);
-  switch (comp) {
-    case FMB_BEAM_TIP_U: *value = rho[0] - node * b->le; break;
-    case FMB_BEAM_TIP_V: *value = rho[1]; break;
-    case FMB_BEAM_TIP_U_RATE: *value = rt[0]; break;
-    case FMB_BEAM_TIP_V_RATE: *value = rt[1]; break;
-    case FMB_BEAM_TIP_X: *value = q[0] + c * rho[0] - s * rho[1]; break;
-    default: *value = q[1] + s * rho[0] + c * rho[1]; break;
-  }
+  const double u[2] = {rho[0] - node * b->le, rho[1]};
+  *value = fmb_beam_node_value(comp, q, u, rt, rho);
   return 0;
 }
 
