@@ -1811,13 +1811,15 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
   /* `kinematics: intrinsic` (model: exact only): the same continuum in strain and angle
      coordinates, bodies/beam_intrinsic.c */
   extern const fmbBodyType fmb_body_beam_intrinsic;
-  int intrinsic = 0;
-  if (fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, kinematics_names, &intrinsic)) return NULL;
-  if (model != 3 && fmb_find_key(p, item, "kinematics") >= 0) {
+  if (model == 3) {
+    int intrinsic = 0;
+    if (fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, kinematics_names, &intrinsic)) return NULL;
+    return intrinsic ? &fmb_body_beam_intrinsic : &fmb_body_beam_exact;
+  }
+  if (fmb_find_key(p, item, "kinematics") >= 0) { /* not read: the other models' key lists stay as they were */
     fmb_parse_error(p, fmb_find_key(p, item, "kinematics"), "'kinematics' is for model: exact (cable or intrinsic)");
     return NULL;
   }
-  if (model == 3) return intrinsic ? &fmb_body_beam_intrinsic : &fmb_body_beam_exact;
   if (reduced) return &fmb_body_beam_modal;
   return differences ? &beam_fd : &fmb_body_beam;
 }

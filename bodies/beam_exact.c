@@ -251,9 +251,7 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   exact_setup(b);
   /* as for the other models (beam.c): parameters that are each valid can still combine into an
      element whose mass or stiffness is not a usable double (length 1e-300: EI/le^3 overflows) */
-  const double me = b->mu * b->le, k_axial = b->EA / b->le, k_bend = 12.0 * b->EI / (b->le * b->le * b->le);
-  if (!isnormal(me) || !isnormal(k_axial) || !isnormal(k_bend) || !isfinite(fmax(k_axial, k_bend) / me)) {
-    fmb_beam_refuse_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
+  if (fmb_beam_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod)) {
     free(b);
     return -1;
   }

@@ -140,6 +140,16 @@ static inline int fmb_beam_centreline(double L, int ne, int n, double* local) {
   return n;
 }
 
+/* non-zero, after the parse error, when the section's element mass or stiffness (le = L/ne) is
+   not a usable double: the check every model makes after reading the section */
+static inline int fmb_beam_degenerate(fmbParser* p, fmbNode item, double L, int ne, double rho, double A, double Izz,
+                                      double E) {
+  const double le = L / ne, me = rho * A * le, k_axial = E * A / le, k_bend = 12.0 * E * Izz / (le * le * le);
+  if (isnormal(me) && isnormal(k_axial) && isnormal(k_bend) && isfinite(fmax(k_axial, k_bend) / me)) return 0;
+  fmb_beam_refuse_degenerate(p, item, L, ne, rho, A, Izz, E, me, k_bend, k_axial);
+  return -1;
+}
+
 /* The section's keys (FMB_BEAM_SECTION_PARAMS) and the frame's initial state (FMB_BEAM_FRAME_PARAMS)
    as the exact beam's two forms read them (beam_exact.c, beam_intrinsic.c); non-zero on an error */
 static inline int fmb_beam_read_section(fmbParser* p, fmbNode item, int max_elements, double* L, int* ne, double* rho,
