@@ -139,6 +139,7 @@ static const char* const model_names[] = {"zoac", "foac", "complete", NULL};
 static const char* const assembly_names[] = {"auto", "dense", "banded", NULL};
 static const char* const integration_names[] = {"reduced", "full", NULL};      /* model: exact's */
 static const char* const axial_form_names[] = {"mixed", "displacement", NULL}; /* model: exact's */
+static const char* const kinematics_names[] = {"cable", "intrinsic", NULL};    /* model: exact's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on: below it the dense blocks are small
    and the fewer unknowns win (docs/performance.md, "Scaling") */
@@ -1744,6 +1745,12 @@ const fmbParam fmb_beam_params[] = {
      .choices = axial_form_names,
      .doc = "model: exact: the axial strains as unknowns Newton iterates on (mixed), or the displacement form "
             "before it (to compare); the other models ignore it"},
+    {.key = "kinematics",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "cable",
+     .choices = kinematics_names,
+     .doc = "model: exact: nodal positions and slopes (cable), or axial strain and tangent angle along the beam "
+            "(intrinsic: constant stiffness, bodies/beam_intrinsic.c); the other models refuse it"},
     FMB_BEAM_REDUCTION_PARAM,
     {.key = "jacobian",
      .kind = FMB_PARAM_CHOICE,
@@ -1801,7 +1808,18 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
                     "jacobian: differences is for the complete, foac and zoac models without reduction");
     return NULL;
   }
-  if (model == 3) return &fmb_body_beam_exact;
+  /* `kinematics: intrinsic` (model: exact only): the same continuum in strain and angle
+     coordinates, bodies/beam_intrinsic.c */
+  extern const fmbBodyType fmb_body_beam_intrinsic;
+  if (model == 3) {
+    int intrinsic = 0;
+    if (fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, kinematics_names, &intrinsic)) return NULL;
+    return intrinsic ? &fmb_body_beam_intrinsic : &fmb_body_beam_exact;
+  }
+  if (fmb_find_key(p, item, "kinematics") >= 0) { /* not read: the other models' key lists stay as they were */
+    fmb_parse_error(p, fmb_find_key(p, item, "kinematics"), "'kinematics' is for model: exact (cable or intrinsic)");
+    return NULL;
+  }
   if (reduced) return &fmb_body_beam_modal;
   return differences ? &beam_fd : &fmb_body_beam;
 }

@@ -211,6 +211,7 @@ static const char* const exact_models[] = {"zoac", "foac", "complete", "exact", 
 static const char* const exact_integrations[] = {"reduced", "full", NULL};
 static const char* const exact_assemblies[] = {"auto", "dense", "banded", NULL}; /* as beam.c's */
 static const char* const exact_axial_forms[] = {"mixed", "displacement", NULL};  /* as beam.c's */
+static const char* const exact_kinematics[] = {"cable", "intrinsic", NULL};      /* as beam.c's */
 enum { ASSEMBLY_AUTO, ASSEMBLY_DENSE, ASSEMBLY_BANDED };
 /* `assembly: auto` is banded from this many elements on. Unlike beam.c's (whose banded form adds
    auxiliary unknowns), this pattern adds nothing: measured (bench/exact_banded.sh, the omega0 = 15
@@ -221,14 +222,11 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   BeamExact* b = calloc(1, sizeof *b);
   if (!b) return fmb_parse_error(p, item, "out of memory");
   int model = 3, err = 0;
-  err |= fmb_get_double(p, item, "length", FMB_REQUIRED | FMB_POSITIVE, &b->L);
-  err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, EXACT_MAX_ELEMENTS, &b->ne);
-  err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, &b->rho);
-  err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, &b->A);
-  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, &b->Izz);
-  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, &b->Emod);
+  err |= fmb_beam_read_section(p, item, EXACT_MAX_ELEMENTS, &b->L, &b->ne, &b->rho, &b->A, &b->Izz, &b->Emod);
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, exact_models, &model); /* "exact": beam.c chose this table */
   err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, exact_integrations, &b->integration);
+  int kinematics = 0; /* "intrinsic" is bodies/beam_intrinsic.c's (beam.c's variant chose): "cable" here */
+  err |= fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, exact_kinematics, &kinematics);
   int assembly = ASSEMBLY_AUTO;
   err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, exact_assemblies, &assembly);
   b->banded = assembly == ASSEMBLY_BANDED || (assembly == ASSEMBLY_AUTO && b->ne >= BANDED_FROM_ELEMENTS);
@@ -238,10 +236,7 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_choice(p, item, "axial_form", FMB_OPTIONAL, exact_axial_forms, &displacement_form);
   b->mixed = !displacement_form && b->integration == INTEGRATION_REDUCED && assembly != ASSEMBLY_DENSE;
   if (b->mixed) b->banded = 1;
-  err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, b->pos0);
-  err |= fmb_get_angle(p, item, "angle", FMB_POSE, &b->angle0);
-  err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, b->vel0);
-  err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, &b->omega0);
+  err |= fmb_beam_read_frame(p, item, b->pos0, &b->angle0, b->vel0, &b->omega0);
   if (!err && fmb_find_key(p, item, "damping") >= 0)
     err = fmb_parse_error(p, fmb_find_key(p, item, "damping"),
                           "'damping' is not available with model: exact "
@@ -256,9 +251,7 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   exact_setup(b);
   /* as for the other models (beam.c): parameters that are each valid can still combine into an
      element whose mass or stiffness is not a usable double (length 1e-300: EI/le^3 overflows) */
-  const double me = b->mu * b->le, k_axial = b->EA / b->le, k_bend = 12.0 * b->EI / (b->le * b->le * b->le);
-  if (!isnormal(me) || !isnormal(k_axial) || !isnormal(k_bend) || !isfinite(fmax(k_axial, k_bend) / me)) {
-    fmb_beam_refuse_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod, me, k_bend, k_axial);
+  if (fmb_beam_degenerate(p, item, b->L, b->ne, b->rho, b->A, b->Izz, b->Emod)) {
     free(b);
     return -1;
   }
@@ -272,15 +265,7 @@ static int exact_ncoord(const void* self) { return 3 + ((const BeamExact*)self)-
 
 static void exact_initial(const void* self, double* q0, double* v0) {
   const BeamExact* b = self;
-  const int nc = 3 + b->n;
-  memset(q0, 0, sizeof(double) * (size_t)nc);
-  memset(v0, 0, sizeof(double) * (size_t)nc);
-  q0[0] = b->pos0[0];
-  q0[1] = b->pos0[1];
-  q0[2] = b->angle0;
-  v0[0] = b->vel0[0];
-  v0[1] = b->vel0[1];
-  v0[2] = b->omega0;
+  fmb_beam_frame_initial(3 + b->n, b->pos0, b->angle0, b->vel0, b->omega0, q0, v0);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -348,17 +333,6 @@ static void point_frame(const Shape* sh, int e, const double X[8], const double 
   pf->ncol = nc;
 }
 
-/* frame quantities shared by the residual and the Jacobian */
-static void frame_terms(const fmbEnv* env, const double* q, const double* a, double* c, double* s, double G0[2]) {
-  *c = cos(q[2]);
-  *s = sin(q[2]);
-  double g[2] = {0.0, 0.0};
-  if (env && env->has_gravity) g[0] = env->gravity[0], g[1] = env->gravity[1];
-  const double d[2] = {a[0] - g[0], a[1] - g[1]};
-  G0[0] = *c * d[0] + *s * d[1];
-  G0[1] = -*s * d[0] + *c * d[1];
-}
-
 /* element e's nodal displacements D, positions X, rates Xd and accelerations Xdd */
 static void element_state(const BeamExact* b, const double* q, const double* v, const double* a, int e, double D[8],
                           double X[8], double Xd[8], double Xdd[8]) {
@@ -390,7 +364,7 @@ static double axial_strain(const BeamExact* b, int g, const double D[8], double 
 static int exact_eval(const BeamExact* b, const fmbEnv* env, const double* q, const double* v, const double* a,
                       const double* z, double* R, double* Rz) {
   double c, s, G0[2];
-  frame_terms(env, q, a, &c, &s, G0);
+  fmb_beam_frame_load(env, q, a, &c, &s, G0);
   memset(R, 0, sizeof(double) * (size_t)(3 + b->n));
   if (Rz) memset(Rz, 0, sizeof(double) * (size_t)(2 * b->ne + 1));
   for (int e = 0; e < b->ne; ++e) {
@@ -466,7 +440,7 @@ static int exact_fill(const BeamExact* b, int banded, const fmbEnv* env, const d
                       const double* a, const double* z, double* K, double* C, double* M) {
   const size_t nc = (size_t)(3 + b->n), nv = banded ? (size_t)exact_npair_all(b) : nc * nc;
   double c, s, G0[2];
-  frame_terms(env, q, a, &c, &s, G0);
+  fmb_beam_frame_load(env, q, a, &c, &s, G0);
   const double om = v[2], al = a[2];
   if (K) memset(K, 0, sizeof(double) * nv);
   if (C) memset(C, 0, sizeof(double) * nv);
@@ -687,15 +661,9 @@ static void exact_integrals(const BeamExact* b, const fmbEnv* env, const double*
     }
     Ue += element_elastic(b, D, NULL, f, NULL);
   }
-  double Ug = 0.0;
-  if (env && env->has_gravity) {
-    /* -int mu g . (r0 + A rho) */
-    const double m = b->mu * b->L, gx = env->gravity[0], gy = env->gravity[1];
-    Ug = -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
-  }
   en->kinetic = T;
   en->strain = Ue;
-  en->gravity = Ug;
+  en->gravity = fmb_beam_gravity_potential(env, b->mu * b->L, q, c, s, mrho);
   en->spring = 0.0;
   if (ptheta) *ptheta = pth;
 }
@@ -727,28 +695,14 @@ static int exact_output(const void* self, int id, const double* q, const double*
     *value = angle - q[2];
     return 0;
   }
-  int node = b->ne, comp = id;
-  if (id >= FMB_BEAM_NODE_BASE) {
-    node = (id - FMB_BEAM_NODE_BASE) / FMB_BEAM_NODE_STRIDE;
-    const int k = (id - FMB_BEAM_NODE_BASE) % FMB_BEAM_NODE_STRIDE;
-    comp = k == 0 ? FMB_BEAM_TIP_U : k == 1 ? FMB_BEAM_TIP_V : k == 2 ? FMB_BEAM_TIP_X : FMB_BEAM_TIP_Y;
-  } else if (id < 0 || id >= FMB_BEAM_NTIP) {
-    return -1;
-  }
+  int node, comp;
+  if (fmb_beam_output_node(b->ne, id, &node, &comp)) return -1;
   /* a node's displacement and rate are coordinates (the root node is fixed in the frame) */
   const int i = 4 + 4 * (node - 1);
   const double u[2] = {node ? q[i] : 0.0, node ? q[i + 1] : 0.0};
   const double ud[2] = {node ? v[i] : 0.0, node ? v[i + 1] : 0.0};
   const double rho[2] = {node * b->le + u[0], u[1]};
-  const double c = cos(q[2]), s = sin(q[2]);
-  switch (comp) {
-    case FMB_BEAM_TIP_U: *value = u[0]; break;
-    case FMB_BEAM_TIP_V: *value = u[1]; break;
-    case FMB_BEAM_TIP_U_RATE: *value = ud[0]; break;
-    case FMB_BEAM_TIP_V_RATE: *value = ud[1]; break;
-    case FMB_BEAM_TIP_X: *value = q[0] + c * rho[0] - s * rho[1]; break;
-    default: *value = q[1] + s * rho[0] + c * rho[1]; break;
-  }
+  *value = fmb_beam_node_value(comp, q, u, ud, rho);
   return 0;
 }
 
@@ -836,6 +790,11 @@ static const fmbParam exact_params[] = {
      .choices = exact_axial_forms,
      .doc = "mixed: the axial strains at the axial points are unknowns Newton iterates on (integration: reduced, "
             "assembly not dense); displacement: the form before it, to compare (docs/models.md, \"Newton\")"},
+    {.key = "kinematics",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "cable",
+     .choices = exact_kinematics,
+     .doc = "cable here: nodal positions and slopes (intrinsic: bodies/beam_intrinsic.c)"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},

@@ -140,6 +140,70 @@ static inline int fmb_beam_centreline(double L, int ne, int n, double* local) {
   return n;
 }
 
+/* non-zero, after the parse error, when the section's element mass or stiffness (le = L/ne) is
+   not a usable double: the check every model makes after reading the section */
+static inline int fmb_beam_degenerate(fmbParser* p, fmbNode item, double L, int ne, double rho, double A, double Izz,
+                                      double E) {
+  const double le = L / ne, me = rho * A * le, k_axial = E * A / le, k_bend = 12.0 * E * Izz / (le * le * le);
+  if (isnormal(me) && isnormal(k_axial) && isnormal(k_bend) && isfinite(fmax(k_axial, k_bend) / me)) return 0;
+  fmb_beam_refuse_degenerate(p, item, L, ne, rho, A, Izz, E, me, k_bend, k_axial);
+  return -1;
+}
+
+/* The section's keys (FMB_BEAM_SECTION_PARAMS) and the frame's initial state (FMB_BEAM_FRAME_PARAMS)
+   as the exact beam's two forms read them (beam_exact.c, beam_intrinsic.c); non-zero on an error */
+static inline int fmb_beam_read_section(fmbParser* p, fmbNode item, int max_elements, double* L, int* ne, double* rho,
+                                        double* A, double* Izz, double* E) {
+  int err = 0;
+  err |= fmb_get_double(p, item, "length", FMB_REQUIRED | FMB_POSITIVE, L);
+  err |= fmb_get_int(p, item, "elements", FMB_REQUIRED, 1, max_elements, ne);
+  err |= fmb_get_double(p, item, "density", FMB_REQUIRED | FMB_POSITIVE, rho);
+  err |= fmb_get_double(p, item, "area", FMB_REQUIRED | FMB_POSITIVE, A);
+  err |= fmb_get_double(p, item, "second_moment", FMB_REQUIRED | FMB_POSITIVE, Izz);
+  err |= fmb_get_double(p, item, "youngs_modulus", FMB_REQUIRED | FMB_POSITIVE, E);
+  return err;
+}
+static inline int fmb_beam_read_frame(fmbParser* p, fmbNode item, double pos0[2], double* angle0, double vel0[2],
+                                      double* omega0) {
+  int err = 0;
+  err |= fmb_get_vec2(p, item, "position", FMB_OPTIONAL, pos0);
+  err |= fmb_get_angle(p, item, "angle", FMB_POSE, angle0);
+  err |= fmb_get_vec2(p, item, "velocity", FMB_OPTIONAL, vel0);
+  err |= fmb_get_double(p, item, "angular_velocity", FMB_OPTIONAL, omega0);
+  return err;
+}
+/* q0, v0 of nc coordinates: the frame's initial state, the rest zero (the undeformed beam) */
+static inline void fmb_beam_frame_initial(int nc, const double pos0[2], double angle0, const double vel0[2],
+                                          double omega0, double* q0, double* v0) {
+  memset(q0, 0, sizeof(double) * (size_t)nc);
+  memset(v0, 0, sizeof(double) * (size_t)nc);
+  q0[0] = pos0[0];
+  q0[1] = pos0[1];
+  q0[2] = angle0;
+  v0[0] = vel0[0];
+  v0[1] = vel0[1];
+  v0[2] = omega0;
+}
+/* cos, sin of the frame angle q[2] and G0 = A^T (r0'' - g): the frame's share of a_b - f_b */
+static inline void fmb_beam_frame_load(const fmbEnv* env, const double* q, const double* a, double* c, double* s,
+                                       double G0[2]) {
+  *c = cos(q[2]);
+  *s = sin(q[2]);
+  double g[2] = {0.0, 0.0};
+  if (env && env->has_gravity) g[0] = env->gravity[0], g[1] = env->gravity[1];
+  const double d[2] = {a[0] - g[0], a[1] - g[1]};
+  G0[0] = *c * d[0] + *s * d[1];
+  G0[1] = -*s * d[0] + *c * d[1];
+}
+/* U_g = -int mu g . (r0 + A rho) of a beam of mass m whose first moment in the frame is mrho =
+   int mu rho (c, s: cos, sin of q[2]); 0 without gravity */
+static inline double fmb_beam_gravity_potential(const fmbEnv* env, double m, const double* q, double c, double s,
+                                                const double mrho[2]) {
+  if (!(env && env->has_gravity)) return 0.0;
+  const double gx = env->gravity[0], gy = env->gravity[1];
+  return -m * (gx * q[0] + gy * q[1]) - (gx * (c * mrho[0] - s * mrho[1]) + gy * (s * mrho[0] + c * mrho[1]));
+}
+
 /* The outputs every beam model gives (the same ids, so `--models` compares like with like): the
    tip's deformation, its rates and position, the angular momentum, the tip cross-section's angle
    to the frame (the marker's angle at (L, 0) less theta: the slope w2'(L) of the small-strain
@@ -174,5 +238,30 @@ static inline int fmb_beam_output_lookup(int ne, const char* quantity) {
   static const char comp[] = "uvxy";
   const char* at = strchr(comp, end[1]);
   return at ? FMB_BEAM_NODE_BASE + FMB_BEAM_NODE_STRIDE * (int)k + (int)(at - comp) : -1;
+}
+/* the node (ne for the tip quantities) and component (FMB_BEAM_TIP_U ... _Y) of output id, or -1
+   when id is not a node's or the tip's position or displacement quantity */
+static inline int fmb_beam_output_node(int ne, int id, int* node, int* comp) {
+  *node = ne, *comp = id;
+  if (id >= FMB_BEAM_NODE_BASE) {
+    *node = (id - FMB_BEAM_NODE_BASE) / FMB_BEAM_NODE_STRIDE;
+    const int k = (id - FMB_BEAM_NODE_BASE) % FMB_BEAM_NODE_STRIDE;
+    *comp = k == 0 ? FMB_BEAM_TIP_U : k == 1 ? FMB_BEAM_TIP_V : k == 2 ? FMB_BEAM_TIP_X : FMB_BEAM_TIP_Y;
+    return 0;
+  }
+  return id < 0 || id >= FMB_BEAM_NTIP ? -1 : 0;
+}
+/* component comp at a node of displacement u (its rate ud) and position rho in the frame of q */
+static inline double fmb_beam_node_value(int comp, const double* q, const double u[2], const double ud[2],
+                                         const double rho[2]) {
+  const double c = cos(q[2]), s = sin(q[2]);
+  switch (comp) {
+    case FMB_BEAM_TIP_U: return u[0];
+    case FMB_BEAM_TIP_V: return u[1];
+    case FMB_BEAM_TIP_U_RATE: return ud[0];
+    case FMB_BEAM_TIP_V_RATE: return ud[1];
+    case FMB_BEAM_TIP_X: return q[0] + c * rho[0] - s * rho[1];
+    default: return q[1] + s * rho[0] + c * rho[1];
+  }
 }
 #endif
