@@ -416,7 +416,7 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   int lu_ok = 1;
   if (m->solver.linear_solver == FMB_LS_KLU) {
     lu_ok = (c->red1 = fmb_schur_new(m, 0)) != NULL;
-    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new(m, 1));
+    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new_like(c->red1, 1));
   } else {
     lu_ok = (c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0)) != NULL;
     for (int p = 0; p < c->npair; ++p)
