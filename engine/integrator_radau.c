@@ -198,7 +198,7 @@ typedef struct {
   double* e2rhs[2];             /* the complex systems' right sides, interleaved (2 ny) */
   double *err, *err2;
   /* Jacobian parts on the model's CSC pattern, and the two iteration matrices */
-  double *jy, *jyp, *e1, *e2[2];
+  double *jy, *jyp, *e1, *e2; /* e2: the E2 of each pair in turn (decompose) */
   /* J_y' by rows, its nonzeros only (jyp_rows, for the error estimate's product) */
   long *jyp_row_ptr, *jyp_row_next;
   int* jyp_row_col;
@@ -249,9 +249,9 @@ static void radau_destroy(void* self) {
   for (int p = 0; p < 2; ++p) {
     fmb_klu_free(c->lu2[p]);
     fmb_schur_free(c->red2[p]);
-    free(c->e2[p]);
     free(c->e2rhs[p]);
   }
+  free(c->e2);
   double** vs[] = {&c->atol,     &c->scal,     &c->ewt,  &c->y,        &c->yp,   &c->ys,
                    &c->yps,      &c->err,      &c->err2, &c->jy,       &c->jyp,  &c->e1,
                    &c->work_old, &c->work_new, &c->p0,   &c->work_out, &c->pend, &c->work_atol};
@@ -362,6 +362,24 @@ static int radau_reinit(void* self, double t0, const double* y0, const double* y
   return 0;
 }
 
+/* klu_full's KLU objects on the whole pattern (at create, or at the fallback from the reduced
+   systems): 0, or 1 when out of memory or KLU could not analyze the pattern */
+static int full_lu_new(RadauRun* c) {
+  const fmbModel* m = c->m;
+  const size_t n = (size_t)c->ny, nnz = (size_t)m->nnz;
+  if (!c->colptr) { /* KLU's index type; made here only: the reduced systems have their own */
+    c->colptr = malloc(sizeof(SuiteSparse_long) * (n + 1));
+    c->rowind = malloc(sizeof(SuiteSparse_long) * (nnz ? nnz : 1));
+    if (!c->colptr || !c->rowind) return 1;
+    for (size_t i = 0; i <= n; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
+    for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
+  }
+  if (!(c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0))) return 1;
+  for (int p = 0; p < c->npair; ++p)
+    if (!(c->lu2[p] = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX))) return 1;
+  return 0;
+}
+
 static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup* s, double t0, const double* y0,
                               const double* yp0, fmbDiag* diag) {
   const fmbModel* m = s->m;
@@ -394,15 +412,19 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   c->jy = dalloc(nnz);
   c->jyp = dalloc(nnz);
   c->e1 = dalloc(nnz);
-  c->colptr = calloc(n + 1, sizeof(SuiteSparse_long));
   c->jyp_row_ptr = calloc(n + 1, sizeof(long));
   c->jyp_row_next = calloc(n + 1, sizeof(long));
-  c->jyp_row_col = calloc(nnz ? nnz : 1, sizeof(int));
-  c->jyp_row_val = dalloc(nnz);
-  c->rowind = calloc(nnz ? nnz : 1, sizeof(SuiteSparse_long));
+  /* J_y' by rows holds J_y''s nonzeros only (jyp_rows), a fraction of the pattern: sized for all,
+     written as far as they go (malloc: the pages beyond are never touched, where calloc's clearing
+     touched them all; each first touch costs a page fault) */
+  c->jyp_row_col = malloc(sizeof(int) * (nnz ? nnz : 1));
+  c->jyp_row_val = malloc(sizeof(double) * (nnz ? nnz : 1));
+  /* one E2 for every pair: each is formed and factorized in turn (decompose), and the
+     factorizations keep what they need */
+  c->e2 = c->npair ? dalloc(2 * nnz) : NULL;
   int ok = c->atol && c->scal && c->ewt && c->y && c->yp && c->ys && c->yps && c->err && c->err2 && c->jy && c->jyp &&
-           c->e1 && c->colptr && c->rowind && c->jyp_row_ptr && c->jyp_row_next && c->jyp_row_col && c->jyp_row_val;
-  for (int p = 0; p < c->npair; ++p) ok = ok && (c->e2[p] = dalloc(2 * nnz)) && (c->e2rhs[p] = dalloc(2 * n));
+           c->e1 && c->jyp_row_ptr && c->jyp_row_next && c->jyp_row_col && c->jyp_row_val && (c->e2 || !c->npair);
+  for (int p = 0; p < c->npair; ++p) ok = ok && (c->e2rhs[p] = dalloc(2 * n));
   for (int k = 0; k < c->s; ++k) {
     c->z[k] = dalloc(n);
     c->wt[k] = dalloc(n);
@@ -411,16 +433,12 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   }
   for (int k = 0; k <= c->s; ++k) ok = ok && (c->cont[k] = dalloc(n));
   if (!ok) goto oom;
-  for (int i = 0; i <= ny; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
-  for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
   int lu_ok = 1;
   if (m->solver.linear_solver == FMB_LS_KLU) {
     lu_ok = (c->red1 = fmb_schur_new(m, 0)) != NULL;
     for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new_like(c->red1, 1));
   } else {
-    lu_ok = (c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0)) != NULL;
-    for (int p = 0; p < c->npair; ++p)
-      lu_ok = lu_ok && (c->lu2[p] = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX));
+    lu_ok = full_lu_new(c) == 0;
   }
   if (!lu_ok) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
@@ -526,21 +544,15 @@ static int decompose(RadauRun* c) {
   const long nnz = c->m->nnz;
   const double g = c->tab->gamma / c->h;
   for (long k = 0; k < nnz; ++k) c->e1[k] = c->jy[k] + g * c->jyp[k];
-  for (int p = 0; p < c->npair; ++p) {
+  int failed = c->red1 ? fmb_schur_factor(c->red1, c->e1) : fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK;
+  for (int p = 0; p < c->npair && !failed; ++p) { /* each E2 in the one buffer, then factorized */
     const double a = c->tab->alpha[p] / c->h, b = c->tab->beta[p] / c->h;
-    double* e2 = c->e2[p];
+    double* e2 = c->e2;
     for (long k = 0; k < nnz; ++k) {
       e2[2 * k] = c->jy[k] + a * c->jyp[k];
       e2[2 * k + 1] = b * c->jyp[k];
     }
-  }
-  int failed = 0;
-  if (c->red1) {
-    failed = fmb_schur_factor(c->red1, c->e1);
-    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_schur_factor(c->red2[p], c->e2[p]);
-  } else {
-    failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK;
-    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_klu_factor(c->lu2[p], c->e2[p]) != FMB_KLU_OK;
+    failed = c->red1 ? fmb_schur_factor(c->red2[p], e2) : fmb_klu_factor(c->lu2[p], e2) != FMB_KLU_OK;
   }
   if (failed) {
     c->h_lu = 0.0;
@@ -1128,9 +1140,7 @@ static int fall_back_to_full(RadauRun* c) {
     c->red2[p] = NULL;
   }
   c->fell_back = 1;
-  if (!(c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0))) return 1;
-  for (int p = 0; p < c->npair; ++p)
-    if (!(c->lu2[p] = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX))) return 1;
+  if (full_lu_new(c)) return 1;
   if (c->hold > 0.0) c->h = c->hold;
   c->need_jac = 1;
   c->h_lu = 0.0;
