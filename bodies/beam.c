@@ -1299,19 +1299,20 @@ static int beam_marker(const void* self, const double* q, const double local[2],
 /* ---------------------------------------------------------------------------------------------
  * Energy: each model's own kinetic energy, strain energy 1/2 p^T K p, gravity -int rho g.r.
  * ------------------------------------------------------------------------------------------- */
-/* two doubles, one per lane (GCC's and Clang's vector extension: SSE2 on x86-64, NEON on arm64) */
-typedef double dbl2 __attribute__((vector_size(2 * sizeof(double))));
-static inline dbl2 splat(double a) { return (dbl2){a, a}; }
+/* four doubles, one per lane (GCC's and Clang's vector extension: two SSE2 registers on a baseline
+   x86-64, one with beam_integrals' AVX2 version, two NEON ones on arm64) */
+typedef double dbl4 __attribute__((vector_size(4 * sizeof(double))));
+/* macros, not functions: a function returning a 4-double vector has another ABI with and without
+   AVX (GCC's -Wpsabi), and beam_integrals is compiled both ways */
+#define splat(a) ((dbl4){(a), (a), (a), (a)})
 /* dot4(n, d) in each lane, in dot4's order */
-static inline dbl2 dot4v(const dbl2 n[4], const double d[4]) {
-  return n[0] * splat(d[0]) + n[1] * splat(d[1]) + n[2] * splat(d[2]) + n[3] * splat(d[3]);
-}
+#define dot4v(n, d) ((n)[0] * splat((d)[0]) + (n)[1] * splat((d)[1]) + (n)[2] * splat((d)[2]) + (n)[3] * splat((d)[3]))
 
 /* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
    momentum about the frame origin for the complete model) in one pass; with the coupling integrals
    over the whole beam (coupled models) */
-static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
-                           double* ptheta, double coupling_total[2]) {
+FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v,
+                                             fmbEnergy* en, double* ptheta, double coupling_total[2]) {
   const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
   const double le = b->le;
   const double* p = q + 3;
@@ -1327,6 +1328,23 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0, pth = 0.0;
   double Ipp = 0.0, Ipv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
+  /* the quadrature's tables in groups of four points (the point loop's lanes, below), made once a
+     call: the lanes past the last point repeat it */
+  enum { NGROUP = (FMB_GAUSS_MAX + 3) / 4 };
+  dbl4 xi_g[NGROUP], wg_g[NGROUP], ns_g[NGROUP][4], nd_g[NGROUP][4], pw_g[NGROUP][5];
+  for (int g = 0; g < ng; g += 4) {
+    const int grp = g / 4;
+    int gl[4];
+    for (int l = 0; l < 4; ++l) gl[l] = g + l < ng ? g + l : ng - 1;
+    xi_g[grp] = (dbl4){b->xg[gl[0]], b->xg[gl[1]], b->xg[gl[2]], b->xg[gl[3]]};
+    wg_g[grp] = (dbl4){b->wg[gl[0]], b->wg[gl[1]], b->wg[gl[2]], b->wg[gl[3]]};
+    for (int j = 0; j < 4; ++j) {
+      ns_g[grp][j] = (dbl4){b->ns_out[gl[0]][j], b->ns_out[gl[1]][j], b->ns_out[gl[2]][j], b->ns_out[gl[3]][j]};
+      nd_g[grp][j] = (dbl4){b->nd_out[gl[0]][j], b->nd_out[gl[1]][j], b->nd_out[gl[2]][j], b->nd_out[gl[3]][j]};
+    }
+    for (int k = 0; k < 5; ++k)
+      pw_g[grp][k] = (dbl4){b->pw_out[gl[0]][k], b->pw_out[gl[1]][k], b->pw_out[gl[2]][k], b->pw_out[gl[3]][k]};
+  }
   for (int e = 0; e < ne; ++e) {
     double ua[2], d[4], uda[2], dd[4], pp[5] = {0}, pv5[5] = {0}; /* set and read only when coupled */
     gather(p, e, ua, d);
@@ -1335,26 +1353,24 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
       double cp[3], cv[3];
       slope_products(b, d, dd, cp, cv, pp, pv5);
     }
-    /* two quadrature points at a time, one in each lane of a vector (lane 1 repeats the last point
-       when ng is odd, and is then not summed): the same operations in the same order per point as
-       one at a time, so bit for bit the same sums, in about half the instructions (this pass was
-       the largest part of the rows' cost, docs/performance.md "Row output") */
-    for (int g = 0; g < ng; g += 2) {
-      const int g1 = g + 1 < ng ? g + 1 : g;
-      const dbl2 xi = {b->xg[g], b->xg[g1]}, x = splat(e * le) + xi * splat(le);
-      dbl2 ns[4], nd[4];
-      for (int j = 0; j < 4; ++j) {
-        ns[j] = (dbl2){b->ns_out[g][j], b->ns_out[g1][j]};
-        nd[j] = (dbl2){b->nd_out[g][j], b->nd_out[g1][j]};
-      }
-      const dbl2 n1[2] = {splat(1.0) - xi, xi};
-      const dbl2 w1 = n1[0] * splat(ua[0]) + n1[1] * splat(ua[1]), w2 = dot4v(ns, d), w2s = dot4v(nd, d);
-      const dbl2 w1d = n1[0] * splat(uda[0]) + n1[1] * splat(uda[1]), w2d = dot4v(ns, dd), w2sd = dot4v(nd, dd);
-      dbl2 wc = splat(0.0), wcd = splat(0.0);
+    /* four quadrature points at a time, one in each lane of a vector (the lanes past the last point
+       repeat it, and are then not summed): the same operations in the same order per point as one
+       at a time (no FMA: FMB_VECTOR_CLONES), so bit for bit the same sums, in about a third of the
+       instructions with AVX2 (this pass was the largest part of the rows' cost, docs/performance.md
+       "Row output"; two lanes at a time before) */
+    for (int g = 0; g < ng; g += 4) {
+      const int grp = g / 4, nlane = ng - g < 4 ? ng - g : 4;
+      const dbl4 xi = xi_g[grp], x = splat(e * le) + xi * splat(le);
+      const dbl4* ns = ns_g[grp];
+      const dbl4* nd = nd_g[grp];
+      const dbl4 n1[2] = {splat(1.0) - xi, xi};
+      const dbl4 w1 = n1[0] * splat(ua[0]) + n1[1] * splat(ua[1]), w2 = dot4v(ns, d), w2s = dot4v(nd, d);
+      const dbl4 w1d = n1[0] * splat(uda[0]) + n1[1] * splat(uda[1]), w2d = dot4v(ns, dd), w2sd = dot4v(nd, dd);
+      dbl4 wc = splat(0.0), wcd = splat(0.0);
       if (coupled) {
-        dbl2 pwp = splat(0.0), pwv = splat(0.0); /* dot5 with pw_out, term by term as dot5 adds them */
+        dbl4 pwp = splat(0.0), pwv = splat(0.0); /* dot5 with pw_out, term by term as dot5 adds them */
         for (int k = 0; k < 5; ++k) {
-          const dbl2 pw = {b->pw_out[g][k], b->pw_out[g1][k]};
+          const dbl4 pw = pw_g[grp][k];
           pwp = k ? pwp + splat(pp[k]) * pw : splat(pp[k]) * pw;
           pwv = k ? pwv + splat(pv5[k]) * pw : splat(pv5[k]) * pw;
         }
@@ -1364,14 +1380,16 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
       /* The cross-section pair y = -r, +r (mass m each): every velocity and lever arm below is
          affine in y, X = X0 + y X1, so the pair sums in closed form as in the residual:
          sum m (A + yB).(C + yD) = M2 (A.C + r^2 B.D), M2 = 2m; terms linear in y cancel. */
-      const dbl2 M2 = splat(2.0 * mhalf) * (dbl2){b->wg[g], b->wg[g1]}, r2 = splat(b->r * b->r), omv = splat(om);
-      const dbl2 vR0[2] = {splat(v0[0]), splat(v0[1]) + x * omv}, vR1[2] = {splat(-om), splat(0.0)};
-      const dbl2 vRD0[2] = {vR0[0] - w2 * omv + w1d, vR0[1] + w1 * omv + w2d};
-      const dbl2 vRD1[2] = {vR1[0] - w2sd, -w2s * omv};
-      const dbl2 vC[2] = {wcd, wc * omv};
+      const dbl4 M2 = splat(2.0 * mhalf) * wg_g[grp], r2 = splat(b->r * b->r), omv = splat(om);
+      /* the rigid velocity's parts vR0 = (vR0x, vR0y) and vR1 = (vR1x, 0) (two-vector arrays made
+         GCC's vector lowering warn of uninitialized lanes) */
+      const dbl4 vR0x = splat(v0[0]), vR0y = splat(v0[1]) + x * omv, vR1x = splat(-om);
+      const dbl4 vRD0[2] = {vR0x - w2 * omv + w1d, vR0y + w1 * omv + w2d};
+      const dbl4 vRD1[2] = {vR1x - w2sd, -w2s * omv};
+      const dbl4 vC[2] = {wcd, wc * omv};
       /* d v / d theta' of the parts: I~(rho0 + u_D) = gRD0 + y gRD1, I~ rho0 = [-y, x] */
-      const dbl2 gRD0[2] = {-w2, x + w1}, gRD1[2] = {splat(-1.0), -w2s};
-      dbl2 dT, dp;
+      const dbl4 gRD0[2] = {-w2, x + w1}, gRD1[2] = {splat(-1.0), -w2s};
+      dbl4 dT, dp;
       switch (model) {
         case BEAM_ZOAC:
           dT = splat(0.5) * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
@@ -1380,20 +1398,20 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
         case BEAM_FOAC:
           dT = M2 *
                (splat(0.5) * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
-                vR0[0] * vC[0] + vR0[1] * vC[1]);
+                vR0x * vC[0] + vR0y * vC[1]);
           dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) + x * vC[1] +
-                     wc * vR0[1]);
+                     wc * vR0y);
           break;
         default: {
-          const dbl2 vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
+          const dbl4 vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
           dT = splat(0.5) * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
           dp = M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
           break;
         }
       }
       /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
-      const dbl2 dUg = grav ? M2 * (splat(f[0]) * (x + w1 + wc) + splat(f[1]) * w2) : splat(0.0);
-      for (int lane = 0; lane < (g1 > g ? 2 : 1); ++lane) { /* in the order of the points */
+      const dbl4 dUg = grav ? M2 * (splat(f[0]) * (x + w1 + wc) + splat(f[1]) * w2) : splat(0.0);
+      for (int lane = 0; lane < nlane; ++lane) { /* in the order of the points */
         T += dT[lane];
         pth += dp[lane];
         if (grav) Ug -= dUg[lane];
@@ -1417,6 +1435,9 @@ static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, co
   coupling_total[0] = Ipp; /* int_0^L w2'^2 and int_0^L w2' w2d' (coupled models): the tip's w_c, rate */
   coupling_total[1] = Ipv;
 }
+
+#undef splat
+#undef dot4v
 
 /* ---------------------------------------------------------------------------------------------
  * The outputs' cache: a row asks several outputs of one state (q, v). The energies and

@@ -415,6 +415,19 @@ FMB_API double fmb_eval_input_rate(const fmbJointEval* ev, double* accel);
 /* ---------------------------------------------------------------------------------------------
  * Numerics shared by plugins (one quadrature for the whole project, engine/quad.c).
  * ------------------------------------------------------------------------------------------- */
+/* A hot vector kernel in two versions, picked once at load time by the CPU (GCC's target_clones,
+   an ifunc): SSE2, x86-64's baseline the build targets, and AVX2, whose vectors hold twice the
+   values. Only for element-wise loops (axpys, scalings): the wider vectors then do the same
+   operations on each value in the same order, so results are bit for bit the same (no FMA: "avx2"
+   does not enable it, and -std=c11 keeps contraction off). GCC on x86-64 Linux; one version
+   elsewhere (clang, other targets). Public, so that a type's own hot loop can use it (the beam's
+   energy pass). */
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define FMB_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define FMB_VECTOR_CLONES
+#endif
+
 #define FMB_GAUSS_MAX 10
 /* n-point Gauss-Legendre rule on [0, 1] (1 <= n <= FMB_GAUSS_MAX); exact to degree 2n-1.
    Returns 0, or -1 for an unsupported n. */

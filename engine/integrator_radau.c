@@ -198,7 +198,7 @@ typedef struct {
   double* e2rhs[2];             /* the complex systems' right sides, interleaved (2 ny) */
   double *err, *err2;
   /* Jacobian parts on the model's CSC pattern, and the two iteration matrices */
-  double *jy, *jyp, *e1, *e2[2];
+  double *jy, *jyp, *e1, *e2; /* e2: the E2 of each pair in turn (decompose) */
   /* J_y' by rows, its nonzeros only (jyp_rows, for the error estimate's product) */
   long *jyp_row_ptr, *jyp_row_next;
   int* jyp_row_col;
@@ -249,9 +249,9 @@ static void radau_destroy(void* self) {
   for (int p = 0; p < 2; ++p) {
     fmb_klu_free(c->lu2[p]);
     fmb_schur_free(c->red2[p]);
-    free(c->e2[p]);
     free(c->e2rhs[p]);
   }
+  free(c->e2);
   double** vs[] = {&c->atol,     &c->scal,     &c->ewt,  &c->y,        &c->yp,   &c->ys,
                    &c->yps,      &c->err,      &c->err2, &c->jy,       &c->jyp,  &c->e1,
                    &c->work_old, &c->work_new, &c->p0,   &c->work_out, &c->pend, &c->work_atol};
@@ -362,6 +362,24 @@ static int radau_reinit(void* self, double t0, const double* y0, const double* y
   return 0;
 }
 
+/* klu_full's KLU objects on the whole pattern (at create, or at the fallback from the reduced
+   systems): 0, or 1 when out of memory or KLU could not analyze the pattern */
+static int full_lu_new(RadauRun* c) {
+  const fmbModel* m = c->m;
+  const size_t n = (size_t)c->ny, nnz = (size_t)m->nnz;
+  if (!c->colptr) { /* KLU's index type; made here only: the reduced systems have their own */
+    c->colptr = malloc(sizeof(SuiteSparse_long) * (n + 1));
+    c->rowind = malloc(sizeof(SuiteSparse_long) * (nnz ? nnz : 1));
+    if (!c->colptr || !c->rowind) return 1;
+    for (size_t i = 0; i <= n; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
+    for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
+  }
+  if (!(c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0))) return 1;
+  for (int p = 0; p < c->npair; ++p)
+    if (!(c->lu2[p] = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX))) return 1;
+  return 0;
+}
+
 static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup* s, double t0, const double* y0,
                               const double* yp0, fmbDiag* diag) {
   const fmbModel* m = s->m;
@@ -394,15 +412,19 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   c->jy = dalloc(nnz);
   c->jyp = dalloc(nnz);
   c->e1 = dalloc(nnz);
-  c->colptr = calloc(n + 1, sizeof(SuiteSparse_long));
   c->jyp_row_ptr = calloc(n + 1, sizeof(long));
   c->jyp_row_next = calloc(n + 1, sizeof(long));
-  c->jyp_row_col = calloc(nnz ? nnz : 1, sizeof(int));
-  c->jyp_row_val = dalloc(nnz);
-  c->rowind = calloc(nnz ? nnz : 1, sizeof(SuiteSparse_long));
+  /* J_y' by rows holds J_y''s nonzeros only (jyp_rows), a fraction of the pattern: sized for all,
+     written as far as they go (malloc: the pages beyond are never touched, where calloc's clearing
+     touched them all; each first touch costs a page fault) */
+  c->jyp_row_col = malloc(sizeof(int) * (nnz ? nnz : 1));
+  c->jyp_row_val = malloc(sizeof(double) * (nnz ? nnz : 1));
+  /* one E2 for every pair: each is formed and factorized in turn (decompose), and the
+     factorizations keep what they need */
+  c->e2 = c->npair ? dalloc(2 * nnz) : NULL;
   int ok = c->atol && c->scal && c->ewt && c->y && c->yp && c->ys && c->yps && c->err && c->err2 && c->jy && c->jyp &&
-           c->e1 && c->colptr && c->rowind && c->jyp_row_ptr && c->jyp_row_next && c->jyp_row_col && c->jyp_row_val;
-  for (int p = 0; p < c->npair; ++p) ok = ok && (c->e2[p] = dalloc(2 * nnz)) && (c->e2rhs[p] = dalloc(2 * n));
+           c->e1 && c->jyp_row_ptr && c->jyp_row_next && c->jyp_row_col && c->jyp_row_val && (c->e2 || !c->npair);
+  for (int p = 0; p < c->npair; ++p) ok = ok && (c->e2rhs[p] = dalloc(2 * n));
   for (int k = 0; k < c->s; ++k) {
     c->z[k] = dalloc(n);
     c->wt[k] = dalloc(n);
@@ -411,16 +433,12 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   }
   for (int k = 0; k <= c->s; ++k) ok = ok && (c->cont[k] = dalloc(n));
   if (!ok) goto oom;
-  for (int i = 0; i <= ny; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
-  for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
   int lu_ok = 1;
   if (m->solver.linear_solver == FMB_LS_KLU) {
     lu_ok = (c->red1 = fmb_schur_new(m, 0)) != NULL;
-    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new(m, 1));
+    for (int p = 0; p < c->npair; ++p) lu_ok = lu_ok && (c->red2[p] = fmb_schur_new_like(c->red1, 1));
   } else {
-    lu_ok = (c->lu1 = fmb_klu_new(ny, c->colptr, c->rowind, 0)) != NULL;
-    for (int p = 0; p < c->npair; ++p)
-      lu_ok = lu_ok && (c->lu2[p] = fmb_klu_new(ny, c->colptr, c->rowind, FMB_KLU_COMPLEX));
+    lu_ok = full_lu_new(c) == 0;
   }
   if (!lu_ok) {
     fmb_diag_set(diag, FMB_EXIT_SOLVER, m->path, 0, 0, "radau5: KLU could not analyze the Newton matrix's pattern");
@@ -519,26 +537,31 @@ static int evaluate_jacobian(RadauRun* c) {
   return 0;
 }
 
-/* E1 = J_y + (gamma/h) J_y' and, per complex pair p, E2_p = J_y + ((alpha_p + i beta_p)/h) J_y',
-   factorized: 0 ok, 1 singular, -1 a reduced factorization failed outright (KLU, or the tests'
-   fault injection) */
-/* the iteration matrices' values from J_y and J_y' (element-wise: an AVX2 clone, internal.h) */
-FMB_VECTOR_CLONES static void iteration_matrices(RadauRun* c) {
+/* the iteration matrices' values from J_y and J_y' for the full-pattern KLU (element-wise: AVX2
+   clones, internal.h): E1 = J_y + (gamma/h) J_y', and E2_p = J_y + ((alpha_p + i beta_p)/h) J_y'
+   into the one E2 buffer, pair by pair (each is factorized before the next is formed: KLU keeps
+   what it needs) */
+FMB_VECTOR_CLONES static void iteration_matrix_real(RadauRun* c) {
   const long nnz = c->m->nnz;
   const double g = c->tab->gamma / c->h;
   const double* restrict jy = c->jy, * restrict jyp = c->jyp;
   double* restrict e1 = c->e1;
   for (long k = 0; k < nnz; ++k) e1[k] = jy[k] + g * jyp[k];
-  for (int p = 0; p < c->npair; ++p) {
-    const double a = c->tab->alpha[p] / c->h, b = c->tab->beta[p] / c->h;
-    double* restrict e2 = c->e2[p];
-    for (long k = 0; k < nnz; ++k) {
-      e2[2 * k] = jy[k] + a * jyp[k];
-      e2[2 * k + 1] = b * jyp[k];
-    }
+}
+
+FMB_VECTOR_CLONES static void iteration_matrix_complex(RadauRun* c, int p) {
+  const long nnz = c->m->nnz;
+  const double a = c->tab->alpha[p] / c->h, b = c->tab->beta[p] / c->h;
+  const double* restrict jy = c->jy, * restrict jyp = c->jyp;
+  double* restrict e2 = c->e2;
+  for (long k = 0; k < nnz; ++k) {
+    e2[2 * k] = jy[k] + a * jyp[k];
+    e2[2 * k + 1] = b * jyp[k];
   }
 }
 
+/* E1 and each E2_p factorized: 0 ok, 1 singular, -1 a reduced factorization failed outright
+   (KLU, or the tests' fault injection) */
 static int decompose(RadauRun* c) {
   int failed = 0;
   if (c->red1) { /* the reduced factorizations read the matrices' entries from J_y and J_y' */
@@ -546,9 +569,12 @@ static int decompose(RadauRun* c) {
     for (int p = 0; p < c->npair && !failed; ++p)
       failed = fmb_schur_factor_pencil(c->red2[p], c->jy, c->jyp, c->tab->alpha[p] / c->h, c->tab->beta[p] / c->h);
   } else {
-    iteration_matrices(c);
+    iteration_matrix_real(c);
     failed = fmb_klu_factor(c->lu1, c->e1) != FMB_KLU_OK;
-    for (int p = 0; p < c->npair && !failed; ++p) failed = fmb_klu_factor(c->lu2[p], c->e2[p]) != FMB_KLU_OK;
+    for (int p = 0; p < c->npair && !failed; ++p) {
+      iteration_matrix_complex(c, p);
+      failed = fmb_klu_factor(c->lu2[p], c->e2) != FMB_KLU_OK;
+    }
   }
   if (failed) {
     c->h_lu = 0.0;
@@ -1137,9 +1163,7 @@ static int fall_back_to_full(RadauRun* c) {
     c->red2[p] = NULL;
   }
   c->fell_back = 1;
-  if (!(c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0))) return 1;
-  for (int p = 0; p < c->npair; ++p)
-    if (!(c->lu2[p] = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX))) return 1;
+  if (full_lu_new(c)) return 1;
   if (c->hold > 0.0) c->h = c->hold;
   c->need_jac = 1;
   c->h_lu = 0.0;

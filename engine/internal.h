@@ -8,18 +8,6 @@
 #include "flexmbd_cli.h"
 #include "flexmbd_plugin.h"
 
-/* A hot vector kernel in two versions, picked once at load time by the CPU (GCC's target_clones,
-   an ifunc): SSE2, x86-64's baseline the build targets, and AVX2, whose vectors hold twice the
-   values. Only for element-wise loops (axpys, scalings): the wider vectors then do the same
-   operations on each value in the same order, so results are bit for bit the same (no FMA: "avx2"
-   does not enable it, and -std=c11 keeps contraction off). GCC on x86-64 Linux; one version
-   elsewhere (clang, other targets). */
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define FMB_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define FMB_VECTOR_CLONES
-#endif
-
 #define FMB_NAME_MAX 64
 #define FMB_WORLD 0 /* body index of the fixed world frame, named "ground" */
 

@@ -19,7 +19,8 @@
  * IV.8 (8.16)-(8.17)), whose q-blocks are (gamma/h) I and ((alpha + i beta)/h) I minus the same
  * O(|mu|) term. So the elimination is written once for a scalar type (schur_kernels.h) and
  * compiled for double and double complex; the pattern of S and the block indices depend on the
- * model's pattern only and are built here once per fmbSchur.
+ * model's pattern only: built here once, and shared by the systems made from the first
+ * (fmb_schur_new_like: radau's real and complex ones).
  *
  * S's pattern and KLU's symbolic analysis are made once, at fmb_schur_new; the numeric
  * factorization follows the one KLU policy (klu.c: a new pivot order only when the condition
@@ -68,6 +69,9 @@ struct fmbSchur {
      the N-th and later factorizations fail as unrecoverable: how the tests reach the backends'
      fallback to klu_full (integrator_ida.c, integrator_radau.c), which no shipped scene needs */
   long factorizations, fail_from;
+  /* the index arrays above (first_kept to qr_row) depend on the model's pattern only: made once
+     and shared by every fmbSchur made from the first one (fmb_schur_new_like), freed by the last */
+  int* pattern_refs;
 };
 
 /* Where the factorization reads J (schur_kernels.h's jval): J itself, interleaved (re, im) when
@@ -124,20 +128,23 @@ void fmb_schur_forget(fmbSchur* s) {
 void fmb_schur_free(fmbSchur* s) {
   if (!s) return;
   fmb_schur_forget(s);
-  fmb_klu_free(s->klu);
-  free(s->first_kept);
-  free(s->diag_pos);
+  fmb_klu_free(s->klu); /* before the pattern it points into */
+  if (!s->pattern_refs || --*s->pattern_refs <= 0) {
+    free(s->pattern_refs);
+    free(s->first_kept);
+    free(s->diag_pos);
+    free(s->colptr);
+    free(s->rowind);
+    free(s->rq_ptr);
+    free(s->rq_run_ptr);
+    free(s->run_row);
+    free(s->run_len);
+    free(s->qr_ptr);
+    free(s->qr_row);
+  }
   free(s->dinv);
-  free(s->colptr);
-  free(s->rowind);
   free(s->data);
-  free(s->rq_ptr);
-  free(s->rq_run_ptr);
-  free(s->run_row);
-  free(s->run_len);
   free(s->rq_val);
-  free(s->qr_ptr);
-  free(s->qr_row);
   free(s->qr_val);
   free(s->acc);
   free(s->dq);
@@ -146,67 +153,84 @@ void fmb_schur_free(fmbSchur* s) {
   free(s);
 }
 
-static int cmp_sslong(const void* a, const void* b) {
-  SuiteSparse_long x = *(const SuiteSparse_long*)a, y = *(const SuiteSparse_long*)b;
-  return (x > y) - (x < y);
-}
+static int schur_use_dense(const fmbSchur* s);
 
-/* S's pattern: the kept rows of J's column, and for each eliminated row i in it, the kept rows
-   of J's column i. Returns 0, or -1 when out of memory. */
-static int schur_pattern(fmbSchur* s) {
+/* S's column c: the kept rows of J's column nq + c and, for each eliminated row i in it, the kept
+   rows of J's column i, each row once (mark[r] == c once seen): counted per row (row_count), or
+   c appended to each row's list (row_col at row_ptr[r], advanced). Returns how many. */
+static long schur_column(const fmbSchur* s, int c, int* mark, long* row_count, SuiteSparse_long* row_ptr,
+                         int* row_col) {
   const fmbModel* m = s->m;
-  const int nq = s->nq, nr = s->nr;
-  s->colptr = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1));
-  int* mark = malloc(sizeof(int) * (size_t)nr);
-  SuiteSparse_long* list = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1)); /* rows of one column */
-  if (!s->colptr || !mark || !list) {
-    free(mark);
-    free(list);
-    return -1;
-  }
-  for (int pass = 0; pass < 2; ++pass) {
-    SuiteSparse_long nnz = 0;
-    for (int r = 0; r < nr; ++r) mark[r] = -1;
-    for (int c = 0; c < nr; ++c) {
-      const int jc = nq + c;
-      s->colptr[c] = nnz;
-      long nl = 0; /* the column's rows, collected and sorted: O(nnz log) rather than O(nr) per column */
-      for (long k = m->colptr[jc]; k < m->colptr[jc + 1]; ++k) {
-        const long i = m->rowind[k];
-        if (i >= nq) {
-          if (mark[i - nq] != c) list[nl++] = i - nq;
-          mark[i - nq] = c;
-        } else {
-          for (long kk = s->first_kept[i]; kk < m->colptr[i + 1]; ++kk) {
-            const long r = m->rowind[kk] - nq;
-            if (mark[r] != c) list[nl++] = r;
-            mark[r] = c;
-          }
-        }
-      }
-      qsort(list, (size_t)nl, sizeof *list, cmp_sslong);
-      for (long k = 0; k < nl; ++k) {
-        if (pass) s->rowind[nnz] = list[k];
-        ++nnz;
-      }
-    }
-    s->colptr[nr] = nnz;
-    if (!pass) {
-      s->rowind = malloc(sizeof(SuiteSparse_long) * (size_t)(nnz + 1));
-      s->data = calloc((size_t)s->nc * ((size_t)nnz + 1), sizeof(double));
-      if (!s->rowind || !s->data) {
-        free(mark);
-        free(list);
-        return -1;
-      }
+  const int nq = s->nq, jc = nq + c;
+  long n = 0;
+  for (long k = m->colptr[jc]; k < m->colptr[jc + 1]; ++k) {
+    const long i = m->rowind[k];
+    const long from = i >= nq ? k : s->first_kept[i], to = i >= nq ? k + 1 : m->colptr[i + 1];
+    for (long kk = from; kk < to; ++kk) {
+      const long r = m->rowind[kk] - nq;
+      if (mark[r] == c) continue;
+      mark[r] = c;
+      ++n;
+      if (row_count) row_count[r]++;
+      if (row_col) row_col[row_ptr[r]++] = c;
     }
   }
-  free(mark);
-  free(list);
-  return 0;
+  return n;
 }
 
-/* index arrays of the compact J_Rq and J_qR copies; 0 or -1 when out of memory */
+/* S's pattern, built once per model (fmb_schur_new_like shares it). colptr from a counting pass
+   (its count decides a dense S: schur_use_dense); where KLU factorizes S, rowind with each
+   column's rows ascending, as KLU's analysis was made with: the pattern by rows first (a second
+   pass, columns visited in ascending order, so each row's columns come out ascending), then back
+   to columns by visiting the rows in ascending order (a counting sort both ways: O(nnz), where a
+   sort per column took 3.2 M instructions for the three systems of the w15 spin-up's radau9).
+   A dense S needs neither rowind nor KLU's values (schur_kernels.h writes it into lu). 0, or -1
+   when out of memory. */
+static int schur_pattern(fmbSchur* s) {
+  const int nr = s->nr;
+  s->colptr = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1));
+  int* mark = malloc(sizeof(int) * (size_t)(nr + 1));
+  long* row_count = calloc((size_t)nr + 1, sizeof(long));
+  int rc = -1;
+  if (!s->colptr || !mark || !row_count) goto done;
+  SuiteSparse_long nnz = 0;
+  for (int r = 0; r < nr; ++r) mark[r] = -1;
+  for (int c = 0; c < nr; ++c) {
+    s->colptr[c] = nnz;
+    nnz += schur_column(s, c, mark, row_count, NULL, NULL);
+  }
+  s->colptr[nr] = nnz;
+  rc = 0;
+  if (schur_use_dense(s)) goto done;
+  rc = -1;
+  SuiteSparse_long* row_end = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1));
+  SuiteSparse_long* col_next = malloc(sizeof(SuiteSparse_long) * (size_t)(nr + 1));
+  int* row_col = malloc(sizeof(int) * (size_t)(nnz + 1));
+  s->rowind = malloc(sizeof(SuiteSparse_long) * (size_t)(nnz + 1));
+  if (row_end && col_next && row_col && s->rowind) {
+    SuiteSparse_long at = 0;
+    for (int r = 0; r < nr; ++r) { /* row r's start, advanced to its end as its columns come */
+      row_end[r] = at;
+      at += row_count[r];
+    }
+    for (int r = 0; r < nr; ++r) mark[r] = -1;
+    for (int c = 0; c < nr; ++c) schur_column(s, c, mark, NULL, row_end, row_col);
+    for (int c = 0; c < nr; ++c) col_next[c] = s->colptr[c];
+    for (int r = 0; r < nr; ++r)
+      for (SuiteSparse_long k = row_end[r] - row_count[r]; k < row_end[r]; ++k) s->rowind[col_next[row_col[k]]++] = r;
+    rc = 0;
+  }
+  free(row_end);
+  free(col_next);
+  free(row_col);
+done:
+  free(mark);
+  free(row_count);
+  return rc;
+}
+
+/* index arrays of the compact J_Rq and J_qR copies (shared like S's pattern); 0 or -1 when out of
+   memory */
 static int schur_blocks(fmbSchur* s) {
   const fmbModel* m = s->m;
   const int nq = s->nq, nr = s->nr;
@@ -219,11 +243,10 @@ static int schur_blocks(fmbSchur* s) {
     n += m->colptr[i + 1] - s->first_kept[i];
   }
   s->rq_ptr[nq] = (int)n;
-  s->rq_val = malloc(sizeof(double) * (size_t)(n + 1)); /* real, see fmbSchur */
   s->rq_run_ptr = malloc(sizeof(int) * (size_t)(nq + 1));
   s->run_row = malloc(sizeof(int) * (size_t)(n + 1));
   s->run_len = malloc(sizeof(int) * (size_t)(n + 1));
-  if (!s->rq_val || !s->rq_run_ptr || !s->run_row || !s->run_len) return -1;
+  if (!s->rq_run_ptr || !s->run_row || !s->run_len) return -1;
   int nrun = 0;
   for (int i = 0; i < nq; ++i) {
     s->rq_run_ptr[i] = nrun;
@@ -245,8 +268,7 @@ static int schur_blocks(fmbSchur* s) {
   }
   s->qr_ptr[nr] = (int)n;
   s->qr_row = malloc(sizeof(int) * (size_t)(n + 1));
-  s->qr_val = malloc(sizeof(double) * (size_t)s->nc * (size_t)(n + 1));
-  if (!s->qr_row || !s->qr_val) return -1;
+  if (!s->qr_row) return -1;
   for (int c = 0; c < nr; ++c)
     for (long k = m->colptr[nq + c]; k < s->first_kept[nq + c]; ++k)
       s->qr_row[s->qr_ptr[c] + (k - m->colptr[nq + c])] = (int)m->rowind[k];
@@ -273,21 +295,29 @@ static int schur_use_dense(const fmbSchur* s) {
   return s->nr > 0 && s->nr <= 200 && (double)s->colptr[s->nr] >= 0.9 * nr * nr;
 }
 
-fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
-  fmbSchur* s = calloc(1, sizeof *s);
-  if (!s) return NULL;
-  s->m = m;
-  s->nq = m->nq;
-  s->nr = m->ny - m->nq;
-  s->nc = complex_values ? 2 : 1;
-  const size_t nc = (size_t)s->nc;
+/* the pattern's index arrays (first_kept to qr_row): made for s, or like's shared */
+static int schur_index(fmbSchur* s, const fmbSchur* like) {
+  if (like) {
+    s->pattern_refs = like->pattern_refs;
+    ++*s->pattern_refs;
+    s->first_kept = like->first_kept;
+    s->diag_pos = like->diag_pos;
+    s->colptr = like->colptr;
+    s->rowind = like->rowind;
+    s->rq_ptr = like->rq_ptr;
+    s->rq_run_ptr = like->rq_run_ptr;
+    s->run_row = like->run_row;
+    s->run_len = like->run_len;
+    s->qr_ptr = like->qr_ptr;
+    s->qr_row = like->qr_row;
+    return 0;
+  }
+  const fmbModel* m = s->m;
+  s->pattern_refs = malloc(sizeof(int));
   s->first_kept = malloc(sizeof(long) * (size_t)m->ny);
   s->diag_pos = malloc(sizeof(long) * (size_t)(m->nq + 1));
-  s->dinv = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
-  s->acc = calloc(nc * ((size_t)s->nr + 1), sizeof(double));
-  s->dq = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
-  if (!s->first_kept || !s->diag_pos || !s->dinv || !s->acc || !s->dq) goto fail;
-  s->fail_from = m->solver.fault_reduced_setup;
+  if (!s->pattern_refs || !s->first_kept || !s->diag_pos) return -1;
+  *s->pattern_refs = 1;
   for (int c = 0; c < m->nq; ++c) s->diag_pos[c] = -1;
   for (int c = 0; c < m->ny; ++c) {
     long k = m->colptr[c];
@@ -298,20 +328,46 @@ fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) {
     s->first_kept[c] = k;
   }
   for (int c = 0; c < m->nq; ++c)
-    if (s->diag_pos[c] < 0) goto fail; /* pattern.c always holds F_q's diagonal */
-  if (schur_pattern(s) || schur_blocks(s)) goto fail;
-  if (schur_use_dense(s)) {
+    if (s->diag_pos[c] < 0) return -1; /* pattern.c always holds F_q's diagonal */
+  return schur_pattern(s) || schur_blocks(s) ? -1 : 0;
+}
+
+static fmbSchur* schur_new(const fmbModel* m, int complex_values, const fmbSchur* like) {
+  fmbSchur* s = calloc(1, sizeof *s);
+  if (!s) return NULL;
+  s->m = m;
+  s->nq = m->nq;
+  s->nr = m->ny - m->nq;
+  s->nc = complex_values ? 2 : 1;
+  const size_t nc = (size_t)s->nc;
+  s->fail_from = m->solver.fault_reduced_setup;
+  if (schur_index(s, like)) goto fail;
+  s->dinv = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
+  s->acc = calloc(nc * ((size_t)s->nr + 1), sizeof(double));
+  s->dq = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
+  s->rq_val = malloc(sizeof(double) * (size_t)(s->rq_ptr[s->nq] + 1)); /* real, see fmbSchur */
+  s->qr_val = malloc(sizeof(double) * nc * (size_t)(s->qr_ptr[s->nr] + 1));
+  if (!s->dinv || !s->acc || !s->dq || !s->rq_val || !s->qr_val) goto fail;
+  if (schur_use_dense(s)) { /* S lives in lu: no KLU, no values on S's pattern (nor rowind) */
     s->lu = malloc(sizeof(double) * nc * (size_t)s->nr * (size_t)s->nr + sizeof(double));
     s->ipiv = malloc(sizeof(int) * ((size_t)s->nr + 1));
     if (!s->lu || !s->ipiv) goto fail;
     return s;
   }
+  s->data = calloc(nc * ((size_t)s->colptr[s->nr] + 1), sizeof(double));
+  if (!s->data) goto fail;
   s->klu = fmb_klu_new(s->nr, s->colptr, s->rowind, nc == 2 ? FMB_KLU_COMPLEX : 0);
   if (!s->klu) goto fail;
   return s;
 fail:
   fmb_schur_free(s);
   return NULL;
+}
+
+fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values) { return schur_new(m, complex_values, NULL); }
+
+fmbSchur* fmb_schur_new_like(const fmbSchur* like, int complex_values) {
+  return like ? schur_new(like->m, complex_values, like) : NULL;
 }
 
 /* ---- IDA's linear solver: the real fmbSchur as a SUNLinearSolver ---- */

@@ -12,6 +12,9 @@
    picks a new pivot order). */
 typedef struct fmbSchur fmbSchur;
 fmbSchur* fmb_schur_new(const fmbModel* m, int complex_values);
+/* another matrix on like's pattern (its own values and factorization), sharing like's index arrays
+   and S's pattern: kept until the last of them is freed */
+fmbSchur* fmb_schur_new_like(const fmbSchur* like, int complex_values);
 int fmb_schur_factor(fmbSchur* s, const double* J);
 /* the same for J = jy + (a + i b) jyp (real: jy + a jyp, b unused) on the model's pattern, its
    entries computed as read: jy[k] + a jyp[k] and b jyp[k], bit for bit the values of the stored
