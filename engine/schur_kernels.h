@@ -12,7 +12,13 @@
 static inline SCHUR_T SCHUR_FN(jval)(const SchurSource* src, long k) {
   if (src->J) return ((const SCHUR_T*)src->J)[k];
 #if SCHUR_IS_COMPLEX
-  return CMPLX(src->jy[k] + src->a * src->jyp[k], src->b * src->jyp[k]);
+  /* set by parts, C11's layout of a complex (6.2.5): CMPLX is not defined by glibc's complex.h
+     under clang, and re + im * I is not the same value when re is -0 */
+  SCHUR_T z;
+  double* part = (double*)&z;
+  part[0] = src->jy[k] + src->a * src->jyp[k];
+  part[1] = src->b * src->jyp[k];
+  return z;
 #else
   return src->jy[k] + src->a * src->jyp[k];
 #endif
