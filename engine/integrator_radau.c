@@ -374,6 +374,11 @@ static int full_lu_new(RadauRun* c) {
     for (size_t i = 0; i <= n; ++i) c->colptr[i] = (SuiteSparse_long)m->colptr[i];
     for (size_t k = 0; k < nnz; ++k) c->rowind[k] = (SuiteSparse_long)m->rowind[k];
   }
+  /* the iteration matrices' values, which only this path stores (the reduced systems read
+     J_y and J_y' as they go: fmb_schur_factor_pencil): one E2 for every pair, each formed and
+     factorized in turn (decompose), the factorizations keeping what they need */
+  if (!c->e1 && !(c->e1 = dalloc(nnz))) return 1;
+  if (c->npair && !c->e2 && !(c->e2 = dalloc(2 * nnz))) return 1;
   if (!(c->lu1 = fmb_klu_new(c->ny, c->colptr, c->rowind, 0))) return 1;
   for (int p = 0; p < c->npair; ++p)
     if (!(c->lu2[p] = fmb_klu_new(c->ny, c->colptr, c->rowind, FMB_KLU_COMPLEX))) return 1;
@@ -411,7 +416,6 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
   c->err2 = dalloc(n);
   c->jy = dalloc(nnz);
   c->jyp = dalloc(nnz);
-  c->e1 = dalloc(nnz);
   c->jyp_row_ptr = calloc(n + 1, sizeof(long));
   c->jyp_row_next = calloc(n + 1, sizeof(long));
   /* J_y' by rows holds J_y''s nonzeros only (jyp_rows), a fraction of the pattern: sized for all,
@@ -419,11 +423,8 @@ static void* radau_create_tab(const RadauTableau* tab, const fmbIntegratorSetup*
      touched them all; each first touch costs a page fault) */
   c->jyp_row_col = malloc(sizeof(int) * (nnz ? nnz : 1));
   c->jyp_row_val = malloc(sizeof(double) * (nnz ? nnz : 1));
-  /* one E2 for every pair: each is formed and factorized in turn (decompose), and the
-     factorizations keep what they need */
-  c->e2 = c->npair ? dalloc(2 * nnz) : NULL;
   int ok = c->atol && c->scal && c->ewt && c->y && c->yp && c->ys && c->yps && c->err && c->err2 && c->jy && c->jyp &&
-           c->e1 && c->jyp_row_ptr && c->jyp_row_next && c->jyp_row_col && c->jyp_row_val && (c->e2 || !c->npair);
+           c->jyp_row_ptr && c->jyp_row_next && c->jyp_row_col && c->jyp_row_val;
   for (int p = 0; p < c->npair; ++p) ok = ok && (c->e2rhs[p] = dalloc(2 * n));
   for (int k = 0; k < c->s; ++k) {
     c->z[k] = dalloc(n);
