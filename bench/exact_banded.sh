@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # bench/exact_banded.sh — the exact beam's banded assembly (bodies/beam_exact.c exact_pattern with
 # its analytic values) against its dense block, by element count (docs/models.md, "Banded
-# assembly"). The omega0 = 15 spin-up's first T seconds (default 0.5) with model: exact, rtol
+# assembly"). The omega0 = 15 spin-up's first T seconds (default 0.5) with model: exact, kinematics: cable, rtol
 # 1e-7, atol 1e-9, positions only, at 4 ... 512 elements (dense to 256: it is O(n^2) memory and
 # O(n^3) factorization); per run CPU per step (median of REPS, default 3) and peak resident memory.
 # The exponents of CPU/step and memory against n are fitted by least squares over n >= 64.
@@ -34,7 +34,7 @@ for asm in dense banded; do
     cpus=()
     for r in $(seq "$REPS"); do
       /usr/bin/time -f "%M" -o "$WORK/mem" "$F" run scenes/paper/spinup_w15.yaml -o "$WORK/out.csv" \
-        --set bodies.beam.model=exact --set bodies.beam.elements="$ne" --set bodies.beam.assembly="$asm" \
+        --set bodies.beam.model=exact --set bodies.beam.kinematics=cable --set bodies.beam.elements="$ne" --set bodies.beam.assembly="$asm" \
         --set solver.t_end="$TEND" --set solver.rtol=1e-7 --set solver.atol=1e-9 \
         --set solver.error_control=positions 2> "$WORK/err"
       stats=$(tail -n 1 "$WORK/err")

@@ -2,7 +2,7 @@
 # bench/exact_intrinsic.sh — issue 32 item 4's hypothesis put to the test: the exact beam's frozen
 # Newton matrix goes stale because EA's stiff direction turns with the cable's slope. The same
 # continuum in intrinsic coordinates (`model: exact`, `kinematics: intrinsic`, bodies/
-# beam_intrinsic.c: constant stiffness) against the cable (`kinematics: cable`, the default) and
+# beam_intrinsic.c: constant stiffness; the default since issue 32 item 4) against the cable (`kinematics: cable`) and
 # the complete model at the same settings: the pendulum's first 0.2 s and 0.5 s and the omega0 = 4
 # and 15 spin-ups (20 s), under auto (radau9), radau5 and IDA. Per run: steps, Jacobians, Newton
 # iterations, convergence failures (counts: the last of REPS runs, default 3) and the median CPU,

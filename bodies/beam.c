@@ -1753,8 +1753,8 @@ const fmbParam fmb_beam_params[] = {
      .kind = FMB_PARAM_CHOICE,
      .fallback = "reduced",
      .choices = integration_names,
-     .doc = "model: exact: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 and 3 (full); "
-            "the other models ignore it"},
+     .doc = "model: exact, kinematics: cable: axial term at 3 Lobatto, bending at 2 Gauss points (reduced), or 5 "
+            "and 3 (full); the other models ignore it"},
     {.key = "assembly",
      .kind = FMB_PARAM_CHOICE,
      .fallback = "auto",
@@ -1764,14 +1764,14 @@ const fmbParam fmb_beam_params[] = {
      .kind = FMB_PARAM_CHOICE,
      .fallback = "mixed",
      .choices = axial_form_names,
-     .doc = "model: exact: the axial strains as unknowns Newton iterates on (mixed), or the displacement form "
-            "before it (to compare); the other models ignore it"},
+     .doc = "model: exact, kinematics: cable: the axial strains as unknowns Newton iterates on (mixed), or the "
+            "displacement form before it (to compare); the other models ignore it"},
     {.key = "kinematics",
      .kind = FMB_PARAM_CHOICE,
-     .fallback = "cable",
+     .fallback = "intrinsic",
      .choices = kinematics_names,
-     .doc = "model: exact: nodal positions and slopes (cable), or axial strain and tangent angle along the beam "
-            "(intrinsic: constant stiffness, bodies/beam_intrinsic.c); the other models refuse it"},
+     .doc = "model: exact: axial strain and tangent angle along the beam (intrinsic: constant stiffness, "
+            "bodies/beam_intrinsic.c), or nodal positions and slopes (cable); the other models refuse it"},
     FMB_BEAM_REDUCTION_PARAM,
     {.key = "jacobian",
      .kind = FMB_PARAM_CHOICE,
@@ -1833,7 +1833,7 @@ static const fmbBodyType* beam_variant(fmbParser* p, fmbNode item) {
      coordinates, bodies/beam_intrinsic.c */
   extern const fmbBodyType fmb_body_beam_intrinsic;
   if (model == 3) {
-    int intrinsic = 0;
+    int intrinsic = 1; /* the default since issue 32 item 4: a healthy Newton iteration (docs/models.md) */
     if (fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, kinematics_names, &intrinsic)) return NULL;
     return intrinsic ? &fmb_body_beam_intrinsic : &fmb_body_beam_exact;
   }

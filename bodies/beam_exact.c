@@ -225,7 +225,8 @@ static int exact_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_beam_read_section(p, item, EXACT_MAX_ELEMENTS, &b->L, &b->ne, &b->rho, &b->A, &b->Izz, &b->Emod);
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, exact_models, &model); /* "exact": beam.c chose this table */
   err |= fmb_get_choice(p, item, "integration", FMB_OPTIONAL, exact_integrations, &b->integration);
-  int kinematics = 0; /* "intrinsic" is bodies/beam_intrinsic.c's (beam.c's variant chose): "cable" here */
+  int kinematics =
+      0; /* "intrinsic" (the default) is bodies/beam_intrinsic.c's (beam.c's variant chose): "cable" here */
   err |= fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, exact_kinematics, &kinematics);
   int assembly = ASSEMBLY_AUTO;
   err |= fmb_get_choice(p, item, "assembly", FMB_OPTIONAL, exact_assemblies, &assembly);
@@ -794,7 +795,8 @@ static const fmbParam exact_params[] = {
      .kind = FMB_PARAM_CHOICE,
      .fallback = "cable",
      .choices = exact_kinematics,
-     .doc = "cable here: nodal positions and slopes (intrinsic: bodies/beam_intrinsic.c)"},
+     .doc = "cable here, written out: nodal positions and slopes (model: exact's default is intrinsic, "
+            "bodies/beam_intrinsic.c)"},
     FMB_BEAM_FRAME_PARAMS,
     /* keys of type beam that this model refuses, with the reason (so they are looked up) */
     {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
@@ -837,5 +839,5 @@ const fmbBodyType fmb_body_beam_exact = {
     .centreline = exact_centreline,
     .params = exact_params,
     .example = "length: 1\nelements: 2\ndensity: 1000\narea: 1e-3\nsecond_moment: 1e-7\nyoungs_modulus: 1e6\n"
-               "model: exact\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",
+               "model: exact\nkinematics: cable\nangular_velocity: 3\nvelocity: [0.2, 0.5]\n",
 };

@@ -187,6 +187,41 @@ static void add_tangent_work(int e, const double w[6], const double cs[3], doubl
 static const char* const intrinsic_models[] = {"zoac", "foac", "complete", "exact", NULL}; /* as beam.c's */
 static const char* const intrinsic_kinematics[] = {"cable", "intrinsic", NULL};            /* as beam.c's */
 
+/* the cable's choices (beam.c's), declared here only to be refused by name */
+static const char* const refused_integrations[] = {"reduced", "full", NULL};
+static const char* const refused_assemblies[] = {"auto", "dense", "banded", NULL};
+static const char* const refused_axial_forms[] = {"mixed", "displacement", NULL};
+/* keys of type beam this form refuses, with the reason. One list each: the params table below
+   declares them (so `types` and conform look them up) and intrinsic_parse refuses each of them.
+   The exact beam has neither of the first two in either kinematics ... */
+#define INTRINSIC_REFUSED_PARAMS                                                                                     \
+  {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"}, { \
+    .key = "quadrature_points", .kind = FMB_PARAM_INT, .unit = "1", .lo = 1, .hi = FMB_GAUSS_MAX,                    \
+    .doc = "refused: its rules are fixed (the cable's are chosen by `integration`)"                                  \
+  }
+/* ... and these three are the cable's (bodies/beam_exact.c) */
+#define INTRINSIC_CABLE_PARAMS                                                                                      \
+  {.key = "integration", .kind = FMB_PARAM_CHOICE, .choices = refused_integrations, .doc = "refused: the cable's"}, \
+      {.key = "assembly", .kind = FMB_PARAM_CHOICE, .choices = refused_assemblies, .doc = "refused: dense"}, {      \
+    .key = "axial_form", .kind = FMB_PARAM_CHOICE, .choices = refused_axial_forms, .doc = "refused: the cable's"    \
+  }
+static const fmbParam intrinsic_refused[] = {INTRINSIC_REFUSED_PARAMS, {.key = NULL}};
+static const fmbParam intrinsic_cable_only[] = {INTRINSIC_CABLE_PARAMS, {.key = NULL}};
+static const fmbParam intrinsic_params[] = {
+    FMB_BEAM_SECTION_PARAMS(INTRINSIC_MAX_ELEMENTS),
+    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = intrinsic_models, .doc = "exact here"},
+    {.key = "kinematics",
+     .kind = FMB_PARAM_CHOICE,
+     .fallback = "intrinsic",
+     .choices = intrinsic_kinematics,
+     .doc = "intrinsic here (model: exact's default): axial strain and tangent angle along the beam (constant "
+            "stiffness)"},
+    FMB_BEAM_FRAME_PARAMS,
+    INTRINSIC_REFUSED_PARAMS,
+    INTRINSIC_CABLE_PARAMS,
+    {.key = NULL},
+};
+
 static int intrinsic_parse(fmbParser* p, fmbNode item, void** self) {
   BeamIntrinsic* b = calloc(1, sizeof *b);
   if (!b) return fmb_parse_error(p, item, "out of memory");
@@ -195,13 +230,21 @@ static int intrinsic_parse(fmbParser* p, fmbNode item, void** self) {
   err |= fmb_get_choice(p, item, "model", FMB_OPTIONAL, intrinsic_models, &model);
   err |= fmb_get_choice(p, item, "kinematics", FMB_OPTIONAL, intrinsic_kinematics, &kinematics);
   err |= fmb_beam_read_frame(p, item, b->pos0, &b->angle0, b->vel0, &b->omega0);
-  const char* const refused[] = {"damping", "quadrature_points", "integration", "assembly", "axial_form"};
-  for (int k = 0; k < 5 && !err; ++k)
-    if (fmb_find_key(p, item, refused[k]) >= 0)
-      err = fmb_parse_error(p, fmb_find_key(p, item, refused[k]),
-                            "'%s' is not available with kinematics: intrinsic (undamped; its quadrature is fixed, "
-                            "its Jacobian dense by differences: docs/models.md); remove the key",
-                            refused[k]);
+  for (const fmbParam* k = intrinsic_refused; k->key && !err; ++k)
+    if (fmb_find_key(p, item, k->key) >= 0)
+      err = fmb_parse_error(p, fmb_find_key(p, item, k->key),
+                            "'%s' is not available with model: exact (%s); remove the key", k->key, k->doc);
+  /* the cable's keys: refused by name, whether `kinematics: intrinsic` was written or is the default
+     (so a scene written for the cable does not silently change physics: it says how to keep it) */
+  const int written = fmb_find_key(p, item, "kinematics") >= 0;
+  for (const fmbParam* k = intrinsic_cable_only; k->key && !err; ++k)
+    if (fmb_find_key(p, item, k->key) >= 0)
+      err = fmb_parse_error(
+          p, fmb_find_key(p, item, k->key),
+          "'%s' is only with kinematics: cable, %s (its quadrature is fixed, its Jacobian dense by "
+          "differences: docs/models.md); %s",
+          k->key, written ? "not intrinsic" : "and model: exact is kinematics: intrinsic by default",
+          written ? "remove the key" : "write `kinematics: cable` to keep the cable, or remove the key");
   if (err) {
     free(b);
     return err;
@@ -494,7 +537,8 @@ static void intrinsic_describe(const void* self, FILE* f) {
   const BeamIntrinsic* b = self;
   fprintf(f,
           "exact model in intrinsic kinematics (strain and angle along the beam, constant stiffness), %d elements, "
-          "nested %d-point rule, dense Jacobian by differences\n",
+          "nested %d-point rule, dense Jacobian by differences; no range limit (its accuracy is the mesh's and the "
+          "tolerance's, docs/models.md)\n",
           b->ne, b->nq);
 }
 
@@ -545,33 +589,6 @@ static int intrinsic_centreline(const void* self, int n, double* local) {
   const BeamIntrinsic* b = self;
   return fmb_beam_centreline(b->L, b->ne, n, local);
 }
-
-/* the cable's choices (beam.c's), declared here only to be refused by name */
-static const char* const refused_integrations[] = {"reduced", "full", NULL};
-static const char* const refused_assemblies[] = {"auto", "dense", "banded", NULL};
-static const char* const refused_axial_forms[] = {"mixed", "displacement", NULL};
-static const fmbParam intrinsic_params[] = {
-    FMB_BEAM_SECTION_PARAMS(INTRINSIC_MAX_ELEMENTS),
-    {.key = "model", .kind = FMB_PARAM_CHOICE, .fallback = "exact", .choices = intrinsic_models, .doc = "exact here"},
-    {.key = "kinematics",
-     .kind = FMB_PARAM_CHOICE,
-     .fallback = "cable",
-     .choices = intrinsic_kinematics,
-     .doc = "intrinsic here: axial strain and tangent angle along the beam (constant stiffness)"},
-    FMB_BEAM_FRAME_PARAMS,
-    /* keys of type beam that this form refuses, with the reason (so they are looked up) */
-    {.key = "damping", .kind = FMB_PARAM_NUMBER, .flags = FMB_NONNEGATIVE, .unit = "s", .doc = "refused: undamped"},
-    {.key = "quadrature_points",
-     .kind = FMB_PARAM_INT,
-     .unit = "1",
-     .lo = 1,
-     .hi = FMB_GAUSS_MAX,
-     .doc = "refused: its rules are fixed"},
-    {.key = "integration", .kind = FMB_PARAM_CHOICE, .choices = refused_integrations, .doc = "refused: the cable's"},
-    {.key = "assembly", .kind = FMB_PARAM_CHOICE, .choices = refused_assemblies, .doc = "refused: dense"},
-    {.key = "axial_form", .kind = FMB_PARAM_CHOICE, .choices = refused_axial_forms, .doc = "refused: the cable's"},
-    {.key = NULL},
-};
 
 const fmbBodyType fmb_body_beam_intrinsic = {
     .name = "beam",

@@ -1,9 +1,9 @@
 /*
  * test_exact_scenes.c — the paper's scenes run with `model: exact` by the engine.
  *
- * - Pendulum (scenes/paper/pendulum.yaml): the exact beam is Lagrangian and conservative, so
- *   T + U_e + U_g stays constant to a drift that falls when the tolerances are tightened
- *   (rtol 1e-5 -> 1e-8: at least 10x smaller).
+ * - Pendulum (scenes/paper/pendulum.yaml, without its max_step): the exact beam is Lagrangian and
+ *   conservative, so T + U_e + U_g stays constant to a drift that falls when the tolerances are
+ *   tightened (rtol 1e-5 -> 1e-8: at least 10x smaller).
  * - Spin-up at omega0 = 1 rad/s (scenes/paper/spinup_w1.yaml): exact and complete agree on the tip
  *   deflection to about 1e-5 m (the complete model's own error there is 8.3e-6 m; tolerance
  *   2e-5 m, against a peak of 1.8e-2 m); and the exact model's energy balance against the drive's
@@ -12,8 +12,10 @@
  *   speed) the residual free vibration of tip_v has the rotating cantilever's first in-plane
  *   frequency 6.33515 rad/s. Zero crossings over about 7 periods sampled at 0.01 s resolve it to
  *   about 0.05 %; tolerance 0.3 % (the linearized value is checked to 1e-4 in test_exact_element).
- * - The same spin-up at 16 elements with `assembly: banded` and `dense`: tip deflections agree to
- *   2e-6 m and the banded run needs no more Newton iterations than 1.3x the dense one.
+ * - The same spin-up at 16 elements with the cable's (`kinematics: cable`) `assembly: banded` and
+ *   `dense`: tip deflections agree to 2e-6 m and the banded run needs no more Newton iterations
+ *   than 1.3x the dense one.
+ * The others run model: exact's default kinematics (intrinsic since issue 32 item 4).
  */
 #include <string.h>
 
@@ -32,12 +34,16 @@ static void pendulum(void) {
   const char* tol[2][2] = {{"solver.rtol=1e-5", "solver.atol=1e-7"}, {"solver.rtol=1e-8", "solver.atol=1e-10"}};
   double d[2] = {0.0, 0.0};
   for (int k = 0; k < 2; ++k) {
-    const char* ov[] = {"bodies.beam.model=exact", "solver.t_end=1.0", tol[k][0], tol[k][1]};
+    /* max_step 0: the steps follow the tolerance. With the scene's max_step (3e-4 s) the intrinsic
+       beam's steps at rtol 1e-5 ... 1e-8 are all near the cap (3,654 and 4,089 in 1 s), so its drift
+       is the cap's, not the tolerance's (1.6e-8 and 1.4e-7 J); without it 1.9e-5 J in 240 steps and
+       1.3e-7 J in 2,578 (the cable's steps followed rtol under the cap) */
+    const char* ov[] = {"bodies.beam.model=exact", "solver.t_end=1.0", tol[k][0], tol[k][1], "solver.max_step=0"};
     char out[64];
     snprintf(out, sizeof out, "exact_pendulum_%d.csv", k);
     fmbtCsv c;
     fmbStats st;
-    ENSURE(fmbt_run_read("scenes/paper/pendulum.yaml", ov, 4, out, &c, &st) == 0);
+    ENSURE(fmbt_run_read("scenes/paper/pendulum.yaml", ov, 5, out, &c, &st) == 0);
     const double* e = fmbt_col(&c, "energy.total");
     const double* g = fmbt_col(&c, "energy.gravity");
     double scale = 0.0;
@@ -96,7 +102,7 @@ static void spinup_w15_vibration(void) {
   fmbt_csv_free(&c);
 }
 
-/* The banded assembly (exact_pattern with its analytic values, the engine's sparse path) against
+/* The cable's banded assembly (exact_pattern with its analytic values, the engine's sparse path) against
    the dense block: the same equations, so the runs agree to the integration error (rtol 1e-8 on
    a tip deflection of 0.19 m: 2e-6 m allowed, measured 4.6e-7 m), and a Jacobian the pattern got wrong would show as
    extra Newton iterations (allowed: 1.3x the dense run's). */
@@ -108,9 +114,10 @@ static void spinup_w15_banded(void) {
     char set[64], out[64];
     snprintf(set, sizeof set, "bodies.beam.assembly=%s", assembly[k]);
     snprintf(out, sizeof out, "exact_w15_%s.csv", assembly[k]);
-    const char* ov[] = {"bodies.beam.model=exact", "bodies.beam.elements=16", set,
-                        "solver.rtol=1e-8",        "solver.atol=1e-10",       "solver.error_control=positions"};
-    ENSURE(fmbt_run_read("scenes/paper/spinup_w15.yaml", ov, 6, out, &c[k], &st[k]) == 0);
+    const char* ov[] = {
+        "bodies.beam.model=exact", "bodies.beam.kinematics=cable",  "bodies.beam.elements=16", set, "solver.rtol=1e-8",
+        "solver.atol=1e-10",       "solver.error_control=positions"};
+    ENSURE(fmbt_run_read("scenes/paper/spinup_w15.yaml", ov, 7, out, &c[k], &st[k]) == 0);
     printf("spin-up omega0 = 15, exact, 16 elements, %-6s assembly: %ld steps, %ld Newton iterations, %.3f s CPU\n",
            assembly[k], st[k].steps, st[k].newton_iters, st[k].cpu_s);
   }
