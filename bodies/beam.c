@@ -61,6 +61,14 @@ typedef struct Beam {
   double ncubic[4][4], mu[12];
 } Beam;
 
+/* a kernel inlined into one copy per model (element_terms, element_derivs), where the model is a
+   constant */
+#if defined(__GNUC__)
+#define FMB_BEAM_SPECIALIZED __attribute__((always_inline))
+#else
+#define FMB_BEAM_SPECIALIZED
+#endif
+
 /* ---------------------------------------------------------------------------------------------
  * Shape functions on one element, xi in [0, 1], element length le.
  * ------------------------------------------------------------------------------------------- */
@@ -336,15 +344,15 @@ typedef struct {
   double cp[3], cv[3], ca[3], pp[5], pv5[5], ha[5];
 } ElementState;
 
-static void element_state(const Beam* b, int e, const double* p, const double* pd, const double* pdd,
-                          ElementState* es) {
+static inline FMB_BEAM_SPECIALIZED void element_state(const Beam* b, const int model, int e, const double* p,
+                                                     const double* pd, const double* pdd, ElementState* es) {
   gather(p, e, es->ua, es->d);
   gather(pd, e, es->uda, es->dd);
   gather(pdd, e, es->udda, es->ddd);
   slope_poly(b, es->d, es->cp);
   slope_poly(b, es->dd, es->cv);
   slope_poly(b, es->ddd, es->ca);
-  if (b->model != BEAM_ZOAC) {
+  if (model != BEAM_ZOAC) {
     double vv[5];
     poly_mul(es->cp, es->cp, es->pp);
     poly_mul(es->cp, es->cv, es->pv5);
@@ -362,9 +370,8 @@ typedef struct {
   double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
 } PointTerms;
 
-static void point_terms(const Beam* b, const FrameMotion* fm, int e, int g, const ElementState* es,
-                        const double prefix[3], PointTerms* pt) {
-  const int model = b->model;
+static inline FMB_BEAM_SPECIALIZED void point_terms(const Beam* b, const int model, const FrameMotion* fm, int e, int g,
+                                                    const ElementState* es, const double prefix[3], PointTerms* pt) {
   const double le = b->le, om = fm->om, om2 = fm->om2, al = fm->al;
   const double *a0 = fm->a0, *f = fm->f;
   const double* ns = b->ns_out[g];
@@ -423,14 +430,15 @@ static inline void poly_moments(const double* mu, const double* F, int nc, int n
    and each integral is a dot product of coefficients with moments mu_k = 1/(k+1): the same
    numbers as the Gauss sums (exact to degree 2 ng - 1 >= 10, test_beam_residual) at about half
    the flops (bench/beam_residual.c). */
-static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                          const double* pdd, const double prefix[3], ElementTerms* out) {
-  const int model = b->model, coupled = model != BEAM_ZOAC;
+static inline FMB_BEAM_SPECIALIZED void element_terms_of(const Beam* b, const int model, const FrameMotion* fm, int e,
+                                                         const double* p, const double* pd, const double* pdd,
+                                                         const double prefix[3], ElementTerms* out) {
+  const int coupled = model != BEAM_ZOAC;
   const double le = b->le, r2 = b->r * b->r, om = fm->om, om2 = fm->om2, al = fm->al;
   const double* mu = b->mu;
   const double me = b->rho * b->A * le; /* the element's mass: int rho A dx = me int_0^1 dxi */
   ElementState es;
-  element_state(b, e, p, pd, pdd, &es);
+  element_state(b, model, e, p, pd, pdd, &es);
   /* the fields as coefficients of xi^k: x, w1 (and rates) linear, w2 (and rates) cubic, the
      slopes w2' = cp, cv, ca quadratic (element_state), the coupling terms quintic */
   const double x[2] = {e * le, le};
@@ -550,6 +558,18 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
   }
 }
 
+/* element_terms_of per model: the model a constant in each copy, so the coefficient loops lose
+   point_forces' switch and the compiler can vectorize them; the same operations in the same order
+   (no contraction under -std=c11), so the same numbers as one copy reading b->model */
+static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
+                          const double* pdd, const double prefix[3], ElementTerms* out) {
+  switch (b->model) {
+    case BEAM_ZOAC: element_terms_of(b, BEAM_ZOAC, fm, e, p, pd, pdd, prefix, out); break;
+    case BEAM_FOAC: element_terms_of(b, BEAM_FOAC, fm, e, p, pd, pdd, prefix, out); break;
+    default: element_terms_of(b, BEAM_COMPLETE, fm, e, p, pd, pdd, prefix, out); break;
+  }
+}
+
 /* ---------------------------------------------------------------------------------------------
  * Derivatives of element_terms. An element's terms depend on few inputs (its "local inputs",
  * the columns below): its six dofs in q, v and a, theta (through A^T a and A^T g), theta',
@@ -580,12 +600,13 @@ typedef struct {
   double Fv[4];
 } ElementDerivs;
 
-static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                           const double* pdd, const double prefix[3], ElementDerivs* D) {
-  const int model = b->model, coupled = model != BEAM_ZOAC;
+static inline FMB_BEAM_SPECIALIZED void element_derivs_of(const Beam* b, const int model, const FrameMotion* fm, int e,
+                                                          const double* p, const double* pd, const double* pdd,
+                                                          const double prefix[3], ElementDerivs* D) {
+  const int coupled = model != BEAM_ZOAC;
   const double r2 = b->r * b->r, om = fm->om, om2 = fm->om2, al = fm->al;
   ElementState es;
-  element_state(b, e, p, pd, pdd, &es);
+  element_state(b, model, e, p, pd, pdd, &es);
   memset(D, 0, sizeof *D);
   /* the frame scalars' gradients, the same at every point: d(A^T a)/dtheta = (a0_y, -a0_x) */
   double ga0[2][NL] = {{0.0}}, gf[2][NL] = {{0.0}}, gom[NL] = {0.0}, gom2[NL] = {0.0}, gal[NL] = {0.0};
@@ -599,7 +620,7 @@ static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const do
     const double* ns = b->ns_out[g];
     const double* nd = b->nd_out[g];
     PointTerms pt;
-    point_terms(b, fm, e, g, &es, prefix, &pt);
+    point_terms(b, model, fm, e, g, &es, prefix, &pt);
     const double x = pt.x, w1 = pt.w1, w2 = pt.w2, w2s = pt.w2s, wc = pt.wc;
     /* the deformation scalars are linear in the element's dofs: their gradients are the shape
        functions; the coupling's are h (of p, pd, pdd) at the point */
@@ -675,6 +696,16 @@ static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const do
       D->dprefix[2][LV + 2 + j] = 2.0 * hv;
       D->dprefix[2][LA + 2 + j] = hp;
     }
+}
+
+/* element_derivs_of per model, as element_terms */
+static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
+                           const double* pdd, const double prefix[3], ElementDerivs* D) {
+  switch (b->model) {
+    case BEAM_ZOAC: element_derivs_of(b, BEAM_ZOAC, fm, e, p, pd, pdd, prefix, D); break;
+    case BEAM_FOAC: element_derivs_of(b, BEAM_FOAC, fm, e, p, pd, pdd, prefix, D); break;
+    default: element_derivs_of(b, BEAM_COMPLETE, fm, e, p, pd, pdd, prefix, D); break;
+  }
 }
 
 /* index in p of an element's local dof l (0..5, gather's order), or -1 at the clamped root */
