@@ -988,10 +988,12 @@ static void add_local_row(int e, const double* T, double s, double* rq, double* 
   ra[2 * st] += s * T[LAL];
 }
 
-/* Adds s * g (a gradient over all of q, v, a: g, g + nq, g + 2 nq) to one row of K, C, M */
-static void add_global_row(const double* g, double s, int nq, double* rq, double* rv, double* ra, size_t st) {
+/* Adds s * g (a gradient over all of q, v, a: g, g + nq, g + 2 nq) to one row of K, C, M, over the
+   columns c0..c1-1 of each (those where g may be nonzero: the rest would add exact zeros) */
+static void add_global_row(const double* g, double s, int nq, int c0, int c1, double* rq, double* rv, double* ra,
+                           size_t st) {
   if (s == 0.0) return;
-  for (int c = 0; c < nq; ++c) {
+  for (int c = c0; c < c1; ++c) {
     rq[(size_t)c * st] += s * g[c];
     rv[(size_t)c * st] += s * g[nq + c];
     ra[(size_t)c * st] += s * g[2 * nq + c];
@@ -1051,6 +1053,9 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
     ElementDerivs Dz;
     if (!coupled) element_derivs(b, &fm, e, q + 3, v + 3, a + 3, zero, &Dz);
     const ElementDerivs* D = coupled ? &Dall[e] : &Dz;
+    /* dP_e is nonzero on the p dofs of the nodes 1..e only (the elements inboard of e): the
+       columns 3..pend-1 of each of its q, v, a parts */
+    const int pend = 3 + 3 * e;
     /* the rows of its dofs: local, through P_e, and the tail -F_e T_e */
     for (int l = 0; l < 6; ++l) {
       const int i = ldof(e, l);
@@ -1058,10 +1063,10 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
       double *rq = K + 3 + i, *rv = C + 3 + i, *ra = M + 3 + i;
       add_local_row(e, D->rp[l], 1.0, rq, rv, ra, st);
       if (!coupled) continue;
-      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D->rp[l][LP + k], nq, rq, rv, ra, st);
+      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D->rp[l][LP + k], nq, 3, pend, rq, rv, ra, st);
       if (l < 2) continue; /* the tail acts on the transverse dofs (h) */
       add_local_row(e, D->F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
-      add_global_row(dT, -D->Fv[l - 2], nq, rq, rv, ra, st);
+      add_global_row(dT, -D->Fv[l - 2], nq, 0, nq, rq, rv, ra, st);
     }
     /* the frame rows: S_k gathers frame_k of every element */
     for (int i = 0; i < 3; ++i)
@@ -1070,13 +1075,14 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
         add_local_row(e, D->frame[k], W[i][k], K + i, C + i, M + i, st);
         if (coupled)
           for (int m = 0; m < 3; ++m)
-            add_global_row(dP + 3 * st * m, W[i][k] * D->frame[k][LP + m], nq, K + i, C + i, M + i, st);
+            add_global_row(dP + 3 * st * m, W[i][k] * D->frame[k][LP + m], nq, 3, pend, K + i, C + i, M + i, st);
       }
     if (!coupled) continue;
     /* dT_(e-1) = dT_e + dcsum_e */
     add_local_row(e, D->csum, 1.0, dT, dT + st, dT + 2 * st, 1);
     for (int m = 0; m < 3; ++m)
-      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D->csum[LP + m] * dP[3 * st * m + c];
+      for (size_t part = 0; part < 3; ++part) /* q, v, a */
+        for (size_t c = part * st + 3; c < part * st + (size_t)pend; ++c) dT[c] += D->csum[LP + m] * dP[3 * st * m + c];
     /* dP_(e-1): element e-1's dofs drop out; its left node keeps element e-2's part */
     if (e == 0) break;
     for (int k = 0; k < 3; ++k) {
