@@ -59,6 +59,11 @@ typedef struct Beam {
   /* for the residual's exact integration (element_terms): the coefficients of xi^0..3 in the
      shape functions N2j (ncubic) and the moments mu_k = int_0^1 xi^k (k = 0..11) */
   double ncubic[4][4], mu[12];
+  /* the energy pass's quadrature tables in groups of four points, one per lane (beam_integrals):
+     the lanes past the last point repeat it */
+  double lane_xi[(FMB_GAUSS_MAX + 3) / 4][4], lane_wg[(FMB_GAUSS_MAX + 3) / 4][4];
+  double lane_ns[(FMB_GAUSS_MAX + 3) / 4][4][4], lane_nd[(FMB_GAUSS_MAX + 3) / 4][4][4];
+  double lane_pw[(FMB_GAUSS_MAX + 3) / 4][5][4];
 } Beam;
 
 /* a kernel inlined into one copy per model (element_terms, element_derivs), where the model is a
@@ -182,6 +187,17 @@ static void beam_setup(Beam* b) {
   const double nc[4][4] = {{1.0, 0.0, -3.0, 2.0}, {0.0, le, -2.0 * le, le}, {0.0, 0.0, 3.0, -2.0}, {0.0, 0.0, -le, le}};
   memcpy(b->ncubic, nc, sizeof nc);
   for (int k = 0; k < 12; ++k) b->mu[k] = 1.0 / (k + 1);
+  for (int g = 0; g < b->ng; g += 4)
+    for (int l = 0; l < 4; ++l) {
+      const int grp = g / 4, gl = g + l < b->ng ? g + l : b->ng - 1;
+      b->lane_xi[grp][l] = b->xg[gl];
+      b->lane_wg[grp][l] = b->wg[gl];
+      for (int j = 0; j < 4; ++j) {
+        b->lane_ns[grp][j][l] = b->ns_out[gl][j];
+        b->lane_nd[grp][j][l] = b->nd_out[gl][j];
+      }
+      for (int k = 0; k < 5; ++k) b->lane_pw[grp][k][l] = b->pw_out[gl][k];
+    }
 }
 
 /* default Gauss points per element (the Jacobian's; the residual integrates exactly): the
@@ -1365,23 +1381,16 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
   double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0, pth = 0.0;
   double Ipp = 0.0, Ipv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
-  /* the quadrature's tables in groups of four points (the point loop's lanes, below), made once a
-     call: the lanes past the last point repeat it */
+  /* the quadrature's tables in groups of four points (the point loop's lanes, below; made at setup,
+     beam_setup's lane_*), copied into vectors: the struct's doubles need not be a vector's alignment */
   enum { NGROUP = (FMB_GAUSS_MAX + 3) / 4 };
   dbl4 xi_g[NGROUP], wg_g[NGROUP], ns_g[NGROUP][4], nd_g[NGROUP][4], pw_g[NGROUP][5];
-  for (int g = 0; g < ng; g += 4) {
-    const int grp = g / 4;
-    int gl[4];
-    for (int l = 0; l < 4; ++l) gl[l] = g + l < ng ? g + l : ng - 1;
-    xi_g[grp] = (dbl4){b->xg[gl[0]], b->xg[gl[1]], b->xg[gl[2]], b->xg[gl[3]]};
-    wg_g[grp] = (dbl4){b->wg[gl[0]], b->wg[gl[1]], b->wg[gl[2]], b->wg[gl[3]]};
-    for (int j = 0; j < 4; ++j) {
-      ns_g[grp][j] = (dbl4){b->ns_out[gl[0]][j], b->ns_out[gl[1]][j], b->ns_out[gl[2]][j], b->ns_out[gl[3]][j]};
-      nd_g[grp][j] = (dbl4){b->nd_out[gl[0]][j], b->nd_out[gl[1]][j], b->nd_out[gl[2]][j], b->nd_out[gl[3]][j]};
-    }
-    for (int k = 0; k < 5; ++k)
-      pw_g[grp][k] = (dbl4){b->pw_out[gl[0]][k], b->pw_out[gl[1]][k], b->pw_out[gl[2]][k], b->pw_out[gl[3]][k]};
-  }
+  const size_t ngroup = (size_t)(ng + 3) / 4;
+  memcpy(xi_g, b->lane_xi, ngroup * sizeof xi_g[0]);
+  memcpy(wg_g, b->lane_wg, ngroup * sizeof wg_g[0]);
+  memcpy(ns_g, b->lane_ns, ngroup * sizeof ns_g[0]);
+  memcpy(nd_g, b->lane_nd, ngroup * sizeof nd_g[0]);
+  memcpy(pw_g, b->lane_pw, ngroup * sizeof pw_g[0]);
   for (int e = 0; e < ne; ++e) {
     double ua[2], d[4], uda[2], dd[4], pp[5] = {0}, pv5[5] = {0}; /* set and read only when coupled */
     gather(p, e, ua, d);
@@ -1451,8 +1460,10 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
       for (int lane = 0; lane < nlane; ++lane) { /* in the order of the points */
         T += dT[lane];
         pth += dp[lane];
-        if (grav) Ug -= dUg[lane];
-        mtot += M2[lane];
+        if (grav) {
+          Ug -= dUg[lane];
+          mtot += M2[lane]; /* read only with gravity */
+        }
       }
     }
     if (coupled) {
