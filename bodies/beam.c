@@ -577,8 +577,9 @@ static inline FMB_BEAM_SPECIALIZED void element_terms_of(const Beam* b, const in
 /* element_terms_of per model: the model a constant in each copy, so the coefficient loops lose
    point_forces' switch and the compiler can vectorize them; the same operations in the same order
    (no contraction under -std=c11), so the same numbers as one copy reading b->model */
-static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                          const double* pdd, const double prefix[3], ElementTerms* out) {
+FMB_VECTOR_CLONES static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p,
+                                            const double* pd, const double* pdd, const double prefix[3],
+                                            ElementTerms* out) {
   switch (b->model) {
     case BEAM_ZOAC: element_terms_of(b, BEAM_ZOAC, fm, e, p, pd, pdd, prefix, out); break;
     case BEAM_FOAC: element_terms_of(b, BEAM_FOAC, fm, e, p, pd, pdd, prefix, out); break;
