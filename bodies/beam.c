@@ -716,8 +716,9 @@ static inline FMB_BEAM_SPECIALIZED void element_derivs_of(const Beam* b, const i
 }
 
 /* element_derivs_of per model, as element_terms */
-static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                           const double* pdd, const double prefix[3], ElementDerivs* D) {
+FMB_VECTOR_CLONES static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p,
+                                             const double* pd, const double* pdd, const double prefix[3],
+                                             ElementDerivs* D) {
   switch (b->model) {
     case BEAM_ZOAC: element_derivs_of(b, BEAM_ZOAC, fm, e, p, pd, pdd, prefix, D); break;
     case BEAM_FOAC: element_derivs_of(b, BEAM_FOAC, fm, e, p, pd, pdd, prefix, D); break;
