@@ -751,7 +751,7 @@ static void add_element_rows(int e, const ElementTerms* t, double* Rp) {
 }
 
 /* elastic and damping forces: K (p + beta pd), element by element */
-static void add_elastic(const Beam* b, const double* p, const double* pd, double* Rp) {
+FMB_VECTOR_CLONES static void add_elastic(const Beam* b, const double* p, const double* pd, double* Rp) {
   for (int e = 0; e < b->ne; ++e) {
     double ua[2], d[4], uda[2], dd[4];
     gather(p, e, ua, d);
