@@ -1035,8 +1035,8 @@ static size_t jacobian_nwork(const Beam* b) {
    and the frame rows A(theta) S with S = sum_e frame_e. One sweep outboard to inboard carries
    dT_e; dP_e (nonzero on the dofs of the nodes up to e only) is rebuilt from the stored dprefix
    gradients, without cancellation, as the sweep moves inboard. */
-static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                         double* K, double* C, double* M, double* work) {
+FMB_VECTOR_CLONES static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v,
+                                           const double* a, double* K, double* C, double* M, double* work) {
   const Beam* b = self;
   if (!K || !C || !M) return -1;
   const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
