@@ -361,7 +361,7 @@ typedef struct {
 } ElementState;
 
 static inline FMB_BEAM_SPECIALIZED void element_state(const Beam* b, const int model, int e, const double* p,
-                                                     const double* pd, const double* pdd, ElementState* es) {
+                                                      const double* pd, const double* pdd, ElementState* es) {
   gather(p, e, es->ua, es->d);
   gather(pd, e, es->uda, es->dd);
   gather(pdd, e, es->udda, es->ddd);
