@@ -74,6 +74,14 @@ typedef struct Beam {
 #define FMB_BEAM_SPECIALIZED
 #endif
 
+/* f(b, MODEL, ...) with b's model a constant: one inlined copy of f per model */
+#define PER_MODEL(f, b, ...)                               \
+  switch ((b)->model) {                                    \
+    case BEAM_ZOAC: f((b), BEAM_ZOAC, __VA_ARGS__); break; \
+    case BEAM_FOAC: f((b), BEAM_FOAC, __VA_ARGS__); break; \
+    default: f((b), BEAM_COMPLETE, __VA_ARGS__); break;    \
+  }
+
 /* ---------------------------------------------------------------------------------------------
  * Shape functions on one element, xi in [0, 1], element length le.
  * ------------------------------------------------------------------------------------------- */
@@ -580,11 +588,7 @@ static inline FMB_BEAM_SPECIALIZED void element_terms_of(const Beam* b, const in
 FMB_VECTOR_CLONES static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p,
                                             const double* pd, const double* pdd, const double prefix[3],
                                             ElementTerms* out) {
-  switch (b->model) {
-    case BEAM_ZOAC: element_terms_of(b, BEAM_ZOAC, fm, e, p, pd, pdd, prefix, out); break;
-    case BEAM_FOAC: element_terms_of(b, BEAM_FOAC, fm, e, p, pd, pdd, prefix, out); break;
-    default: element_terms_of(b, BEAM_COMPLETE, fm, e, p, pd, pdd, prefix, out); break;
-  }
+  PER_MODEL(element_terms_of, b, fm, e, p, pd, pdd, prefix, out);
 }
 
 /* ---------------------------------------------------------------------------------------------
@@ -719,11 +723,7 @@ static inline FMB_BEAM_SPECIALIZED void element_derivs_of(const Beam* b, const i
 FMB_VECTOR_CLONES static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p,
                                              const double* pd, const double* pdd, const double prefix[3],
                                              ElementDerivs* D) {
-  switch (b->model) {
-    case BEAM_ZOAC: element_derivs_of(b, BEAM_ZOAC, fm, e, p, pd, pdd, prefix, D); break;
-    case BEAM_FOAC: element_derivs_of(b, BEAM_FOAC, fm, e, p, pd, pdd, prefix, D); break;
-    default: element_derivs_of(b, BEAM_COMPLETE, fm, e, p, pd, pdd, prefix, D); break;
-  }
+  PER_MODEL(element_derivs_of, b, fm, e, p, pd, pdd, prefix, D);
 }
 
 /* index in p of an element's local dof l (0..5, gather's order), or -1 at the clamped root */
