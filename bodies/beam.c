@@ -59,7 +59,28 @@ typedef struct Beam {
   /* for the residual's exact integration (element_terms): the coefficients of xi^0..3 in the
      shape functions N2j (ncubic) and the moments mu_k = int_0^1 xi^k (k = 0..11) */
   double ncubic[4][4], mu[12];
+  /* the energy pass's quadrature tables in groups of four points, one per lane (beam_integrals):
+     the lanes past the last point repeat it */
+  double lane_xi[(FMB_GAUSS_MAX + 3) / 4][4], lane_wg[(FMB_GAUSS_MAX + 3) / 4][4];
+  double lane_ns[(FMB_GAUSS_MAX + 3) / 4][4][4], lane_nd[(FMB_GAUSS_MAX + 3) / 4][4][4];
+  double lane_pw[(FMB_GAUSS_MAX + 3) / 4][5][4];
 } Beam;
+
+/* a kernel inlined into one copy per model (element_terms, element_derivs), where the model is a
+   constant */
+#if defined(__GNUC__)
+#define FMB_BEAM_SPECIALIZED __attribute__((always_inline))
+#else
+#define FMB_BEAM_SPECIALIZED
+#endif
+
+/* f(b, MODEL, ...) with b's model a constant: one inlined copy of f per model */
+#define PER_MODEL(f, b, ...)                               \
+  switch ((b)->model) {                                    \
+    case BEAM_ZOAC: f((b), BEAM_ZOAC, __VA_ARGS__); break; \
+    case BEAM_FOAC: f((b), BEAM_FOAC, __VA_ARGS__); break; \
+    default: f((b), BEAM_COMPLETE, __VA_ARGS__); break;    \
+  }
 
 /* ---------------------------------------------------------------------------------------------
  * Shape functions on one element, xi in [0, 1], element length le.
@@ -174,6 +195,17 @@ static void beam_setup(Beam* b) {
   const double nc[4][4] = {{1.0, 0.0, -3.0, 2.0}, {0.0, le, -2.0 * le, le}, {0.0, 0.0, 3.0, -2.0}, {0.0, 0.0, -le, le}};
   memcpy(b->ncubic, nc, sizeof nc);
   for (int k = 0; k < 12; ++k) b->mu[k] = 1.0 / (k + 1);
+  for (int g = 0; g < b->ng; g += 4)
+    for (int l = 0; l < 4; ++l) {
+      const int grp = g / 4, gl = g + l < b->ng ? g + l : b->ng - 1;
+      b->lane_xi[grp][l] = b->xg[gl];
+      b->lane_wg[grp][l] = b->wg[gl];
+      for (int j = 0; j < 4; ++j) {
+        b->lane_ns[grp][j][l] = b->ns_out[gl][j];
+        b->lane_nd[grp][j][l] = b->nd_out[gl][j];
+      }
+      for (int k = 0; k < 5; ++k) b->lane_pw[grp][k][l] = b->pw_out[gl][k];
+    }
 }
 
 /* default Gauss points per element (the Jacobian's; the residual integrates exactly): the
@@ -336,15 +368,15 @@ typedef struct {
   double cp[3], cv[3], ca[3], pp[5], pv5[5], ha[5];
 } ElementState;
 
-static void element_state(const Beam* b, int e, const double* p, const double* pd, const double* pdd,
-                          ElementState* es) {
+static inline FMB_BEAM_SPECIALIZED void element_state(const Beam* b, const int model, int e, const double* p,
+                                                      const double* pd, const double* pdd, ElementState* es) {
   gather(p, e, es->ua, es->d);
   gather(pd, e, es->uda, es->dd);
   gather(pdd, e, es->udda, es->ddd);
   slope_poly(b, es->d, es->cp);
   slope_poly(b, es->dd, es->cv);
   slope_poly(b, es->ddd, es->ca);
-  if (b->model != BEAM_ZOAC) {
+  if (model != BEAM_ZOAC) {
     double vv[5];
     poly_mul(es->cp, es->cp, es->pp);
     poly_mul(es->cp, es->cv, es->pv5);
@@ -362,9 +394,8 @@ typedef struct {
   double FR0[2], FD0[2], FC0[2], FR1[2], FD1[2], FC1[2];
 } PointTerms;
 
-static void point_terms(const Beam* b, const FrameMotion* fm, int e, int g, const ElementState* es,
-                        const double prefix[3], PointTerms* pt) {
-  const int model = b->model;
+static inline FMB_BEAM_SPECIALIZED void point_terms(const Beam* b, const int model, const FrameMotion* fm, int e, int g,
+                                                    const ElementState* es, const double prefix[3], PointTerms* pt) {
   const double le = b->le, om = fm->om, om2 = fm->om2, al = fm->al;
   const double *a0 = fm->a0, *f = fm->f;
   const double* ns = b->ns_out[g];
@@ -423,14 +454,15 @@ static inline void poly_moments(const double* mu, const double* F, int nc, int n
    and each integral is a dot product of coefficients with moments mu_k = 1/(k+1): the same
    numbers as the Gauss sums (exact to degree 2 ng - 1 >= 10, test_beam_residual) at about half
    the flops (bench/beam_residual.c). */
-static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                          const double* pdd, const double prefix[3], ElementTerms* out) {
-  const int model = b->model, coupled = model != BEAM_ZOAC;
+static inline FMB_BEAM_SPECIALIZED void element_terms_of(const Beam* b, const int model, const FrameMotion* fm, int e,
+                                                         const double* p, const double* pd, const double* pdd,
+                                                         const double prefix[3], ElementTerms* out) {
+  const int coupled = model != BEAM_ZOAC;
   const double le = b->le, r2 = b->r * b->r, om = fm->om, om2 = fm->om2, al = fm->al;
   const double* mu = b->mu;
   const double me = b->rho * b->A * le; /* the element's mass: int rho A dx = me int_0^1 dxi */
   ElementState es;
-  element_state(b, e, p, pd, pdd, &es);
+  element_state(b, model, e, p, pd, pdd, &es);
   /* the fields as coefficients of xi^k: x, w1 (and rates) linear, w2 (and rates) cubic, the
      slopes w2' = cp, cv, ca quadratic (element_state), the coupling terms quintic */
   const double x[2] = {e * le, le};
@@ -550,6 +582,15 @@ static void element_terms(const Beam* b, const FrameMotion* fm, int e, const dou
   }
 }
 
+/* element_terms_of per model: the model a constant in each copy, so the coefficient loops lose
+   point_forces' switch and the compiler can vectorize them; the same operations in the same order
+   (no contraction under -std=c11), so the same numbers as one copy reading b->model */
+FMB_VECTOR_CLONES static void element_terms(const Beam* b, const FrameMotion* fm, int e, const double* p,
+                                            const double* pd, const double* pdd, const double prefix[3],
+                                            ElementTerms* out) {
+  PER_MODEL(element_terms_of, b, fm, e, p, pd, pdd, prefix, out);
+}
+
 /* ---------------------------------------------------------------------------------------------
  * Derivatives of element_terms. An element's terms depend on few inputs (its "local inputs",
  * the columns below): its six dofs in q, v and a, theta (through A^T a and A^T g), theta',
@@ -580,12 +621,13 @@ typedef struct {
   double Fv[4];
 } ElementDerivs;
 
-static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p, const double* pd,
-                           const double* pdd, const double prefix[3], ElementDerivs* D) {
-  const int model = b->model, coupled = model != BEAM_ZOAC;
+static inline FMB_BEAM_SPECIALIZED void element_derivs_of(const Beam* b, const int model, const FrameMotion* fm, int e,
+                                                          const double* p, const double* pd, const double* pdd,
+                                                          const double prefix[3], ElementDerivs* D) {
+  const int coupled = model != BEAM_ZOAC;
   const double r2 = b->r * b->r, om = fm->om, om2 = fm->om2, al = fm->al;
   ElementState es;
-  element_state(b, e, p, pd, pdd, &es);
+  element_state(b, model, e, p, pd, pdd, &es);
   memset(D, 0, sizeof *D);
   /* the frame scalars' gradients, the same at every point: d(A^T a)/dtheta = (a0_y, -a0_x) */
   double ga0[2][NL] = {{0.0}}, gf[2][NL] = {{0.0}}, gom[NL] = {0.0}, gom2[NL] = {0.0}, gal[NL] = {0.0};
@@ -599,7 +641,7 @@ static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const do
     const double* ns = b->ns_out[g];
     const double* nd = b->nd_out[g];
     PointTerms pt;
-    point_terms(b, fm, e, g, &es, prefix, &pt);
+    point_terms(b, model, fm, e, g, &es, prefix, &pt);
     const double x = pt.x, w1 = pt.w1, w2 = pt.w2, w2s = pt.w2s, wc = pt.wc;
     /* the deformation scalars are linear in the element's dofs: their gradients are the shape
        functions; the coupling's are h (of p, pd, pdd) at the point */
@@ -677,6 +719,13 @@ static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const do
     }
 }
 
+/* element_derivs_of per model, as element_terms */
+FMB_VECTOR_CLONES static void element_derivs(const Beam* b, const FrameMotion* fm, int e, const double* p,
+                                             const double* pd, const double* pdd, const double prefix[3],
+                                             ElementDerivs* D) {
+  PER_MODEL(element_derivs_of, b, fm, e, p, pd, pdd, prefix, D);
+}
+
 /* index in p of an element's local dof l (0..5, gather's order), or -1 at the clamped root */
 static int ldof(int e, int l) { return l < 2 ? adof(e, l) : tdof(e, l - 2); }
 
@@ -702,7 +751,7 @@ static void add_element_rows(int e, const ElementTerms* t, double* Rp) {
 }
 
 /* elastic and damping forces: K (p + beta pd), element by element */
-static void add_elastic(const Beam* b, const double* p, const double* pd, double* Rp) {
+FMB_VECTOR_CLONES static void add_elastic(const Beam* b, const double* p, const double* pd, double* Rp) {
   for (int e = 0; e < b->ne; ++e) {
     double ua[2], d[4], uda[2], dd[4];
     gather(p, e, ua, d);
@@ -957,10 +1006,12 @@ static void add_local_row(int e, const double* T, double s, double* rq, double* 
   ra[2 * st] += s * T[LAL];
 }
 
-/* Adds s * g (a gradient over all of q, v, a: g, g + nq, g + 2 nq) to one row of K, C, M */
-static void add_global_row(const double* g, double s, int nq, double* rq, double* rv, double* ra, size_t st) {
+/* Adds s * g (a gradient over all of q, v, a: g, g + nq, g + 2 nq) to one row of K, C, M, over the
+   columns c0..c1-1 of each (those where g may be nonzero: the rest would add exact zeros) */
+static void add_global_row(const double* g, double s, int nq, int c0, int c1, double* rq, double* rv, double* ra,
+                           size_t st) {
   if (s == 0.0) return;
-  for (int c = 0; c < nq; ++c) {
+  for (int c = c0; c < c1; ++c) {
     rq[(size_t)c * st] += s * g[c];
     rv[(size_t)c * st] += s * g[nq + c];
     ra[(size_t)c * st] += s * g[2 * nq + c];
@@ -984,8 +1035,8 @@ static size_t jacobian_nwork(const Beam* b) {
    and the frame rows A(theta) S with S = sum_e frame_e. One sweep outboard to inboard carries
    dT_e; dP_e (nonzero on the dofs of the nodes up to e only) is rebuilt from the stored dprefix
    gradients, without cancellation, as the sweep moves inboard. */
-static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v, const double* a,
-                         double* K, double* C, double* M, double* work) {
+FMB_VECTOR_CLONES static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, const double* v,
+                                           const double* a, double* K, double* C, double* M, double* work) {
   const Beam* b = self;
   if (!K || !C || !M) return -1;
   const int ne = b->ne, nq = 3 + b->n, coupled = b->model != BEAM_ZOAC;
@@ -1020,6 +1071,9 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
     ElementDerivs Dz;
     if (!coupled) element_derivs(b, &fm, e, q + 3, v + 3, a + 3, zero, &Dz);
     const ElementDerivs* D = coupled ? &Dall[e] : &Dz;
+    /* dP_e is nonzero on the p dofs of the nodes 1..e only (the elements inboard of e): the
+       columns 3..pend-1 of each of its q, v, a parts */
+    const int pend = 3 + 3 * e;
     /* the rows of its dofs: local, through P_e, and the tail -F_e T_e */
     for (int l = 0; l < 6; ++l) {
       const int i = ldof(e, l);
@@ -1027,10 +1081,10 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
       double *rq = K + 3 + i, *rv = C + 3 + i, *ra = M + 3 + i;
       add_local_row(e, D->rp[l], 1.0, rq, rv, ra, st);
       if (!coupled) continue;
-      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D->rp[l][LP + k], nq, rq, rv, ra, st);
+      for (int k = 0; k < 3; ++k) add_global_row(dP + 3 * st * k, D->rp[l][LP + k], nq, 3, pend, rq, rv, ra, st);
       if (l < 2) continue; /* the tail acts on the transverse dofs (h) */
       add_local_row(e, D->F[l - 2], -z[zT(b, e)], rq, rv, ra, st);
-      add_global_row(dT, -D->Fv[l - 2], nq, rq, rv, ra, st);
+      add_global_row(dT, -D->Fv[l - 2], nq, 0, nq, rq, rv, ra, st);
     }
     /* the frame rows: S_k gathers frame_k of every element */
     for (int i = 0; i < 3; ++i)
@@ -1039,13 +1093,14 @@ static int beam_jacobian(const void* self, const fmbEnv* env, const double* q, c
         add_local_row(e, D->frame[k], W[i][k], K + i, C + i, M + i, st);
         if (coupled)
           for (int m = 0; m < 3; ++m)
-            add_global_row(dP + 3 * st * m, W[i][k] * D->frame[k][LP + m], nq, K + i, C + i, M + i, st);
+            add_global_row(dP + 3 * st * m, W[i][k] * D->frame[k][LP + m], nq, 3, pend, K + i, C + i, M + i, st);
       }
     if (!coupled) continue;
     /* dT_(e-1) = dT_e + dcsum_e */
     add_local_row(e, D->csum, 1.0, dT, dT + st, dT + 2 * st, 1);
     for (int m = 0; m < 3; ++m)
-      for (size_t c = 0; c < 3 * st; ++c) dT[c] += D->csum[LP + m] * dP[3 * st * m + c];
+      for (size_t part = 0; part < 3; ++part) /* q, v, a */
+        for (size_t c = part * st + 3; c < part * st + (size_t)pend; ++c) dT[c] += D->csum[LP + m] * dP[3 * st * m + c];
     /* dP_(e-1): element e-1's dofs drop out; its left node keeps element e-2's part */
     if (e == 0) break;
     for (int k = 0; k < 3; ++k) {
@@ -1328,23 +1383,16 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
   double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0, pth = 0.0;
   double Ipp = 0.0, Ipv = 0.0;
   const double mhalf = 0.5 * b->rho * b->A * le;
-  /* the quadrature's tables in groups of four points (the point loop's lanes, below), made once a
-     call: the lanes past the last point repeat it */
+  /* the quadrature's tables in groups of four points (the point loop's lanes, below; made at setup,
+     beam_setup's lane_*), copied into vectors: the struct's doubles need not be a vector's alignment */
   enum { NGROUP = (FMB_GAUSS_MAX + 3) / 4 };
   dbl4 xi_g[NGROUP], wg_g[NGROUP], ns_g[NGROUP][4], nd_g[NGROUP][4], pw_g[NGROUP][5];
-  for (int g = 0; g < ng; g += 4) {
-    const int grp = g / 4;
-    int gl[4];
-    for (int l = 0; l < 4; ++l) gl[l] = g + l < ng ? g + l : ng - 1;
-    xi_g[grp] = (dbl4){b->xg[gl[0]], b->xg[gl[1]], b->xg[gl[2]], b->xg[gl[3]]};
-    wg_g[grp] = (dbl4){b->wg[gl[0]], b->wg[gl[1]], b->wg[gl[2]], b->wg[gl[3]]};
-    for (int j = 0; j < 4; ++j) {
-      ns_g[grp][j] = (dbl4){b->ns_out[gl[0]][j], b->ns_out[gl[1]][j], b->ns_out[gl[2]][j], b->ns_out[gl[3]][j]};
-      nd_g[grp][j] = (dbl4){b->nd_out[gl[0]][j], b->nd_out[gl[1]][j], b->nd_out[gl[2]][j], b->nd_out[gl[3]][j]};
-    }
-    for (int k = 0; k < 5; ++k)
-      pw_g[grp][k] = (dbl4){b->pw_out[gl[0]][k], b->pw_out[gl[1]][k], b->pw_out[gl[2]][k], b->pw_out[gl[3]][k]};
-  }
+  const size_t ngroup = (size_t)(ng + 3) / 4;
+  memcpy(xi_g, b->lane_xi, ngroup * sizeof xi_g[0]);
+  memcpy(wg_g, b->lane_wg, ngroup * sizeof wg_g[0]);
+  memcpy(ns_g, b->lane_ns, ngroup * sizeof ns_g[0]);
+  memcpy(nd_g, b->lane_nd, ngroup * sizeof nd_g[0]);
+  memcpy(pw_g, b->lane_pw, ngroup * sizeof pw_g[0]);
   for (int e = 0; e < ne; ++e) {
     double ua[2], d[4], uda[2], dd[4], pp[5] = {0}, pv5[5] = {0}; /* set and read only when coupled */
     gather(p, e, ua, d);
@@ -1414,8 +1462,10 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
       for (int lane = 0; lane < nlane; ++lane) { /* in the order of the points */
         T += dT[lane];
         pth += dp[lane];
-        if (grav) Ug -= dUg[lane];
-        mtot += M2[lane];
+        if (grav) {
+          Ug -= dUg[lane];
+          mtot += M2[lane]; /* read only with gravity */
+        }
       }
     }
     if (coupled) {
