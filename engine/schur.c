@@ -54,9 +54,11 @@ struct fmbSchur {
      The real system keeps J_Rq D^-1 (schur_kernels.h) */
   double* rq_val;
   /* values, nc doubles each */
-  double* dinv; /* 1 / J_ii of the last factorization */
-  double* data; /* S */
-  double* qr_val;
+  double* dinv;   /* 1 / J_ii of the last factorization */
+  double* data;   /* S */
+  double* qr_val; /* D^-1 J_qR's nonzeros only, by kept column (qz_ptr, qz_row: made at each
+                     factorization, since which entries are zero depends on the values) */
+  int *qz_ptr, *qz_row;
   double* acc; /* dense column / vector scratch, nr, kept zero between uses */
   double* dq;
   fmbKlu* klu; /* S's LU (klu.c), complex when nc == 2 */
@@ -146,6 +148,8 @@ void fmb_schur_free(fmbSchur* s) {
   free(s->data);
   free(s->rq_val);
   free(s->qr_val);
+  free(s->qz_ptr);
+  free(s->qz_row);
   free(s->acc);
   free(s->dq);
   free(s->lu);
@@ -347,7 +351,9 @@ static fmbSchur* schur_new(const fmbModel* m, int complex_values, const fmbSchur
   s->dq = calloc(nc * ((size_t)m->nq + 1), sizeof(double));
   s->rq_val = malloc(sizeof(double) * (size_t)(s->rq_ptr[s->nq] + 1)); /* real, see fmbSchur */
   s->qr_val = malloc(sizeof(double) * nc * (size_t)(s->qr_ptr[s->nr] + 1));
-  if (!s->dinv || !s->acc || !s->dq || !s->rq_val || !s->qr_val) goto fail;
+  s->qz_ptr = malloc(sizeof(int) * ((size_t)s->nr + 1));
+  s->qz_row = malloc(sizeof(int) * (size_t)(s->qr_ptr[s->nr] + 1));
+  if (!s->dinv || !s->acc || !s->dq || !s->rq_val || !s->qr_val || !s->qz_ptr || !s->qz_row) goto fail;
   if (schur_use_dense(s)) { /* S lives in lu: no KLU, no values on S's pattern (nor rowind) */
     s->lu = malloc(sizeof(double) * nc * (size_t)s->nr * (size_t)s->nr + sizeof(double));
     s->ipiv = malloc(sizeof(int) * ((size_t)s->nr + 1));
