@@ -604,16 +604,7 @@ static int exact_marker(const void* self, const double* q, const double local[2]
     pb[1] = rho[1] + y * t[0];
     phi = atan2(rp[1], rp[0]);
   }
-  pos[0] = q[0] + c * pb[0] - s * pb[1];
-  pos[1] = q[1] + s * pb[0] + c * pb[1];
-  if (angle) *angle = q[2] + phi;
-  if (dangle_dq) dangle_dq[2] = 1.0;
-  if (dpos_dq) {
-    dpos_dq[0] = 1.0;
-    dpos_dq[nc + 1] = 1.0;
-    dpos_dq[2] = -s * pb[0] - c * pb[1];
-    dpos_dq[nc + 2] = c * pb[0] - s * pb[1];
-  }
+  fmb_beam_frame_marker(nc, q, c, s, pb, phi, pos, angle, dpos_dq, dangle_dq);
   if (!onbeam) return 0;
   for (int l = 0; l < 8; ++l) {
     const int i = edof(e, l);

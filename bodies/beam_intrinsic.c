@@ -410,16 +410,7 @@ static int intrinsic_marker(const void* self, const double* q, const double loca
     pb[0] = rho[0] + d[0] - y * sin(phi);
     pb[1] = rho[1] + d[1] + y * cos(phi);
   }
-  pos[0] = q[0] + c * pb[0] - s * pb[1];
-  pos[1] = q[1] + s * pb[0] + c * pb[1];
-  if (angle) *angle = q[2] + phi;
-  if (dangle_dq) dangle_dq[2] = 1.0;
-  if (dpos_dq) {
-    dpos_dq[0] = 1.0;
-    dpos_dq[nc + 1] = 1.0;
-    dpos_dq[2] = -s * pb[0] - c * pb[1];
-    dpos_dq[nc + 2] = c * pb[0] - s * pb[1];
-  }
+  fmb_beam_frame_marker(nc, q, c, s, pb, phi, pos, angle, dpos_dq, dangle_dq);
   if (!onbeam) return 0;
   if (dangle_dq)
     for (int l = 0; l < 6; ++l)

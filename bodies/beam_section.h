@@ -184,6 +184,22 @@ static inline void fmb_beam_frame_initial(int nc, const double pos0[2], double a
   v0[1] = vel0[1];
   v0[2] = omega0;
 }
+/* A marker at pb in the frame (q[0..2]; c, s: cos, sin of q[2]) turned phi from it: its position and
+   angle, and their derivatives by the frame's coordinates, columns 0..2 of dpos_dq (2 rows of nc)
+   and dangle_dq (already zeroed; the caller adds the beam's own columns) */
+static inline void fmb_beam_frame_marker(int nc, const double* q, double c, double s, const double pb[2], double phi,
+                                         double pos[2], double* angle, double* dpos_dq, double* dangle_dq) {
+  pos[0] = q[0] + c * pb[0] - s * pb[1];
+  pos[1] = q[1] + s * pb[0] + c * pb[1];
+  if (angle) *angle = q[2] + phi;
+  if (dangle_dq) dangle_dq[2] = 1.0;
+  if (dpos_dq) {
+    dpos_dq[0] = 1.0;
+    dpos_dq[nc + 1] = 1.0;
+    dpos_dq[2] = -s * pb[0] - c * pb[1];
+    dpos_dq[nc + 2] = c * pb[0] - s * pb[1];
+  }
+}
 /* cos, sin of the frame angle q[2] and G0 = A^T (r0'' - g): the frame's share of a_b - f_b */
 static inline void fmb_beam_frame_load(const fmbEnv* env, const double* q, const double* a, double* c, double* s,
                                        double G0[2]) {
