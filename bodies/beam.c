@@ -34,6 +34,9 @@
 enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
 enum { MAX_ELEMENTS = 4096 };
 
+/* the energy pass's groups of four quadrature points (beam_integrals' vector lanes) */
+enum { BEAM_LANE_GROUPS = (FMB_GAUSS_MAX + 3) / 4 };
+
 typedef struct Beam {
   /* parameters */
   double L, rho, A, Izz, Emod, beta;
@@ -61,9 +64,9 @@ typedef struct Beam {
   double ncubic[4][4], mu[12];
   /* the energy pass's quadrature tables in groups of four points, one per lane (beam_integrals):
      the lanes past the last point repeat it */
-  double lane_xi[(FMB_GAUSS_MAX + 3) / 4][4], lane_wg[(FMB_GAUSS_MAX + 3) / 4][4];
-  double lane_ns[(FMB_GAUSS_MAX + 3) / 4][4][4], lane_nd[(FMB_GAUSS_MAX + 3) / 4][4][4];
-  double lane_pw[(FMB_GAUSS_MAX + 3) / 4][5][4];
+  double lane_xi[BEAM_LANE_GROUPS][4], lane_wg[BEAM_LANE_GROUPS][4];
+  double lane_ns[BEAM_LANE_GROUPS][4][4], lane_nd[BEAM_LANE_GROUPS][4][4];
+  double lane_pw[BEAM_LANE_GROUPS][5][4];
 } Beam;
 
 /* a kernel inlined into one copy per model (element_terms, element_derivs), where the model is a
@@ -1385,8 +1388,8 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
   const double mhalf = 0.5 * b->rho * b->A * le;
   /* the quadrature's tables in groups of four points (the point loop's lanes, below; made at setup,
      beam_setup's lane_*), copied into vectors: the struct's doubles need not be a vector's alignment */
-  enum { NGROUP = (FMB_GAUSS_MAX + 3) / 4 };
-  dbl4 xi_g[NGROUP], wg_g[NGROUP], ns_g[NGROUP][4], nd_g[NGROUP][4], pw_g[NGROUP][5];
+  dbl4 xi_g[BEAM_LANE_GROUPS], wg_g[BEAM_LANE_GROUPS], ns_g[BEAM_LANE_GROUPS][4], nd_g[BEAM_LANE_GROUPS][4],
+      pw_g[BEAM_LANE_GROUPS][5];
   const size_t ngroup = (size_t)(ng + 3) / 4;
   memcpy(xi_g, b->lane_xi, ngroup * sizeof xi_g[0]);
   memcpy(wg_g, b->lane_wg, ngroup * sizeof wg_g[0]);
