@@ -10,8 +10,9 @@
 # steps (radau_advance) and its phases: the factorizations (fmb_schur_factor: S formed and its
 # LU, dense_lu_*), the Schur solves (fmb_schur_solve, dense_solve_*), the residuals
 # (system_residual: the beam's element_terms, the joints' joint_eval), the Jacobians
-# (fmb_system_jacobian) and radau's stage combinations; a kernel one build does not have (inlined,
-# or new) shows as 0 for it. Instruction counts do not move with the machine's load (two
+# (fmb_system_jacobian), radau's stage combinations and the rows (fmb_csv_row: the beam's energy
+# pass beam_integrals); a kernel one build does not have (inlined, or new) shows as 0 for it.
+# Instruction counts do not move with the machine's load (two
 # runs of one build agree to a few hundred instructions), which timings on a shared machine do;
 # bench/shipped.sh --scene spinup_w15 times the same builds. Results:
 # bench/results/phases.csv (--tag: phases_NAME.csv).
@@ -43,7 +44,7 @@ mkdir -p "$RES"
 PHASES="fmb_run radau_advance fmb_schur_factor(_pencil)? schur_form_real schur_form_complex dense_lu_real dense_lu_complex
 fmb_schur_solve schur_solve_real schur_solve_complex dense_solve_real dense_solve_complex system_residual
 element_terms element_state joint_eval fmb_system_jacobian beam_jacobian element_derivs stage_combination
-dense_poly fmb_csv_row"
+dense_poly fmb_csv_row beam_integrals"
 profile() { # binary label
   valgrind --tool=callgrind --callgrind-out-file="$WORK/$2.cg" "$1" run "$ROOT/$SCENE" -o "$WORK/$2.csv" --quiet \
     2> "$WORK/$2.err" < /dev/null

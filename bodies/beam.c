@@ -34,9 +34,6 @@
 enum { BEAM_ZOAC = 0, BEAM_FOAC = 1, BEAM_COMPLETE = 2 };
 enum { MAX_ELEMENTS = 4096 };
 
-/* the energy pass's groups of four quadrature points (beam_integrals' vector lanes) */
-enum { BEAM_LANE_GROUPS = (FMB_GAUSS_MAX + 3) / 4 };
-
 typedef struct Beam {
   /* parameters */
   double L, rho, A, Izz, Emod, beta;
@@ -62,11 +59,6 @@ typedef struct Beam {
   /* for the residual's exact integration (element_terms): the coefficients of xi^0..3 in the
      shape functions N2j (ncubic) and the moments mu_k = int_0^1 xi^k (k = 0..11) */
   double ncubic[4][4], mu[12];
-  /* the energy pass's quadrature tables in groups of four points, one per lane (beam_integrals):
-     the lanes past the last point repeat it */
-  double lane_xi[BEAM_LANE_GROUPS][4], lane_wg[BEAM_LANE_GROUPS][4];
-  double lane_ns[BEAM_LANE_GROUPS][4][4], lane_nd[BEAM_LANE_GROUPS][4][4];
-  double lane_pw[BEAM_LANE_GROUPS][5][4];
 } Beam;
 
 /* a kernel inlined into one copy per model (element_terms, element_derivs), where the model is a
@@ -198,17 +190,6 @@ static void beam_setup(Beam* b) {
   const double nc[4][4] = {{1.0, 0.0, -3.0, 2.0}, {0.0, le, -2.0 * le, le}, {0.0, 0.0, 3.0, -2.0}, {0.0, 0.0, -le, le}};
   memcpy(b->ncubic, nc, sizeof nc);
   for (int k = 0; k < 12; ++k) b->mu[k] = 1.0 / (k + 1);
-  for (int g = 0; g < b->ng; g += 4)
-    for (int l = 0; l < 4; ++l) {
-      const int grp = g / 4, gl = g + l < b->ng ? g + l : b->ng - 1;
-      b->lane_xi[grp][l] = b->xg[gl];
-      b->lane_wg[grp][l] = b->wg[gl];
-      for (int j = 0; j < 4; ++j) {
-        b->lane_ns[grp][j][l] = b->ns_out[gl][j];
-        b->lane_nd[grp][j][l] = b->nd_out[gl][j];
-      }
-      for (int k = 0; k < 5; ++k) b->lane_pw[grp][k][l] = b->pw_out[gl][k];
-    }
 }
 
 /* default Gauss points per element (the Jacobian's; the residual integrates exactly): the
@@ -1357,129 +1338,189 @@ static int beam_marker(const void* self, const double* q, const double local[2],
 /* ---------------------------------------------------------------------------------------------
  * Energy: each model's own kinetic energy, strain energy 1/2 p^T K p, gravity -int rho g.r.
  * ------------------------------------------------------------------------------------------- */
-/* four doubles, one per lane (GCC's and Clang's vector extension: two SSE2 registers on a baseline
-   x86-64, one with beam_integrals' AVX2 version, two NEON ones on arm64) */
+/* four doubles, one element of the beam in each lane (GCC's and Clang's vector extension: two SSE2
+   registers on a baseline x86-64, one in beam_integrals' AVX2 version, two NEON ones on arm64) */
 typedef double dbl4 __attribute__((vector_size(4 * sizeof(double))));
 /* macros, not functions: a function returning a 4-double vector has another ABI with and without
    AVX (GCC's -Wpsabi), and beam_integrals is compiled both ways */
 #define splat(a) ((dbl4){(a), (a), (a), (a)})
-/* dot4(n, d) in each lane, in dot4's order */
-#define dot4v(n, d) ((n)[0] * splat((d)[0]) + (n)[1] * splat((d)[1]) + (n)[2] * splat((d)[2]) + (n)[3] * splat((d)[3]))
+/* m_k = int_0^1 a(xi) xi^k dxi (k < nk) of a polynomial given by its na coefficients: the Hankel
+   product sum_i a_i mu_(i+k). Then int_0^1 a b = b . m for b of degree < nk */
+#define MOMENTS(mu, a, na, m, nk)                                                         \
+  for (int k_ = 0; k_ < (nk); ++k_) {                                                     \
+    (m)[k_] = (a)[0] * splat((mu)[k_]);                                                   \
+    for (int i_ = 1; i_ < (na); ++i_) (m)[k_] = (m)[k_] + (a)[i_] * splat((mu)[i_ + k_]); \
+  }
 
 /* T (the model's own), U_e, U_g and the generalized momentum p_theta = dT/dtheta' (the angular
    momentum about the frame origin for the complete model) in one pass; with the coupling integrals
-   over the whole beam (coupled models) */
+   over the whole beam (coupled models). Each element is integrated exactly by moments, as
+   element_terms integrates the residual: every integrand is a product of two fields that are
+   polynomials in xi, x and w1 linear, w2 cubic, the slopes quadratic and w_c and its rate quintic
+   (the inboard integrals plus int_0^xi of quartics), so int_0^1 a b = sum_i a_i sum_k b_k
+   mu_(i+k). Four elements at a time, one per lane of a vector (the lanes past the last element
+   repeat it, and are then not summed); the sums over elements in their order. The Gauss
+   quadrature this replaced (points in the lanes) was exact for the same degrees (<= 10): the same
+   energies up to rounding, in about a third of the instructions. */
 FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, const double* q, const double* v,
                                              fmbEnergy* en, double* ptheta, double coupling_total[2]) {
-  const int ne = b->ne, ng = b->ng, model = b->model, coupled = model != BEAM_ZOAC;
-  const double le = b->le;
+  const int ne = b->ne, model = b->model, coupled = model != BEAM_ZOAC;
+  const double le = b->le, r2 = b->r * b->r;
+  const double* mu = b->mu;
   const double* p = q + 3;
   const double* pd = v + 3;
-  double c = cos(q[2]), s = sin(q[2]), om = v[2];
-  double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
-  int grav = env && env->has_gravity;
+  const double c = cos(q[2]), s = sin(q[2]), om = v[2];
+  const double v0[2] = {c * v[0] + s * v[1], -s * v[0] + c * v[1]};
+  const int grav = env && env->has_gravity;
   double f[2] = {0.0, 0.0};
   if (grav) {
     f[0] = c * env->gravity[0] + s * env->gravity[1];
     f[1] = -s * env->gravity[0] + c * env->gravity[1];
   }
-  double T = 0.0, Ug = 0.0, Ue = 0.0, mtot = 0.0, pth = 0.0;
-  double Ipp = 0.0, Ipv = 0.0;
-  const double mhalf = 0.5 * b->rho * b->A * le;
-  /* the quadrature's tables in groups of four points (the point loop's lanes, below; made at setup,
-     beam_setup's lane_*), copied into vectors: the struct's doubles need not be a vector's alignment */
-  dbl4 xi_g[BEAM_LANE_GROUPS], wg_g[BEAM_LANE_GROUPS], ns_g[BEAM_LANE_GROUPS][4], nd_g[BEAM_LANE_GROUPS][4],
-      pw_g[BEAM_LANE_GROUPS][5];
-  const size_t ngroup = (size_t)(ng + 3) / 4;
-  memcpy(xi_g, b->lane_xi, ngroup * sizeof xi_g[0]);
-  memcpy(wg_g, b->lane_wg, ngroup * sizeof wg_g[0]);
-  memcpy(ns_g, b->lane_ns, ngroup * sizeof ns_g[0]);
-  memcpy(nd_g, b->lane_nd, ngroup * sizeof nd_g[0]);
-  memcpy(pw_g, b->lane_pw, ngroup * sizeof pw_g[0]);
-  for (int e = 0; e < ne; ++e) {
-    double ua[2], d[4], uda[2], dd[4], pp[5] = {0}, pv5[5] = {0}; /* set and read only when coupled */
-    gather(p, e, ua, d);
-    gather(pd, e, uda, dd);
+  double T = 0.0, Ug = 0.0, Ue = 0.0, pth = 0.0, Ipp = 0.0, Ipv = 0.0;
+  /* the element's mass: a cross-section pair y = -r, +r of rho A dx / 2 each, whose velocities
+     and lever arms are affine in y, X = X0 + y X1, so the pair sums in closed form as in the
+     residual: sum m (A + yB).(C + yD) = rho A dx (A.C + r^2 B.D) */
+  const double me = b->rho * b->A * le;
+  const dbl4 omv = splat(om), zero = splat(0.0), lev = splat(le);
+  for (int e0 = 0; e0 < ne; e0 += 4) {
+    const int nlane = ne - e0 < 4 ? ne - e0 : 4;
+    dbl4 ua[2] = {zero, zero}, d[4] = {zero, zero, zero, zero}, uda[2] = {zero, zero}, dd[4] = {zero, zero, zero, zero},
+         x0 = zero;
+    for (int l = 0; l < 4; ++l) {
+      const int e = e0 + (l < nlane ? l : nlane - 1);
+      double ua_l[2], d_l[4], uda_l[2], dd_l[4];
+      gather(p, e, ua_l, d_l);
+      gather(pd, e, uda_l, dd_l);
+      for (int j = 0; j < 2; ++j) ua[j][l] = ua_l[j], uda[j][l] = uda_l[j];
+      for (int j = 0; j < 4; ++j) d[j][l] = d_l[j], dd[j][l] = dd_l[j];
+      x0[l] = e * le;
+    }
+    /* the fields as coefficients of xi^0..5 (element_terms' layout; slope_poly's cp, cv) */
+    dbl4 cp[3], cv[3], w2[4], w2d[4];
+    for (int i = 0; i < 3; ++i) {
+      cp[i] = splat(b->nslope[0][i]) * d[0] + splat(b->nslope[1][i]) * d[1] + splat(b->nslope[2][i]) * d[2] +
+              splat(b->nslope[3][i]) * d[3];
+      cv[i] = splat(b->nslope[0][i]) * dd[0] + splat(b->nslope[1][i]) * dd[1] + splat(b->nslope[2][i]) * dd[2] +
+              splat(b->nslope[3][i]) * dd[3];
+    }
+    for (int k = 0; k < 4; ++k) {
+      w2[k] = splat(b->ncubic[0][k]) * d[0] + splat(b->ncubic[1][k]) * d[1] + splat(b->ncubic[2][k]) * d[2] +
+              splat(b->ncubic[3][k]) * d[3];
+      w2d[k] = splat(b->ncubic[0][k]) * dd[0] + splat(b->ncubic[1][k]) * dd[1] + splat(b->ncubic[2][k]) * dd[2] +
+               splat(b->ncubic[3][k]) * dd[3];
+    }
+    /* x = x0 + le xi (lev) */
+    const dbl4 w1[2] = {ua[0], ua[1] - ua[0]}, w1d[2] = {uda[0], uda[1] - uda[0]};
+    dbl4 wc[6], wcd[6];
+    for (int k = 0; k < 6; ++k) wc[k] = wcd[k] = zero;
     if (coupled) {
-      double cp[3], cv[3];
-      slope_products(b, d, dd, cp, cv, pp, pv5);
-    }
-    /* four quadrature points at a time, one in each lane of a vector (the lanes past the last point
-       repeat it, and are then not summed): the same operations in the same order per point as one
-       at a time (no FMA: FMB_VECTOR_CLONES), so bit for bit the same sums, in about a third of the
-       instructions with AVX2 (this pass was the largest part of the rows' cost, docs/performance.md
-       "Row output"; two lanes at a time before) */
-    for (int g = 0; g < ng; g += 4) {
-      const int grp = g / 4, nlane = ng - g < 4 ? ng - g : 4;
-      const dbl4 xi = xi_g[grp], x = splat(e * le) + xi * splat(le);
-      const dbl4* ns = ns_g[grp];
-      const dbl4* nd = nd_g[grp];
-      const dbl4 n1[2] = {splat(1.0) - xi, xi};
-      const dbl4 w1 = n1[0] * splat(ua[0]) + n1[1] * splat(ua[1]), w2 = dot4v(ns, d), w2s = dot4v(nd, d);
-      const dbl4 w1d = n1[0] * splat(uda[0]) + n1[1] * splat(uda[1]), w2d = dot4v(ns, dd), w2sd = dot4v(nd, dd);
-      dbl4 wc = splat(0.0), wcd = splat(0.0);
-      if (coupled) {
-        dbl4 pwp = splat(0.0), pwv = splat(0.0); /* dot5 with pw_out, term by term as dot5 adds them */
-        for (int k = 0; k < 5; ++k) {
-          const dbl4 pw = pw_g[grp][k];
-          pwp = k ? pwp + splat(pp[k]) * pw : splat(pp[k]) * pw;
-          pwv = k ? pwv + splat(pv5[k]) * pw : splat(pv5[k]) * pw;
-        }
-        wc = splat(-0.5) * (splat(Ipp) + pwp);
-        wcd = -(splat(Ipv) + pwv);
+      /* w_c = -1/2 (P0 + int_0^xi w2'^2), its rate -(P1 + int_0^xi w2' w2d'), P the inboard
+         elements' integrals: the quartics in poly_mul's order, whole-element integrals summed in
+         the elements' order (the tip outputs read them: beam_output) */
+      const dbl4 pp[5] = {cp[0] * cp[0], cp[0] * cp[1] + cp[1] * cp[0], cp[0] * cp[2] + cp[1] * cp[1] + cp[2] * cp[0],
+                          cp[1] * cp[2] + cp[2] * cp[1], cp[2] * cp[2]};
+      const dbl4 pv[5] = {cp[0] * cv[0], cp[0] * cv[1] + cp[1] * cv[0], cp[0] * cv[2] + cp[1] * cv[1] + cp[2] * cv[0],
+                          cp[1] * cv[2] + cp[2] * cv[1], cp[2] * cv[2]};
+      const double* pw = b->pw_full;
+      const dbl4 dpp = pp[0] * splat(pw[0]) + pp[1] * splat(pw[1]) + pp[2] * splat(pw[2]) + pp[3] * splat(pw[3]) +
+                       pp[4] * splat(pw[4]);
+      const dbl4 dpv = pv[0] * splat(pw[0]) + pv[1] * splat(pw[1]) + pv[2] * splat(pw[2]) + pv[3] * splat(pw[3]) +
+                       pv[4] * splat(pw[4]);
+      dbl4 P0, P1;
+      for (int l = 0; l < 4; ++l) {
+        P0[l] = Ipp;
+        P1[l] = Ipv;
+        if (l < nlane) Ipp += dpp[l], Ipv += dpv[l];
       }
-      /* The cross-section pair y = -r, +r (mass m each): every velocity and lever arm below is
-         affine in y, X = X0 + y X1, so the pair sums in closed form as in the residual:
-         sum m (A + yB).(C + yD) = M2 (A.C + r^2 B.D), M2 = 2m; terms linear in y cancel. */
-      const dbl4 M2 = splat(2.0 * mhalf) * wg_g[grp], r2 = splat(b->r * b->r), omv = splat(om);
-      /* the rigid velocity's parts vR0 = (vR0x, vR0y) and vR1 = (vR1x, 0) (two-vector arrays made
-         GCC's vector lowering warn of uninitialized lanes) */
-      const dbl4 vR0x = splat(v0[0]), vR0y = splat(v0[1]) + x * omv, vR1x = splat(-om);
-      const dbl4 vRD0[2] = {vR0x - w2 * omv + w1d, vR0y + w1 * omv + w2d};
-      const dbl4 vRD1[2] = {vR1x - w2sd, -w2s * omv};
-      const dbl4 vC[2] = {wcd, wc * omv};
-      /* d v / d theta' of the parts: I~(rho0 + u_D) = gRD0 + y gRD1, I~ rho0 = [-y, x] */
-      const dbl4 gRD0[2] = {-w2, x + w1}, gRD1[2] = {splat(-1.0), -w2s};
-      dbl4 dT, dp;
-      switch (model) {
-        case BEAM_ZOAC:
-          dT = splat(0.5) * M2 * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
-          dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
-          break;
-        case BEAM_FOAC:
-          dT = M2 *
-               (splat(0.5) * (vRD0[0] * vRD0[0] + vRD0[1] * vRD0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1])) +
-                vR0x * vC[0] + vR0y * vC[1]);
-          dp = M2 * (gRD0[0] * vRD0[0] + gRD0[1] * vRD0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]) + x * vC[1] +
-                     wc * vR0y);
-          break;
-        default: {
-          const dbl4 vt0[2] = {vRD0[0] + vC[0], vRD0[1] + vC[1]};
-          dT = splat(0.5) * M2 * (vt0[0] * vt0[0] + vt0[1] * vt0[1] + r2 * (vRD1[0] * vRD1[0] + vRD1[1] * vRD1[1]));
-          dp = M2 * (gRD0[0] * vt0[0] + (gRD0[1] + wc) * vt0[1] + r2 * (gRD1[0] * vRD1[0] + gRD1[1] * vRD1[1]));
-          break;
-        }
-      }
-      /* gravity: -m f.(rho0 + u) in the body frame; the frame origin term is added below */
-      const dbl4 dUg = grav ? M2 * (splat(f[0]) * (x + w1 + wc) + splat(f[1]) * w2) : splat(0.0);
-      for (int lane = 0; lane < nlane; ++lane) { /* in the order of the points */
-        T += dT[lane];
-        pth += dp[lane];
-        if (grav) {
-          Ug -= dUg[lane];
-          mtot += M2[lane]; /* read only with gravity */
-        }
+      wc[0] = splat(-0.5) * P0;
+      wcd[0] = -P1;
+      for (int k = 0; k < 5; ++k) {
+        const double w = le * mu[k];
+        wc[k + 1] = splat(-0.5 * w) * pp[k];
+        wcd[k + 1] = splat(-w) * pv[k];
       }
     }
-    if (coupled) {
-      Ipp += dot5(pp, b->pw_full);
-      Ipv += dot5(pv5, b->pw_full);
+    /* body-frame velocities of the pair, V = V0 + y V1: the rigid and linear deformation parts
+       vRD0 = vR0 + (w1d - om w2, om w1 + w2d), vR0 = (v0x, v0y + om x), vRD1 = (-om - w2d',
+       -om w2') (B below); the coupling's vC = (w_c rate, om w_c); and dV/dtheta' of the parts,
+       gRD0 = (-w2, x + w1), gRD1 = (-1, -w2'). The complete model's own velocity is vRD0 + vC
+       (V below), its p_theta gRD0.V + w_c V_y; ZOAC and FOAC keep vRD0 (FOAC adding vR0.vC to T
+       and x om w_c + w_c vR0y to p_theta) */
+    dbl4 V[2][6], gy[6], B[2][3];
+    for (int k = 0; k < 6; ++k) V[0][k] = V[1][k] = gy[k] = zero;
+    for (int k = 0; k < 4; ++k) {
+      V[0][k] = -omv * w2[k];
+      V[1][k] = w2d[k];
     }
-    /* strain energy of the element */
-    Ue += 0.5 * b->ka * (ua[1] - ua[0]) * (ua[1] - ua[0]);
-    for (int j = 0; j < 4; ++j) Ue += 0.5 * d[j] * dot4(b->kb[j], d);
+    gy[0] = x0 + w1[0];
+    gy[1] = lev + w1[1];
+    for (int k = 0; k < 2; ++k) {
+      V[0][k] = V[0][k] + w1d[k];
+      V[1][k] = V[1][k] + omv * gy[k];
+    }
+    V[0][0] = V[0][0] + splat(v0[0]);
+    V[1][0] = V[1][0] + splat(v0[1]);
+    if (model == BEAM_COMPLETE)
+      for (int k = 0; k < 6; ++k) {
+        V[0][k] = V[0][k] + wcd[k];
+        V[1][k] = V[1][k] + omv * wc[k];
+        gy[k] = gy[k] + wc[k];
+      }
+    for (int k = 0; k < 3; ++k) {
+      B[0][k] = -cv[k];
+      B[1][k] = -omv * cp[k];
+    }
+    B[0][0] = B[0][0] - omv;
+    dbl4 mV[2][6], mB[2][3];
+    MOMENTS(mu, V[0], 6, mV[0], 6);
+    MOMENTS(mu, V[1], 6, mV[1], 6);
+    MOMENTS(mu, B[0], 3, mB[0], 3);
+    MOMENTS(mu, B[1], 3, mB[1], 3);
+    dbl4 sqV = zero, sqB = zero, momV = zero;
+    for (int k = 0; k < 6; ++k) {
+      sqV = sqV + V[0][k] * mV[0][k] + V[1][k] * mV[1][k];
+      momV = momV + gy[k] * mV[1][k];
+    }
+    for (int k = 0; k < 4; ++k) momV = momV - w2[k] * mV[0][k];
+    dbl4 momB = -mB[0][0];
+    for (int k = 0; k < 3; ++k) {
+      sqB = sqB + B[0][k] * mB[0][k] + B[1][k] * mB[1][k];
+      momB = momB - cp[k] * mB[1][k];
+    }
+    dbl4 dT = splat(0.5) * (sqV + splat(r2) * sqB), dp = momV + splat(r2) * momB;
+    if (model == BEAM_FOAC) {
+      dbl4 mwc[2], iwcd = zero;
+      MOMENTS(mu, wc, 6, mwc, 2);
+      for (int k = 0; k < 6; ++k) iwcd = iwcd + wcd[k] * splat(mu[k]);
+      const dbl4 vR0y[2] = {splat(v0[1]) + omv * x0, omv * lev};
+      const dbl4 vR0y_wc = vR0y[0] * mwc[0] + vR0y[1] * mwc[1];
+      dT = dT + splat(v0[0]) * iwcd + omv * vR0y_wc;
+      dp = dp + omv * (x0 * mwc[0] + lev * mwc[1]) + vR0y_wc;
+    }
+    /* gravity: -m f.(rho0 + u) in the body frame (the frame origin term is added below); the
+       strain energy 1/2 ka (u2 - u1)^2 + 1/2 d.kb d */
+    dbl4 dUg = zero;
+    if (grav) {
+      dbl4 ax = x0 * splat(mu[0]) + lev * splat(mu[1]) + w1[0] * splat(mu[0]) + w1[1] * splat(mu[1]), aw2 = zero;
+      for (int k = 0; k < 6; ++k) ax = ax + wc[k] * splat(mu[k]);
+      for (int k = 0; k < 4; ++k) aw2 = aw2 + w2[k] * splat(mu[k]);
+      dUg = splat(f[0]) * ax + splat(f[1]) * aw2;
+    }
+    const dbl4 du = ua[1] - ua[0];
+    dbl4 dUe = splat(0.5 * b->ka) * du * du;
+    for (int j = 0; j < 4; ++j)
+      dUe = dUe + splat(0.5) * d[j] *
+                      (splat(b->kb[j][0]) * d[0] + splat(b->kb[j][1]) * d[1] + splat(b->kb[j][2]) * d[2] +
+                       splat(b->kb[j][3]) * d[3]);
+    for (int l = 0; l < nlane; ++l) { /* in the order of the elements */
+      T += me * dT[l];
+      pth += me * dp[l];
+      Ue += dUe[l];
+      Ug -= me * dUg[l];
+    }
   }
-  if (grav) Ug -= mtot * (env->gravity[0] * q[0] + env->gravity[1] * q[1]);
+  if (grav) Ug -= me * ne * (env->gravity[0] * q[0] + env->gravity[1] * q[1]);
   en->kinetic = T;
   en->strain = Ue;
   en->gravity = Ug;
@@ -1490,7 +1531,7 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
 }
 
 #undef splat
-#undef dot4v
+#undef MOMENTS
 
 /* ---------------------------------------------------------------------------------------------
  * The outputs' cache: a row asks several outputs of one state (q, v). The energies and

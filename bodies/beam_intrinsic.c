@@ -439,15 +439,20 @@ static int intrinsic_marker(const void* self, const double* q, const double loca
  * Energy and outputs.
  * ------------------------------------------------------------------------------------------- */
 /* One sweep at (q, v) for every output and the energy: the nodes' rho and rho_t (2 (ne + 1)
-   each), then T, U_e, p_theta (angular momentum about the frame origin) and sum w mu rho_g (2).
-   An output row asks for several outputs and the energy at one state: the sweep is kept in the
-   scratch with the (q, v) it was made at and made again only when they differ (bitwise). */
+   each), then, with need_sums, T, U_e, p_theta (angular momentum about the frame origin) and
+   sum w mu rho_g (2). An output row asks for several outputs and the energy at one state: the
+   sweep is kept in the scratch with the (q, v) it was made at and made again only when they
+   differ (bitwise) or the sums are asked of a sweep made without them. The nodes alone (the tip
+   outputs) skip the mass points' integrals, most of a row's cost when no energy is asked (the
+   nodes' values are the same either way: the sums do not enter them). */
 enum { SWEEP_T, SWEEP_UE, SWEEP_PTHETA, SWEEP_MRHO };
-static const double* sweep_state(const BeamIntrinsic* b, const double* q, const double* v, double* work) {
+static const double* sweep_state(const BeamIntrinsic* b, const double* q, const double* v, int need_sums,
+                                 double* work) {
   const size_t nc = (size_t)(3 + b->n);
   double* key = work + cache_at(b);
   double* out = key + 1 + 2 * nc;
-  if (key[0] == 1.0 && !memcmp(key + 1, q, nc * sizeof(double)) && !memcmp(key + 1 + nc, v, nc * sizeof(double)))
+  const double level = need_sums ? 2.0 : 1.0; /* key[0]: 0 nothing kept, 1 the nodes, 2 and the sums */
+  if (key[0] >= level && !memcmp(key + 1, q, nc * sizeof(double)) && !memcmp(key + 1 + nc, v, nc * sizeof(double)))
     return out;
   double* rho_n = out;
   double* rt_n = out + 2 * (b->ne + 1);
@@ -460,7 +465,7 @@ static const double* sweep_state(const BeamIntrinsic* b, const double* q, const 
     double X[6], Xd[6], d[2], dt[2], rp[INTRINSIC_MAX_POINTS][2], rpt[INTRINSIC_MAX_POINTS][2];
     element_dofs(q, e, X), element_dofs(v, e, Xd);
     element_tangents(b, X, Xd, NULL, rp, rpt, NULL, NULL);
-    for (int g = 0; g < b->nm; ++g) {
+    for (int g = 0; need_sums && g < b->nm; ++g) {
       integrate_points(b, b->W[g], (const double(*)[2])rp, d);
       integrate_points(b, b->W[g], (const double(*)[2])rpt, dt);
       const double r[2] = {rho[0] + d[0], rho[1] + d[1]};
@@ -483,7 +488,7 @@ static const double* sweep_state(const BeamIntrinsic* b, const double* q, const 
   sums[SWEEP_MRHO] = mrho[0], sums[SWEEP_MRHO + 1] = mrho[1];
   memcpy(key + 1, q, nc * sizeof(double));
   memcpy(key + 1 + nc, v, nc * sizeof(double));
-  key[0] = 1.0;
+  key[0] = level;
   return out;
 }
 
@@ -493,7 +498,7 @@ static const double* sweep_sums(const BeamIntrinsic* b, const double* sweep) { r
 static void intrinsic_energy(const void* self, const fmbEnv* env, const double* q, const double* v, fmbEnergy* en,
                              double* work) {
   const BeamIntrinsic* b = self;
-  const double* sums = sweep_sums(b, sweep_state(b, q, v, work));
+  const double* sums = sweep_sums(b, sweep_state(b, q, v, 1, work));
   en->kinetic = sums[SWEEP_T];
   en->strain = sums[SWEEP_UE];
   en->gravity = fmb_beam_gravity_potential(env, b->mu * b->L, q, cos(q[2]), sin(q[2]), sums + SWEEP_MRHO);
@@ -508,7 +513,7 @@ static int intrinsic_output_lookup(const void* self, const char* quantity) {
 static int intrinsic_output(const void* self, int id, const double* q, const double* v, double* value, double* work) {
   const BeamIntrinsic* b = self;
   if (id == FMB_BEAM_ANG_MOMENTUM) {
-    *value = sweep_sums(b, sweep_state(b, q, v, work))[SWEEP_PTHETA];
+    *value = sweep_sums(b, sweep_state(b, q, v, 1, work))[SWEEP_PTHETA];
     return 0;
   }
   if (id == FMB_BEAM_TIP_ANGLE) {
@@ -517,7 +522,7 @@ static int intrinsic_output(const void* self, int id, const double* q, const dou
   }
   int node, comp;
   if (fmb_beam_output_node(b->ne, id, &node, &comp)) return -1;
-  const double* sweep = sweep_state(b, q, v, work);
+  const double* sweep = sweep_state(b, q, v, 0, work);
   const double *rho = sweep + 2 * node, *rt = sweep + 2 * (b->ne + 1) + 2 * node;
   const double u[2] = {rho[0] - node * b->le, rho[1]};
   *value = fmb_beam_node_value(comp, q, u, rt, rho);
