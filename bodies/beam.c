@@ -1346,6 +1346,16 @@ typedef double dbl4 __attribute__((vector_size(4 * sizeof(double))));
 #define splat(a) ((dbl4){(a), (a), (a), (a)})
 /* m_k = int_0^1 a(xi) xi^k dxi (k < nk) of a polynomial given by its na coefficients: the Hankel
    product sum_i a_i mu_(i+k). Then int_0^1 a b = b . m for b of degree < nk */
+/* sum_j m[j][i] x_j over a 4 x n table's column i, and sum_j r[j] x_j (dot4's order) */
+#define COLUMN4(m, i, x) \
+  (splat((m)[0][i]) * (x)[0] + splat((m)[1][i]) * (x)[1] + splat((m)[2][i]) * (x)[2] + splat((m)[3][i]) * (x)[3])
+#define ROW4(r, x) (splat((r)[0]) * (x)[0] + splat((r)[1]) * (x)[1] + splat((r)[2]) * (x)[2] + splat((r)[3]) * (x)[3])
+/* poly_mul's product of two quadratics in each lane, in its order */
+#define POLY_MUL(a, c)                                                                                       \
+  {                                                                                                          \
+    (a)[0] * (c)[0], (a)[0] * (c)[1] + (a)[1] * (c)[0], (a)[0] * (c)[2] + (a)[1] * (c)[1] + (a)[2] * (c)[0], \
+        (a)[1] * (c)[2] + (a)[2] * (c)[1], (a)[2] * (c)[2]                                                   \
+  }
 #define MOMENTS(mu, a, na, m, nk)                                                         \
   for (int k_ = 0; k_ < (nk); ++k_) {                                                     \
     (m)[k_] = (a)[0] * splat((mu)[k_]);                                                   \
@@ -1399,16 +1409,12 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
     /* the fields as coefficients of xi^0..5 (element_terms' layout; slope_poly's cp, cv) */
     dbl4 cp[3], cv[3], w2[4], w2d[4];
     for (int i = 0; i < 3; ++i) {
-      cp[i] = splat(b->nslope[0][i]) * d[0] + splat(b->nslope[1][i]) * d[1] + splat(b->nslope[2][i]) * d[2] +
-              splat(b->nslope[3][i]) * d[3];
-      cv[i] = splat(b->nslope[0][i]) * dd[0] + splat(b->nslope[1][i]) * dd[1] + splat(b->nslope[2][i]) * dd[2] +
-              splat(b->nslope[3][i]) * dd[3];
+      cp[i] = COLUMN4(b->nslope, i, d);
+      cv[i] = COLUMN4(b->nslope, i, dd);
     }
     for (int k = 0; k < 4; ++k) {
-      w2[k] = splat(b->ncubic[0][k]) * d[0] + splat(b->ncubic[1][k]) * d[1] + splat(b->ncubic[2][k]) * d[2] +
-              splat(b->ncubic[3][k]) * d[3];
-      w2d[k] = splat(b->ncubic[0][k]) * dd[0] + splat(b->ncubic[1][k]) * dd[1] + splat(b->ncubic[2][k]) * dd[2] +
-               splat(b->ncubic[3][k]) * dd[3];
+      w2[k] = COLUMN4(b->ncubic, k, d);
+      w2d[k] = COLUMN4(b->ncubic, k, dd);
     }
     /* x = x0 + le xi (lev) */
     const dbl4 w1[2] = {ua[0], ua[1] - ua[0]}, w1d[2] = {uda[0], uda[1] - uda[0]};
@@ -1418,10 +1424,7 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
       /* w_c = -1/2 (P0 + int_0^xi w2'^2), its rate -(P1 + int_0^xi w2' w2d'), P the inboard
          elements' integrals: the quartics in poly_mul's order, whole-element integrals summed in
          the elements' order (the tip outputs read them: beam_output) */
-      const dbl4 pp[5] = {cp[0] * cp[0], cp[0] * cp[1] + cp[1] * cp[0], cp[0] * cp[2] + cp[1] * cp[1] + cp[2] * cp[0],
-                          cp[1] * cp[2] + cp[2] * cp[1], cp[2] * cp[2]};
-      const dbl4 pv[5] = {cp[0] * cv[0], cp[0] * cv[1] + cp[1] * cv[0], cp[0] * cv[2] + cp[1] * cv[1] + cp[2] * cv[0],
-                          cp[1] * cv[2] + cp[2] * cv[1], cp[2] * cv[2]};
+      const dbl4 pp[5] = POLY_MUL(cp, cp), pv[5] = POLY_MUL(cp, cv);
       const double* pw = b->pw_full;
       const dbl4 dpp = pp[0] * splat(pw[0]) + pp[1] * splat(pw[1]) + pp[2] * splat(pw[2]) + pp[3] * splat(pw[3]) +
                        pp[4] * splat(pw[4]);
@@ -1509,10 +1512,7 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
     }
     const dbl4 du = ua[1] - ua[0];
     dbl4 dUe = splat(0.5 * b->ka) * du * du;
-    for (int j = 0; j < 4; ++j)
-      dUe = dUe + splat(0.5) * d[j] *
-                      (splat(b->kb[j][0]) * d[0] + splat(b->kb[j][1]) * d[1] + splat(b->kb[j][2]) * d[2] +
-                       splat(b->kb[j][3]) * d[3]);
+    for (int j = 0; j < 4; ++j) dUe = dUe + splat(0.5) * d[j] * ROW4(b->kb[j], d);
     for (int l = 0; l < nlane; ++l) { /* in the order of the elements */
       T += me * dT[l];
       pth += me * dp[l];
@@ -1531,6 +1531,9 @@ FMB_VECTOR_CLONES static void beam_integrals(const Beam* b, const fmbEnv* env, c
 }
 
 #undef splat
+#undef COLUMN4
+#undef ROW4
+#undef POLY_MUL
 #undef MOMENTS
 
 /* ---------------------------------------------------------------------------------------------
